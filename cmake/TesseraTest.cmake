@@ -1,0 +1,13 @@
+# tessera_add_test(NAME SOURCES src... [LIBRARIES lib...] [LABELS label...])
+# A GoogleTest executable registered with CTest, test by test.
+function(tessera_add_test name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;LIBRARIES;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBRARIES} GTest::gtest GTest::gtest_main)
+  tessera_set_compile_options(${name})
+  include(GoogleTest)
+  gtest_discover_tests(${name}
+    PROPERTIES LABELS "${ARG_LABELS}"
+               ENVIRONMENT "TESSERA_SOURCE_DIR=${PROJECT_SOURCE_DIR};TESSERA_BINARY_DIR=${PROJECT_BINARY_DIR};TESSERA_PLUGIN_DIR=${TESSERA_PLUGIN_OUTPUT_DIR}"
+    DISCOVERY_TIMEOUT 60)
+endfunction()

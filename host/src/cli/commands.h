@@ -1,0 +1,27 @@
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <vector>
+
+namespace tessera {
+
+struct GlobalOptions {
+  bool quiet = false;
+  bool verbose = false;
+};
+
+// A verb: its CLI11 subcommand and what runs when it was given. run() returns the
+// exit code and may throw InputError (exit 2) or any other exception (exit 1).
+struct CommandRegistration {
+  CLI::App* subcommand = nullptr;
+  std::function<int()> run;
+};
+
+std::vector<CommandRegistration> RegisterCommands(CLI::App& app, const GlobalOptions& global);
+
+// One registration function per verb, each in its own file.
+CommandRegistration RegisterPluginsCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions& global);
+
+}  // namespace tessera

@@ -1,0 +1,12 @@
+#pragma once
+
+namespace tessera {
+
+// Exit codes of the `tessera` executable, documented in the README.
+enum ExitCode : int {
+  kExitSuccess = 0,
+  kExitInternalError = 1,  // a bug or an unexpected failure (please report it)
+  kExitBadInput = 2,       // bad input or configuration: the message says what to fix
+};
+
+}  // namespace tessera

@@ -1,0 +1,51 @@
+// The `tessera` command line: one subcommand per verb. Every verb maps bad input to
+// exit code 2 with a one-line message, and unexpected failures to exit code 1.
+
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "cli/commands.h"
+#include "cli/exit_codes.h"
+#include "tessera/errors.h"
+
+int main(int argc, char** argv) {
+  using namespace tessera;
+  CLI::App app{"Tessera: Structure-from-Motion whose every stage is a plugin"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", TESSERA_VERSION);
+  GlobalOptions global;
+  app.add_flag("-q,--quiet", global.quiet, "Only warnings and errors on stderr");
+  app.add_flag("-v,--verbose", global.verbose, "Debug output");
+
+  std::vector<CommandRegistration> commands = RegisterCommands(app, global);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& error) {
+    const int code = app.exit(error);
+    return code == 0 ? kExitSuccess : kExitBadInput;
+  }
+
+  auto logger = spdlog::stderr_color_mt("tessera");
+  spdlog::set_default_logger(logger);
+  spdlog::set_pattern("%^[%l]%$ %v");
+  spdlog::set_level(global.quiet ? spdlog::level::warn
+                                 : (global.verbose ? spdlog::level::debug : spdlog::level::info));
+
+  for (const auto& command : commands) {
+    if (!command.subcommand->parsed()) continue;
+    try {
+      return command.run();
+    } catch (const InputError& error) {
+      spdlog::error("{}", error.what());
+      return kExitBadInput;
+    } catch (const std::exception& error) {
+      spdlog::error("internal error: {}", error.what());
+      return kExitInternalError;
+    }
+  }
+  return kExitInternalError;
+}

@@ -1,0 +1,59 @@
+#include "cli/pipeline_context.h"
+
+#include "util/paths.h"
+
+namespace tessera {
+
+PipelineContext PipelineContext::Create(const std::filesystem::path& manifest_file) {
+  const std::filesystem::path file = manifest_file.empty() ? DefaultManifestFile() : manifest_file;
+  return Create(Manifest::Load(file));
+}
+
+PipelineContext PipelineContext::Create(Manifest manifest) {
+  PipelineContext context;
+  context.registry = PluginRegistry::Discover(PluginSearchPath(manifest.plugin_paths));
+  const std::string source = manifest.file.empty() ? "manifest" : manifest.file.string();
+  try {
+    if (manifest.detector) {
+      const auto& slot = *manifest.detector;
+      context.detector =
+          context.registry.Create<Detector>("detector", slot.plugin, slot.options, slot.json_path);
+    }
+    if (manifest.pair_selector) {
+      const auto& slot = *manifest.pair_selector;
+      context.pair_selector = context.registry.Create<PairSelector>("pair_selector", slot.plugin,
+                                                                    slot.options, slot.json_path);
+    }
+    if (manifest.matcher) {
+      const auto& slot = *manifest.matcher;
+      context.matcher =
+          context.registry.Create<Matcher>("matcher", slot.plugin, slot.options, slot.json_path);
+    }
+    if (manifest.bundle_adjuster) {
+      const auto& slot = *manifest.bundle_adjuster;
+      context.bundle_adjuster = context.registry.Create<BundleAdjuster>(
+          "bundle_adjuster", slot.plugin, slot.options, slot.json_path);
+    }
+    for (const auto& slot : manifest.exporters) {
+      context.exporters.push_back(
+          context.registry.Create<Exporter>("exporter", slot.plugin, slot.options, slot.json_path));
+    }
+  } catch (const InputError& error) {
+    throw InputError(source + ": " + error.what());
+  }
+  context.manifest = std::move(manifest);
+  return context;
+}
+
+void PipelineContext::Require(const std::string& slot, const std::string& stage) const {
+  const bool present =
+      (slot == "detector" && detector) || (slot == "pair_selector" && pair_selector) ||
+      (slot == "matcher" && matcher) || (slot == "bundle_adjuster" && bundle_adjuster);
+  if (!present) {
+    const std::string source = manifest.file.empty() ? "manifest" : manifest.file.string();
+    throw InputError(source + ": pipeline." + slot + ": missing; the " + stage + " stage needs a " +
+                     slot + " plugin");
+  }
+}
+
+}  // namespace tessera

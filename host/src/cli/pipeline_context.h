@@ -1,0 +1,33 @@
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+#include "manifest/manifest.h"
+#include "plugin/plugin_registry.h"
+#include "tessera/sdk.h"
+
+namespace tessera {
+
+// The plugins of one run, made from a manifest. Construction parses the manifest,
+// discovers plugins and instantiates every slot the manifest names (which validates
+// all plugin options) before any image is read.
+struct PipelineContext {
+  Manifest manifest;
+  PluginRegistry registry;
+  PluginInstance<Detector> detector;
+  PluginInstance<PairSelector> pair_selector;
+  PluginInstance<Matcher> matcher;
+  PluginInstance<BundleAdjuster> bundle_adjuster;
+  std::vector<PluginInstance<Exporter>> exporters;
+
+  // `manifest_file` empty: the default manifest. Throws InputError on any problem.
+  static PipelineContext Create(const std::filesystem::path& manifest_file);
+  // From an already parsed manifest.
+  static PipelineContext Create(Manifest manifest);
+
+  // Throws InputError naming the missing slot when a stage needs it.
+  void Require(const std::string& slot, const std::string& stage) const;
+};
+
+}  // namespace tessera

@@ -1,0 +1,57 @@
+// `tessera plugins [--json] [--manifest FILE]`: every plugin found on the search path,
+// with the ones the host would refuse marked and why.
+
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "cli/commands.h"
+#include "cli/exit_codes.h"
+#include "manifest/manifest.h"
+#include "plugin/plugin_registry.h"
+#include "util/paths.h"
+
+namespace tessera {
+
+CommandRegistration RegisterPluginsCommand(CLI::App& app, const GlobalOptions&) {
+  struct Options {
+    bool json = false;
+    std::string manifest;
+  };
+  auto options = std::make_shared<Options>();
+  CLI::App* sub = app.add_subcommand("plugins", "List the plugins found and the ones refused");
+  sub->add_flag("--json", options->json, "Print JSON instead of a table");
+  sub->add_option("--manifest", options->manifest, "Also search the plugin_paths of this manifest");
+
+  auto run = [options]() {
+    std::vector<std::filesystem::path> manifest_paths;
+    if (!options->manifest.empty()) manifest_paths = Manifest::Load(options->manifest).plugin_paths;
+    const PluginRegistry registry = PluginRegistry::Discover(PluginSearchPath(manifest_paths));
+
+    if (options->json) {
+      nlohmann::json json = {{"abi_version", kPluginAbiVersion},
+                             {"search_paths", nlohmann::json::array()},
+                             {"plugins", nlohmann::json::array()}};
+      for (const auto& path : registry.search_paths())
+        json["search_paths"].push_back(path.string());
+      for (const auto& record : registry.records()) json["plugins"].push_back(record.ToJson());
+      std::cout << json.dump(2) << std::endl;
+      return static_cast<int>(kExitSuccess);
+    }
+    std::cout << "Plugin ABI version " << kPluginAbiVersion << "; searched:";
+    for (const auto& path : registry.search_paths()) std::cout << ' ' << path.string();
+    std::cout << "\n";
+    for (const auto& record : registry.records()) {
+      if (record.usable()) {
+        std::printf("  %-16s %-18s %-8s %s\n", record.kind.c_str(), record.name.c_str(),
+                    record.version.c_str(), record.file.string().c_str());
+      } else {
+        std::printf("  REFUSED %s\n", record.refusal.c_str());
+      }
+    }
+    if (registry.records().empty()) std::cout << "  (no plugins found)\n";
+    return static_cast<int>(kExitSuccess);
+  };
+  return {sub, run};
+}
+
+}  // namespace tessera

@@ -1,0 +1,126 @@
+#pragma once
+
+#include <boost/dll/shared_library.hpp>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "tessera/sdk.h"
+
+namespace tessera {
+
+// The five plugin kinds, by the names used in info records and manifests.
+const std::vector<std::string>& PluginKindNames();
+
+// One plugin file found on the search path, loadable or not.
+struct PluginRecord {
+  std::filesystem::path file;
+  uint32_t abi_version = 0;
+  std::string kind;
+  std::string name;
+  std::string version;
+  std::string description;
+  // Why the host refuses this plugin; empty when it is usable.
+  std::string refusal;
+  // Open while the record is usable; shared with every object made from it.
+  std::shared_ptr<boost::dll::shared_library> library;
+
+  bool usable() const { return refusal.empty(); }
+  nlohmann::json ToJson() const;
+};
+
+// A plugin object together with the library it came from. Members are destroyed in
+// reverse order, so the object always goes before its library is unloaded.
+template <typename Interface>
+class PluginInstance {
+ public:
+  PluginInstance() = default;
+  PluginInstance(std::shared_ptr<boost::dll::shared_library> library,
+                 std::unique_ptr<Interface> object, const PluginRecord& record)
+      : library_(std::move(library)),
+        object_(std::move(object)),
+        name_(record.name),
+        version_(record.version),
+        file_(record.file) {}
+  PluginInstance(PluginInstance&&) noexcept = default;
+  PluginInstance& operator=(PluginInstance&& other) noexcept {
+    object_ = std::move(other.object_);  // release our object before our library
+    library_ = std::move(other.library_);
+    name_ = std::move(other.name_);
+    version_ = std::move(other.version_);
+    file_ = std::move(other.file_);
+    return *this;
+  }
+  ~PluginInstance() { object_.reset(); }
+
+  explicit operator bool() const { return object_ != nullptr; }
+  Interface* operator->() const { return object_.get(); }
+  Interface& operator*() const { return *object_; }
+  Interface* get() const { return object_.get(); }
+  const std::string& name() const { return name_; }
+  const std::string& version() const { return version_; }
+  const std::filesystem::path& file() const { return file_; }
+  // Name, version and effective options: what produced a result.
+  nlohmann::json Provenance() const {
+    return {{"plugin", name_}, {"version", version_}, {"options", object_->EffectiveOptions()}};
+  }
+
+ private:
+  std::shared_ptr<boost::dll::shared_library> library_;  // first: destroyed last
+  std::unique_ptr<Interface> object_;
+  std::string name_;
+  std::string version_;
+  std::filesystem::path file_;
+};
+
+// Reads the info record of one file and checks it: opens, has the record, ABI version
+// equal to the host's, known kind, has a factory. Never throws; a failure is
+// recorded in `refusal` as one sentence naming the file.
+PluginRecord InspectPluginFile(const std::filesystem::path& file);
+
+// Every plugin found on a search path.
+class PluginRegistry {
+ public:
+  // Scans the folders in order for shared objects (*.so). A name seen a second time
+  // is refused as a duplicate; the first one found wins. Missing folders are skipped.
+  static PluginRegistry Discover(const std::vector<std::filesystem::path>& search_paths);
+
+  const std::vector<PluginRecord>& records() const { return records_; }
+  const std::vector<std::filesystem::path>& search_paths() const { return search_paths_; }
+
+  // Usable plugin names of a kind, sorted.
+  std::vector<std::string> NamesOfKind(const std::string& kind) const;
+
+  // Makes the plugin `name` for the slot of kind `kind`. `json_path` is where the
+  // slot sits in the manifest (e.g. "pipeline.detector"); errors name it and the file.
+  // Throws InputError when the plugin is missing, refused, of another kind, its
+  // factory throws or it rejects its options.
+  template <typename Interface>
+  PluginInstance<Interface> Create(const std::string& kind, const std::string& name,
+                                   const nlohmann::json& options,
+                                   const std::string& json_path) const {
+    const PluginRecord& record = Resolve(kind, name, json_path);
+    std::unique_ptr<Plugin> plugin = CreateObject(record, options, json_path);
+    auto* typed = dynamic_cast<Interface*>(plugin.get());
+    if (typed == nullptr) {
+      throw InputError(record.file.string() + ": plugin '" + name + "' says it is a " + kind +
+                       " but its factory made an object of another kind");
+    }
+    plugin.release();
+    return PluginInstance<Interface>(record.library, std::unique_ptr<Interface>(typed), record);
+  }
+
+ private:
+  const PluginRecord& Resolve(const std::string& kind, const std::string& name,
+                              const std::string& json_path) const;
+  std::unique_ptr<Plugin> CreateObject(const PluginRecord& record, const nlohmann::json& options,
+                                       const std::string& json_path) const;
+
+  std::vector<std::filesystem::path> search_paths_;
+  std::vector<PluginRecord> records_;
+};
+
+}  // namespace tessera

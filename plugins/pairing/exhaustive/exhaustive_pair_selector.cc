@@ -1,0 +1,31 @@
+// Every pair of images: n (n - 1) / 2 pairs. Best for unordered photo sets of up to a
+// few hundred images.
+
+#include "tessera/sdk.h"
+
+namespace tessera {
+
+class ExhaustivePairSelector : public PairSelector {
+ public:
+  explicit ExhaustivePairSelector(const nlohmann::json& options) {
+    OptionReader reader(options);
+    reader.Finish();
+    effective_options_ = reader.Effective();
+  }
+
+  std::vector<ImageIndexPair> SelectPairs(
+      const std::vector<std::string>& image_names) const override {
+    std::vector<ImageIndexPair> pairs;
+    const size_t n = image_names.size();
+    pairs.reserve(n * (n > 0 ? n - 1 : 0) / 2);
+    for (size_t i = 0; i < n; ++i) {
+      for (size_t j = i + 1; j < n; ++j) pairs.emplace_back(i, j);
+    }
+    return pairs;
+  }
+};
+
+}  // namespace tessera
+
+TESSERA_PLUGIN(pair_selector, tessera::ExhaustivePairSelector, "exhaustive", "1.0.0",
+               "Every pair of images (n(n-1)/2 pairs)")
