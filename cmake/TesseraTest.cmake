@@ -8,6 +8,5 @@ function(tessera_add_test name)
   include(GoogleTest)
   gtest_discover_tests(${name}
     PROPERTIES LABELS "${ARG_LABELS}"
-               ENVIRONMENT "TESSERA_SOURCE_DIR=${PROJECT_SOURCE_DIR};TESSERA_BINARY_DIR=${PROJECT_BINARY_DIR};TESSERA_PLUGIN_DIR=${TESSERA_PLUGIN_OUTPUT_DIR}"
     DISCOVERY_TIMEOUT 60)
 endfunction()

@@ -1,0 +1,66 @@
+#pragma once
+
+// Helpers shared by the tests: loading bundled plugins through the real loader, and
+// finding the shared datasets.
+
+#include <cstdlib>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "plugin/plugin_registry.h"
+
+namespace tessera::testing {
+
+// Folder of the built bundled plugins (set by tessera_add_test).
+inline std::filesystem::path PluginDir() {
+  const char* dir = std::getenv("TESSERA_PLUGIN_DIR");
+  return dir != nullptr ? dir : TESSERA_TEST_PLUGIN_DIR;
+}
+
+inline std::filesystem::path SourceDir() {
+  const char* dir = std::getenv("TESSERA_SOURCE_DIR");
+  return dir != nullptr ? dir : TESSERA_TEST_SOURCE_DIR;
+}
+
+inline std::filesystem::path BinaryDir() {
+  const char* dir = std::getenv("TESSERA_BINARY_DIR");
+  return dir != nullptr ? dir : TESSERA_TEST_BINARY_DIR;
+}
+
+// ../shared beside the repository (datasets and COLMAP anchors), or TESSERA_SHARED_DIR.
+inline std::filesystem::path SharedDir() {
+  if (const char* dir = std::getenv("TESSERA_SHARED_DIR")) return dir;
+  return (SourceDir() / ".." / "shared").lexically_normal();
+}
+
+// A bundled plugin loaded through the plugin registry, as the host loads it.
+template <typename Interface>
+PluginInstance<Interface> LoadBundledPlugin(
+    const std::string& kind, const std::string& name,
+    const nlohmann::json& options = nlohmann::json::object(),
+    const std::string& json_path = "pipeline.test") {
+  static const PluginRegistry registry = PluginRegistry::Discover({PluginDir()});
+  return registry.Create<Interface>(kind, name, options, json_path);
+}
+
+// A fresh empty temporary folder, removed when the object goes.
+class TemporaryDir {
+ public:
+  TemporaryDir() {
+    std::string pattern = (std::filesystem::temp_directory_path() / "tessera-test-XXXXXX").string();
+    path_ = mkdtemp(pattern.data());
+  }
+  ~TemporaryDir() {
+    std::error_code error;
+    std::filesystem::remove_all(path_, error);
+  }
+  TemporaryDir(const TemporaryDir&) = delete;
+  TemporaryDir& operator=(const TemporaryDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+}  // namespace tessera::testing
