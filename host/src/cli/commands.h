@@ -23,5 +23,8 @@ std::vector<CommandRegistration> RegisterCommands(CLI::App& app, const GlobalOpt
 // One registration function per verb, each in its own file.
 CommandRegistration RegisterPluginsCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterExtractCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterMatchCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera

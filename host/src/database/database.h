@@ -1,0 +1,150 @@
+#pragma once
+
+// The workspace database: a SQLite file with COLMAP 3.8's `database.db` schema, so
+// that `colmap mapper` reads what Tessera wrote and Tessera reads what COLMAP wrote,
+// plus two tables of Tessera's own (prefixed `tessera_`, which COLMAP ignores).
+
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "tessera/camera.h"
+#include "tessera/features.h"
+#include "tessera/ids.h"
+#include "tessera/reconstruction.h"
+#include "tessera/two_view_geometry.h"
+
+namespace tessera {
+
+// One connection to a workspace database. Every SQLite error becomes an exception
+// that names the file and the operation: InputError for a file that is not a usable
+// database, std::runtime_error otherwise. Calls are serialised by an internal lock,
+// so the object may be shared between threads; a Transaction holds the lock for its
+// thread until it ends, so that other threads' writes do not land inside it.
+//
+// Pair data (matches, two-view geometries) is stored under the pair id of
+// (min id, max id) as COLMAP does; callers always get data in their own order.
+class Database {
+ public:
+  // Stage names for the provenance table, one per table that a stage fills.
+  static constexpr const char* kFeaturesStage = "features";
+  static constexpr const char* kMatchesStage = "matches";
+  static constexpr const char* kTwoViewGeometriesStage = "two_view_geometries";
+
+  // Opens or creates the database at `path` and creates missing tables. Throws
+  // InputError naming the file if it cannot be opened or is not a SQLite database /
+  // has an incompatible schema.
+  explicit Database(const std::filesystem::path& path);
+  ~Database();
+  Database(const Database&) = delete;
+  Database& operator=(const Database&) = delete;
+
+  const std::filesystem::path& path() const;
+
+  // RAII transaction: rolls back unless Commit() was called. Nested use is an error
+  // (std::logic_error). Writes inside it become visible, and durable, together.
+  class Transaction {
+   public:
+    explicit Transaction(Database* database);
+    ~Transaction();
+    Transaction(const Transaction&) = delete;
+    Transaction& operator=(const Transaction&) = delete;
+    void Commit();
+
+   private:
+    Database* database_;
+    std::unique_lock<std::recursive_mutex> lock_;
+    bool active_ = false;
+  };
+
+  // Cameras. The calibration source is written to tessera_camera_priors as well.
+  // Returns the new id: camera.camera_id if use_camera_id, else the next free one.
+  camera_t WriteCamera(const Camera& camera, bool use_camera_id = false);
+  // Overwrites the camera with camera.camera_id; throws if there is none.
+  void UpdateCamera(const Camera& camera);
+  // Sorted by camera_id. The calibration source comes from tessera_camera_priors;
+  // a camera without a row there (written by COLMAP) is CalibrationSource::kDatabase.
+  // Throws InputError for a camera model Tessera does not know.
+  std::vector<Camera> ReadAllCameras() const;
+  std::optional<Camera> ReadCamera(camera_t camera_id) const;
+
+  // Images: name and camera_id (COLMAP's pose priors are left NULL, as COLMAP 3.8
+  // writes them when it has none). Returns the new id.
+  image_t WriteImage(const Image& image, bool use_image_id = false);
+  std::optional<Image> ReadImageWithName(const std::string& name) const;
+  // Sorted by image_id; poses are identity, points2D left empty.
+  std::vector<Image> ReadAllImages() const;
+
+  size_t NumCameras() const;
+  size_t NumImages() const;
+
+  // Keypoints: Tessera writes 6 float columns (x y a11 a12 a21 a22); 2 (x y) and
+  // 4 (x y scale orientation) columns are accepted on read, as in COLMAP. Writes
+  // replace an existing row. Reads of an image without a row return an empty list.
+  bool ExistsKeypoints(image_t image_id) const;
+  void WriteKeypoints(image_t image_id, const FeatureKeypoints& keypoints);
+  FeatureKeypoints ReadKeypoints(image_t image_id) const;
+  size_t NumKeypoints() const;  // summed over all images
+
+  // Descriptors: uint8 rows x cols. COLMAP's table has no place for the metric, so
+  // the caller says which one the stage's detector produced.
+  bool ExistsDescriptors(image_t image_id) const;
+  void WriteDescriptors(image_t image_id, const FeatureDescriptors& descriptors);
+  FeatureDescriptors ReadDescriptors(image_t image_id, DescriptorMetric metric) const;
+
+  // Matches of (image_id1, image_id2), point2D_idx1 indexing image_id1's keypoints
+  // whatever the order of the ids. An empty list is written as rows=0 (the pair was
+  // matched and nothing was found). Reads of a pair without a row return empty.
+  bool ExistsMatches(image_t image_id1, image_t image_id2) const;
+  void WriteMatches(image_t image_id1, image_t image_id2, const FeatureMatches& matches);
+  FeatureMatches ReadMatches(image_t image_id1, image_t image_id2) const;
+  // Every pair with a row in `matches`, empty ones included, sorted.
+  std::vector<image_pair_t> ReadMatchedPairIds() const;
+  size_t NumMatchedPairs() const;
+
+  // Two-view geometry of (image_id1, image_id2), relating image_id1 to image_id2
+  // (x2^T F x1 = 0, cam2_from_cam1) whatever the order of the ids: a swapped pair is
+  // stored inverted as COLMAP's TwoViewGeometry::Invert does and inverted back on read.
+  // Reads of a pair without a row return an UNDEFINED geometry.
+  bool ExistsTwoViewGeometry(image_t image_id1, image_t image_id2) const;
+  void WriteTwoViewGeometry(image_t image_id1, image_t image_id2, const TwoViewGeometry& geometry);
+  TwoViewGeometry ReadTwoViewGeometry(image_t image_id1, image_t image_id2) const;
+  // Every row: (pair_id, geometry in the stored order image_id1 < image_id2), sorted.
+  std::vector<std::pair<image_pair_t, TwoViewGeometry>> ReadAllTwoViewGeometries() const;
+  // Rows with at least one inlier and a config other than DEGENERATE/UNDEFINED.
+  size_t NumVerifiedPairs() const;
+
+  // Each clear also clears the tables that depend on the cleared one, and the
+  // provenance of every stage it clears.
+  void ClearKeypointsAndDescriptors();  // and matches, two-view geometries
+  void ClearMatches();                  // and two-view geometries
+  void ClearTwoViewGeometries();
+
+  // What produced a stage's table (plugin, version, effective options...), so that a
+  // change invalidates only what depends on it. nullopt if the stage has no record.
+  std::optional<nlohmann::json> ReadStageProvenance(const std::string& stage) const;
+  void WriteStageProvenance(const std::string& stage, const nlohmann::json& provenance);
+
+  void WriteCalibrationSource(camera_t camera_id, CalibrationSource source);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  mutable std::recursive_mutex mutex_;
+};
+
+// The inverse of CalibrationSourceName; nullopt for an unknown name.
+std::optional<CalibrationSource> CalibrationSourceFromName(const std::string& name);
+
+// The geometry seen from the other image: F^T, E^T, H^-1 (H kept if singular),
+// cam1_from_cam2, and the inlier matches' columns swapped (COLMAP's
+// TwoViewGeometry::Invert).
+TwoViewGeometry InvertTwoViewGeometry(const TwoViewGeometry& geometry);
+
+}  // namespace tessera

@@ -1,0 +1,242 @@
+#include "eval/evaluation.h"
+
+#include <Eigen/SVD>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <numeric>
+
+namespace tessera {
+namespace {
+
+constexpr size_t kMinNumAlignedImages = 3;
+
+double Mean(const std::vector<double>& values) {
+  return std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
+}
+
+// As numpy.median: the mean of the two middle values for an even count.
+double Median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : (values[n / 2 - 1] + values[n / 2]) / 2;
+}
+
+double Max(const std::vector<double>& values) {
+  return *std::max_element(values.begin(), values.end());
+}
+
+// Angle of the rotation between two orientations, in degrees.
+double RotationAngleDeg(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b) {
+  const double cos_angle = std::clamp(((R_a * R_b.transpose()).trace() - 1) / 2, -1.0, 1.0);
+  return std::acos(cos_angle) * 180 / M_PI;
+}
+
+void AddModelStatistics(const Reconstruction& model, EvaluationResult* result) {
+  result->num_points3D = model.points3D.size();
+  double error_sum = 0;
+  size_t num_errors = 0;
+  for (const auto& [point3D_id, point3D] : model.points3D) {
+    result->num_observations += point3D.track.size();
+    for (const TrackElement& element : point3D.track) {
+      const auto image = model.images.find(element.image_id);
+      if (image == model.images.end() || !image->second.registered ||
+          element.point2D_idx >= image->second.points2D.size()) {
+        continue;
+      }
+      const auto camera = model.cameras.find(image->second.camera_id);
+      if (camera == model.cameras.end() || !camera->second.IsValid()) continue;
+      const Eigen::Vector3d point_in_cam = image->second.cam_from_world * point3D.xyz;
+      if (point_in_cam.z() <= std::numeric_limits<double>::epsilon()) {
+        ++result->num_observations_behind_camera;
+        continue;
+      }
+      const Eigen::Vector2d projected = camera->second.ImgFromCam(point_in_cam);
+      error_sum += (projected - image->second.points2D[element.point2D_idx].xy).norm();
+      ++num_errors;
+    }
+  }
+  result->mean_track_length =
+      model.points3D.empty()
+          ? 0.0
+          : result->num_observations / static_cast<double>(model.points3D.size());
+  if (num_errors > 0) result->mean_reprojection_error = error_sum / num_errors;
+}
+
+std::string FormatNumber(double value, const char* format) {
+  if (std::isnan(value)) return "-";
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), format, value);
+  return buffer;
+}
+
+}  // namespace
+
+Similarity3d EstimateSimilarity(const std::vector<Eigen::Vector3d>& src,
+                                const std::vector<Eigen::Vector3d>& dst) {
+  const size_t n = src.size();
+  Eigen::Vector3d mean_src = Eigen::Vector3d::Zero(), mean_dst = Eigen::Vector3d::Zero();
+  for (size_t i = 0; i < n; ++i) {
+    mean_src += src[i];
+    mean_dst += dst[i];
+  }
+  mean_src /= n;
+  mean_dst /= n;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  double variance_src = 0;
+  for (size_t i = 0; i < n; ++i) {
+    covariance += (dst[i] - mean_dst) * (src[i] - mean_src).transpose();
+    variance_src += (src[i] - mean_src).squaredNorm();
+  }
+  covariance /= n;
+  variance_src /= n;
+
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance,
+                                              Eigen::ComputeFullU | Eigen::ComputeFullV);
+  // A reflection would fit better when the points are noisy or planar-degenerate; the
+  // sign fix keeps a proper rotation.
+  Eigen::Vector3d signs = Eigen::Vector3d::Ones();
+  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) signs(2) = -1;
+  Similarity3d dst_from_src;
+  dst_from_src.rotation = svd.matrixU() * signs.asDiagonal() * svd.matrixV().transpose();
+  dst_from_src.scale = svd.singularValues().dot(signs) / variance_src;
+  dst_from_src.translation = mean_dst - dst_from_src.scale * dst_from_src.rotation * mean_src;
+  return dst_from_src;
+}
+
+EvaluationResult EvaluateReconstruction(
+    const Reconstruction& model, const std::map<std::string, GroundTruthPose>& ground_truth) {
+  EvaluationResult result;
+  AddModelStatistics(model, &result);
+  const std::map<std::string, GroundTruthPose> estimated = PosesByBasename(model);
+
+  std::vector<std::string> names;
+  std::vector<Eigen::Vector3d> centers_model, centers_gt;
+  for (const auto& [name, gt_pose] : ground_truth) {
+    ImageEvaluation row;
+    row.name = name;
+    const auto it = estimated.find(name);
+    row.registered = it != estimated.end();
+    if (row.registered) {
+      names.push_back(name);
+      centers_model.push_back(it->second.center_in_world);
+      centers_gt.push_back(gt_pose.center_in_world);
+    }
+    result.images.push_back(row);
+  }
+  result.num_total = ground_truth.size();
+  result.num_registered = names.size();
+  if (names.size() < kMinNumAlignedImages) {
+    result.error = "only " + std::to_string(names.size()) +
+                   " images of the model are in the ground truth; aligning needs at least " +
+                   std::to_string(kMinNumAlignedImages);
+    return result;
+  }
+
+  result.gt_from_model = EstimateSimilarity(centers_model, centers_gt);
+  result.aligned = true;
+  std::vector<double> position_errors, rotation_errors;
+  for (ImageEvaluation& row : result.images) {
+    if (!row.registered) continue;
+    const GroundTruthPose& estimate = estimated.at(row.name);
+    const GroundTruthPose& truth = ground_truth.at(row.name);
+    row.position_error =
+        (result.gt_from_model * estimate.center_in_world - truth.center_in_world).norm();
+    // cam_from_gt_world = cam_from_model_world * model_from_gt_world.
+    row.rotation_error_deg =
+        RotationAngleDeg(truth.R_cam_from_world,
+                         estimate.R_cam_from_world * result.gt_from_model.rotation.transpose());
+    position_errors.push_back(row.position_error);
+    rotation_errors.push_back(row.rotation_error_deg);
+  }
+  result.position_error_mean = Mean(position_errors);
+  result.position_error_median = Median(position_errors);
+  result.position_error_max = Max(position_errors);
+  result.rotation_error_mean_deg = Mean(rotation_errors);
+  result.rotation_error_max_deg = Max(rotation_errors);
+
+  Eigen::Vector3d mean_gt = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& center : centers_gt) mean_gt += center;
+  mean_gt /= centers_gt.size();
+  result.scene_extent = 0;
+  for (const Eigen::Vector3d& center : centers_gt) {
+    result.scene_extent = std::max(result.scene_extent, (center - mean_gt).norm());
+  }
+  result.position_error_mean_relative = result.position_error_mean / result.scene_extent;
+  return result;
+}
+
+nlohmann::json EvaluationResult::ToJson() const {
+  nlohmann::json json = {{"registered", num_registered}, {"total", num_total}};
+  if (!aligned) json["error"] = error;
+  if (aligned) {
+    json["rot_mean_deg"] = rotation_error_mean_deg;
+    json["rot_max_deg"] = rotation_error_max_deg;
+    json["pos_mean"] = position_error_mean;
+    json["pos_median"] = position_error_median;
+    json["pos_max"] = position_error_max;
+    json["pos_mean_rel"] = position_error_mean_relative;
+    json["scene_extent"] = scene_extent;
+    json["alignment_scale"] = gt_from_model.scale;
+  }
+  json["num_points3D"] = num_points3D;
+  json["num_observations"] = num_observations;
+  json["mean_track_length"] = mean_track_length;
+  json["mean_reprojection_error_px"] = mean_reprojection_error;  // null when there is none
+  json["num_observations_behind_camera"] = num_observations_behind_camera;
+  json["images"] = nlohmann::json::array();
+  for (const ImageEvaluation& row : images) {
+    nlohmann::json image = {{"name", row.name}, {"registered", row.registered}};
+    if (row.registered && aligned) {
+      image["pos_error"] = row.position_error;
+      image["rot_error_deg"] = row.rotation_error_deg;
+    }
+    json["images"].push_back(image);
+  }
+  return json;
+}
+
+std::string EvaluationResult::ToTable() const {
+  size_t name_width = 5;
+  for (const ImageEvaluation& row : images) name_width = std::max(name_width, row.name.size());
+  std::string table;
+  char line[512];
+  std::snprintf(line, sizeof(line), "%-*s  %16s  %18s\n", static_cast<int>(name_width), "image",
+                "position error", "rotation error deg");
+  table += line;
+  for (const ImageEvaluation& row : images) {
+    if (!row.registered) {
+      std::snprintf(line, sizeof(line), "%-*s  %16s\n", static_cast<int>(name_width),
+                    row.name.c_str(), "not registered");
+    } else {
+      std::snprintf(line, sizeof(line), "%-*s  %16s  %18s\n", static_cast<int>(name_width),
+                    row.name.c_str(), FormatNumber(row.position_error, "%.6g").c_str(),
+                    FormatNumber(row.rotation_error_deg, "%.4f").c_str());
+    }
+    table += line;
+  }
+  table += "registered: " + std::to_string(num_registered) + "/" + std::to_string(num_total) + "\n";
+  if (!aligned) {
+    table += "not aligned: " + error + "\n";
+  } else {
+    table += "position error (ground-truth units): mean " +
+             FormatNumber(position_error_mean, "%.6g") + ", median " +
+             FormatNumber(position_error_median, "%.6g") + ", max " +
+             FormatNumber(position_error_max, "%.6g") + "\n";
+    table += "mean position error / scene extent (" + FormatNumber(scene_extent, "%.6g") +
+             "): " + FormatNumber(100 * position_error_mean_relative, "%.4f") + "%\n";
+    table += "rotation error (deg): mean " + FormatNumber(rotation_error_mean_deg, "%.4f") +
+             ", max " + FormatNumber(rotation_error_max_deg, "%.4f") + "\n";
+  }
+  table += "3D points: " + std::to_string(num_points3D) + ", mean track length " +
+           FormatNumber(mean_track_length, "%.4f") + ", mean reprojection error " +
+           FormatNumber(mean_reprojection_error, "%.4f") + " px";
+  if (num_observations_behind_camera > 0) {
+    table += " (" + std::to_string(num_observations_behind_camera) +
+             " observations behind their camera left out)";
+  }
+  table += "\n";
+  return table;
+}
+
+}  // namespace tessera

@@ -1,0 +1,81 @@
+#pragma once
+
+// Accuracy of a reconstruction against ground-truth poses: a similarity alignment of the
+// camera centres (Umeyama), then per-image position and rotation errors. The figures
+// follow /work/shared/anchors/eval_gt.py, the independent reference.
+
+#include <Eigen/Core>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "eval/ground_truth.h"
+#include "tessera/reconstruction.h"
+
+namespace tessera {
+
+// x_b = scale * rotation * x_a + translation.
+struct Similarity3d {
+  double scale = 1;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+
+  Eigen::Vector3d operator*(const Eigen::Vector3d& x) const {
+    return scale * rotation * x + translation;
+  }
+};
+
+// Least-squares similarity dst_from_src (Umeyama 1991, with the reflection fix).
+// Needs at least 3 pairs, not all collinear, for a unique answer.
+Similarity3d EstimateSimilarity(const std::vector<Eigen::Vector3d>& src,
+                                const std::vector<Eigen::Vector3d>& dst);
+
+struct ImageEvaluation {
+  std::string name;         // basename, as in the ground truth
+  bool registered = false;  // whether the model has a registered image of this name
+  double position_error = std::numeric_limits<double>::quiet_NaN();      // GT units
+  double rotation_error_deg = std::numeric_limits<double>::quiet_NaN();  // degrees
+};
+
+struct EvaluationResult {
+  // One row per ground-truth image, by name.
+  std::vector<ImageEvaluation> images;
+  size_t num_registered = 0;  // ground-truth images registered in the model
+  size_t num_total = 0;       // ground-truth images
+  // False (with `error` saying why) when fewer than 3 images could be aligned; the
+  // error figures are then NaN.
+  bool aligned = false;
+  std::string error;
+  Similarity3d gt_from_model;  // the alignment
+
+  double position_error_mean = std::numeric_limits<double>::quiet_NaN();
+  double position_error_median = std::numeric_limits<double>::quiet_NaN();
+  double position_error_max = std::numeric_limits<double>::quiet_NaN();
+  double rotation_error_mean_deg = std::numeric_limits<double>::quiet_NaN();
+  double rotation_error_max_deg = std::numeric_limits<double>::quiet_NaN();
+  // Largest distance of an aligned ground-truth centre from their mean, and the mean
+  // position error divided by it.
+  double scene_extent = std::numeric_limits<double>::quiet_NaN();
+  double position_error_mean_relative = std::numeric_limits<double>::quiet_NaN();
+
+  // From the model alone.
+  size_t num_points3D = 0;
+  size_t num_observations = 0;  // track elements
+  double mean_track_length = 0;
+  // Mean distance in pixels between the observed keypoints and the projections of
+  // their 3D points, recomputed from the points and cameras (not the stored errors);
+  // observations behind their camera are left out and counted.
+  double mean_reprojection_error = std::numeric_limits<double>::quiet_NaN();
+  size_t num_observations_behind_camera = 0;
+
+  // Keys follow eval_gt.py ("registered", "total", "pos_mean", "rot_mean_deg", ...).
+  nlohmann::json ToJson() const;
+  std::string ToTable() const;
+};
+
+EvaluationResult EvaluateReconstruction(const Reconstruction& model,
+                                        const std::map<std::string, GroundTruthPose>& ground_truth);
+
+}  // namespace tessera

@@ -1,0 +1,77 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+
+#include "tessera/options.h"
+#include "util/parallel.h"
+#include "util/random.h"
+#include "util/strings.h"
+
+namespace tessera {
+namespace {
+
+TEST(NaturalLess, OrdersDigitRunsByValue) {
+  std::vector<std::string> names = {"img10.jpg", "img2.jpg", "IMG1.jpg",
+                                    "img02.jpg", "a.jpg",    "img1b.jpg"};
+  std::sort(names.begin(), names.end(), NaturalLess);
+  EXPECT_EQ(names, (std::vector<std::string>{"a.jpg", "IMG1.jpg", "img1b.jpg", "img02.jpg",
+                                             "img2.jpg", "img10.jpg"}));
+  EXPECT_FALSE(NaturalLess("x", "x"));
+  EXPECT_TRUE(NaturalLess("frame_99999999999999999999", "frame_100000000000000000000"));
+}
+
+TEST(ParallelFor, VisitsEveryIndexOnceAndRethrows) {
+  std::vector<std::atomic<int>> visits(1000);
+  ParallelFor(visits.size(), 4, [&](size_t i) { ++visits[i]; });
+  EXPECT_TRUE(std::all_of(visits.begin(), visits.end(), [](const auto& v) { return v == 1; }));
+  EXPECT_THROW(ParallelFor(100, 3,
+                           [](size_t i) {
+                             if (i == 57) throw std::runtime_error("fails");
+                           }),
+               std::runtime_error);
+}
+
+TEST(DeriveSeed, DependsOnBothInputsOnly) {
+  EXPECT_EQ(DeriveSeed(1, 2), DeriveSeed(1, 2));
+  EXPECT_NE(DeriveSeed(1, 2), DeriveSeed(1, 3));
+  EXPECT_NE(DeriveSeed(1, 2), DeriveSeed(2, 2));
+}
+
+TEST(OptionReader, SuggestsTheClosestKnownName) {
+  EXPECT_EQ(EditDistance("flan", "flann"), 1u);
+  EXPECT_EQ(ClosestName("flan", {"brute_force", "flann"}), "flann");
+  EXPECT_EQ(ClosestName("zzzzzz", {"brute_force", "flann"}), "");
+  OptionReader reader(nlohmann::json{{"ratoi", 0.7}});
+  EXPECT_EQ(reader.Get<double>("ratio", 0.8, 0, 1), 0.8);
+  try {
+    reader.Finish();
+    FAIL();
+  } catch (const OptionError& error) {
+    EXPECT_EQ(std::string(error.what()), "ratoi: unknown key; did you mean 'ratio'?");
+    EXPECT_EQ(error.path(), "ratoi");
+  }
+}
+
+TEST(OptionReader, ChecksTypesAndRangesAndRecordsEffectiveOptions) {
+  OptionReader reader(nlohmann::json{{"n", 5}, {"name", "b"}}, "opts");
+  EXPECT_EQ(reader.Get<int>("n", 1, 1, 10), 5);
+  EXPECT_EQ(reader.GetString("name", "a", {"a", "b"}), "b");
+  EXPECT_TRUE(reader.GetBool("flag", true));
+  reader.Finish();
+  EXPECT_EQ(reader.Effective(), (nlohmann::json{{"n", 5}, {"name", "b"}, {"flag", true}}));
+
+  OptionReader bad(nlohmann::json{{"n", 2.5}});
+  EXPECT_THROW(bad.Get<int>("n", 1), OptionError);
+  OptionReader out_of_range(nlohmann::json{{"x", 11.0}}, "o");
+  try {
+    out_of_range.Get<double>("x", 1, 0, 10);
+    FAIL();
+  } catch (const OptionError& error) {
+    EXPECT_EQ(std::string(error.what()), "o.x: = 11.0 is out of range; must be in [0, 10]");
+  }
+  EXPECT_THROW(OptionReader(nlohmann::json::array()), OptionError);
+}
+
+}  // namespace
+}  // namespace tessera

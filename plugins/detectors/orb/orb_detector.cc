@@ -1,0 +1,159 @@
+// ORB keypoints and 256-bit binary descriptors from OpenCV, with keypoints in
+// COLMAP's convention (the top-left pixel's centre at (0.5, 0.5)). Much faster than
+// SIFT and less distinctive; its descriptors are compared by Hamming distance.
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <numeric>
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "tessera/sdk.h"
+
+namespace tessera {
+namespace {
+
+constexpr int kDescriptorBytes = 32;
+
+struct OrbOptions {
+  // Keep at most this many keypoints, the strongest by Harris response.
+  int max_num_features = 8192;
+  // Downscale (area averaging) so that the longer side is at most this many pixels.
+  int max_image_size = 3200;
+  // Ratio between the sizes of neighbouring pyramid levels.
+  double scale_factor = 1.2;
+  // Number of pyramid levels.
+  int num_levels = 8;
+  // FAST threshold: least grey-level difference between a corner and its ring.
+  int fast_threshold = 20;
+  // Border in pixels, at each level, where no keypoint is detected.
+  int edge_threshold = 31;
+};
+
+// The working copy of an image and how its pixels relate to the full-resolution one.
+struct ScaledImage {
+  cv::Mat image;
+  double scale_x = 1;  // full-resolution pixels per working pixel, horizontally
+  double scale_y = 1;  // and vertically
+};
+
+ScaledImage ScaleToMaxSize(const ImageView& view, int max_image_size) {
+  if (view.data == nullptr || view.width <= 0 || view.height <= 0 ||
+      view.stride < static_cast<size_t>(view.width)) {
+    throw InputError("orb: cannot detect features in an empty or malformed image view (" +
+                     std::to_string(view.width) + "x" + std::to_string(view.height) + ")");
+  }
+  // The view is only read: OpenCV's Mat has no const-data constructor.
+  const cv::Mat full(view.height, view.width, CV_8UC1, const_cast<uint8_t*>(view.data),
+                     view.stride);
+  ScaledImage scaled;
+  const int long_side = std::max(view.width, view.height);
+  if (long_side <= max_image_size) {
+    scaled.image = full;
+    return scaled;
+  }
+  const double factor = static_cast<double>(max_image_size) / long_side;
+  const int width = std::max(1, static_cast<int>(std::lround(view.width * factor)));
+  const int height = std::max(1, static_cast<int>(std::lround(view.height * factor)));
+  cv::resize(full, scaled.image, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  scaled.scale_x = static_cast<double>(view.width) / width;
+  scaled.scale_y = static_cast<double>(view.height) / height;
+  return scaled;
+}
+
+// Where a keypoint of OpenCV's ORB lies, in pixels of the image ORB was given, in
+// COLMAP's convention. ORB finds corners at whole pixels x_l of a pyramid level made by
+// cv::resize, whose pixel centres sit at (x_l + 0.5) * width / level_width - 0.5 in the
+// image, but it reports x_l * scale_factor^level: up to a few pixels off at coarse
+// levels, and not symmetric under a flip of the image.
+cv::Point2d OrbKeypointPosition(const cv::KeyPoint& kp, const cv::Size& image_size,
+                                float scale_factor) {
+  // The level's scale and size exactly as OpenCV 4.6 computes them (in float).
+  const float level_scale =
+      static_cast<float>(std::pow(static_cast<double>(scale_factor), kp.octave));
+  const float inverse_scale = 1.f / level_scale;
+  const int level_width = cvRound(image_size.width * inverse_scale);
+  const int level_height = cvRound(image_size.height * inverse_scale);
+  return {(kp.pt.x / level_scale + 0.5) * image_size.width / level_width,
+          (kp.pt.y / level_scale + 0.5) * image_size.height / level_height};
+}
+
+// Indices of at most `max_count` keypoints, strongest first. Ties are broken by
+// position, size and angle so that the choice does not depend on OpenCV's order.
+std::vector<int> StrongestFirst(const std::vector<cv::KeyPoint>& keypoints, int max_count) {
+  std::vector<int> order(keypoints.size());
+  std::iota(order.begin(), order.end(), 0);
+  auto key = [&](int i) {
+    const cv::KeyPoint& kp = keypoints[i];
+    return std::make_tuple(-kp.response, kp.pt.y, kp.pt.x, kp.size, kp.angle, kp.octave, i);
+  };
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
+  if (order.size() > static_cast<size_t>(max_count)) order.resize(max_count);
+  return order;
+}
+
+class OrbDetector : public Detector {
+ public:
+  explicit OrbDetector(const nlohmann::json& options) {
+    OptionReader reader(options);
+    options_.max_num_features =
+        reader.Get<int>("max_num_features", options_.max_num_features, 1, 1000000);
+    options_.max_image_size =
+        reader.Get<int>("max_image_size", options_.max_image_size, 16, 100000);
+    options_.scale_factor = reader.Get<double>("scale_factor", options_.scale_factor, 1.01, 4.0);
+    options_.num_levels = reader.Get<int>("num_levels", options_.num_levels, 1, 32);
+    options_.fast_threshold = reader.Get<int>("fast_threshold", options_.fast_threshold, 1, 255);
+    options_.edge_threshold = reader.Get<int>("edge_threshold", options_.edge_threshold, 0, 256);
+    reader.Finish();
+    effective_options_ = reader.Effective();
+  }
+
+  FeatureSet Detect(const ImageView& view) const override {
+    const ScaledImage scaled = ScaleToMaxSize(view, options_.max_image_size);
+
+    // A detector per call: sharing one cv::ORB across threads is not documented as safe.
+    const cv::Ptr<cv::ORB> orb = cv::ORB::create(
+        options_.max_num_features, static_cast<float>(options_.scale_factor), options_.num_levels,
+        options_.edge_threshold, /*firstLevel=*/0, /*WTA_K=*/2, cv::ORB::HARRIS_SCORE,
+        /*patchSize=*/31, options_.fast_threshold);
+    std::vector<cv::KeyPoint> cv_keypoints;
+    cv::Mat cv_descriptors;
+    orb->detectAndCompute(scaled.image, cv::noArray(), cv_keypoints, cv_descriptors);
+    // ORB fills its quota level by level and may keep ties beyond it.
+    const std::vector<int> order = StrongestFirst(cv_keypoints, options_.max_num_features);
+
+    FeatureSet features;
+    features.keypoints.reserve(order.size());
+    features.descriptors.metric = DescriptorMetric::kHamming;
+    features.descriptors.data.resize(static_cast<Eigen::Index>(order.size()), kDescriptorBytes);
+    const double mean_scale = (scaled.scale_x + scaled.scale_y) / 2;
+    const float scale_factor = static_cast<float>(options_.scale_factor);
+    for (size_t row = 0; row < order.size(); ++row) {
+      const cv::KeyPoint& kp = cv_keypoints[order[row]];
+      const cv::Point2d position = OrbKeypointPosition(kp, scaled.image.size(), scale_factor);
+      features.keypoints.emplace_back(static_cast<float>(position.x * scaled.scale_x),
+                                      static_cast<float>(position.y * scaled.scale_y),
+                                      static_cast<float>(kp.size / 2 * mean_scale),
+                                      static_cast<float>(kp.angle * CV_PI / 180));
+      std::memcpy(features.descriptors.data.row(static_cast<Eigen::Index>(row)).data(),
+                  cv_descriptors.ptr<uint8_t>(order[row]), kDescriptorBytes);
+    }
+    return features;
+  }
+
+  DescriptorMetric Metric() const override { return DescriptorMetric::kHamming; }
+
+ private:
+  OrbOptions options_;
+};
+
+}  // namespace
+}  // namespace tessera
+
+TESSERA_PLUGIN(detector, tessera::OrbDetector, "orb", "1.0.0",
+               "ORB keypoints and 256-bit binary descriptors from OpenCV")

@@ -1,0 +1,175 @@
+// SIFT keypoints and descriptors from OpenCV, converted to COLMAP's conventions:
+// keypoints with the top-left pixel's centre at (0.5, 0.5), descriptors as uint8 rows
+// scaled by 512 (RootSIFT by default), so that they are interchangeable with the
+// features COLMAP writes to its database.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "tessera/sdk.h"
+
+namespace tessera {
+namespace {
+
+constexpr int kDescriptorDimension = 128;
+
+// OpenCV 4.6 doubles the image with INTER_LINEAR before the first octave, which puts
+// upsampled pixel j at original position j / 2 - 0.25 while SIFT reports j / 2: every
+// keypoint is 0.25 px too far right and down (opencv/opencv#23123; OpenCV 4.8 adds
+// `enable_precise_upscale` for this). Measured on symmetric blobs: 0.24 to 0.29 px.
+constexpr double kOpenCvUpscaleBias = 0.25;
+
+struct SiftOptions {
+  // Keep at most this many keypoints, the strongest by DoG response.
+  int max_num_features = 8192;
+  // Downscale (area averaging) so that the longer side is at most this many pixels.
+  int max_image_size = 3200;
+  // OpenCV's contrast threshold; 0.02 equals COLMAP's peak threshold of 0.02 / 3.
+  double contrast_threshold = 0.02;
+  // Largest ratio of principal curvatures of a kept DoG extremum (COLMAP: 10).
+  double edge_threshold = 10;
+  // DoG layers per octave (COLMAP's octave_resolution).
+  int num_octave_layers = 3;
+  // Blur of the first octave's base image.
+  double sigma = 1.6;
+  // RootSIFT descriptors (L1-normalise, then square root), as COLMAP's default.
+  bool root_sift = true;
+};
+
+// The working copy of an image and how its pixels relate to the full-resolution one.
+struct ScaledImage {
+  cv::Mat image;
+  double scale_x = 1;  // full-resolution pixels per working pixel, horizontally
+  double scale_y = 1;  // and vertically
+};
+
+ScaledImage ScaleToMaxSize(const ImageView& view, int max_image_size) {
+  if (view.data == nullptr || view.width <= 0 || view.height <= 0 ||
+      view.stride < static_cast<size_t>(view.width)) {
+    throw InputError("sift: cannot detect features in an empty or malformed image view (" +
+                     std::to_string(view.width) + "x" + std::to_string(view.height) + ")");
+  }
+  // The view is only read: OpenCV's Mat has no const-data constructor.
+  const cv::Mat full(view.height, view.width, CV_8UC1, const_cast<uint8_t*>(view.data),
+                     view.stride);
+  ScaledImage scaled;
+  const int long_side = std::max(view.width, view.height);
+  if (long_side <= max_image_size) {
+    scaled.image = full;
+    return scaled;
+  }
+  const double factor = static_cast<double>(max_image_size) / long_side;
+  const int width = std::max(1, static_cast<int>(std::lround(view.width * factor)));
+  const int height = std::max(1, static_cast<int>(std::lround(view.height * factor)));
+  cv::resize(full, scaled.image, cv::Size(width, height), 0, 0, cv::INTER_AREA);
+  scaled.scale_x = static_cast<double>(view.width) / width;
+  scaled.scale_y = static_cast<double>(view.height) / height;
+  return scaled;
+}
+
+// Indices of at most `max_count` keypoints, strongest first. Ties are broken by
+// position, size and angle so that the choice does not depend on OpenCV's order.
+std::vector<int> StrongestFirst(const std::vector<cv::KeyPoint>& keypoints, int max_count) {
+  std::vector<int> order(keypoints.size());
+  std::iota(order.begin(), order.end(), 0);
+  auto key = [&](int i) {
+    const cv::KeyPoint& kp = keypoints[i];
+    return std::make_tuple(-kp.response, kp.pt.y, kp.pt.x, kp.size, kp.angle, kp.octave, i);
+  };
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
+  if (order.size() > static_cast<size_t>(max_count)) order.resize(max_count);
+  return order;
+}
+
+class SiftDetector : public Detector {
+ public:
+  explicit SiftDetector(const nlohmann::json& options) {
+    OptionReader reader(options);
+    options_.max_num_features =
+        reader.Get<int>("max_num_features", options_.max_num_features, 1, 1000000);
+    options_.max_image_size =
+        reader.Get<int>("max_image_size", options_.max_image_size, 16, 100000);
+    options_.contrast_threshold =
+        reader.Get<double>("contrast_threshold", options_.contrast_threshold, 0.0, 1.0);
+    options_.edge_threshold =
+        reader.Get<double>("edge_threshold", options_.edge_threshold, 1.0, 1000.0);
+    options_.num_octave_layers =
+        reader.Get<int>("num_octave_layers", options_.num_octave_layers, 1, 10);
+    options_.sigma = reader.Get<double>("sigma", options_.sigma, 0.5, 10.0);
+    options_.root_sift = reader.GetBool("root_sift", options_.root_sift);
+    reader.Finish();
+    effective_options_ = reader.Effective();
+  }
+
+  FeatureSet Detect(const ImageView& view) const override {
+    const ScaledImage scaled = ScaleToMaxSize(view, options_.max_image_size);
+
+    // A detector per call: sharing one cv::SIFT across threads is not documented as safe.
+    const cv::Ptr<cv::SIFT> sift =
+        cv::SIFT::create(options_.max_num_features, options_.num_octave_layers,
+                         options_.contrast_threshold, options_.edge_threshold, options_.sigma);
+    std::vector<cv::KeyPoint> cv_keypoints;
+    cv::Mat cv_descriptors;
+    sift->detectAndCompute(scaled.image, cv::noArray(), cv_keypoints, cv_descriptors);
+    // OpenCV keeps every keypoint whose response ties with the last one kept.
+    const std::vector<int> order = StrongestFirst(cv_keypoints, options_.max_num_features);
+
+    FeatureSet features;
+    features.keypoints.reserve(order.size());
+    features.descriptors.metric = DescriptorMetric::kL2;
+    features.descriptors.data.resize(static_cast<Eigen::Index>(order.size()), kDescriptorDimension);
+    const double mean_scale = (scaled.scale_x + scaled.scale_y) / 2;
+    Eigen::RowVectorXf descriptor(kDescriptorDimension);
+    for (size_t row = 0; row < order.size(); ++row) {
+      const cv::KeyPoint& kp = cv_keypoints[order[row]];
+      // OpenCV puts pixel centres at integers, COLMAP at half-integers.
+      const double x = kp.pt.x - kOpenCvUpscaleBias + 0.5;
+      const double y = kp.pt.y - kOpenCvUpscaleBias + 0.5;
+      features.keypoints.emplace_back(
+          static_cast<float>(x * scaled.scale_x), static_cast<float>(y * scaled.scale_y),
+          static_cast<float>(kp.size / 2 * mean_scale), static_cast<float>(kp.angle * CV_PI / 180));
+      const float* values = cv_descriptors.ptr<float>(order[row]);
+      for (int col = 0; col < kDescriptorDimension; ++col) descriptor(col) = values[col];
+      features.descriptors.data.row(static_cast<Eigen::Index>(row)) = ToUnsignedByte(descriptor);
+    }
+    return features;
+  }
+
+  DescriptorMetric Metric() const override { return DescriptorMetric::kL2; }
+
+ private:
+  // COLMAP's conversion: normalise (L2, or L1 then square root for RootSIFT), then
+  // 512 times the value, rounded and clamped to [0, 255].
+  Eigen::Matrix<uint8_t, 1, kDescriptorDimension> ToUnsignedByte(
+      Eigen::RowVectorXf descriptor) const {
+    if (options_.root_sift) {
+      const float l1 = descriptor.lpNorm<1>();
+      if (l1 > 0) descriptor = (descriptor / l1).cwiseSqrt();
+    } else {
+      const float l2 = descriptor.norm();
+      if (l2 > 0) descriptor /= l2;
+    }
+    Eigen::Matrix<uint8_t, 1, kDescriptorDimension> bytes;
+    for (int col = 0; col < kDescriptorDimension; ++col) {
+      const float value = std::round(512.0f * descriptor(col));
+      bytes(col) = static_cast<uint8_t>(std::clamp(value, 0.0f, 255.0f));
+    }
+    return bytes;
+  }
+
+  SiftOptions options_;
+};
+
+}  // namespace
+}  // namespace tessera
+
+TESSERA_PLUGIN(detector, tessera::SiftDetector, "sift", "1.0.0",
+               "SIFT keypoints and (Root)SIFT descriptors from OpenCV, in COLMAP's conventions")

@@ -1,0 +1,261 @@
+// Approximate nearest neighbours with FLANN, filtered by Lowe's ratio test, an optional
+// absolute distance threshold and a mutual-best (cross) check, like brute_force.
+//
+// Determinism: the FLANN packaged by Debian 12 (1.9.2) shuffles with std::random_device
+// when it builds kd-trees (KDTreeIndex) and LSH tables, so no seed can make those
+// repeatable. The default indexes are therefore FLANN's two clustering trees, whose only
+// randomness is std::rand(): a hierarchical k-means tree for l2 descriptors and a
+// hierarchical clustering tree for binary ones (Muja and Lowe, 2012). They are built
+// after srand(random_seed) under a process-wide mutex, so the same descriptors give the
+// same matches on every run and in every thread. kd-trees and LSH stay available
+// (l2_index = "kdtree", hamming_index = "lsh") for speed, without that guarantee.
+
+#include <cmath>
+#include <flann/flann.hpp>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "tessera/sdk.h"
+
+namespace tessera {
+
+struct FlannMatchOptions {
+  // Lowe's ratio test: keep a match if best < ratio * second-best distance (not squared).
+  double ratio = 0.8;
+  // Keep a match a -> b only if a is also b's (approximate) nearest neighbour.
+  bool cross_check = true;
+  // Largest distance of a kept match: Euclidean in uint8 descriptor units for l2, bits for
+  // hamming. 0 turns the threshold off.
+  double max_distance = 0;
+  // Index for l2 descriptors: "kmeans" (deterministic) or "kdtree" (randomized kd-trees).
+  std::string l2_index = "kmeans";
+  // Index for binary descriptors: "hierarchical" (deterministic) or "lsh".
+  std::string hamming_index = "hierarchical";
+  // Leaves (descriptors) examined per query by kmeans, kdtree and hierarchical: more is
+  // slower and closer to exact.
+  int checks = 128;
+  // Children per node of the kmeans and hierarchical trees.
+  int branching = 32;
+  // Lloyd iterations per node of the kmeans tree.
+  int kmeans_iterations = 5;
+  // Number of trees of kdtree and hierarchical, searched together.
+  int trees = 4;
+  // Most descriptors in a leaf of the hierarchical tree.
+  int leaf_max_size = 100;
+  // LSH: number of hash tables, bits per key, and how far (in key bits) neighbouring
+  // buckets are probed.
+  int lsh_tables = 6;
+  int lsh_key_size = 12;
+  int lsh_multi_probe_level = 1;
+  // Seed of std::rand() while kmeans and hierarchical indexes are built.
+  int random_seed = 1;
+};
+
+namespace {
+
+// Nearest neighbours of each query row among the indexed rows; -1 where there is none.
+struct Neighbors {
+  std::vector<int> best;
+  std::vector<int> second;
+  std::vector<float> best_distance;
+  std::vector<float> second_distance;
+};
+
+// std::rand() is process-wide: builds that must replay one seeded sequence take turns.
+std::mutex& SeededBuildMutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+flann::Matrix<unsigned char> WrapDescriptors(const FeatureDescriptors& descriptors) {
+  // FLANN wants a mutable pointer but only reads through it.
+  return flann::Matrix<unsigned char>(const_cast<uint8_t*>(descriptors.data.data()),
+                                      static_cast<size_t>(descriptors.size()),
+                                      static_cast<size_t>(descriptors.dimension()));
+}
+
+// The concrete index type is used (not NNIndex) because LshIndex hides knnSearch with a
+// version that keeps a descriptor found in several tables from filling both slots.
+template <typename Index>
+Neighbors Search(const Index& index, const FeatureDescriptors& query, size_t k,
+                 const flann::SearchParams& params, bool squared_distances) {
+  std::vector<std::vector<size_t>> indices;
+  std::vector<std::vector<typename Index::DistanceType>> distances;
+  index.knnSearch(WrapDescriptors(query), indices, distances, k, params);
+  const size_t num_queries = static_cast<size_t>(query.size());
+  Neighbors neighbors;
+  neighbors.best.assign(num_queries, -1);
+  neighbors.second.assign(num_queries, -1);
+  neighbors.best_distance.assign(num_queries, 0);
+  neighbors.second_distance.assign(num_queries, 0);
+  const auto to_distance = [squared_distances](double value) {
+    return static_cast<float>(squared_distances ? std::sqrt(value) : value);
+  };
+  for (size_t i = 0; i < num_queries && i < indices.size(); ++i) {
+    if (!indices[i].empty()) {
+      neighbors.best[i] = static_cast<int>(indices[i][0]);
+      neighbors.best_distance[i] = to_distance(distances[i][0]);
+    }
+    if (indices[i].size() > 1) {
+      neighbors.second[i] = static_cast<int>(indices[i][1]);
+      neighbors.second_distance[i] = to_distance(distances[i][1]);
+    }
+  }
+  return neighbors;
+}
+
+}  // namespace
+
+class FlannMatcher : public Matcher {
+ public:
+  explicit FlannMatcher(const nlohmann::json& options) {
+    OptionReader reader(options);
+    options_.ratio = reader.Get<double>("ratio", options_.ratio);
+    if (!(options_.ratio > 0 && options_.ratio <= 1)) {
+      throw OptionError(reader.KeyPath("ratio"), "= " + nlohmann::json(options_.ratio).dump() +
+                                                     " is out of range; must be in (0, 1]");
+    }
+    options_.cross_check = reader.GetBool("cross_check", options_.cross_check);
+    options_.max_distance = reader.Get<double>("max_distance", options_.max_distance, 0.0, 1e9);
+    options_.l2_index = reader.GetString("l2_index", options_.l2_index, {"kmeans", "kdtree"});
+    options_.hamming_index =
+        reader.GetString("hamming_index", options_.hamming_index, {"hierarchical", "lsh"});
+    options_.checks = reader.Get<int>("checks", options_.checks, 1, 100000000);
+    options_.branching = reader.Get<int>("branching", options_.branching, 2, 1024);
+    options_.kmeans_iterations =
+        reader.Get<int>("kmeans_iterations", options_.kmeans_iterations, 1, 100);
+    options_.trees = reader.Get<int>("trees", options_.trees, 1, 64);
+    options_.leaf_max_size = reader.Get<int>("leaf_max_size", options_.leaf_max_size, 1, 100000);
+    options_.lsh_tables = reader.Get<int>("lsh_tables", options_.lsh_tables, 1, 64);
+    options_.lsh_key_size = reader.Get<int>("lsh_key_size", options_.lsh_key_size, 1, 32);
+    options_.lsh_multi_probe_level =
+        reader.Get<int>("lsh_multi_probe_level", options_.lsh_multi_probe_level, 0, 4);
+    options_.random_seed =
+        reader.Get<int>("random_seed", options_.random_seed, 0, std::numeric_limits<int>::max());
+    reader.Finish();
+    effective_options_ = reader.Effective();
+  }
+
+  FeatureMatches Match(const FeatureDescriptors& descriptors1,
+                       const FeatureDescriptors& descriptors2) const override {
+    // An image without features has nothing to match, whatever its declared metric.
+    if (descriptors1.size() == 0 || descriptors2.size() == 0) return {};
+    CheckCompatible(descriptors1, descriptors2);
+    // Forward: the two nearest rows of set 2 for each row of set 1. Backward (cross
+    // check): the nearest row of set 1 for each row of set 2.
+    const Neighbors forward = FindNeighbors(descriptors2, descriptors1, 2);
+    Neighbors backward;
+    if (options_.cross_check) backward = FindNeighbors(descriptors1, descriptors2, 1);
+    return SelectMatches(forward, backward, descriptors2.size());
+  }
+
+ private:
+  void CheckCompatible(const FeatureDescriptors& descriptors1,
+                       const FeatureDescriptors& descriptors2) const {
+    if (descriptors1.metric != descriptors2.metric) {
+      throw InputError(std::string("Cannot match ") + DescriptorMetricName(descriptors1.metric) +
+                       " descriptors against " + DescriptorMetricName(descriptors2.metric) +
+                       " descriptors: both images must be described by the same detector.");
+    }
+    if (descriptors1.dimension() != descriptors2.dimension()) {
+      throw InputError("Cannot match descriptors of " + std::to_string(descriptors1.dimension()) +
+                       " bytes against descriptors of " + std::to_string(descriptors2.dimension()) +
+                       " bytes: both images must be described by the same detector.");
+    }
+    if (descriptors1.metric == DescriptorMetric::kHamming && options_.hamming_index == "lsh" &&
+        options_.lsh_key_size > 8 * descriptors1.dimension()) {
+      throw InputError("The flann matcher's lsh_key_size of " +
+                       std::to_string(options_.lsh_key_size) + " bits exceeds the " +
+                       std::to_string(8 * descriptors1.dimension()) +
+                       " bits of the binary descriptors.");
+    }
+  }
+
+  // Builds an index over `data`; seeded builds replay one std::rand() sequence.
+  template <typename Index>
+  std::unique_ptr<Index> Build(const FeatureDescriptors& data, const flann::IndexParams& params,
+                               bool seeded) const {
+    auto index = std::make_unique<Index>(WrapDescriptors(data), params);
+    if (seeded) {
+      std::lock_guard<std::mutex> lock(SeededBuildMutex());
+      flann::seed_random(static_cast<unsigned int>(options_.random_seed));
+      index->buildIndex();
+    } else {
+      index->buildIndex();
+    }
+    return index;
+  }
+
+  Neighbors FindNeighbors(const FeatureDescriptors& data, const FeatureDescriptors& query,
+                          size_t k) const {
+    k = std::min(k, static_cast<size_t>(data.size()));
+    flann::SearchParams search_params(options_.checks);
+    search_params.cores = 1;  // the host parallelises over pairs
+    if (data.metric == DescriptorMetric::kL2) {
+      using Distance = flann::L2<unsigned char>;
+      if (options_.l2_index == "kmeans") {
+        const auto index = Build<flann::KMeansIndex<Distance>>(
+            data,
+            flann::KMeansIndexParams(options_.branching, options_.kmeans_iterations,
+                                     flann::FLANN_CENTERS_KMEANSPP),
+            /*seeded=*/true);
+        return Search(*index, query, k, search_params, /*squared_distances=*/true);
+      }
+      const auto index = Build<flann::KDTreeIndex<Distance>>(
+          data, flann::KDTreeIndexParams(options_.trees), /*seeded=*/false);
+      return Search(*index, query, k, search_params, /*squared_distances=*/true);
+    }
+    using Distance = flann::Hamming<unsigned char>;
+    if (options_.hamming_index == "hierarchical") {
+      const auto index = Build<flann::HierarchicalClusteringIndex<Distance>>(
+          data,
+          flann::HierarchicalClusteringIndexParams(options_.branching,
+                                                   flann::FLANN_CENTERS_KMEANSPP, options_.trees,
+                                                   options_.leaf_max_size),
+          /*seeded=*/true);
+      return Search(*index, query, k, search_params, /*squared_distances=*/false);
+    }
+    const auto index = Build<flann::LshIndex<Distance>>(
+        data,
+        flann::LshIndexParams(options_.lsh_tables, options_.lsh_key_size,
+                              options_.lsh_multi_probe_level),
+        /*seeded=*/false);
+    return Search(*index, query, k, search_params, /*squared_distances=*/false);
+  }
+
+  // a -> b matches that pass the ratio test, the distance threshold and, when asked,
+  // the cross check; in ascending order of the first index.
+  FeatureMatches SelectMatches(const Neighbors& forward, const Neighbors& backward,
+                               Eigen::Index num_train) const {
+    FeatureMatches matches;
+    for (size_t i = 0; i < forward.best.size(); ++i) {
+      const int j = forward.best[i];
+      if (j < 0) continue;
+      if (options_.max_distance > 0 && forward.best_distance[i] > options_.max_distance) continue;
+      if (forward.second[i] >= 0) {
+        // Strict, so that two equally close neighbours (ambiguous) always fail.
+        if (!(forward.best_distance[i] < options_.ratio * forward.second_distance[i])) continue;
+      } else if (num_train > 1) {
+        // LSH saw no second candidate although there are others: the ratio test cannot
+        // be evaluated, and a lone candidate in a sparse bucket is often a wrong one.
+        continue;
+      }
+      // With a single row in set 2 there is no second neighbour and the ratio test passes.
+      if (options_.cross_check && backward.best[j] != static_cast<int>(i)) continue;
+      FeatureMatch match;
+      match.point2D_idx1 = static_cast<point2D_t>(i);
+      match.point2D_idx2 = static_cast<point2D_t>(j);
+      matches.push_back(match);
+    }
+    return matches;
+  }
+
+  FlannMatchOptions options_;
+};
+
+}  // namespace tessera
+
+TESSERA_PLUGIN(matcher, tessera::FlannMatcher, "flann", "1.0.0",
+               "Approximate nearest neighbours (FLANN k-means / hierarchical clustering trees) "
+               "with ratio test and cross check")

@@ -1,0 +1,324 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+#include <set>
+#include <thread>
+
+#include "test_support.h"
+
+namespace tessera {
+namespace {
+
+// Two descriptor sets with known correspondences: set 2 holds a perturbed copy of every
+// row of set 1, shuffled, plus unrelated distractor rows.
+struct SyntheticPair {
+  FeatureDescriptors descriptors1;
+  FeatureDescriptors descriptors2;
+  std::vector<int> truth;  // truth[i]: the row of set 2 that copies row i of set 1
+};
+
+SyntheticPair MakeL2Pair(int num_points, int num_distractors, double noise_sigma, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> uniform(0, 255);
+  std::normal_distribution<double> noise(0, noise_sigma);
+  const int dim = 128;
+  SyntheticPair pair;
+  pair.descriptors1.data.resize(num_points, dim);
+  pair.descriptors2.data.resize(num_points + num_distractors, dim);
+  std::vector<int> rows(num_points + num_distractors);
+  std::iota(rows.begin(), rows.end(), 0);
+  std::shuffle(rows.begin(), rows.end(), rng);
+  for (int i = 0; i < num_points; ++i) {
+    for (int d = 0; d < dim; ++d) pair.descriptors1.data(i, d) = static_cast<uint8_t>(uniform(rng));
+  }
+  for (int k = 0; k < num_points + num_distractors; ++k) {
+    for (int d = 0; d < dim; ++d) {
+      const int value =
+          k < num_points ? pair.descriptors1.data(k, d) + std::lround(noise(rng)) : uniform(rng);
+      pair.descriptors2.data(rows[k], d) = static_cast<uint8_t>(std::clamp(value, 0, 255));
+    }
+  }
+  pair.truth.assign(rows.begin(), rows.begin() + num_points);
+  return pair;
+}
+
+SyntheticPair MakeHammingPair(int num_points, int num_distractors, int num_flips, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<int> uniform(0, 255);
+  const int bytes = 32;
+  SyntheticPair pair;
+  pair.descriptors1.metric = pair.descriptors2.metric = DescriptorMetric::kHamming;
+  pair.descriptors1.data.resize(num_points, bytes);
+  pair.descriptors2.data.resize(num_points + num_distractors, bytes);
+  std::vector<int> rows(num_points + num_distractors);
+  std::iota(rows.begin(), rows.end(), 0);
+  std::shuffle(rows.begin(), rows.end(), rng);
+  for (int i = 0; i < num_points; ++i) {
+    for (int b = 0; b < bytes; ++b)
+      pair.descriptors1.data(i, b) = static_cast<uint8_t>(uniform(rng));
+  }
+  std::vector<int> bits(bytes * 8);
+  std::iota(bits.begin(), bits.end(), 0);
+  for (int k = 0; k < num_points + num_distractors; ++k) {
+    if (k < num_points) {
+      pair.descriptors2.data.row(rows[k]) = pair.descriptors1.data.row(k);
+      std::shuffle(bits.begin(), bits.end(), rng);  // flip exactly num_flips distinct bits
+      for (int f = 0; f < num_flips; ++f) {
+        pair.descriptors2.data(rows[k], bits[f] / 8) ^= static_cast<uint8_t>(1 << (bits[f] % 8));
+      }
+    } else {
+      for (int b = 0; b < bytes; ++b) {
+        pair.descriptors2.data(rows[k], b) = static_cast<uint8_t>(uniform(rng));
+      }
+    }
+  }
+  pair.truth.assign(rows.begin(), rows.begin() + num_points);
+  return pair;
+}
+
+struct Quality {
+  double recall = 0;
+  double precision = 0;
+};
+
+Quality Evaluate(const FeatureMatches& matches, const std::vector<int>& truth) {
+  int correct = 0;
+  for (const FeatureMatch& match : matches) {
+    correct += truth.at(match.point2D_idx1) == static_cast<int>(match.point2D_idx2);
+  }
+  Quality quality;
+  quality.recall = static_cast<double>(correct) / truth.size();
+  quality.precision = matches.empty() ? 0 : static_cast<double>(correct) / matches.size();
+  return quality;
+}
+
+FeatureDescriptors L2Rows(const std::vector<std::vector<int>>& rows) {
+  FeatureDescriptors descriptors;
+  descriptors.data.resize(rows.size(), 128);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    for (int d = 0; d < 128; ++d) descriptors.data(i, d) = static_cast<uint8_t>(rows[i][d]);
+  }
+  return descriptors;
+}
+
+// A 128-d row of constant value with `delta` added at dimension `at`.
+std::vector<int> Row(int value, int at = 0, int delta = 0) {
+  std::vector<int> row(128, value);
+  row[at] += delta;
+  return row;
+}
+
+FeatureMatches MatchesOf(std::vector<std::pair<int, int>> pairs) {
+  FeatureMatches matches;
+  for (const auto& [i, j] : pairs) {
+    FeatureMatch match;
+    match.point2D_idx1 = i;
+    match.point2D_idx2 = j;
+    matches.push_back(match);
+  }
+  return matches;
+}
+
+PluginInstance<Matcher> Load(const nlohmann::json& options = nlohmann::json::object()) {
+  return testing::LoadBundledPlugin<Matcher>("matcher", "flann", options, "pipeline.matcher");
+}
+
+// |A and B| / |A or B|: 1 when two matchers return the same matches.
+double Agreement(const FeatureMatches& a, const FeatureMatches& b) {
+  std::set<std::pair<point2D_t, point2D_t>> set_a, set_b, both;
+  for (const FeatureMatch& m : a) set_a.emplace(m.point2D_idx1, m.point2D_idx2);
+  for (const FeatureMatch& m : b) set_b.emplace(m.point2D_idx1, m.point2D_idx2);
+  std::set_intersection(set_a.begin(), set_a.end(), set_b.begin(), set_b.end(),
+                        std::inserter(both, both.begin()));
+  const size_t either = set_a.size() + set_b.size() - both.size();
+  return either == 0 ? 1.0 : static_cast<double>(both.size()) / either;
+}
+
+TEST(FlannMatcher, FindsTheTrueMatchesOfSiftLikeDescriptors) {
+  const SyntheticPair pair = MakeL2Pair(500, 200, 10, 1);
+  for (const char* index : {"kmeans", "kdtree"}) {
+    const Quality quality = Evaluate(
+        Load({{"l2_index", index}})->Match(pair.descriptors1, pair.descriptors2), pair.truth);
+    EXPECT_GE(quality.recall, 0.90) << index;
+    EXPECT_GE(quality.precision, 0.99) << index;
+  }
+}
+
+TEST(FlannMatcher, FindsTheTrueMatchesOfBinaryDescriptors) {
+  const SyntheticPair pair = MakeHammingPair(500, 200, 20, 2);
+  for (const char* index : {"hierarchical", "lsh"}) {
+    const Quality quality = Evaluate(
+        Load({{"hamming_index", index}})->Match(pair.descriptors1, pair.descriptors2), pair.truth);
+    EXPECT_GE(quality.recall, 0.90) << index;
+    EXPECT_GE(quality.precision, 0.99) << index;
+  }
+}
+
+TEST(FlannMatcher, AgreesWithBruteForce) {
+  const auto brute_force =
+      testing::LoadBundledPlugin<Matcher>("matcher", "brute_force", nlohmann::json::object());
+  const auto flann = Load();
+  const SyntheticPair l2 = MakeL2Pair(500, 200, 10, 3);
+  EXPECT_GE(Agreement(flann->Match(l2.descriptors1, l2.descriptors2),
+                      brute_force->Match(l2.descriptors1, l2.descriptors2)),
+            0.95);
+  const SyntheticPair binary = MakeHammingPair(500, 200, 20, 4);
+  EXPECT_GE(Agreement(flann->Match(binary.descriptors1, binary.descriptors2),
+                      brute_force->Match(binary.descriptors1, binary.descriptors2)),
+            0.95);
+}
+
+TEST(FlannMatcher, RatioTestDropsAmbiguousMatches) {
+  // Row 0 of set 1 lies exactly between rows 0 and 1 of set 2 (distance 5 to each);
+  // row 1 has its neighbours at 10 and 20 (ratio 0.5).
+  const FeatureDescriptors descriptors1 = L2Rows({Row(100), Row(30)});
+  const FeatureDescriptors descriptors2 =
+      L2Rows({Row(100, 0, 5), Row(100, 0, -5), Row(30, 1, 10), Row(30, 1, -20)});
+  EXPECT_EQ(Load()->Match(descriptors1, descriptors2), MatchesOf({{1, 2}}));
+  EXPECT_EQ(Load({{"ratio", 0.51}})->Match(descriptors1, descriptors2), MatchesOf({{1, 2}}));
+  EXPECT_TRUE(Load({{"ratio", 0.49}})->Match(descriptors1, descriptors2).empty());
+  EXPECT_EQ(Load({{"ratio", 1.0}})->Match(descriptors1, descriptors2), MatchesOf({{1, 2}}));
+}
+
+TEST(FlannMatcher, CrossCheckDropsNonMutualMatches) {
+  const FeatureDescriptors descriptors1 = L2Rows({Row(100, 0, 3), Row(100, 0, 10)});
+  const FeatureDescriptors descriptors2 = L2Rows({Row(100), Row(200)});
+  EXPECT_EQ(Load()->Match(descriptors1, descriptors2), MatchesOf({{0, 0}}));
+  EXPECT_EQ(Load({{"cross_check", false}})->Match(descriptors1, descriptors2),
+            MatchesOf({{0, 0}, {1, 0}}));
+}
+
+TEST(FlannMatcher, MaxDistanceIsInDescriptorUnits) {
+  const FeatureDescriptors descriptors1 = L2Rows({Row(100), Row(30)});
+  const FeatureDescriptors descriptors2 = L2Rows({Row(100, 0, 30), Row(30, 5, 3)});
+  EXPECT_EQ(Load({{"max_distance", 31}})->Match(descriptors1, descriptors2),
+            MatchesOf({{0, 0}, {1, 1}}));
+  EXPECT_EQ(Load({{"max_distance", 29}})->Match(descriptors1, descriptors2), MatchesOf({{1, 1}}));
+  const SyntheticPair binary = MakeHammingPair(300, 0, 12, 5);
+  const FeatureMatches all = Load()->Match(binary.descriptors1, binary.descriptors2);
+  EXPECT_GE(all.size(), 270u);
+  EXPECT_TRUE(
+      Load({{"max_distance", 11}})->Match(binary.descriptors1, binary.descriptors2).empty());
+  EXPECT_EQ(Load({{"max_distance", 12}})->Match(binary.descriptors1, binary.descriptors2), all);
+}
+
+TEST(FlannMatcher, SmallAndEmptySets) {
+  const auto matcher = Load();
+  EXPECT_EQ(matcher->Match(L2Rows({Row(10), Row(200)}), L2Rows({Row(12)})), MatchesOf({{0, 0}}));
+  EXPECT_EQ(matcher->Match(L2Rows({Row(12)}), L2Rows({Row(10), Row(200)})), MatchesOf({{0, 0}}));
+  EXPECT_TRUE(matcher->Match(L2Rows({}), L2Rows({Row(1), Row(2)})).empty());
+  EXPECT_TRUE(matcher->Match(L2Rows({Row(1)}), L2Rows({})).empty());
+  FeatureDescriptors empty;
+  empty.metric = DescriptorMetric::kHamming;
+  EXPECT_TRUE(matcher->Match(empty, L2Rows({Row(1)})).empty());
+  const SyntheticPair single = MakeHammingPair(1, 0, 3, 6);
+  EXPECT_EQ(matcher->Match(single.descriptors1, single.descriptors2), MatchesOf({{0, 0}}));
+}
+
+TEST(FlannMatcher, RejectsIncompatibleDescriptors) {
+  const auto matcher = Load();
+  FeatureDescriptors binary;
+  binary.metric = DescriptorMetric::kHamming;
+  binary.data.setZero(3, 32);
+  try {
+    matcher->Match(binary, L2Rows({Row(1)}));
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(),
+                 "Cannot match hamming descriptors against l2 descriptors: both images must be "
+                 "described by the same detector.");
+  }
+  FeatureDescriptors short_rows;
+  short_rows.data.setZero(2, 64);
+  try {
+    matcher->Match(L2Rows({Row(1)}), short_rows);
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(),
+                 "Cannot match descriptors of 128 bytes against descriptors of 64 bytes: both "
+                 "images must be described by the same detector.");
+  }
+  FeatureDescriptors tiny;
+  tiny.metric = DescriptorMetric::kHamming;
+  tiny.data.setZero(2, 1);
+  try {
+    Load({{"hamming_index", "lsh"}})->Match(tiny, tiny);
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(),
+                 "The flann matcher's lsh_key_size of 12 bits exceeds the 8 bits of the binary "
+                 "descriptors.");
+  }
+}
+
+TEST(FlannMatcher, DeterministicAcrossCallsInstancesAndThreads) {
+  std::vector<SyntheticPair> pairs;
+  for (uint32_t seed = 20; seed < 24; ++seed) {
+    // Heavier noise and more distractors than above, so that approximate search has
+    // choices to make and a different tree would change some results.
+    pairs.push_back(seed % 2 ? MakeHammingPair(400, 400, 60, seed)
+                             : MakeL2Pair(400, 400, 40, seed));
+  }
+  const auto matcher = Load({{"cross_check", false}, {"ratio", 1.0}, {"checks", 16}});
+  std::vector<FeatureMatches> serial;
+  for (const SyntheticPair& pair : pairs) {
+    serial.push_back(matcher->Match(pair.descriptors1, pair.descriptors2));
+    EXPECT_EQ(matcher->Match(pair.descriptors1, pair.descriptors2), serial.back());
+  }
+  const auto other = Load({{"cross_check", false}, {"ratio", 1.0}, {"checks", 16}});
+  EXPECT_EQ(other->Match(pairs[0].descriptors1, pairs[0].descriptors2), serial[0]);
+
+  std::vector<FeatureMatches> parallel(pairs.size());
+  std::vector<std::thread> threads;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    threads.emplace_back([&, k] {
+      for (int repeat = 0; repeat < 3; ++repeat) {
+        parallel[k] = matcher->Match(pairs[k].descriptors1, pairs[k].descriptors2);
+      }
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  EXPECT_EQ(parallel, serial);
+
+  // A different seed builds different trees: the check above is not vacuous.
+  const auto reseeded =
+      Load({{"cross_check", false}, {"ratio", 1.0}, {"checks", 16}, {"random_seed", 7}});
+  bool any_difference = false;
+  for (size_t k = 0; k < pairs.size(); ++k) {
+    any_difference |= reseeded->Match(pairs[k].descriptors1, pairs[k].descriptors2) != serial[k];
+  }
+  EXPECT_TRUE(any_difference);
+}
+
+TEST(FlannMatcher, ValidatesOptions) {
+  try {
+    Load({{"l2_index", "kd_tree"}});
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("pipeline.matcher.options.l2_index: 'kd_tree' is not one of 'kmeans', "
+                        "'kdtree'; did you mean 'kdtree'?"),
+              std::string::npos)
+        << error.what();
+  }
+  try {
+    Load({{"ratio", -0.5}});
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_NE(
+        std::string(error.what())
+            .find("pipeline.matcher.options.ratio: = -0.5 is out of range; must be in (0, 1]"),
+        std::string::npos)
+        << error.what();
+  }
+  const nlohmann::json effective = Load()->EffectiveOptions();
+  EXPECT_EQ(effective.size(), 14u);
+  EXPECT_EQ(effective.at("l2_index"), "kmeans");
+  EXPECT_EQ(effective.at("hamming_index"), "hierarchical");
+  EXPECT_EQ(effective.at("checks"), 128);
+}
+
+}  // namespace
+}  // namespace tessera

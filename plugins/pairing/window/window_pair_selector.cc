@@ -1,0 +1,54 @@
+// Each image with its `window` neighbours on each side in capture order: pairs (i, j)
+// with 0 < j - i <= window, about `window` pairs per image. With `loop` the order is a
+// circle (a 360-degree capture), so the last images are also paired with the first.
+
+#include <algorithm>
+
+#include "tessera/sdk.h"
+
+namespace tessera {
+
+struct WindowPairOptions {
+  // Neighbours on each side that each image is paired with.
+  int window = 5;
+  // Treat the capture order as circular: also pair (i, j) within `window` steps across the end.
+  bool loop = false;
+};
+
+class WindowPairSelector : public PairSelector {
+ public:
+  explicit WindowPairSelector(const nlohmann::json& options) {
+    OptionReader reader(options);
+    options_.window = reader.Get<int>("window", options_.window, 1, 1000000);
+    options_.loop = reader.GetBool("loop", options_.loop);
+    reader.Finish();
+    effective_options_ = reader.Effective();
+  }
+
+  std::vector<ImageIndexPair> SelectPairs(
+      const std::vector<std::string>& image_names) const override {
+    const size_t n = image_names.size();
+    const size_t window = static_cast<size_t>(options_.window);
+    std::vector<ImageIndexPair> pairs;
+    pairs.reserve(n * std::min(n, (options_.loop ? 2 : 1) * window));
+    for (size_t i = 0; i < n; ++i) {
+      const size_t forward_end = std::min(n, i + window + 1);
+      for (size_t j = i + 1; j < forward_end; ++j) pairs.emplace_back(i, j);
+      if (options_.loop && n > window) {
+        // Across the end the circular distance of (i, j) is n - (j - i) <= window, that is
+        // j >= i + n - window. (When n <= window the forward run already has every pair.)
+        for (size_t j = std::max(forward_end, i + n - window); j < n; ++j) pairs.emplace_back(i, j);
+      }
+    }
+    return pairs;
+  }
+
+ private:
+  WindowPairOptions options_;
+};
+
+}  // namespace tessera
+
+TESSERA_PLUGIN(pair_selector, tessera::WindowPairSelector, "window", "1.0.0",
+               "Each image with its `window` neighbours on each side in capture order, optionally "
+               "circular")

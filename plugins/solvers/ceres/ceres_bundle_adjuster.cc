@@ -1,0 +1,393 @@
+// Bundle adjustment with Ceres: refines poses, intrinsics and 3D points of a
+// reconstruction by minimizing the robustified reprojection error in pixels.
+
+#include <ceres/ceres.h>
+#include <ceres/rotation.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cost_functions.h"
+#include "tessera/sdk.h"
+
+namespace tessera {
+namespace {
+
+// COLMAP's thresholds for choosing the linear solver by the number of images.
+constexpr size_t kMaxNumImagesDenseSolver = 50;
+constexpr size_t kMaxNumImagesSparseSolver = 1000;
+
+struct CeresBundleAdjusterOptions {
+  // Robust loss on each observation: "huber", "cauchy" or "trivial" (plain squares).
+  std::string loss = "huber";
+  // Residual norm in pixels where the robust loss starts to down-weight.
+  double loss_scale = 1.0;
+  // Maximum number of Levenberg-Marquardt iterations.
+  int max_num_iterations = 100;
+  // Ceres convergence tolerances (relative cost change, gradient, step size).
+  double function_tolerance = 1e-6;
+  double gradient_tolerance = 1e-10;
+  double parameter_tolerance = 1e-8;
+  // Threads for Jacobian evaluation and the linear solver; 0 means one per core.
+  int num_threads = 0;
+  // "auto", "dense_schur", "sparse_schur" or "iterative_schur".
+  std::string linear_solver = "auto";
+  // Print Ceres' per-iteration progress to stdout.
+  bool minimizer_progress = false;
+};
+
+// Pose parameter block: angle-axis rotation then translation of cam_from_world.
+using PoseBlock = std::array<double, kPoseBlockSize>;
+
+PoseBlock PoseToBlock(const Rigid3d& cam_from_world) {
+  const Eigen::Quaterniond& q = cam_from_world.rotation;
+  const double quaternion[4] = {q.w(), q.x(), q.y(), q.z()};
+  PoseBlock block;
+  ceres::QuaternionToAngleAxis(quaternion, block.data());
+  for (int i = 0; i < 3; ++i) block[kPoseTranslationOffset + i] = cam_from_world.translation(i);
+  return block;
+}
+
+Rigid3d BlockToPose(const PoseBlock& block) {
+  double quaternion[4];
+  ceres::AngleAxisToQuaternion(block.data(), quaternion);
+  return Rigid3d(
+      Eigen::Quaterniond(quaternion[0], quaternion[1], quaternion[2], quaternion[3]).normalized(),
+      Eigen::Vector3d(block[kPoseTranslationOffset], block[kPoseTranslationOffset + 1],
+                      block[kPoseTranslationOffset + 2]));
+}
+
+BundleAdjustmentSummary InvalidProblem(const std::string& message) {
+  BundleAdjustmentSummary summary;
+  summary.usable = false;
+  summary.message = message;
+  return summary;
+}
+
+// One residual of the problem.
+struct Observation {
+  point3D_t point3D_id;
+  image_t image_id;
+  Eigen::Vector2d xy;
+};
+
+// Mean reprojection error in pixels of a point over every observation whose image is
+// registered, or -1 when there is none.
+double MeanReprojectionError(const Reconstruction& reconstruction, const Point3D& point3D) {
+  double sum = 0;
+  int count = 0;
+  for (const TrackElement& element : point3D.track) {
+    const auto image_it = reconstruction.images.find(element.image_id);
+    if (image_it == reconstruction.images.end() || !image_it->second.registered) continue;
+    const Image& image = image_it->second;
+    const auto camera_it = reconstruction.cameras.find(image.camera_id);
+    if (camera_it == reconstruction.cameras.end() || !camera_it->second.IsValid() ||
+        element.point2D_idx >= image.points2D.size()) {
+      continue;
+    }
+    const Eigen::Vector2d projected =
+        camera_it->second.ImgFromCam(image.cam_from_world * point3D.xyz);
+    sum += (projected - image.points2D[element.point2D_idx].xy).norm();
+    ++count;
+  }
+  return count > 0 ? sum / count : -1;
+}
+
+}  // namespace
+
+class CeresBundleAdjuster : public BundleAdjuster {
+ public:
+  explicit CeresBundleAdjuster(const nlohmann::json& options) {
+    OptionReader reader(options);
+    options_.loss = reader.GetString("loss", options_.loss, {"huber", "cauchy", "trivial"});
+    options_.loss_scale = reader.Get<double>("loss_scale", options_.loss_scale, 1e-6, 1e6);
+    options_.max_num_iterations =
+        reader.Get<int>("max_num_iterations", options_.max_num_iterations, 0, 1000000);
+    options_.function_tolerance =
+        reader.Get<double>("function_tolerance", options_.function_tolerance, 0, 1);
+    options_.gradient_tolerance =
+        reader.Get<double>("gradient_tolerance", options_.gradient_tolerance, 0, 1);
+    options_.parameter_tolerance =
+        reader.Get<double>("parameter_tolerance", options_.parameter_tolerance, 0, 1);
+    options_.num_threads = reader.Get<int>("num_threads", options_.num_threads, 0, 1024);
+    options_.linear_solver =
+        reader.GetString("linear_solver", options_.linear_solver,
+                         {"auto", "dense_schur", "sparse_schur", "iterative_schur"});
+    options_.minimizer_progress = reader.GetBool("minimizer_progress", options_.minimizer_progress);
+    reader.Finish();
+    effective_options_ = reader.Effective();
+  }
+
+  BundleAdjustmentSummary Adjust(const BundleAdjustmentConfig& config,
+                                 Reconstruction* reconstruction) const override {
+    const auto start_time = std::chrono::steady_clock::now();
+    BundleAdjustmentSummary summary = AdjustImpl(config, reconstruction);
+    summary.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+    return summary;
+  }
+
+ private:
+  BundleAdjustmentSummary AdjustImpl(const BundleAdjustmentConfig& config,
+                                     Reconstruction* reconstruction) const {
+    if (reconstruction == nullptr) return InvalidProblem("no reconstruction was given");
+    Reconstruction& rec = *reconstruction;
+
+    // The images whose observations enter the problem.
+    std::set<image_t> image_ids;
+    if (config.images.empty()) {
+      for (const auto& [image_id, image] : rec.images) {
+        if (image.registered) image_ids.insert(image_id);
+      }
+    } else {
+      for (const image_t image_id : config.images) {
+        const auto it = rec.images.find(image_id);
+        if (it == rec.images.end()) {
+          return InvalidProblem("image " + std::to_string(image_id) +
+                                " of the configuration is not in the reconstruction");
+        }
+        if (!it->second.registered) {
+          return InvalidProblem("image " + std::to_string(image_id) +
+                                " of the configuration is not registered");
+        }
+        image_ids.insert(image_id);
+      }
+    }
+    if (image_ids.empty()) return InvalidProblem("no registered images to adjust");
+    for (const image_t image_id : image_ids) {
+      const Image& image = rec.images.at(image_id);
+      const auto camera_it = rec.cameras.find(image.camera_id);
+      if (camera_it == rec.cameras.end()) {
+        return InvalidProblem("image " + std::to_string(image_id) + " refers to camera " +
+                              std::to_string(image.camera_id) + ", which does not exist");
+      }
+      if (!camera_it->second.IsValid()) {
+        return InvalidProblem("camera " + std::to_string(image.camera_id) + " of image " +
+                              std::to_string(image_id) +
+                              " has an unknown model, a wrong parameter count or no size");
+      }
+    }
+
+    // Every observation of a 3D point in one of the chosen images, point by point so
+    // that the order of residuals (and so the result) does not depend on anything else.
+    std::vector<Observation> observations;
+    std::map<point3D_t, int> num_observations;
+    for (const auto& [point3D_id, point3D] : rec.points3D) {
+      for (const TrackElement& element : point3D.track) {
+        if (image_ids.count(element.image_id) == 0) continue;
+        const Image& image = rec.images.at(element.image_id);
+        if (element.point2D_idx >= image.points2D.size()) {
+          return InvalidProblem("the track of point " + std::to_string(point3D_id) +
+                                " refers to keypoint " + std::to_string(element.point2D_idx) +
+                                " of image " + std::to_string(element.image_id) + ", which has " +
+                                std::to_string(image.points2D.size()) + " keypoints");
+        }
+        observations.push_back(
+            {point3D_id, element.image_id, image.points2D[element.point2D_idx].xy});
+        ++num_observations[point3D_id];
+      }
+    }
+    if (observations.empty()) {
+      return InvalidProblem("none of the " + std::to_string(image_ids.size()) +
+                            " images observes a 3D point");
+    }
+
+    // Parameter blocks are copies, written back only when the solution is usable.
+    std::map<image_t, PoseBlock> poses;
+    std::map<camera_t, std::vector<double>> cameras;
+    std::map<point3D_t, Eigen::Vector3d> points;
+    ceres::Problem problem;
+    ceres::LossFunction* loss_function = CreateLossFunction();  // shared, owned by the problem
+    for (const Observation& observation : observations) {
+      const Image& image = rec.images.at(observation.image_id);
+      const Camera& camera = rec.cameras.at(image.camera_id);
+      auto pose_it = poses.find(observation.image_id);
+      if (pose_it == poses.end()) {
+        pose_it = poses.emplace(observation.image_id, PoseToBlock(image.cam_from_world)).first;
+      }
+      auto camera_it = cameras.find(image.camera_id);
+      if (camera_it == cameras.end()) {
+        camera_it = cameras.emplace(image.camera_id, camera.params).first;
+      }
+      auto point_it = points.find(observation.point3D_id);
+      if (point_it == points.end()) {
+        point_it =
+            points.emplace(observation.point3D_id, rec.points3D.at(observation.point3D_id).xyz)
+                .first;
+      }
+      problem.AddResidualBlock(CreateReprojectionErrorCostFunction(camera.model_id, observation.xy),
+                               loss_function, pose_it->second.data(), point_it->second.data(),
+                               camera_it->second.data());
+    }
+
+    // What stays constant. `num_variable` counts the blocks that can still move.
+    size_t num_variable = 0;
+    for (auto& [point3D_id, xyz] : points) {
+      // A point seen once in the problem is free along its ray: hold it instead.
+      if (config.constant_points.count(point3D_id) > 0 || num_observations.at(point3D_id) < 2) {
+        problem.SetParameterBlockConstant(xyz.data());
+      } else {
+        ++num_variable;
+      }
+    }
+    bool has_constant_pose = false;
+    for (auto& [image_id, pose] : poses) {
+      if (config.constant_poses.count(image_id) > 0) {
+        problem.SetParameterBlockConstant(pose.data());
+        has_constant_pose = true;
+      }
+    }
+    std::set<image_t> gauge_fixed_images;
+    if (config.fix_gauge && !has_constant_pose) {
+      // 7 degrees of freedom: the first pose (6) and the scale through one translation
+      // coordinate of the second, its largest so that the scale is well defined.
+      auto pose_it = poses.begin();
+      problem.SetParameterBlockConstant(pose_it->second.data());
+      gauge_fixed_images.insert(pose_it->first);
+      if (++pose_it != poses.end()) {
+        int largest = 0;
+        for (int i = 1; i < 3; ++i) {
+          if (std::abs(pose_it->second[kPoseTranslationOffset + i]) >
+              std::abs(pose_it->second[kPoseTranslationOffset + largest])) {
+            largest = i;
+          }
+        }
+        problem.SetManifold(
+            pose_it->second.data(),
+            new ceres::SubsetManifold(kPoseBlockSize, {kPoseTranslationOffset + largest}));
+      }
+    }
+    for (const auto& [image_id, pose] : poses) {
+      if (config.constant_poses.count(image_id) == 0 && gauge_fixed_images.count(image_id) == 0) {
+        ++num_variable;
+      }
+    }
+    std::set<camera_t> variable_cameras;
+    for (auto& [camera_id, params] : cameras) {
+      const Camera& camera = rec.cameras.at(camera_id);
+      std::vector<int> constant_params;
+      const auto hold = [&](bool refine, const std::vector<int>& indices) {
+        if (!refine) constant_params.insert(constant_params.end(), indices.begin(), indices.end());
+      };
+      hold(config.refine_focal_length, camera.FocalIdx());
+      hold(config.refine_principal_point, camera.PrincipalPointIdx());
+      hold(config.refine_extra_params, camera.ExtraParamsIdx());
+      if (constant_params.size() == params.size()) {
+        problem.SetParameterBlockConstant(params.data());
+      } else {
+        if (!constant_params.empty()) {
+          problem.SetManifold(params.data(), new ceres::SubsetManifold(
+                                                 static_cast<int>(params.size()), constant_params));
+        }
+        variable_cameras.insert(camera_id);
+        ++num_variable;
+      }
+    }
+    if (num_variable == 0) {
+      return InvalidProblem("nothing to optimise: every pose, point and camera of the " +
+                            std::to_string(observations.size()) + " observations is constant");
+    }
+
+    ceres::Solver::Options solver_options = SolverOptions(poses.size());
+    std::string error;
+    if (!solver_options.IsValid(&error)) return InvalidProblem("invalid solver options: " + error);
+    ceres::Solver::Summary ceres_summary;
+    ceres::Solve(solver_options, &problem, &ceres_summary);
+
+    BundleAdjustmentSummary summary;
+    summary.initial_cost = ceres_summary.initial_cost;
+    summary.final_cost = ceres_summary.final_cost;
+    summary.num_iterations =
+        ceres_summary.num_successful_steps + ceres_summary.num_unsuccessful_steps;
+    summary.num_residuals = static_cast<int>(observations.size());
+    summary.usable = ceres_summary.IsSolutionUsable();
+    summary.message = ceres_summary.BriefReport();
+    if (!summary.usable) return summary;
+
+    // Only what could move is written back, so constant values stay bit-identical.
+    for (const auto& [image_id, pose] : poses) {
+      if (config.constant_poses.count(image_id) > 0 || gauge_fixed_images.count(image_id) > 0) {
+        continue;
+      }
+      rec.images.at(image_id).cam_from_world = BlockToPose(pose);
+    }
+    for (const camera_t camera_id : variable_cameras) {
+      rec.cameras.at(camera_id).params = cameras.at(camera_id);
+    }
+    for (const auto& [point3D_id, xyz] : points) {
+      if (!problem.IsParameterBlockConstant(xyz.data())) rec.points3D.at(point3D_id).xyz = xyz;
+    }
+    for (const auto& [point3D_id, xyz] : points) {
+      Point3D& point3D = rec.points3D.at(point3D_id);
+      point3D.error = MeanReprojectionError(rec, point3D);
+    }
+    return summary;
+  }
+
+  ceres::LossFunction* CreateLossFunction() const {
+    if (options_.loss == "huber") return new ceres::HuberLoss(options_.loss_scale);
+    if (options_.loss == "cauchy") return new ceres::CauchyLoss(options_.loss_scale);
+    return nullptr;  // trivial: plain squared residuals
+  }
+
+  ceres::Solver::Options SolverOptions(size_t num_images) const {
+    ceres::Solver::Options solver_options;
+    solver_options.max_num_iterations = options_.max_num_iterations;
+    solver_options.function_tolerance = options_.function_tolerance;
+    solver_options.gradient_tolerance = options_.gradient_tolerance;
+    solver_options.parameter_tolerance = options_.parameter_tolerance;
+    solver_options.num_threads =
+        options_.num_threads > 0
+            ? options_.num_threads
+            : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+    solver_options.minimizer_progress_to_stdout = options_.minimizer_progress;
+    solver_options.logging_type =
+        options_.minimizer_progress ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+
+    ceres::SparseLinearAlgebraLibraryType sparse_library = ceres::NO_SPARSE;
+    if (ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE)) {
+      sparse_library = ceres::SUITE_SPARSE;
+    } else if (ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE)) {
+      sparse_library = ceres::EIGEN_SPARSE;
+    }
+    std::string linear_solver = options_.linear_solver;
+    if (linear_solver == "auto") {
+      // As COLMAP: dense Schur complements are fastest for few images, sparse ones
+      // up to about a thousand, beyond that only the iterative solver fits in memory.
+      if (num_images < kMaxNumImagesDenseSolver) {
+        linear_solver = "dense_schur";
+      } else if (num_images <= kMaxNumImagesSparseSolver) {
+        linear_solver = "sparse_schur";
+      } else {
+        linear_solver = "iterative_schur";
+      }
+    }
+    if (linear_solver == "sparse_schur" && sparse_library == ceres::NO_SPARSE) {
+      linear_solver = "iterative_schur";  // Ceres built without a sparse library
+    }
+    if (linear_solver == "dense_schur") {
+      solver_options.linear_solver_type = ceres::DENSE_SCHUR;
+    } else if (linear_solver == "sparse_schur") {
+      solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
+      solver_options.sparse_linear_algebra_library_type = sparse_library;
+    } else {
+      solver_options.linear_solver_type = ceres::ITERATIVE_SCHUR;
+      solver_options.preconditioner_type = ceres::SCHUR_JACOBI;
+    }
+    return solver_options;
+  }
+
+  CeresBundleAdjusterOptions options_;
+};
+
+}  // namespace tessera
+
+TESSERA_PLUGIN(bundle_adjuster, tessera::CeresBundleAdjuster, "ceres", "1.0.0",
+               "Bundle adjustment with Ceres Solver (robust reprojection error)")

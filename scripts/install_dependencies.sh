@@ -1,0 +1,45 @@
+#!/bin/bash
+# Installs, by name, the Debian 12 packages Tessera needs to build, test and compare
+# against COLMAP. Idempotent: installs only what is missing. Run as root or with sudo.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config clang-format
+  libopencv-dev libceres-dev libeigen3-dev libboost-dev libboost-filesystem-dev
+  nlohmann-json3-dev libflann-dev libsqlite3-dev sqlite3 bc libexif-dev
+  libglfw3-dev libimgui-dev libgtest-dev libgmock-dev libbenchmark-dev
+  libcli11-dev libspdlog-dev python3-numpy
+)
+# The reference system, for the interoperability tests and benchmarks; optional.
+optional_packages=(colmap)
+
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+
+missing=()
+for package in "${packages[@]}" "${optional_packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" ||
+    missing+=("$package")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install_dependencies: all packages present"
+  exit 0
+fi
+
+echo "install_dependencies: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+required_missing=()
+for package in "${missing[@]}"; do
+  [[ " ${optional_packages[*]} " == *" $package "* ]] || required_missing+=("$package")
+done
+if [ ${#required_missing[@]} -gt 0 ]; then
+  $sudo apt-get install -y -qq --no-install-recommends "${required_missing[@]}" > /dev/null
+fi
+for package in "${optional_packages[@]}"; do
+  if [[ " ${missing[*]} " == *" $package "* ]]; then
+    $sudo apt-get install -y -qq --no-install-recommends "$package" > /dev/null ||
+      echo "install_dependencies: WARNING: could not install optional package '$package';" \
+           "the tests that need it will be skipped"
+  fi
+done

@@ -1,0 +1,12 @@
+#!/bin/bash
+# Installs what is needed, builds Tessera, and runs it on the small sample that ships
+# in examples/. The workspace lands in ./sample-output.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+./scripts/install_dependencies.sh
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DTESSERA_BUILD_TESTS=OFF > /dev/null
+cmake --build build -j"$(nproc)"
+./build/bin/tessera plugins
+./build/bin/tessera run --images examples/fountain-P11-small/images \
+  --camera-K examples/fountain-P11-small/K.txt --output sample-output
+echo "Workspace written to $(pwd)/sample-output"

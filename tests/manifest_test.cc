@@ -1,0 +1,113 @@
+#include "manifest/manifest.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "tessera/errors.h"
+#include "test_support.h"
+
+namespace tessera {
+namespace {
+
+std::string ErrorOf(const nlohmann::json& json) {
+  try {
+    Manifest::FromJson(json, "/base", "m.json");
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(Manifest, ParsesSlotsCameraVerificationAndPaths) {
+  const nlohmann::json json = {
+      {"plugin_paths", {"plugins", "/abs"}},
+      {"seed", 7},
+      {"threads", 2},
+      {"pipeline",
+       {{"detector", {{"plugin", "sift"}, {"options", {{"max_num_features", 100}}}}},
+        {"matcher", {{"plugin", "flann"}}},
+        {"exporters", {{{"plugin", "ply"}}}}}},
+      {"camera", {{"model", "OPENCV"}, {"single_camera", false}, {"K", {1000, 1001, 320, 240}}}},
+      {"verification", {{"max_error_px", 2.5}}}};
+  const Manifest manifest = Manifest::FromJson(json, "/base", "m.json");
+  EXPECT_EQ(manifest.plugin_paths, (std::vector<std::filesystem::path>{"/base/plugins", "/abs"}));
+  EXPECT_EQ(manifest.seed, 7u);
+  EXPECT_EQ(manifest.EffectiveNumThreads(), 2);
+  ASSERT_TRUE(manifest.detector);
+  EXPECT_EQ(manifest.detector->plugin, "sift");
+  EXPECT_EQ(manifest.detector->options["max_num_features"], 100);
+  EXPECT_EQ(manifest.detector->json_path, "pipeline.detector");
+  EXPECT_FALSE(manifest.pair_selector);
+  ASSERT_EQ(manifest.exporters.size(), 1u);
+  EXPECT_EQ(manifest.exporters[0].json_path, "pipeline.exporters[0]");
+  EXPECT_EQ(manifest.camera.model, "OPENCV");
+  EXPECT_FALSE(manifest.camera.single_camera);
+  ASSERT_TRUE(manifest.camera.known_intrinsics);
+  EXPECT_EQ((*manifest.camera.known_intrinsics)(1), 1001);
+  EXPECT_EQ(manifest.verification.max_error_px, 2.5);
+  EXPECT_EQ(manifest.verification.min_num_inliers, 15);
+}
+
+TEST(Manifest, UnknownKeysNameTheirPathAndTheClosestKey) {
+  EXPECT_EQ(ErrorOf({{"pipline", nlohmann::json::object()}}),
+            "m.json: pipline: unknown key; did you mean 'pipeline'?");
+  EXPECT_EQ(ErrorOf({{"pipeline", {{"matchr", {{"plugin", "flann"}}}}}}),
+            "m.json: pipeline.matchr: unknown key; did you mean 'matcher'?");
+  EXPECT_EQ(ErrorOf({{"pipeline", {{"matcher", {{"plugn", "flann"}}}}}}),
+            "m.json: pipeline.matcher: missing key 'plugin'");
+  EXPECT_EQ(ErrorOf({{"camera", {{"modle", "PINHOLE"}}}}),
+            "m.json: camera.modle: unknown key; did you mean 'model'?");
+  EXPECT_EQ(ErrorOf({{"camera", {{"model", "PINHOL"}}}}),
+            "m.json: camera.model: 'PINHOL' is not one of 'SIMPLE_PINHOLE', 'PINHOLE', "
+            "'SIMPLE_RADIAL', 'RADIAL', 'OPENCV'; did you mean 'PINHOLE'?");
+  EXPECT_EQ(ErrorOf({{"verification", {{"max_error_px", -1}}}}),
+            "m.json: verification.max_error_px: = -1 is out of range; must be in [0.1, 100]");
+  EXPECT_EQ(ErrorOf({{"threads", "many"}}), "m.json: threads: expected an integer, got a string");
+  EXPECT_EQ(ErrorOf({{"camera", {{"K", {1, 2, 3}}}}}),
+            "m.json: camera.K: expected [fx, fy, cx, cy] in pixels");
+}
+
+TEST(Manifest, ReadsKFileRelativeToTheManifest) {
+  testing::TemporaryDir dir;
+  std::ofstream(dir.path() / "K.txt") << "2759.48 0 1520.69\n0 2764.16 1006.81\n0 0 1\n";
+  std::ofstream(dir.path() / "m.json") << R"({"camera": {"K_file": "K.txt"}})";
+  const Manifest manifest = Manifest::Load(dir.path() / "m.json");
+  ASSERT_TRUE(manifest.camera.known_intrinsics);
+  EXPECT_DOUBLE_EQ((*manifest.camera.known_intrinsics)(0), 2759.48);
+  EXPECT_DOUBLE_EQ((*manifest.camera.known_intrinsics)(3), 1006.81);
+  EXPECT_EQ(manifest.camera.known_intrinsics_source, (dir.path() / "K.txt").string());
+}
+
+TEST(Manifest, ReportsInvalidJsonWithTheFileAndPosition) {
+  testing::TemporaryDir dir;
+  std::ofstream(dir.path() / "m.json") << "{\n  \"seed\": 1,\n}\n";
+  try {
+    Manifest::Load(dir.path() / "m.json");
+    FAIL();
+  } catch (const InputError& error) {
+    const std::string what = error.what();
+    EXPECT_EQ(
+        what.rfind((dir.path() / "m.json").string() + ": invalid JSON: parse error at line 3", 0),
+        0u)
+        << what;
+  }
+  EXPECT_THROW(Manifest::Load(dir.path() / "missing.json"), InputError);
+}
+
+TEST(Manifest, BadKFileIsAnInputError) {
+  testing::TemporaryDir dir;
+  std::ofstream(dir.path() / "K.txt") << "1 2 3\n";
+  std::ofstream(dir.path() / "m.json") << R"({"camera": {"K_file": "K.txt"}})";
+  try {
+    Manifest::Load(dir.path() / "m.json");
+    FAIL();
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("K.txt: expected 9 numbers (a 3x3 matrix), found 3"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
+}  // namespace
+}  // namespace tessera
