@@ -1,0 +1,231 @@
+#include "image/camera_assignment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <tuple>
+
+#include "image/sensor_database.h"
+#include "tessera/errors.h"
+
+namespace tessera {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+// Diagonal of the 36 x 24 mm frame that "35 mm equivalent" focal lengths refer to.
+const double kFullFrameDiagonalMm = std::hypot(36.0, 24.0);
+
+std::string FormatNumber(double value) {
+  std::ostringstream stream;
+  stream.precision(4);
+  stream << value;
+  return stream.str();
+}
+
+// Horizontal field of view across the longer side, in degrees.
+double FieldOfViewDeg(double focal_px, double longer_side_px) {
+  return 2 * std::atan(longer_side_px / 2 / focal_px) * 180 / kPi;
+}
+
+class PriorBuilder {
+ public:
+  PriorBuilder(const ImageEntry& image, std::vector<std::string>* warnings)
+      : image_(image), warnings_(warnings) {}
+
+  // Whether a positive EXIF value; warns about the others.
+  bool IsPositive(const std::optional<double>& value, const char* tag, const char* unit) {
+    if (!value) return false;
+    if (*value > 0 && std::isfinite(*value)) return true;
+    Warn("EXIF " + std::string(tag) + " of " + FormatNumber(*value) + unit +
+         " is not positive; ignored.");
+    return false;
+  }
+
+  // Whether the focal length gives a plausible field of view; warns about the others.
+  bool IsPlausible(double focal_px, const std::string& what) {
+    const double longer = std::max(image_.width, image_.height);
+    const double fov = FieldOfViewDeg(focal_px, longer);
+    if (std::isfinite(fov) && fov >= kMinPlausibleFieldOfViewDeg &&
+        fov <= kMaxPlausibleFieldOfViewDeg) {
+      return true;
+    }
+    Warn("the focal length from " + what + " (" + FormatNumber(focal_px) +
+         " px) gives a field of view of " + FormatNumber(fov) + " degrees, outside [" +
+         FormatNumber(kMinPlausibleFieldOfViewDeg) + ", " +
+         FormatNumber(kMaxPlausibleFieldOfViewDeg) + "]; ignored.");
+    return false;
+  }
+
+ private:
+  void Warn(const std::string& text) {
+    if (warnings_ != nullptr) warnings_->push_back("Image '" + image_.name + "': " + text);
+  }
+
+  const ImageEntry& image_;
+  std::vector<std::string>* warnings_;
+};
+
+// The focal length per image and where it came from.
+struct ImagePrior {
+  double focal_px;
+  CalibrationSource source;
+  bool has_prior;
+};
+
+double MedianOf(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const size_t mid = values.size() / 2;
+  return values.size() % 2 == 1 ? values[mid] : (values[mid - 1] + values[mid]) / 2;
+}
+
+}  // namespace
+
+std::optional<FocalLengthPrior> EstimateFocalLengthPrior(const ImageEntry& image,
+                                                         std::vector<std::string>* warnings) {
+  const double longer = std::max(image.width, image.height);
+  if (longer <= 0) return std::nullopt;
+  const ExifInfo& exif = image.exif;
+  PriorBuilder builder(image, warnings);
+
+  if (builder.IsPositive(exif.focal_length_mm, "FocalLength", " mm")) {
+    const double focal_mm = *exif.focal_length_mm;
+    if (const auto sensor_width_mm = LookupSensorWidthMm(exif.make, exif.model)) {
+      const double focal_px = focal_mm / *sensor_width_mm * longer;
+      if (builder.IsPlausible(focal_px, "FocalLength " + FormatNumber(focal_mm) +
+                                            " mm and a sensor width of " +
+                                            FormatNumber(*sensor_width_mm) + " mm")) {
+        return FocalLengthPrior{focal_px, CalibrationSource::kExifFocalLength};
+      }
+    } else if (exif.focal_plane_x_resolution && *exif.focal_plane_x_resolution > 0) {
+      // The resolution refers to the image size the camera wrote; a resized copy
+      // has proportionally fewer pixels per millimetre.
+      double scale = 1;
+      if (exif.pixel_x_dimension && exif.pixel_y_dimension) {
+        scale = longer / std::max(*exif.pixel_x_dimension, *exif.pixel_y_dimension);
+      }
+      const double focal_px = focal_mm * *exif.focal_plane_x_resolution * scale;
+      if (builder.IsPlausible(focal_px, "FocalLength " + FormatNumber(focal_mm) +
+                                            " mm and FocalPlaneXResolution")) {
+        return FocalLengthPrior{focal_px, CalibrationSource::kExifFocalLength};
+      }
+    }
+  }
+  if (builder.IsPositive(exif.focal_length_35mm, "FocalLengthIn35mmFilm", " mm")) {
+    const double diagonal_px = std::hypot(image.width, image.height);
+    const double focal_px = *exif.focal_length_35mm / kFullFrameDiagonalMm * diagonal_px;
+    if (builder.IsPlausible(
+            focal_px, "FocalLengthIn35mmFilm " + FormatNumber(*exif.focal_length_35mm) + " mm")) {
+      return FocalLengthPrior{focal_px, CalibrationSource::kExif35mmEquivalent};
+    }
+  }
+  return std::nullopt;
+}
+
+CameraAssignment AssignCameras(const std::vector<ImageEntry>& images,
+                               const CameraSettings& settings) {
+  const CameraModelId model_id = CameraModelNameToId(settings.model);
+  if (model_id == CameraModelId::kInvalid) {
+    std::string known;
+    for (const CameraModelId id : AllCameraModelIds()) {
+      known += (known.empty() ? "" : ", ") + CameraModelIdToName(id);
+    }
+    throw OptionError("camera.model", "unknown camera model '" + settings.model +
+                                          "' (known models: " + known + ")");
+  }
+  if (!(settings.default_focal_length_factor > 0)) {
+    throw OptionError("camera.default_focal_length_factor", "must be positive");
+  }
+  CameraAssignment assignment;
+
+  // The intrinsics each image would get on its own.
+  std::vector<ImagePrior> priors;
+  priors.reserve(images.size());
+  for (const ImageEntry& image : images) {
+    if (image.width <= 0 || image.height <= 0) {
+      throw InputError(image.name + ": the image has no size");
+    }
+    if (settings.known_intrinsics) {
+      priors.push_back({0, CalibrationSource::kUser, true});
+      continue;
+    }
+    if (auto prior = EstimateFocalLengthPrior(image, &assignment.warnings)) {
+      priors.push_back({prior->focal_px, prior->source, true});
+    } else {
+      priors.push_back({settings.default_focal_length_factor * std::max(image.width, image.height),
+                        CalibrationSource::kDefault, false});
+    }
+  }
+
+  // Groups of images sharing a camera, in order of their first image.
+  using GroupKey = std::tuple<int, int, std::string, std::string>;
+  std::map<GroupKey, size_t> group_of_key;
+  std::vector<std::vector<size_t>> groups;
+  for (size_t i = 0; i < images.size(); ++i) {
+    const ImageEntry& image = images[i];
+    if (!settings.single_camera) {
+      groups.push_back({i});
+      continue;
+    }
+    // Known intrinsics describe one physical camera whatever the EXIF says.
+    const bool by_make = !settings.known_intrinsics;
+    const GroupKey key(image.width, image.height, by_make ? image.exif.make : "",
+                       by_make ? image.exif.model : "");
+    const auto [it, inserted] = group_of_key.emplace(key, groups.size());
+    if (inserted) groups.emplace_back();
+    groups[it->second].push_back(i);
+  }
+
+  assignment.image_camera_ids.resize(images.size());
+  for (const std::vector<size_t>& group : groups) {
+    const ImageEntry& first = images[group.front()];
+    const camera_t camera_id = static_cast<camera_t>(assignment.cameras.size() + 1);
+    Camera camera;
+    if (settings.known_intrinsics) {
+      const Eigen::Vector4d& K = *settings.known_intrinsics;
+      if (!(K(2) > 0 && K(2) < first.width && K(3) > 0 && K(3) < first.height)) {
+        throw InputError(settings.known_intrinsics_source + ": the principal point (" +
+                         FormatNumber(K(2)) + ", " + FormatNumber(K(3)) + ") lies outside image '" +
+                         first.name + "' (" + std::to_string(first.width) + "x" +
+                         std::to_string(first.height) +
+                         "); the intrinsics must be given for the images' resolution");
+      }
+      camera = Camera::Create(camera_id, model_id, (K(0) + K(1)) / 2, first.width, first.height);
+      const std::vector<int> focal_idx = camera.FocalIdx();
+      if (focal_idx.size() == 2) {
+        camera.params[focal_idx[0]] = K(0);
+        camera.params[focal_idx[1]] = K(1);
+      }
+      const std::vector<int> pp_idx = camera.PrincipalPointIdx();
+      camera.params[pp_idx[0]] = K(2);
+      camera.params[pp_idx[1]] = K(3);
+      camera.has_prior_focal_length = true;
+      camera.calibration_source = CalibrationSource::kUser;
+    } else {
+      std::vector<std::pair<double, CalibrationSource>> with_prior;
+      for (const size_t i : group) {
+        if (priors[i].has_prior) with_prior.emplace_back(priors[i].focal_px, priors[i].source);
+      }
+      if (with_prior.empty()) {
+        camera = Camera::Create(camera_id, model_id, priors[group.front()].focal_px, first.width,
+                                first.height);
+        camera.has_prior_focal_length = false;
+        camera.calibration_source = CalibrationSource::kDefault;
+      } else {
+        std::vector<double> focals;
+        for (const auto& prior : with_prior) focals.push_back(prior.first);
+        // The source of the lower-median image names where the median came from.
+        std::sort(with_prior.begin(), with_prior.end(),
+                  [](const auto& a, const auto& b) { return a.first < b.first; });
+        camera = Camera::Create(camera_id, model_id, MedianOf(focals), first.width, first.height);
+        camera.has_prior_focal_length = true;
+        camera.calibration_source = with_prior[(with_prior.size() - 1) / 2].second;
+      }
+    }
+    for (const size_t i : group) assignment.image_camera_ids[i] = camera_id;
+    assignment.cameras.push_back(std::move(camera));
+  }
+  return assignment;
+}
+
+}  // namespace tessera
