@@ -18,7 +18,7 @@ struct CommandResult {
 };
 
 // `environment` is prepended to the command, e.g. "TESSERA_PLUGIN_PATH=/x".
-CommandResult Run(const std::string& arguments, const std::string& environment = "") {
+CommandResult RunTessera(const std::string& arguments, const std::string& environment = "") {
   const std::string command =
       environment + " " + std::string(TESSERA_TEST_EXECUTABLE) + " " + arguments + " 2>&1";
   CommandResult result;
@@ -34,26 +34,26 @@ CommandResult Run(const std::string& arguments, const std::string& environment =
 }
 
 TEST(Cli, PrintsItsVersion) {
-  const auto result = Run("--version");
+  const auto result = RunTessera("--version");
   EXPECT_EQ(result.exit_code, 0);
   EXPECT_NE(result.output.find("0."), std::string::npos) << result.output;
 }
 
 TEST(Cli, BadArgumentsAreExitCode2) {
-  EXPECT_EQ(Run("").exit_code, 2);
-  EXPECT_EQ(Run("frobnicate").exit_code, 2);
-  EXPECT_EQ(Run("run --output /tmp/x").exit_code, 2);  // --images missing
+  EXPECT_EQ(RunTessera("").exit_code, 2);
+  EXPECT_EQ(RunTessera("frobnicate").exit_code, 2);
+  EXPECT_EQ(RunTessera("run --output /tmp/x").exit_code, 2);  // --images missing
 }
 
 TEST(Cli, PluginsJsonListsEveryBundledPluginWithKindAndVersion) {
-  const auto result = Run("plugins --json");
+  const auto result = RunTessera("plugins --json");
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const auto json = nlohmann::json::parse(result.output);
   std::map<std::string, std::string> kinds;
   for (const auto& plugin : json["plugins"]) {
     EXPECT_TRUE(plugin["usable"].get<bool>()) << plugin.dump();
     EXPECT_FALSE(plugin["version"].get<std::string>().empty());
-    kinds[plugin["name"]] = plugin["kind"];
+    kinds[plugin["name"].get<std::string>()] = plugin["kind"].get<std::string>();
   }
   const std::map<std::string, std::string> expected = {{"sift", "detector"},
                                                        {"orb", "detector"},
@@ -72,7 +72,7 @@ TEST(Cli, PluginsJsonListsEveryBundledPluginWithKindAndVersion) {
 
 TEST(Cli, PluginsMarksRefusedFilesWithWhy) {
   const std::string path = std::string(TESSERA_TEST_PLUGIN_ROOT) + "/wrong_abi";
-  const auto with_broken = Run("plugins", "TESSERA_PLUGIN_PATH=" + path);
+  const auto with_broken = RunTessera("plugins", "TESSERA_PLUGIN_PATH=" + path);
   EXPECT_EQ(with_broken.exit_code, 0);
   EXPECT_NE(with_broken.output.find("REFUSED " + path), std::string::npos) << with_broken.output;
   EXPECT_NE(with_broken.output.find("got version 999, supported version is 1"), std::string::npos);
@@ -86,7 +86,7 @@ TEST(Cli, MisspeltPluginFailsBeforeReadingImagesWithASuggestion) {
                                                "matcher": {"plugin": "flan"}}})";
   // The image folder does not exist: the manifest error must come first.
   const auto result =
-      Run("run --images " + (dir.path() / "no_such_folder").string() + " --output " +
+      RunTessera("run --images " + (dir.path() / "no_such_folder").string() + " --output " +
           (dir.path() / "out").string() + " --manifest " + manifest.string());
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find(manifest.string() +
@@ -102,7 +102,7 @@ TEST(Cli, InvalidPluginOptionIsExitCode2) {
   const auto manifest = dir.path() / "bad.json";
   std::ofstream(manifest) << R"({"pipeline": {"detector": {"plugin": "sift",
                                  "options": {"max_num_featurs": 10}}}})";
-  const auto result = Run("extract --images /nonexistent --output " +
+  const auto result = RunTessera("extract --images /nonexistent --output " +
                           (dir.path() / "out").string() + " --manifest " + manifest.string());
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find("pipeline.detector.options.max_num_featurs: unknown key; did you "
@@ -115,7 +115,7 @@ TEST(Cli, TooFewImagesIsExitCode2) {
   testing::TemporaryDir dir;
   std::filesystem::create_directories(dir.path() / "images");
   std::ofstream(dir.path() / "images" / "notes.txt") << "not an image";
-  const auto result = Run("extract --images " + (dir.path() / "images").string() + " --output " +
+  const auto result = RunTessera("extract --images " + (dir.path() / "images").string() + " --output " +
                           (dir.path() / "out").string());
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find("0 usable image(s); at least 2 are needed"), std::string::npos)
@@ -123,7 +123,7 @@ TEST(Cli, TooFewImagesIsExitCode2) {
 }
 
 TEST(Cli, MissingManifestIsExitCode2) {
-  const auto result = Run("run --images /tmp --output /tmp/out --manifest /nonexistent/m.json");
+  const auto result = RunTessera("run --images /tmp --output /tmp/out --manifest /nonexistent/m.json");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_NE(result.output.find("/nonexistent/m.json: cannot read the manifest"), std::string::npos)
       << result.output;

@@ -37,7 +37,8 @@ TEST(PluginLoader, LoadsAGoodPluginAndReadsItsInfo) {
 TEST(PluginLoader, RefusesAFileThatWillNotOpen) {
   testing::TemporaryDir dir;
   const auto file = dir.path() / "libnot_a_library.so";
-  std::ofstream(file) << "this is a text file, not a shared object\n";
+  // Longer than an ELF header, so the loader reads it and rejects its contents.
+  std::ofstream(file) << std::string(200, '#') << "\nthis is a text file, not a shared object\n";
   const PluginRecord record = InspectPluginFile(file);
   EXPECT_FALSE(record.usable());
   EXPECT_EQ(record.refusal.rfind(file.string() + ": cannot open the library: ", 0), 0u)
