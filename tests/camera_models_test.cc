@@ -3,9 +3,8 @@
 
 #include <gtest/gtest.h>
 
-#include <random>
-
 #include <Eigen/Geometry>
+#include <random>
 
 #include "tessera/camera.h"
 
@@ -78,7 +77,8 @@ TEST_P(CameraModelRoundTrip, UnprojectInvertsProject) {
   for (int i = 0; i < 1000; ++i) {
     const Eigen::Vector2d xy(pixel_x(rng), pixel_y(rng));
     const Eigen::Vector2d uv = camera.CamFromImg(xy);
-    const Eigen::Vector2d reprojected = camera.ImgFromCam(Eigen::Vector3d(uv.x(), uv.y(), 1.0) * 3.0);
+    const Eigen::Vector2d reprojected =
+        camera.ImgFromCam(Eigen::Vector3d(uv.x(), uv.y(), 1.0) * 3.0);
     max_error = std::max(max_error, (reprojected - xy).norm());
   }
   EXPECT_LT(max_error, 1e-6) << camera.ModelName();

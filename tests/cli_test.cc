@@ -87,7 +87,7 @@ TEST(Cli, MisspeltPluginFailsBeforeReadingImagesWithASuggestion) {
   // The image folder does not exist: the manifest error must come first.
   const auto result =
       RunTessera("run --images " + (dir.path() / "no_such_folder").string() + " --output " +
-          (dir.path() / "out").string() + " --manifest " + manifest.string());
+                 (dir.path() / "out").string() + " --manifest " + manifest.string());
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find(manifest.string() +
                                ": pipeline.matcher.plugin: no matcher plugin 'flan'; did you mean "
@@ -102,8 +102,9 @@ TEST(Cli, InvalidPluginOptionIsExitCode2) {
   const auto manifest = dir.path() / "bad.json";
   std::ofstream(manifest) << R"({"pipeline": {"detector": {"plugin": "sift",
                                  "options": {"max_num_featurs": 10}}}})";
-  const auto result = RunTessera("extract --images /nonexistent --output " +
-                          (dir.path() / "out").string() + " --manifest " + manifest.string());
+  const auto result =
+      RunTessera("extract --images /nonexistent --output " + (dir.path() / "out").string() +
+                 " --manifest " + manifest.string());
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find("pipeline.detector.options.max_num_featurs: unknown key; did you "
                                "mean 'max_num_features'?"),
@@ -115,15 +116,16 @@ TEST(Cli, TooFewImagesIsExitCode2) {
   testing::TemporaryDir dir;
   std::filesystem::create_directories(dir.path() / "images");
   std::ofstream(dir.path() / "images" / "notes.txt") << "not an image";
-  const auto result = RunTessera("extract --images " + (dir.path() / "images").string() + " --output " +
-                          (dir.path() / "out").string());
+  const auto result = RunTessera("extract --images " + (dir.path() / "images").string() +
+                                 " --output " + (dir.path() / "out").string());
   EXPECT_EQ(result.exit_code, 2) << result.output;
   EXPECT_NE(result.output.find("0 usable image(s); at least 2 are needed"), std::string::npos)
       << result.output;
 }
 
 TEST(Cli, MissingManifestIsExitCode2) {
-  const auto result = RunTessera("run --images /tmp --output /tmp/out --manifest /nonexistent/m.json");
+  const auto result =
+      RunTessera("run --images /tmp --output /tmp/out --manifest /nonexistent/m.json");
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_NE(result.output.find("/nonexistent/m.json: cannot read the manifest"), std::string::npos)
       << result.output;
