@@ -14,8 +14,6 @@
 namespace tessera {
 namespace {
 
-constexpr const char* kFeaturesStage = "features";
-
 // What produced the features: a different value means they must be detected again.
 nlohmann::json FeaturesProvenance(const PluginInstance<Detector>& detector) {
   nlohmann::json provenance = detector.Provenance();
@@ -80,14 +78,14 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
   }
 
   const nlohmann::json provenance = FeaturesProvenance(detector);
-  const auto stored = database->ReadStageProvenance(kFeaturesStage);
+  const auto stored = database->ReadStageProvenance(Database::kFeaturesStage);
   if (stored && *stored != provenance) {
     spdlog::info(
         "extract: the detector or its options changed; discarding old features, matches "
         "and geometries");
     database->ClearKeypointsAndDescriptors();
   }
-  database->WriteStageProvenance(kFeaturesStage, provenance);
+  database->WriteStageProvenance(Database::kFeaturesStage, provenance);
 
   const std::vector<Image> images = RegisterImages(scan, manifest.camera, database);
   std::vector<size_t> todo;

@@ -15,10 +15,6 @@
 namespace tessera {
 namespace {
 
-constexpr const char* kFeaturesStage = "features";
-constexpr const char* kMatchesStage = "matches";
-constexpr const char* kGeometriesStage = "two_view_geometries";
-
 nlohmann::json VerificationProvenance(const VerificationSettings& s, uint64_t seed) {
   return {{"max_error_px", s.max_error_px},
           {"confidence", s.confidence},
@@ -43,7 +39,7 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
   const Timer timer;
   MatchingSummary summary;
 
-  const auto features = database->ReadStageProvenance(kFeaturesStage);
+  const auto features = database->ReadStageProvenance(Database::kFeaturesStage);
   if (!features) {
     throw InputError(database->path().string() +
                      ": no features in the workspace; run `tessera "
@@ -59,18 +55,18 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
   const nlohmann::json geometries_provenance = {
       {"matches", matches_provenance},
       {"verification", VerificationProvenance(manifest.verification, manifest.seed)}};
-  const auto stored_matches = database->ReadStageProvenance(kMatchesStage);
+  const auto stored_matches = database->ReadStageProvenance(Database::kMatchesStage);
   if (stored_matches && *stored_matches != matches_provenance) {
     spdlog::info("match: the matcher, its options or the features changed; discarding old matches");
     database->ClearMatches();
   }
-  const auto stored_geometries = database->ReadStageProvenance(kGeometriesStage);
+  const auto stored_geometries = database->ReadStageProvenance(Database::kTwoViewGeometriesStage);
   if (stored_geometries && *stored_geometries != geometries_provenance) {
     spdlog::info("match: the verification settings changed; discarding old two-view geometries");
     database->ClearTwoViewGeometries();
   }
-  database->WriteStageProvenance(kMatchesStage, matches_provenance);
-  database->WriteStageProvenance(kGeometriesStage, geometries_provenance);
+  database->WriteStageProvenance(Database::kMatchesStage, matches_provenance);
+  database->WriteStageProvenance(Database::kTwoViewGeometriesStage, geometries_provenance);
 
   // Images in capture order: pair selectors such as `sequential` rely on it.
   std::vector<Image> images = database->ReadAllImages();
