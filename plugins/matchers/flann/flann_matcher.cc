@@ -11,7 +11,11 @@
 // (l2_index = "kdtree", hamming_index = "lsh") for speed, without that guarantee.
 
 #include <cmath>
+#include <cstring>
 #include <flann/flann.hpp>
+#include <functional>
+#include <future>
+#include <list>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -50,6 +54,9 @@ struct FlannMatchOptions {
   int lsh_multi_probe_level = 1;
   // Seed of std::rand() while kmeans and hierarchical indexes are built.
   int random_seed = 1;
+  // Deterministic (kmeans, hierarchical) indexes kept for reuse: an image takes part in
+  // many pairs, and its index is built once instead of once per pair. 0 disables it.
+  int index_cache_size = 64;
 };
 
 namespace {
@@ -105,6 +112,99 @@ Neighbors Search(const Index& index, const FeatureDescriptors& query, size_t k,
   return neighbors;
 }
 
+// FNV-1a over the descriptor bytes and shape: the cache key of an image's descriptors.
+uint64_t HashDescriptors(const FeatureDescriptors& descriptors) {
+  uint64_t hash = 1469598103934665603ull;
+  auto mix = [&hash](uint64_t value) {
+    hash ^= value;
+    hash *= 1099511628211ull;
+  };
+  mix(static_cast<uint64_t>(descriptors.size()));
+  mix(static_cast<uint64_t>(descriptors.dimension()));
+  mix(static_cast<uint64_t>(descriptors.metric));
+  const uint8_t* bytes = descriptors.data.data();
+  const size_t num_bytes = static_cast<size_t>(descriptors.data.size());
+  for (size_t i = 0; i < num_bytes; ++i) mix(bytes[i]);
+  return hash;
+}
+
+// Indexes of one type built over their own copy of the descriptors (FLANN keeps a
+// pointer to the data), shared by every pair that searches the same image, least
+// recently used evicted first. Thread-safe; a second caller of an index being built
+// waits for it instead of building it again.
+template <typename Index>
+class IndexCache {
+ public:
+  struct Entry {
+    FeatureDescriptors descriptors;
+    std::unique_ptr<Index> index;
+  };
+  using Builder = std::function<std::unique_ptr<Index>(const FeatureDescriptors&)>;
+
+  explicit IndexCache(size_t capacity) : capacity_(capacity) {}
+
+  std::shared_ptr<const Entry> Get(const FeatureDescriptors& descriptors, const Builder& build) {
+    const uint64_t key = HashDescriptors(descriptors);
+    std::shared_future<std::shared_ptr<const Entry>> future;
+    std::promise<std::shared_ptr<const Entry>> promise;
+    bool must_build = false;
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      for (auto it = entries_.begin(); it != entries_.end(); ++it) {
+        if (it->first == key) {
+          entries_.splice(entries_.begin(), entries_, it);  // most recently used first
+          future = it->second;
+          break;
+        }
+      }
+      if (!future.valid()) {
+        future = promise.get_future().share();
+        entries_.emplace_front(key, future);
+        while (entries_.size() > capacity_) entries_.pop_back();
+        must_build = true;
+      }
+    }
+    if (must_build) {
+      try {
+        auto entry = std::make_shared<Entry>();
+        entry->descriptors = descriptors;
+        entry->index = build(entry->descriptors);
+        promise.set_value(std::move(entry));
+      } catch (...) {
+        promise.set_exception(std::current_exception());
+        Forget(key);
+        throw;
+      }
+    }
+    std::shared_ptr<const Entry> entry = future.get();
+    // A hash collision between different descriptors: build privately.
+    if (entry->descriptors.metric != descriptors.metric ||
+        entry->descriptors.data.rows() != descriptors.data.rows() ||
+        entry->descriptors.data.cols() != descriptors.data.cols() ||
+        std::memcmp(entry->descriptors.data.data(), descriptors.data.data(),
+                    static_cast<size_t>(descriptors.data.size())) != 0) {
+      auto own = std::make_shared<Entry>();
+      own->descriptors = descriptors;
+      own->index = build(own->descriptors);
+      return own;
+    }
+    return entry;
+  }
+
+ private:
+  void Forget(uint64_t key) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    entries_.remove_if([key](const auto& item) { return item.first == key; });
+  }
+
+  size_t capacity_;
+  std::mutex mutex_;
+  std::list<std::pair<uint64_t, std::shared_future<std::shared_ptr<const Entry>>>> entries_;
+};
+
+using KMeansL2Index = flann::KMeansIndex<flann::L2<unsigned char>>;
+using HierarchicalHammingIndex = flann::HierarchicalClusteringIndex<flann::Hamming<unsigned char>>;
+
 }  // namespace
 
 class FlannMatcher : public Matcher {
@@ -133,7 +233,12 @@ class FlannMatcher : public Matcher {
         reader.Get<int>("lsh_multi_probe_level", options_.lsh_multi_probe_level, 0, 4);
     options_.random_seed =
         reader.Get<int>("random_seed", options_.random_seed, 0, std::numeric_limits<int>::max());
+    options_.index_cache_size =
+        reader.Get<int>("index_cache_size", options_.index_cache_size, 0, 100000);
     reader.Finish();
+    kmeans_cache_ = std::make_unique<IndexCache<KMeansL2Index>>(options_.index_cache_size);
+    hierarchical_cache_ =
+        std::make_unique<IndexCache<HierarchicalHammingIndex>>(options_.index_cache_size);
     effective_options_ = reader.Effective();
   }
 
@@ -195,12 +300,18 @@ class FlannMatcher : public Matcher {
     if (data.metric == DescriptorMetric::kL2) {
       using Distance = flann::L2<unsigned char>;
       if (options_.l2_index == "kmeans") {
-        const auto index = Build<flann::KMeansIndex<Distance>>(
-            data,
-            flann::KMeansIndexParams(options_.branching, options_.kmeans_iterations,
-                                     flann::FLANN_CENTERS_KMEANSPP),
-            /*seeded=*/true);
-        return Search(*index, query, k, search_params, /*squared_distances=*/true);
+        const auto build = [this](const FeatureDescriptors& descriptors) {
+          return Build<KMeansL2Index>(
+              descriptors,
+              flann::KMeansIndexParams(options_.branching, options_.kmeans_iterations,
+                                       flann::FLANN_CENTERS_KMEANSPP),
+              /*seeded=*/true);
+        };
+        if (options_.index_cache_size > 0) {
+          const auto entry = kmeans_cache_->Get(data, build);
+          return Search(*entry->index, query, k, search_params, /*squared_distances=*/true);
+        }
+        return Search(*build(data), query, k, search_params, /*squared_distances=*/true);
       }
       const auto index = Build<flann::KDTreeIndex<Distance>>(
           data, flann::KDTreeIndexParams(options_.trees), /*seeded=*/false);
@@ -208,13 +319,19 @@ class FlannMatcher : public Matcher {
     }
     using Distance = flann::Hamming<unsigned char>;
     if (options_.hamming_index == "hierarchical") {
-      const auto index = Build<flann::HierarchicalClusteringIndex<Distance>>(
-          data,
-          flann::HierarchicalClusteringIndexParams(options_.branching,
-                                                   flann::FLANN_CENTERS_KMEANSPP, options_.trees,
-                                                   options_.leaf_max_size),
-          /*seeded=*/true);
-      return Search(*index, query, k, search_params, /*squared_distances=*/false);
+      const auto build = [this](const FeatureDescriptors& descriptors) {
+        return Build<HierarchicalHammingIndex>(
+            descriptors,
+            flann::HierarchicalClusteringIndexParams(options_.branching,
+                                                     flann::FLANN_CENTERS_KMEANSPP, options_.trees,
+                                                     options_.leaf_max_size),
+            /*seeded=*/true);
+      };
+      if (options_.index_cache_size > 0) {
+        const auto entry = hierarchical_cache_->Get(data, build);
+        return Search(*entry->index, query, k, search_params, /*squared_distances=*/false);
+      }
+      return Search(*build(data), query, k, search_params, /*squared_distances=*/false);
     }
     const auto index = Build<flann::LshIndex<Distance>>(
         data,
@@ -252,6 +369,8 @@ class FlannMatcher : public Matcher {
   }
 
   FlannMatchOptions options_;
+  std::unique_ptr<IndexCache<KMeansL2Index>> kmeans_cache_;
+  std::unique_ptr<IndexCache<HierarchicalHammingIndex>> hierarchical_cache_;
 };
 
 }  // namespace tessera

@@ -292,6 +292,41 @@ TEST(FlannMatcher, DeterministicAcrossCallsInstancesAndThreads) {
   EXPECT_TRUE(any_difference);
 }
 
+TEST(FlannMatcher, CachedIndexesGiveTheSameMatchesAsFreshOnes) {
+  // Images shared by several pairs, searched from several threads, with a cache smaller
+  // than the number of images so that entries are evicted and rebuilt.
+  std::vector<SyntheticPair> pairs;
+  for (uint32_t seed = 30; seed < 36; ++seed) {
+    pairs.push_back(seed % 2 ? MakeHammingPair(300, 300, 50, seed)
+                             : MakeL2Pair(300, 300, 30, seed));
+  }
+  const auto fresh = Load({{"ratio", 0.9}, {"checks", 16}, {"index_cache_size", 0}});
+  const auto cached = Load({{"ratio", 0.9}, {"checks", 16}, {"index_cache_size", 2}});
+  std::vector<std::pair<const FeatureDescriptors*, const FeatureDescriptors*>> jobs;
+  for (const auto& a : pairs) {
+    for (const auto& b : pairs) {
+      if (a.descriptors1.metric != b.descriptors1.metric) continue;
+      jobs.emplace_back(&a.descriptors1, &b.descriptors2);
+      jobs.emplace_back(&b.descriptors2, &a.descriptors1);
+    }
+  }
+  std::vector<FeatureMatches> expected;
+  for (const auto& [d1, d2] : jobs) expected.push_back(fresh->Match(*d1, *d2));
+  std::vector<FeatureMatches> actual(jobs.size());
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 3; ++t) {
+    threads.emplace_back([&, t] {
+      for (size_t k = t; k < jobs.size(); k += 3)
+        actual[k] = cached->Match(*jobs[k].first, *jobs[k].second);
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  EXPECT_EQ(actual, expected);
+  size_t total = 0;
+  for (const auto& matches : expected) total += matches.size();
+  EXPECT_GT(total, 1000u);
+}
+
 TEST(FlannMatcher, ValidatesOptions) {
   try {
     Load({{"l2_index", "kd_tree"}});
@@ -314,7 +349,8 @@ TEST(FlannMatcher, ValidatesOptions) {
         << error.what();
   }
   const nlohmann::json effective = Load()->EffectiveOptions();
-  EXPECT_EQ(effective.size(), 14u);
+  EXPECT_EQ(effective.size(), 15u);
+  EXPECT_EQ(effective.at("index_cache_size"), 64);
   EXPECT_EQ(effective.at("l2_index"), "kmeans");
   EXPECT_EQ(effective.at("hamming_index"), "hierarchical");
   EXPECT_EQ(effective.at("checks"), 128);
