@@ -13,6 +13,7 @@
 #include <tuple>
 #include <vector>
 
+#include "common/scaled_image.h"
 #include "tessera/sdk.h"
 
 namespace tessera {
@@ -34,37 +35,6 @@ struct OrbOptions {
   // Border in pixels, at each level, where no keypoint is detected.
   int edge_threshold = 31;
 };
-
-// The working copy of an image and how its pixels relate to the full-resolution one.
-struct ScaledImage {
-  cv::Mat image;
-  double scale_x = 1;  // full-resolution pixels per working pixel, horizontally
-  double scale_y = 1;  // and vertically
-};
-
-ScaledImage ScaleToMaxSize(const ImageView& view, int max_image_size) {
-  if (view.data == nullptr || view.width <= 0 || view.height <= 0 ||
-      view.stride < static_cast<size_t>(view.width)) {
-    throw InputError("orb: cannot detect features in an empty or malformed image view (" +
-                     std::to_string(view.width) + "x" + std::to_string(view.height) + ")");
-  }
-  // The view is only read: OpenCV's Mat has no const-data constructor.
-  const cv::Mat full(view.height, view.width, CV_8UC1, const_cast<uint8_t*>(view.data),
-                     view.stride);
-  ScaledImage scaled;
-  const int long_side = std::max(view.width, view.height);
-  if (long_side <= max_image_size) {
-    scaled.image = full;
-    return scaled;
-  }
-  const double factor = static_cast<double>(max_image_size) / long_side;
-  const int width = std::max(1, static_cast<int>(std::lround(view.width * factor)));
-  const int height = std::max(1, static_cast<int>(std::lround(view.height * factor)));
-  cv::resize(full, scaled.image, cv::Size(width, height), 0, 0, cv::INTER_AREA);
-  scaled.scale_x = static_cast<double>(view.width) / width;
-  scaled.scale_y = static_cast<double>(view.height) / height;
-  return scaled;
-}
 
 // Where a keypoint of OpenCV's ORB lies, in pixels of the image ORB was given, in
 // COLMAP's convention. ORB finds corners at whole pixels x_l of a pyramid level made by
@@ -114,7 +84,8 @@ class OrbDetector : public Detector {
   }
 
   FeatureSet Detect(const ImageView& view) const override {
-    const ScaledImage scaled = ScaleToMaxSize(view, options_.max_image_size);
+    const detector_common::ScaledImage scaled =
+        detector_common::ScaleToMaxSize(view, options_.max_image_size, "orb");
 
     // A detector per call: sharing one cv::ORB across threads is not documented as safe.
     const cv::Ptr<cv::ORB> orb = cv::ORB::create(
