@@ -22,6 +22,22 @@ Eigen::Vector3d TriangulatePoint(const Eigen::Matrix<double, 3, 4>& cam1_from_wo
   return solver.eigenvectors().col(0).hnormalized();
 }
 
+Eigen::Vector3d TriangulateMultiViewPoint(
+    const std::vector<Eigen::Matrix<double, 3, 4>>& cams_from_world,
+    const std::vector<Eigen::Vector2d>& points) {
+  // Sum of the 2x4 blocks' normal equations: the same null vector as the stacked
+  // system, accumulated in a 4x4 matrix whatever the number of views.
+  Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
+  for (size_t i = 0; i < points.size(); ++i) {
+    Eigen::Matrix<double, 2, 4> rows;
+    rows.row(0) = points[i].x() * cams_from_world[i].row(2) - cams_from_world[i].row(0);
+    rows.row(1) = points[i].y() * cams_from_world[i].row(2) - cams_from_world[i].row(1);
+    A += rows.transpose() * rows;
+  }
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix4d> solver(A);
+  return solver.eigenvectors().col(0).hnormalized();
+}
+
 double CalculateTriangulationAngle(const Eigen::Vector3d& proj_center1,
                                    const Eigen::Vector3d& proj_center2,
                                    const Eigen::Vector3d& point3D) {

@@ -2,6 +2,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <vector>
 
 namespace tessera {
 
@@ -12,6 +13,13 @@ namespace tessera {
 Eigen::Vector3d TriangulatePoint(const Eigen::Matrix<double, 3, 4>& cam1_from_world,
                                  const Eigen::Matrix<double, 3, 4>& cam2_from_world,
                                  const Eigen::Vector2d& point1, const Eigen::Vector2d& point2);
+
+// 3D point from its observations in two or more views, by the direct linear transform
+// over all of them (least squares on the 2N x 4 system): the multi-view counterpart of
+// TriangulatePoint, for a feature track seen by every registered image of it.
+Eigen::Vector3d TriangulateMultiViewPoint(
+    const std::vector<Eigen::Matrix<double, 3, 4>>& cams_from_world,
+    const std::vector<Eigen::Vector2d>& points);
 
 // Angle (radians) between the rays from two projection centres to a 3D point; of the
 // two angles the rays make, the smaller, since both very acute (far points) and very

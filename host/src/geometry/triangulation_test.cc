@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include "estimators/synthetic_scene_test_util.h"
+#include "util/random.h"
 
 namespace tessera {
 namespace {
@@ -53,6 +56,45 @@ TEST(CalculateTriangulationAngle, RightAngleAndSymmetry) {
   EXPECT_EQ(CalculateTriangulationAngle(Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 0, 0),
                                         Eigen::Vector3d::Zero()),
             0.0);
+}
+
+}  // namespace
+}  // namespace tessera
+
+namespace tessera {
+namespace {
+
+// Five cameras on an arc looking at a point; noise of 1e-3 (1 px at f = 1000 px).
+TEST(TriangulateMultiViewPoint, RecoversThePointFromManyNoisyViewsBetterThanFromTwo) {
+  const Eigen::Vector3d point(0.2, -0.1, 8);
+  std::vector<Eigen::Matrix<double, 3, 4>> cams_from_world;
+  std::vector<Eigen::Vector2d> exact, noisy;
+  RandomEngine engine(3);
+  std::normal_distribution<double> noise(0, 1e-3);
+  for (int i = 0; i < 5; ++i) {
+    const double angle = -0.3 + 0.15 * i;
+    const Eigen::Matrix3d rotation =
+        Eigen::AngleAxisd(angle, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    const Eigen::Vector3d center(8 * std::sin(angle), 0, 8 - 8 * std::cos(angle));
+    Eigen::Matrix<double, 3, 4> cam_from_world;
+    cam_from_world << rotation.transpose(), -rotation.transpose() * center;
+    cams_from_world.push_back(cam_from_world);
+    exact.push_back((cam_from_world * point.homogeneous()).hnormalized());
+    noisy.push_back(exact.back() + Eigen::Vector2d(noise(engine), noise(engine)));
+  }
+  EXPECT_LT((TriangulateMultiViewPoint(cams_from_world, exact) - point).norm(), 1e-9);
+  const double error_all = (TriangulateMultiViewPoint(cams_from_world, noisy) - point).norm();
+  const double error_two =
+      (TriangulatePoint(cams_from_world[0], cams_from_world[1], noisy[0], noisy[1]) - point).norm();
+  EXPECT_LT(error_all, 0.05);
+  EXPECT_LT(error_all, error_two);
+  // Two views give the two-view DLT's answer.
+  const Eigen::Vector3d two_views = TriangulateMultiViewPoint(
+      {cams_from_world[0], cams_from_world[3]}, {noisy[0], noisy[3]});
+  EXPECT_LT((two_views - TriangulatePoint(cams_from_world[0], cams_from_world[3], noisy[0],
+                                          noisy[3]))
+                .norm(),
+            1e-9);
 }
 
 }  // namespace
