@@ -1,0 +1,74 @@
+#pragma once
+
+// The incremental mapper: from verified matches to one or more models of cameras,
+// poses and 3D points, after COLMAP's IncrementalMapper (Schonberger and Frahm, CVPR
+// 2016) with union-find feature tracks (one track, one 3D point).
+//
+//   tracks -> initial pair (relative pose, triangulation, global BA)
+//          -> repeat: next best view, P3P/EPnP LO-RANSAC registration, triangulation
+//             of its tracks, local BA, filtering; global BA as the model grows
+//          -> final rounds of track completion and merging, retriangulation, global BA
+//          -> further models from the images left, while any pair of them initialises
+//
+// Every random choice is seeded from the run's seed and the image or pair it serves,
+// and every loop runs in id order, so the same input and seed give the same models.
+
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "sfm/feature_tracks.h"
+#include "sfm/incremental_mapper_options.h"
+#include "tessera/bundle_adjuster.h"
+#include "tessera/reconstruction.h"
+#include "tessera/two_view_geometry.h"
+
+namespace tessera {
+
+// What the mapper starts from: every camera, every image with its keypoints in
+// points2D (poses unknown), and the verified geometry of each image pair.
+struct MapperInput {
+  std::map<camera_t, Camera> cameras;
+  std::map<image_t, Image> images;
+  struct Pair {
+    image_t image_id1 = kInvalidImageId;
+    image_t image_id2 = kInvalidImageId;
+    TwoViewGeometry geometry;  // inlier_matches index image_id1's then image_id2's keypoints
+  };
+  std::vector<Pair> pairs;
+};
+
+struct MapperResult {
+  // Largest first (most registered images, then most points).
+  std::vector<Reconstruction> models;
+  // Why each image that is in no model was left out.
+  std::map<image_t, std::string> unregistered_reasons;
+  size_t num_tracks = 0;
+  size_t num_refused_matches = 0;
+  int num_global_ba = 0;
+  int num_local_ba = 0;
+  double seconds = 0;
+};
+
+class IncrementalMapper {
+ public:
+  // `bundle_adjuster` must outlive the mapper.
+  IncrementalMapper(const IncrementalMapperOptions& options, const BundleAdjuster& bundle_adjuster,
+                    uint64_t seed);
+
+  MapperResult Reconstruct(const MapperInput& input) const;
+
+ private:
+  IncrementalMapperOptions options_;
+  const BundleAdjuster& bundle_adjuster_;
+  uint64_t seed_;
+};
+
+// Mean reprojection error (px) over all observations of a model's points, and the mean
+// number of observations per point; 0 for an empty model.
+double MeanReprojectionError(const Reconstruction& reconstruction);
+double MeanTrackLength(const Reconstruction& reconstruction);
+size_t NumObservations(const Reconstruction& reconstruction);
+
+}  // namespace tessera

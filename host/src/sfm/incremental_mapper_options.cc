@@ -1,0 +1,71 @@
+#include "sfm/incremental_mapper_options.h"
+
+#include "tessera/options.h"
+
+namespace tessera {
+
+IncrementalMapperOptions IncrementalMapperOptions::FromJson(const nlohmann::json& json) {
+  IncrementalMapperOptions o;
+  OptionReader reader(json, "mapper");
+  o.min_num_matches = reader.Get<int>("min_num_matches", o.min_num_matches, 5, 100000);
+  o.init_min_num_inliers = reader.Get<int>("init_min_num_inliers", o.init_min_num_inliers, 8, 1000000);
+  o.init_min_tri_angle = reader.Get<double>("init_min_tri_angle", o.init_min_tri_angle, 0.0, 90.0);
+  o.init_max_error = reader.Get<double>("init_max_error", o.init_max_error, 1e-3, 1000.0);
+  o.init_max_num_trials = reader.Get<int>("init_max_num_trials", o.init_max_num_trials, 1, 100000);
+  o.abs_pose_max_error = reader.Get<double>("abs_pose_max_error", o.abs_pose_max_error, 1e-3, 1000.0);
+  o.abs_pose_min_num_inliers =
+      reader.Get<int>("abs_pose_min_num_inliers", o.abs_pose_min_num_inliers, 4, 1000000);
+  o.abs_pose_min_inlier_ratio =
+      reader.Get<double>("abs_pose_min_inlier_ratio", o.abs_pose_min_inlier_ratio, 0.0, 1.0);
+  o.max_reg_trials = reader.Get<int>("max_reg_trials", o.max_reg_trials, 1, 1000);
+  o.tri_max_error = reader.Get<double>("tri_max_error", o.tri_max_error, 1e-3, 1000.0);
+  o.tri_min_angle = reader.Get<double>("tri_min_angle", o.tri_min_angle, 0.0, 90.0);
+  o.filter_max_reproj_error =
+      reader.Get<double>("filter_max_reproj_error", o.filter_max_reproj_error, 1e-3, 1000.0);
+  o.filter_min_tri_angle =
+      reader.Get<double>("filter_min_tri_angle", o.filter_min_tri_angle, 0.0, 90.0);
+  o.local_ba_num_images = reader.Get<int>("local_ba_num_images", o.local_ba_num_images, 2, 1000);
+  o.ba_global_images_ratio =
+      reader.Get<double>("ba_global_images_ratio", o.ba_global_images_ratio, 1.0, 100.0);
+  o.ba_global_points_ratio =
+      reader.Get<double>("ba_global_points_ratio", o.ba_global_points_ratio, 1.0, 100.0);
+  o.ba_global_max_refinements =
+      reader.Get<int>("ba_global_max_refinements", o.ba_global_max_refinements, 0, 100);
+  o.ba_refine_focal_length = reader.GetBool("ba_refine_focal_length", o.ba_refine_focal_length);
+  o.ba_refine_principal_point =
+      reader.GetBool("ba_refine_principal_point", o.ba_refine_principal_point);
+  o.ba_refine_extra_params = reader.GetBool("ba_refine_extra_params", o.ba_refine_extra_params);
+  o.multiple_models = reader.GetBool("multiple_models", o.multiple_models);
+  o.max_num_models = reader.Get<int>("max_num_models", o.max_num_models, 1, 100000);
+  o.min_model_size = reader.Get<int>("min_model_size", o.min_model_size, 2, 1000000);
+  reader.Finish();
+  return o;
+}
+
+nlohmann::json IncrementalMapperOptions::ToJson() const {
+  return {{"min_num_matches", min_num_matches},
+          {"init_min_num_inliers", init_min_num_inliers},
+          {"init_min_tri_angle", init_min_tri_angle},
+          {"init_max_error", init_max_error},
+          {"init_max_num_trials", init_max_num_trials},
+          {"abs_pose_max_error", abs_pose_max_error},
+          {"abs_pose_min_num_inliers", abs_pose_min_num_inliers},
+          {"abs_pose_min_inlier_ratio", abs_pose_min_inlier_ratio},
+          {"max_reg_trials", max_reg_trials},
+          {"tri_max_error", tri_max_error},
+          {"tri_min_angle", tri_min_angle},
+          {"filter_max_reproj_error", filter_max_reproj_error},
+          {"filter_min_tri_angle", filter_min_tri_angle},
+          {"local_ba_num_images", local_ba_num_images},
+          {"ba_global_images_ratio", ba_global_images_ratio},
+          {"ba_global_points_ratio", ba_global_points_ratio},
+          {"ba_global_max_refinements", ba_global_max_refinements},
+          {"ba_refine_focal_length", ba_refine_focal_length},
+          {"ba_refine_principal_point", ba_refine_principal_point},
+          {"ba_refine_extra_params", ba_refine_extra_params},
+          {"multiple_models", multiple_models},
+          {"max_num_models", max_num_models},
+          {"min_model_size", min_model_size}};
+}
+
+}  // namespace tessera

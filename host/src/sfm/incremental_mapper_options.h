@@ -1,0 +1,60 @@
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+namespace tessera {
+
+// Settings of the incremental mapper: the manifest's "mapper" object. Names and
+// defaults follow COLMAP's IncrementalMapper options where there is one.
+struct IncrementalMapperOptions {
+  // Pairs with fewer verified inliers do not take part.
+  int min_num_matches = 15;
+
+  // Initial pair: at least this many triangulated points, and a median triangulation
+  // angle (degrees) of at least init_min_tri_angle; up to init_max_num_trials pairs,
+  // the ones with most inliers first, are evaluated per model.
+  int init_min_num_inliers = 100;
+  double init_min_tri_angle = 16.0;
+  double init_max_error = 4.0;  // px, relative pose RANSAC and triangulation
+  int init_max_num_trials = 30;
+
+  // Registration of a new image by P3P/EPnP LO-RANSAC.
+  double abs_pose_max_error = 12.0;  // px
+  int abs_pose_min_num_inliers = 30;
+  double abs_pose_min_inlier_ratio = 0.25;
+  // Failed registrations of one image before it is given up for the model.
+  int max_reg_trials = 3;
+
+  // Triangulation of new points and completion of tracks.
+  double tri_max_error = 4.0;    // px, every observation
+  double tri_min_angle = 1.5;    // degrees, largest angle between two of the rays
+
+  // Filtering after bundle adjustment.
+  double filter_max_reproj_error = 4.0;  // px
+  double filter_min_tri_angle = 1.5;     // degrees
+
+  // Local bundle adjustment: the new image and its most connected neighbours.
+  int local_ba_num_images = 6;
+  // Global bundle adjustment whenever the model has grown by these ratios since the last.
+  double ba_global_images_ratio = 1.1;
+  double ba_global_points_ratio = 1.1;
+  // Rounds of (complete and merge tracks, retriangulate, global BA, filter) at the end.
+  int ba_global_max_refinements = 3;
+  bool ba_refine_focal_length = true;
+  bool ba_refine_principal_point = false;
+  bool ba_refine_extra_params = true;
+
+  // Further models from the images the first could not take.
+  bool multiple_models = true;
+  int max_num_models = 50;
+  // Models with fewer registered images are dropped.
+  int min_model_size = 3;
+
+  // Reads the manifest's "mapper" object; unknown keys and out-of-range values throw
+  // OptionError naming "mapper.<key>".
+  static IncrementalMapperOptions FromJson(const nlohmann::json& json);
+  // Every option with its value, for provenance and logs.
+  nlohmann::json ToJson() const;
+};
+
+}  // namespace tessera

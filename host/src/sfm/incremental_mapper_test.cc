@@ -1,0 +1,175 @@
+#include "sfm/incremental_mapper.h"
+
+#include <gtest/gtest.h>
+
+#include "eval/evaluation.h"
+#include "sfm/synthetic_scene_test_util.h"
+#include "test_support.h"
+#include "tessera/errors.h"
+
+namespace tessera {
+namespace {
+
+using testing::MakeSyntheticScene;
+using testing::SyntheticScene;
+using testing::SyntheticSceneOptions;
+
+const BundleAdjuster& Adjuster() {
+  static const auto adjuster = testing::LoadBundledPlugin<BundleAdjuster>(
+      "bundle_adjuster", "ceres", {{"num_threads", 1}});
+  return *adjuster;
+}
+
+MapperResult Map(const SyntheticScene& scene, IncrementalMapperOptions options = {},
+                 uint64_t seed = 0) {
+  return IncrementalMapper(options, Adjuster(), seed).Reconstruct(scene.input);
+}
+
+// Every observation of every point is a keypoint of one and the same true point.
+void ExpectTracksAreTrue(const SyntheticScene& scene, const Reconstruction& model) {
+  size_t num_wrong = 0;
+  for (const auto& [point3D_id, point3D] : model.points3D) {
+    std::set<int> true_points;
+    for (const TrackElement& element : point3D.track) {
+      true_points.insert(scene.true_point_of_keypoint.at(element.image_id)[element.point2D_idx]);
+    }
+    if (true_points.size() != 1 || *true_points.begin() < 0) ++num_wrong;
+  }
+  EXPECT_EQ(num_wrong, 0u) << "points whose track mixes true points or clutter";
+}
+
+TEST(IncrementalMapper, RecoversASyntheticSceneWithNoise) {
+  SyntheticSceneOptions options;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const MapperResult result = Map(scene);
+  ASSERT_EQ(result.models.size(), 1u);
+  const Reconstruction& model = result.models[0];
+  EXPECT_EQ(model.images.size(), scene.input.images.size());
+  EXPECT_TRUE(result.unregistered_reasons.empty());
+  const EvaluationResult evaluation = EvaluateReconstruction(model, scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  // 0.5 px noise at 1000 px focal length and 10 units distance: 5e-3 units per pixel of
+  // error along the image plane; the cameras end up within a fraction of that.
+  EXPECT_LT(evaluation.position_error_max, 0.01);
+  EXPECT_LT(evaluation.rotation_error_max_deg, 0.05);
+  EXPECT_LT(MeanReprojectionError(model), 0.8);
+  EXPECT_GT(model.points3D.size(), 0.9 * options.num_points);
+  ExpectTracksAreTrue(scene, model);
+}
+
+TEST(IncrementalMapper, FiltersTwoPercentOutlierMatches) {
+  SyntheticSceneOptions options;
+  options.outlier_ratio = 0.02;
+  options.seed = 2;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  ASSERT_GT(scene.num_outlier_matches, 100u);
+  const MapperResult result = Map(scene);
+  ASSERT_EQ(result.models.size(), 1u);
+  const Reconstruction& model = result.models[0];
+  EXPECT_EQ(model.images.size(), scene.input.images.size());
+  ExpectTracksAreTrue(scene, model);
+  const EvaluationResult evaluation = EvaluateReconstruction(model, scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  EXPECT_LT(evaluation.position_error_max, 0.01);
+  EXPECT_LT(MeanReprojectionError(model), 0.8);
+  EXPECT_GT(result.num_refused_matches, 0u);
+}
+
+TEST(IncrementalMapper, RefinesAWrongFocalLengthPriorAndDistortion) {
+  SyntheticSceneOptions options;
+  options.k1 = -0.05;
+  options.prior_focal_factor = 1.1;
+  options.seed = 3;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const MapperResult result = Map(scene);
+  ASSERT_EQ(result.models.size(), 1u);
+  const Reconstruction& model = result.models[0];
+  EXPECT_EQ(model.images.size(), scene.input.images.size());
+  const Camera& camera = model.cameras.at(1);
+  EXPECT_NEAR(camera.FocalLengthX(), options.focal_length, 0.005 * options.focal_length);
+  EXPECT_NEAR(camera.params[3], options.k1, 0.005);
+  const EvaluationResult evaluation = EvaluateReconstruction(model, scene.GroundTruth());
+  EXPECT_LT(evaluation.position_error_max, 0.02);
+}
+
+TEST(IncrementalMapper, DisconnectedGroupsBecomeSeparateModelsLargestFirst) {
+  // Two scenes of 5 and 8 images with no match between them: ids 1-5 and 6-13.
+  SyntheticSceneOptions small_options;
+  small_options.num_images = 5;
+  small_options.seed = 4;
+  SyntheticSceneOptions large_options;
+  large_options.num_images = 8;
+  large_options.seed = 5;
+  SyntheticScene scene = MakeSyntheticScene(small_options);
+  const SyntheticScene large = MakeSyntheticScene(large_options);
+  const image_t offset = 5;
+  for (const auto& [image_id, image] : large.input.images) {
+    Image shifted = image;
+    shifted.image_id = image_id + offset;
+    shifted.name = "large_" + image.name;
+    scene.input.images[shifted.image_id] = shifted;
+  }
+  for (MapperInput::Pair pair : large.input.pairs) {
+    pair.image_id1 += offset;
+    pair.image_id2 += offset;
+    scene.input.pairs.push_back(pair);
+  }
+  // And one image that matches nothing.
+  Image lonely = scene.input.images.at(1);
+  lonely.image_id = 100;
+  lonely.name = "lonely.png";
+  scene.input.images[100] = lonely;
+
+  const MapperResult result = Map(scene);
+  ASSERT_EQ(result.models.size(), 2u);
+  EXPECT_EQ(result.models[0].images.size(), 8u);
+  EXPECT_EQ(result.models[1].images.size(), 5u);
+  EXPECT_EQ(result.models[0].images.begin()->first, 6u);
+  ASSERT_EQ(result.unregistered_reasons.size(), 1u);
+  EXPECT_EQ(result.unregistered_reasons.at(100),
+            "no verified pair with at least 15 inlier matches");
+
+  IncrementalMapperOptions single;
+  single.multiple_models = false;
+  EXPECT_EQ(Map(scene, single).models.size(), 1u);
+}
+
+TEST(IncrementalMapper, SameSeedSameModel) {
+  SyntheticSceneOptions options;
+  options.outlier_ratio = 0.02;
+  options.num_images = 8;
+  options.seed = 6;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const MapperResult a = Map(scene, {}, 7);
+  const MapperResult b = Map(scene, {}, 7);
+  ASSERT_EQ(a.models.size(), 1u);
+  ASSERT_EQ(b.models.size(), 1u);
+  const Reconstruction& model_a = a.models[0];
+  const Reconstruction& model_b = b.models[0];
+  ASSERT_EQ(model_a.points3D.size(), model_b.points3D.size());
+  for (const auto& [image_id, image] : model_a.images) {
+    const Image& other = model_b.images.at(image_id);
+    EXPECT_EQ(image.cam_from_world.translation, other.cam_from_world.translation);
+    EXPECT_EQ(image.cam_from_world.rotation.coeffs(), other.cam_from_world.rotation.coeffs());
+  }
+  for (const auto& [point3D_id, point3D] : model_a.points3D) {
+    EXPECT_EQ(point3D.xyz, model_b.points3D.at(point3D_id).xyz);
+  }
+}
+
+TEST(IncrementalMapperOptions, UnknownKeysAndBadValuesNameTheField) {
+  EXPECT_EQ(IncrementalMapperOptions::FromJson(nlohmann::json::object()).init_min_tri_angle, 16.0);
+  try {
+    IncrementalMapperOptions::FromJson({{"init_min_tri_angel", 8}});
+    FAIL();
+  } catch (const OptionError& error) {
+    EXPECT_NE(std::string(error.what()).find("mapper.init_min_tri_angel"), std::string::npos);
+    EXPECT_NE(std::string(error.what()).find("did you mean 'init_min_tri_angle'"),
+              std::string::npos);
+  }
+  EXPECT_THROW(IncrementalMapperOptions::FromJson({{"abs_pose_min_num_inliers", 2}}), OptionError);
+  EXPECT_THROW(IncrementalMapperOptions::FromJson({{"multiple_models", 1}}), OptionError);
+}
+
+}  // namespace
+}  // namespace tessera

@@ -1,0 +1,179 @@
+#pragma once
+
+// Test helper (header only): a synthetic multi-view scene with known truth for the
+// mapper. Cameras on an arc around a cloud of points, all looking at its centre; the
+// keypoints are the projected points (with Gaussian noise, in shuffled order, plus
+// unmatched clutter) and every pair of images gets the matches of the points both see,
+// a chosen fraction of them replaced by wrong matches.
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "eval/ground_truth.h"
+#include "sfm/incremental_mapper.h"
+#include "util/random.h"
+
+namespace tessera::testing {
+
+struct SyntheticSceneOptions {
+  int num_images = 12;
+  int num_points = 1500;
+  double arc_deg = 120;        // the cameras' spread around the scene
+  double radius = 10;          // distance of the cameras from the scene centre
+  double scene_size = 4;       // side of the cube of points
+  double focal_length = 1000;  // px
+  int width = 1600, height = 1200;
+  double k1 = 0.0;  // SIMPLE_RADIAL distortion of the true camera
+  double noise_px = 0.5;
+  // Fraction of each pair's matches replaced by a match to a random keypoint.
+  double outlier_ratio = 0.0;
+  // Pairs sharing fewer points get no matches; a pair whose images are further apart
+  // than this many positions on the arc gets none either (0: no limit).
+  int min_num_matches = 30;
+  int max_pair_gap = 0;
+  // Focal length given to the mapper, as a factor of the true one (a wrong prior).
+  double prior_focal_factor = 1.0;
+  uint64_t seed = 1;
+};
+
+struct SyntheticScene {
+  MapperInput input;
+  std::map<image_t, Rigid3d> true_cam_from_world;
+  std::vector<Eigen::Vector3d> true_points3D;
+  // For each image, the true point of each keypoint (-1 for clutter).
+  std::map<image_t, std::vector<int>> true_point_of_keypoint;
+  size_t num_outlier_matches = 0;
+
+  std::map<std::string, GroundTruthPose> GroundTruth() const {
+    std::map<std::string, GroundTruthPose> poses;
+    for (const auto& [image_id, cam_from_world] : true_cam_from_world) {
+      GroundTruthPose pose;
+      pose.R_cam_from_world = cam_from_world.rotation.toRotationMatrix();
+      pose.center_in_world = cam_from_world.Inverse().translation;
+      poses[input.images.at(image_id).name] = pose;
+    }
+    return poses;
+  }
+};
+
+inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
+  RandomEngine engine(options.seed);
+  std::uniform_real_distribution<double> unit(-0.5, 0.5);
+  std::normal_distribution<double> noise(0.0, options.noise_px);
+  SyntheticScene scene;
+
+  Camera true_camera = Camera::Create(1, CameraModelId::kSimpleRadial, options.focal_length,
+                                      options.width, options.height);
+  true_camera.params[3] = options.k1;
+  Camera prior_camera = true_camera;
+  prior_camera.params[0] = options.focal_length * options.prior_focal_factor;
+  prior_camera.params[3] = 0;
+  prior_camera.has_prior_focal_length = true;
+  scene.input.cameras[1] = prior_camera;
+
+  for (int i = 0; i < options.num_points; ++i) {
+    scene.true_points3D.emplace_back(options.scene_size * unit(engine),
+                                     options.scene_size * unit(engine),
+                                     options.scene_size * unit(engine));
+  }
+
+  for (int i = 0; i < options.num_images; ++i) {
+    const image_t image_id = static_cast<image_t>(i + 1);
+    const double angle = (options.arc_deg * M_PI / 180) *
+                         (options.num_images > 1 ? static_cast<double>(i) / (options.num_images - 1) - 0.5 : 0);
+    // Centre on the arc (y is down, the arc lies in the x-z plane), looking at the origin
+    // with a little random jitter of the viewing direction.
+    const Eigen::Vector3d center(options.radius * std::sin(angle), 0.3 * unit(engine),
+                                 -options.radius * std::cos(angle));
+    const Eigen::Vector3d z_axis = (-center + Eigen::Vector3d(0.2 * unit(engine), 0.2 * unit(engine), 0)).normalized();
+    const Eigen::Vector3d x_axis = Eigen::Vector3d::UnitY().cross(z_axis).normalized();
+    const Eigen::Vector3d y_axis = z_axis.cross(x_axis);
+    Eigen::Matrix3d world_from_cam;
+    world_from_cam << x_axis, y_axis, z_axis;
+    const Eigen::Quaterniond cam_from_world_rotation(world_from_cam.transpose());
+    const Rigid3d cam_from_world(cam_from_world_rotation, cam_from_world_rotation * -center);
+    scene.true_cam_from_world[image_id] = cam_from_world;
+
+    Image image;
+    image.image_id = image_id;
+    image.camera_id = 1;
+    image.name = "synthetic_" + std::to_string(image_id) + ".png";
+    std::vector<std::pair<Eigen::Vector2d, int>> keypoints;
+    for (int p = 0; p < options.num_points; ++p) {
+      const Eigen::Vector3d point_in_cam = cam_from_world * scene.true_points3D[p];
+      if (point_in_cam.z() <= 0.1) continue;
+      Eigen::Vector2d xy = true_camera.ImgFromCam(point_in_cam);
+      xy += Eigen::Vector2d(noise(engine), noise(engine));
+      if (xy.x() < 0 || xy.y() < 0 || xy.x() >= options.width || xy.y() >= options.height) continue;
+      keypoints.emplace_back(xy, p);
+    }
+    // Clutter: keypoints of nothing, a tenth as many.
+    const size_t num_clutter = keypoints.size() / 10;
+    for (size_t c = 0; c < num_clutter; ++c) {
+      keypoints.emplace_back(Eigen::Vector2d((unit(engine) + 0.5) * options.width,
+                                             (unit(engine) + 0.5) * options.height),
+                             -1);
+    }
+    std::shuffle(keypoints.begin(), keypoints.end(), engine);
+    std::vector<int>& true_point = scene.true_point_of_keypoint[image_id];
+    for (const auto& [xy, p] : keypoints) {
+      Point2D point2D;
+      point2D.xy = xy;
+      image.points2D.push_back(point2D);
+      true_point.push_back(p);
+    }
+    scene.input.images[image_id] = image;
+  }
+
+  for (const auto& [image_id1, image1] : scene.input.images) {
+    std::map<int, point2D_t> keypoint_of_point1;
+    const std::vector<int>& true1 = scene.true_point_of_keypoint.at(image_id1);
+    for (point2D_t idx = 0; idx < true1.size(); ++idx) {
+      if (true1[idx] >= 0) keypoint_of_point1[true1[idx]] = idx;
+    }
+    for (const auto& [image_id2, image2] : scene.input.images) {
+      if (image_id2 <= image_id1) continue;
+      if (options.max_pair_gap > 0 && static_cast<int>(image_id2 - image_id1) > options.max_pair_gap) {
+        continue;
+      }
+      const std::vector<int>& true2 = scene.true_point_of_keypoint.at(image_id2);
+      FeatureMatches matches;
+      for (point2D_t idx2 = 0; idx2 < true2.size(); ++idx2) {
+        const auto it = keypoint_of_point1.find(true2[idx2]);
+        if (true2[idx2] >= 0 && it != keypoint_of_point1.end()) matches.push_back({it->second, idx2});
+      }
+      if (matches.size() < static_cast<size_t>(options.min_num_matches)) continue;
+      std::sort(matches.begin(), matches.end(), [](const FeatureMatch& a, const FeatureMatch& b) {
+        return a.point2D_idx1 < b.point2D_idx1;
+      });
+      std::uniform_int_distribution<point2D_t> any_keypoint2(0, static_cast<point2D_t>(true2.size() - 1));
+      const size_t num_outliers = static_cast<size_t>(std::round(options.outlier_ratio * matches.size()));
+      std::vector<size_t> order(matches.size());
+      std::iota(order.begin(), order.end(), 0);
+      std::shuffle(order.begin(), order.end(), engine);
+      for (size_t k = 0; k < num_outliers; ++k) {
+        FeatureMatch& match = matches[order[k]];
+        point2D_t wrong = any_keypoint2(engine);
+        while (true2[wrong] >= 0 && true2[wrong] == true1[match.point2D_idx1]) wrong = any_keypoint2(engine);
+        match.point2D_idx2 = wrong;
+        ++scene.num_outlier_matches;
+      }
+      MapperInput::Pair pair;
+      pair.image_id1 = image_id1;
+      pair.image_id2 = image_id2;
+      pair.geometry.config = TwoViewGeometry::CALIBRATED;
+      pair.geometry.inlier_matches = std::move(matches);
+      scene.input.pairs.push_back(std::move(pair));
+    }
+  }
+  return scene;
+}
+
+}  // namespace tessera::testing
