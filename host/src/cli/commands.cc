@@ -4,7 +4,8 @@ namespace tessera {
 
 std::vector<CommandRegistration> RegisterCommands(CLI::App& app, const GlobalOptions& global) {
   return {RegisterRunCommand(app, global), RegisterExtractCommand(app, global),
-          RegisterMatchCommand(app, global), RegisterEvalCommand(app, global),
+          RegisterMatchCommand(app, global), RegisterMapCommand(app, global),
+          RegisterEvalCommand(app, global),
           RegisterPluginsCommand(app, global)};
 }
 

@@ -25,6 +25,7 @@ CommandRegistration RegisterPluginsCommand(CLI::App& app, const GlobalOptions& g
 CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterExtractCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterMatchCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera

@@ -7,6 +7,7 @@ enum ExitCode : int {
   kExitSuccess = 0,
   kExitInternalError = 1,  // a bug or an unexpected failure (please report it)
   kExitBadInput = 2,       // bad input or configuration: the message says what to fix
+  kExitNoModel = 3,        // the inputs were fine but no model could be built from them
 };
 
 }  // namespace tessera

@@ -34,6 +34,7 @@ PipelineContext PipelineContext::Create(Manifest manifest) {
       context.bundle_adjuster = context.registry.Create<BundleAdjuster>(
           "bundle_adjuster", slot.plugin, slot.options, slot.json_path);
     }
+    context.mapper_options = IncrementalMapperOptions::FromJson(manifest.mapper);
     for (const auto& slot : manifest.exporters) {
       context.exporters.push_back(
           context.registry.Create<Exporter>("exporter", slot.plugin, slot.options, slot.json_path));

@@ -5,6 +5,7 @@
 
 #include "manifest/manifest.h"
 #include "plugin/plugin_registry.h"
+#include "sfm/incremental_mapper_options.h"
 #include "tessera/sdk.h"
 
 namespace tessera {
@@ -20,6 +21,7 @@ struct PipelineContext {
   PluginInstance<Matcher> matcher;
   PluginInstance<BundleAdjuster> bundle_adjuster;
   std::vector<PluginInstance<Exporter>> exporters;
+  IncrementalMapperOptions mapper_options;  // the manifest's "mapper", checked
 
   // `manifest_file` empty: the default manifest. Throws InputError on any problem.
   static PipelineContext Create(const std::filesystem::path& manifest_file);

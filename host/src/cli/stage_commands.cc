@@ -1,4 +1,4 @@
-// The pipeline verbs: `extract`, `match` and `run` (every stage there is, in order).
+// The pipeline verbs: `extract`, `match`, `map` and `run` (every stage, in order).
 // Each loads and validates the whole manifest and every plugin before reading an image.
 
 #include <spdlog/spdlog.h>
@@ -9,7 +9,13 @@
 #include "database/database.h"
 #include "feature/feature_extraction.h"
 #include "feature/feature_matching.h"
+#include "image/point_colors.h"
+#include "scene/colmap_model_io.h"
+#include "sfm/incremental_mapper.h"
+#include "sfm/mapper_input.h"
 #include "util/timer.h"
+
+#include <fstream>
 
 namespace tessera {
 namespace {
@@ -75,7 +81,152 @@ void LogMatching(const MatchingSummary& s) {
       s.num_inlier_matches, mean_inliers, s.match_seconds, s.verify_seconds, s.seconds);
 }
 
+// The image folder: the option, else the one extract recorded in the workspace.
+std::filesystem::path ImageFolder(const std::string& option, const Database& database) {
+  if (!option.empty()) return option;
+  const auto provenance = database.ReadStageProvenance(Database::kImagesStage);
+  if (provenance && provenance->contains("folder") && provenance->at("folder").is_string()) {
+    return provenance->at("folder").get<std::string>();
+  }
+  return {};
+}
+
+// Removes sparse/<k> folders of an earlier run for k >= num_models, so that the
+// folder never mixes this run's models with stale ones.
+void RemoveStaleModels(const std::filesystem::path& sparse_dir, size_t num_models) {
+  std::error_code error;
+  if (!std::filesystem::is_directory(sparse_dir, error)) return;
+  for (const auto& entry : std::filesystem::directory_iterator(sparse_dir, error)) {
+    const std::string name = entry.path().filename().string();
+    if (!entry.is_directory() || name.empty() ||
+        name.find_first_not_of("0123456789") != std::string::npos || name.size() > 6) {
+      continue;
+    }
+    if (static_cast<size_t>(std::stoul(name)) >= num_models) {
+      spdlog::info("map: removing {} from an earlier run", entry.path().string());
+      std::filesystem::remove_all(entry.path(), error);
+    }
+  }
+}
+
+struct MappingSummary {
+  size_t num_models = 0;
+  size_t num_registered = 0;
+  size_t num_images = 0;
+  double seconds = 0;
+};
+
+// Maps the workspace's verified matches and writes every model: through the manifest's
+// exporters, or as COLMAP binary in OUTPUT/sparse/<index>/ when it lists none.
+MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
+                            const std::filesystem::path& output_dir,
+                            const std::string& image_dir_option) {
+  const Timer timer;
+  const MapperInput input = LoadMapperInput(*database);
+  if (input.pairs.empty()) {
+    throw InputError(database->path().string() +
+                     ": no verified image pairs in the workspace; run match first");
+  }
+  const IncrementalMapper mapper(context.mapper_options, *context.bundle_adjuster,
+                                 context.manifest.seed);
+  MapperResult result = mapper.Reconstruct(input);
+
+  const std::filesystem::path image_dir = ImageFolder(image_dir_option, *database);
+  if (image_dir.empty()) {
+    spdlog::warn("map: the image folder is unknown (pass --images); points are not coloured");
+  } else {
+    for (Reconstruction& model : result.models) {
+      for (const std::string& warning : ColorPointsFromImages(image_dir, &model)) {
+        spdlog::warn("map: {}", warning);
+      }
+    }
+  }
+
+  const std::filesystem::path sparse_dir = output_dir / "sparse";
+  RemoveStaleModels(sparse_dir, result.models.size());
+  nlohmann::json summary_json = {{"models", nlohmann::json::array()},
+                                 {"unregistered", nlohmann::json::array()}};
+  MappingSummary summary;
+  summary.num_images = input.images.size();
+  summary.num_models = result.models.size();
+  for (size_t index = 0; index < result.models.size(); ++index) {
+    const Reconstruction& model = result.models[index];
+    if (context.exporters.empty()) {
+      WriteColmapModel(model, sparse_dir / std::to_string(index), ColmapModelFormat::kBinary);
+    } else {
+      for (const auto& exporter : context.exporters) {
+        exporter->Export(model, {output_dir, image_dir, static_cast<int>(index)});
+      }
+    }
+    summary.num_registered += model.images.size();
+    nlohmann::json images = nlohmann::json::array();
+    for (const auto& [image_id, image] : model.images) images.push_back(image.name);
+    spdlog::info(
+        "map: model {}: {} images, {} points, mean track length {:.2f}, mean reprojection "
+        "error {:.3f} px",
+        index, model.images.size(), model.points3D.size(), MeanTrackLength(model),
+        MeanReprojectionError(model));
+    summary_json["models"].push_back({{"index", index},
+                                      {"folder", (sparse_dir / std::to_string(index)).string()},
+                                      {"num_images", model.images.size()},
+                                      {"num_points3D", model.points3D.size()},
+                                      {"mean_track_length", MeanTrackLength(model)},
+                                      {"mean_reprojection_error", MeanReprojectionError(model)},
+                                      {"images", images}});
+  }
+  for (const auto& [image_id, reason] : result.unregistered_reasons) {
+    const std::string& name = input.images.at(image_id).name;
+    spdlog::warn("map: {} is in no model: {}", name, reason);
+    summary_json["unregistered"].push_back({{"image", name}, {"reason", reason}});
+  }
+  summary.seconds = timer.ElapsedSeconds();
+  summary_json["seconds"] = summary.seconds;
+  summary_json["mapper_options"] = context.mapper_options.ToJson();
+  summary_json["seed"] = context.manifest.seed;
+  {
+    const std::filesystem::path file = output_dir / "mapping_summary.json";
+    const std::filesystem::path temporary = output_dir / ".mapping_summary.json.tmp";
+    std::ofstream stream(temporary);
+    stream << summary_json.dump(2) << "\n";
+    stream.close();
+    if (!stream) throw InputError(file.string() + ": cannot be written");
+    std::filesystem::rename(temporary, file);
+  }
+  spdlog::info("map: {} of {} images registered in {} model(s), {} global and {} local bundle "
+               "adjustments, {:.2f} s",
+               summary.num_registered, summary.num_images, summary.num_models,
+               result.num_global_ba, result.num_local_ba, summary.seconds);
+  return summary;
+}
+
+int MappingExitCode(const MappingSummary& summary, const std::filesystem::path& database) {
+  if (summary.num_models > 0) return kExitSuccess;
+  spdlog::error("{}: no model could be built: no pair of images initialised a model "
+                "(see the warnings above)",
+                database.string());
+  return kExitNoModel;
+}
+
 }  // namespace
+
+CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
+  auto options = std::make_shared<StageOptions>();
+  CLI::App* sub = app.add_subcommand("map", "Reconstruct cameras and points from a workspace");
+  AddCommonOptions(sub, options.get(), /*needs_images=*/false);
+  return {sub, [options]() {
+            PipelineContext context = LoadContext(*options);
+            context.Require("bundle_adjuster", "map");
+            const std::filesystem::path database_file = PrepareWorkspace(options->output);
+            if (!std::filesystem::exists(database_file)) {
+              throw InputError(database_file.string() + ": no workspace database; run extract "
+                                                        "and match first");
+            }
+            Database database(database_file);
+            const MappingSummary summary =
+                MapWorkspace(context, &database, options->output, options->images);
+            return MappingExitCode(summary, database_file);
+          }};
+}
 
 CommandRegistration RegisterExtractCommand(CLI::App& app, const GlobalOptions&) {
   auto options = std::make_shared<StageOptions>();
@@ -116,16 +267,21 @@ CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions&) {
             context.Require("detector", "extract");
             context.Require("pair_selector", "match");
             context.Require("matcher", "match");
-            Database database(PrepareWorkspace(options->output));
+            context.Require("bundle_adjuster", "map");
+            const std::filesystem::path database_file = PrepareWorkspace(options->output);
+            Database database(database_file);
             const ExtractionSummary extraction =
                 ExtractFeatures(options->images, context.manifest, context.detector, &database);
             const MatchingSummary matching =
                 MatchFeatures(context.manifest, context.pair_selector, context.matcher, &database);
             LogExtraction(extraction);
             LogMatching(matching);
-            spdlog::info("run: extract {:.2f} s, match {:.2f} s, total {:.2f} s",
-                         extraction.seconds, matching.seconds, timer.ElapsedSeconds());
-            return static_cast<int>(kExitSuccess);
+            const MappingSummary mapping =
+                MapWorkspace(context, &database, options->output, options->images);
+            spdlog::info("run: extract {:.2f} s, match {:.2f} s, map {:.2f} s, total {:.2f} s",
+                         extraction.seconds, matching.seconds, mapping.seconds,
+                         timer.ElapsedSeconds());
+            return MappingExitCode(mapping, database_file);
           }};
 }
 

@@ -36,6 +36,9 @@ class Database {
   static constexpr const char* kFeaturesStage = "features";
   static constexpr const char* kMatchesStage = "matches";
   static constexpr const char* kTwoViewGeometriesStage = "two_view_geometries";
+  // Not a table: the image folder the images table was filled from, {"folder": path},
+  // so that later stages (point colours, exporters) find the images.
+  static constexpr const char* kImagesStage = "images";
 
   // Opens or creates the database at `path` and creates missing tables. Throws
   // InputError naming the file if it cannot be opened or is not a SQLite database /

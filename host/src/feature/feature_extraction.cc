@@ -86,6 +86,9 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
     database->ClearKeypointsAndDescriptors();
   }
   database->WriteStageProvenance(Database::kFeaturesStage, provenance);
+  database->WriteStageProvenance(
+      Database::kImagesStage,
+      {{"folder", std::filesystem::absolute(image_dir).lexically_normal().string()}});
 
   const std::vector<Image> images = RegisterImages(scan, manifest.camera, database);
   std::vector<size_t> todo;
