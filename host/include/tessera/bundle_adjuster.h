@@ -23,6 +23,9 @@ struct BundleAdjustmentConfig {
   // Fix the gauge: the first pose entirely and one translation coordinate of the
   // second, as COLMAP does, when no pose is constant otherwise.
   bool fix_gauge = true;
+  // Iterations at most for this call (e.g. fewer for local BA); 0: the adjuster's own
+  // setting.
+  int max_num_iterations = 0;
 };
 
 struct BundleAdjustmentSummary {

@@ -110,7 +110,9 @@ class ModelBuilder {
   bool RegisterImage(image_t image_id);
   void TriangulateImage(image_t image_id);
   bool TriangulateTrack(track_t track_id, double max_error);
-  void LocalBundleAdjustment(image_t image_id);
+  // Returns true when the local problem held every registered image with a free pose,
+  // i.e. it was a global bundle adjustment.
+  bool LocalBundleAdjustment(image_t image_id);
   void GlobalBundleAdjustment();
   void GlobalRefinement();
   size_t CompleteTracks(const std::set<point3D_t>& point3D_ids);
@@ -170,6 +172,7 @@ class ModelBuilder {
   std::map<image_t, int> num_registration_trials_;
   size_t num_images_at_global_ba_ = 0;
   size_t num_points_at_global_ba_ = 0;
+  bool changed_since_global_ba_ = false;
 };
 
 ////////////////////////////////////////////////////////////////////////////////
@@ -703,7 +706,7 @@ BundleAdjustmentConfig ModelBuilder::MakeBundleAdjustmentConfig() const {
   return config;
 }
 
-void ModelBuilder::LocalBundleAdjustment(image_t image_id) {
+bool ModelBuilder::LocalBundleAdjustment(image_t image_id) {
   // The neighbours that share most points with the new image.
   std::map<image_t, size_t> num_shared;
   std::set<point3D_t> local_points;
@@ -749,6 +752,7 @@ void ModelBuilder::LocalBundleAdjustment(image_t image_id) {
     }
   }
   config.constant_poses = constant_images;
+  config.max_num_iterations = options_.ba_local_max_num_iterations;
   for (const point3D_t point3D_id : local_points) local.points3D[point3D_id] = rec_.points3D.at(point3D_id);
 
   const BundleAdjustmentSummary summary = run_.bundle_adjuster.Adjust(config, &local);
@@ -769,11 +773,13 @@ void ModelBuilder::LocalBundleAdjustment(image_t image_id) {
   }
   CompleteTracks(local_points);
   FilterPoints(local_points);
+  return summary.usable && constant_images.empty() && local_images.size() == registered_.size();
 }
 
 void ModelBuilder::GlobalBundleAdjustment() {
   BundleAdjustmentConfig config = MakeBundleAdjustmentConfig();
   config.images = registered_;
+  config.max_num_iterations = options_.ba_global_max_num_iterations;
   const BundleAdjustmentSummary summary = run_.bundle_adjuster.Adjust(config, &rec_);
   ++run_.num_global_ba;
   spdlog::debug("map: global BA of {} images, {} points: {}", registered_.size(),
@@ -784,6 +790,7 @@ void ModelBuilder::GlobalBundleAdjustment() {
   std::set<point3D_t> all_points;
   for (const auto& [point3D_id, point3D] : rec_.points3D) all_points.insert(point3D_id);
   FilterPoints(all_points);
+  changed_since_global_ba_ = false;
   num_images_at_global_ba_ = registered_.size();
   num_points_at_global_ba_ = rec_.points3D.size();
 }
@@ -814,15 +821,22 @@ void ModelBuilder::Grow() {
       }
     }
     if (next_image == kInvalidImageId) {
-      // A global refinement may add the points a failed image needed; once.
-      if (refined_since_failure) break;
+      // A global refinement may add the points a failed image needed; once, and only
+      // when the model changed since the last one.
+      if (refined_since_failure || !changed_since_global_ba_) break;
       GlobalRefinement();
       refined_since_failure = true;
       continue;
     }
     refined_since_failure = false;
+    changed_since_global_ba_ = true;
     TriangulateImage(next_image);
-    LocalBundleAdjustment(next_image);
+    if (LocalBundleAdjustment(next_image)) {
+      // Small models: the local problem was the whole model.
+      num_images_at_global_ba_ = registered_.size();
+      num_points_at_global_ba_ = rec_.points3D.size();
+      continue;
+    }
     if (registered_.size() >= options_.ba_global_images_ratio * num_images_at_global_ba_ ||
         rec_.points3D.size() >= options_.ba_global_points_ratio * num_points_at_global_ba_) {
       GlobalRefinement();

@@ -25,6 +25,10 @@ IncrementalMapperOptions IncrementalMapperOptions::FromJson(const nlohmann::json
   o.filter_min_tri_angle =
       reader.Get<double>("filter_min_tri_angle", o.filter_min_tri_angle, 0.0, 90.0);
   o.local_ba_num_images = reader.Get<int>("local_ba_num_images", o.local_ba_num_images, 2, 1000);
+  o.ba_local_max_num_iterations =
+      reader.Get<int>("ba_local_max_num_iterations", o.ba_local_max_num_iterations, 1, 10000);
+  o.ba_global_max_num_iterations =
+      reader.Get<int>("ba_global_max_num_iterations", o.ba_global_max_num_iterations, 1, 10000);
   o.ba_global_images_ratio =
       reader.Get<double>("ba_global_images_ratio", o.ba_global_images_ratio, 1.0, 100.0);
   o.ba_global_points_ratio =
@@ -57,6 +61,8 @@ nlohmann::json IncrementalMapperOptions::ToJson() const {
           {"filter_max_reproj_error", filter_max_reproj_error},
           {"filter_min_tri_angle", filter_min_tri_angle},
           {"local_ba_num_images", local_ba_num_images},
+          {"ba_local_max_num_iterations", ba_local_max_num_iterations},
+          {"ba_global_max_num_iterations", ba_global_max_num_iterations},
           {"ba_global_images_ratio", ba_global_images_ratio},
           {"ba_global_points_ratio", ba_global_points_ratio},
           {"ba_global_max_refinements", ba_global_max_refinements},

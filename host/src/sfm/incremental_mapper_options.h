@@ -35,6 +35,9 @@ struct IncrementalMapperOptions {
 
   // Local bundle adjustment: the new image and its most connected neighbours.
   int local_ba_num_images = 6;
+  // Iterations at most of each local and global bundle adjustment (COLMAP's values).
+  int ba_local_max_num_iterations = 25;
+  int ba_global_max_num_iterations = 50;
   // Global bundle adjustment whenever the model has grown by these ratios since the last.
   double ba_global_images_ratio = 1.1;
   double ba_global_points_ratio = 1.1;

@@ -535,7 +535,7 @@ TEST(CeresBundleAdjuster, EffectiveOptionsHaveDefaults) {
   EXPECT_EQ(options.at("function_tolerance"), 1e-6);
   EXPECT_EQ(options.at("gradient_tolerance"), 1e-10);
   EXPECT_EQ(options.at("parameter_tolerance"), 1e-8);
-  EXPECT_EQ(options.at("num_threads"), 0);
+  EXPECT_EQ(options.at("num_threads"), 1);
   EXPECT_EQ(options.at("linear_solver"), "auto");
   EXPECT_EQ(options.at("minimizer_progress"), false);
 }
