@@ -1,7 +1,5 @@
 #include "scene/colmap_model_io.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <charconv>
 #include <cstring>
@@ -15,6 +13,7 @@
 #include <type_traits>
 
 #include "tessera/errors.h"
+#include "util/file_io.h"
 
 namespace tessera {
 namespace {
@@ -499,30 +498,6 @@ size_t NumObservations(const Reconstruction& reconstruction) {
     for (const Point2D& point2D : image.points2D) num_observations += point2D.HasPoint3D();
   }
   return num_observations;
-}
-
-void WriteFileAtomically(const fs::path& path, const std::string& contents) {
-  const fs::path temporary = path.parent_path() / ("." + path.filename().string() + ".tmp-" +
-                                                   std::to_string(static_cast<long>(getpid())));
-  {
-    std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
-    if (!file)
-      throw InputError("Cannot create " + temporary.string() + " to write " + path.string() + ".");
-    file.write(contents.data(), static_cast<std::streamsize>(contents.size()));
-    file.close();
-    if (!file) {
-      std::error_code error;
-      fs::remove(temporary, error);
-      throw InputError("Cannot write " + temporary.string() + " (is the disk full?).");
-    }
-  }
-  std::error_code error;
-  fs::rename(temporary, path, error);
-  if (error) {
-    fs::remove(temporary, error);
-    throw InputError("Cannot rename " + temporary.string() + " to " + path.string() + ": " +
-                     error.message() + ".");
-  }
 }
 
 std::string CamerasBinary(const Reconstruction& reconstruction, const std::vector<camera_t>& ids) {
