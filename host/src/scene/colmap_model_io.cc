@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <charconv>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 #include <locale>
 #include <set>
@@ -30,14 +29,6 @@ constexpr size_t kImageBinaryBytes = 4 + 7 * 8 + 4 + 1 + 8;  // .., name's NUL, 
 constexpr size_t kPoint2DBinaryBytes = 8 + 8 + 8;
 constexpr size_t kPoint3DBinaryBytes = 8 + 3 * 8 + 3 + 8 + 8;  // id, xyz, rgb, error, length
 constexpr size_t kTrackElementBinaryBytes = 4 + 4;
-
-std::string ReadFileContents(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw InputError("Cannot open " + path.string() + ".");
-  std::string contents((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  if (file.bad()) throw InputError("Cannot read " + path.string() + ".");
-  return contents;
-}
 
 // COLMAP 3.8's NormalizeQuaternion on (w, x, y, z), computed the same way so that
 // normalizing a quaternion COLMAP wrote gives back the same bits.

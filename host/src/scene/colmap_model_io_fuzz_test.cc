@@ -7,14 +7,13 @@
 
 #include <atomic>
 #include <cstdlib>
-#include <fstream>
-#include <iterator>
 #include <new>
 #include <random>
 
 #include "scene/colmap_model_io.h"
 #include "tessera/errors.h"
 #include "test_support.h"
+#include "util/file_io.h"
 
 namespace {
 std::atomic<size_t> largest_allocation{0};
@@ -38,16 +37,6 @@ namespace fs = std::filesystem;
 // Far above what a model of a few kilobytes needs, far below what a corrupt count
 // (up to 2^64 records) would ask for.
 constexpr size_t kMaxAllocationBytes = size_t{1} << 20;
-
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-}
-
-void WriteBytes(const fs::path& path, const std::string& bytes) {
-  std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  file.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-}
 
 // Two cameras, three images with six keypoints each, four points seen twice or thrice.
 Reconstruction SmallModel() {
@@ -92,7 +81,7 @@ class CorruptModel {
   // Reads the model with `name` holding `bytes`; fails the test on anything but success
   // or InputError, or on a large allocation. Returns whether the reader refused it.
   bool Refuses(const std::string& name, const std::string& bytes, const std::string& what) {
-    WriteBytes(File(name), bytes);
+    WriteFileAtomically(File(name), bytes);
     largest_allocation = 0;
     bool refused = false;
     try {
@@ -120,7 +109,7 @@ TEST(ColmapModelFuzz, EveryTruncationOfEachFileIsRefused) {
   for (const auto format : {ColmapModelFormat::kBinary, ColmapModelFormat::kText}) {
     CorruptModel model(format);
     for (const std::string& name : FileNames()) {
-      const std::string bytes = ReadBytes(model.File(name));
+      const std::string bytes = ReadFileContents(model.File(name));
       ASSERT_GT(bytes.size(), 20u);
       int refused = 0;
       for (size_t length = 0; length < bytes.size(); ++length) {
@@ -143,7 +132,7 @@ TEST(ColmapModelFuzz, EverySingleByteChangeReadsOrIsRefused) {
   for (const auto format : {ColmapModelFormat::kBinary, ColmapModelFormat::kText}) {
     CorruptModel model(format);
     for (const std::string& name : FileNames()) {
-      const std::string bytes = ReadBytes(model.File(name));
+      const std::string bytes = ReadFileContents(model.File(name));
       for (size_t offset = 0; offset < bytes.size(); ++offset) {
         for (const unsigned char value : {0x00, 0x7f, 0xff}) {
           std::string corrupt = bytes;
@@ -168,7 +157,7 @@ TEST(ColmapModelFuzz, RandomCorruptionOfEveryFile) {
   for (const auto format : {ColmapModelFormat::kBinary, ColmapModelFormat::kText}) {
     CorruptModel model(format);
     for (const std::string& name : FileNames()) {
-      const std::string bytes = ReadBytes(model.File(name));
+      const std::string bytes = ReadFileContents(model.File(name));
       for (int trial = 0; trial < 300; ++trial) {
         std::string corrupt = bytes;
         const int num_changes = 1 + static_cast<int>(rng() % 8);

@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <iterator>
 #include <system_error>
 
 #include "tessera/errors.h"
@@ -10,6 +11,14 @@
 namespace tessera {
 
 namespace fs = std::filesystem;
+
+std::string ReadFileContents(const fs::path& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw InputError("Cannot open " + path.string() + ".");
+  std::string contents((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  if (file.bad()) throw InputError("Cannot read " + path.string() + ".");
+  return contents;
+}
 
 void WriteFileAtomically(const fs::path& path, const std::string& contents) {
   // In the same folder, so that the rename stays on one file system and is atomic.

@@ -1,11 +1,15 @@
 #pragma once
 
-// Writing output files so that a reader never sees a half-written one.
+// Reading whole files, and writing output files so that a reader never sees a
+// half-written one.
 
 #include <filesystem>
 #include <string>
 
 namespace tessera {
+
+// The bytes of a file. Throws InputError naming the file when it cannot be read.
+std::string ReadFileContents(const std::filesystem::path& path);
 
 // Writes `contents` to a temporary file in the folder of `path` and renames it to `path`
 // when complete (replacing an existing file), so that `path` holds either its old

@@ -3,7 +3,6 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <iterator>
 
 #include "tessera/errors.h"
 #include "test_support.h"
@@ -13,11 +12,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Contents(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-}
-
 size_t NumEntries(const fs::path& dir) {
   return static_cast<size_t>(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
 }
@@ -26,9 +20,9 @@ TEST(WriteFileAtomically, WritesAndReplacesLeavingNoTemporaryFile) {
   testing::TemporaryDir dir;
   const fs::path path = dir.path() / "model.bin";
   WriteFileAtomically(path, std::string("a\0b", 3));
-  EXPECT_EQ(Contents(path), std::string("a\0b", 3));
+  EXPECT_EQ(ReadFileContents(path), std::string("a\0b", 3));
   WriteFileAtomically(path, "longer contents");
-  EXPECT_EQ(Contents(path), "longer contents");
+  EXPECT_EQ(ReadFileContents(path), "longer contents");
   WriteFileAtomically(path, "");
   EXPECT_EQ(fs::file_size(path), 0u);
   EXPECT_EQ(NumEntries(dir.path()), 1u);
@@ -44,6 +38,18 @@ TEST(WriteFileAtomically, MissingFolderIsAnInputErrorNamingTheFile) {
     EXPECT_NE(std::string(error.what()).find(path.string()), std::string::npos) << error.what();
   }
   EXPECT_EQ(NumEntries(dir.path()), 0u);
+}
+
+TEST(ReadFileContents, ReadsBytesAndNamesAFileItCannotOpen) {
+  testing::TemporaryDir dir;
+  WriteFileAtomically(dir.path() / "a", std::string("\0\xff\n", 3));
+  EXPECT_EQ(ReadFileContents(dir.path() / "a"), std::string("\0\xff\n", 3));
+  try {
+    ReadFileContents(dir.path() / "b");
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()), "Cannot open " + (dir.path() / "b").string() + ".");
+  }
 }
 
 TEST(CreateFolder, CreatesParentsAndNamesAFolderItCannotCreate) {

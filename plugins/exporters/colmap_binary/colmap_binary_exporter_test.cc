@@ -1,21 +1,14 @@
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <iterator>
-
 #include "common/synthetic_model_test_util.h"
 #include "scene/colmap_model_io.h"
 #include "test_support.h"
+#include "util/file_io.h"
 
 namespace tessera {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string ReadBytes(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-}
 
 fs::path FountainAnchor() {
   return testing::SharedDir() / "anchors" / "colmap-3.8" / "fountain-P11" / "sparse" / "0";
@@ -67,9 +60,10 @@ TEST(ColmapBinaryExporter, FountainRoundTripIsByteExactWithRecordOrder) {
   context.output_dir = output.path();
   exporter->Export(model, context);
   for (const char* name : {"cameras.bin", "images.bin", "points3D.bin"}) {
-    const std::string written = ReadBytes(output.path() / "sparse" / "0" / name);
+    const std::string written = ReadFileContents(output.path() / "sparse" / "0" / name);
     EXPECT_EQ(written.size(), fs::file_size(FountainAnchor() / name)) << name;
-    EXPECT_TRUE(written == ReadBytes(FountainAnchor() / name)) << name << " differs from COLMAP's";
+    EXPECT_TRUE(written == ReadFileContents(FountainAnchor() / name))
+        << name << " differs from COLMAP's";
   }
 }
 

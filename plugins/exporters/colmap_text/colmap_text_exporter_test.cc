@@ -1,21 +1,14 @@
 #include <gtest/gtest.h>
 
-#include <fstream>
-#include <iterator>
-
 #include "common/synthetic_model_test_util.h"
 #include "scene/colmap_model_io.h"
 #include "test_support.h"
+#include "util/file_io.h"
 
 namespace tessera {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-}
 
 fs::path FountainAnchor() {
   return testing::SharedDir() / "anchors" / "colmap-3.8" / "fountain-P11";
@@ -64,7 +57,8 @@ TEST(ColmapTextExporter, FountainAsTextMatchesModelConverter) {
   context.output_dir = output.path();
   exporter->Export(model, context);
   for (const char* name : {"cameras.txt", "images.txt", "points3D.txt"}) {
-    EXPECT_TRUE(ReadText(output.path() / "sparse" / "0" / name) == ReadText(text_dir / name))
+    EXPECT_TRUE(ReadFileContents(output.path() / "sparse" / "0" / name) ==
+                ReadFileContents(text_dir / name))
         << name << " differs from COLMAP's";
   }
 }
