@@ -26,5 +26,6 @@ CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions& globa
 CommandRegistration RegisterExtractCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterMatchCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera
