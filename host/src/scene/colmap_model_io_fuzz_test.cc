@@ -19,15 +19,17 @@ namespace {
 std::atomic<size_t> largest_allocation{0};
 }  // namespace
 
-void* operator new(size_t size) {
+// Kept out of line: inlined, GCC would pair `new` expressions with the free() inside and
+// warn of a mismatch (-Wmismatched-new-delete).
+__attribute__((noinline)) void* operator new(size_t size) {
   size_t largest = largest_allocation.load(std::memory_order_relaxed);
   while (size > largest && !largest_allocation.compare_exchange_weak(largest, size)) {
   }
   if (void* memory = std::malloc(size > 0 ? size : 1)) return memory;
   throw std::bad_alloc();
 }
-void operator delete(void* memory) noexcept { std::free(memory); }
-void operator delete(void* memory, size_t) noexcept { std::free(memory); }
+__attribute__((noinline)) void operator delete(void* memory) noexcept { std::free(memory); }
+__attribute__((noinline)) void operator delete(void* memory, size_t) noexcept { std::free(memory); }
 
 namespace tessera {
 namespace {
