@@ -10,8 +10,9 @@ packages=(
   libglfw3-dev libimgui-dev libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libspdlog-dev python3-numpy
 )
-# The reference system, for the interoperability tests and benchmarks; optional.
-optional_packages=(colmap)
+# The reference system, for the interoperability tests and benchmarks, and Open3D, an
+# independent PLY reader for the ply exporter's test; optional.
+optional_packages=(colmap python3-open3d)
 
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi

@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "test_support.h"
+#include "util/file_io.h"
 
 namespace tessera {
 namespace {
@@ -63,11 +64,17 @@ TEST(Cli, PluginsJsonListsEveryBundledPluginWithKindAndVersion) {
                                                        {"sequential", "pair_selector"},
                                                        {"window", "pair_selector"},
                                                        {"window_anchor", "pair_selector"},
-                                                       {"ceres", "bundle_adjuster"}};
+                                                       {"ceres", "bundle_adjuster"},
+                                                       {"colmap_binary", "exporter"},
+                                                       {"colmap_text", "exporter"},
+                                                       {"ply", "exporter"},
+                                                       {"gaussian_splatting", "exporter"},
+                                                       {"transforms_json", "exporter"}};
   for (const auto& [name, kind] : expected) {
     ASSERT_TRUE(kinds.count(name)) << "bundled plugin '" << name << "' not listed";
     EXPECT_EQ(kinds[name], kind) << name;
   }
+  EXPECT_EQ(kinds.size(), 14u) << result.output;
 }
 
 TEST(Cli, PluginsMarksRefusedFilesWithWhy) {
@@ -129,6 +136,104 @@ TEST(Cli, MissingManifestIsExitCode2) {
   EXPECT_EQ(result.exit_code, 2);
   EXPECT_NE(result.output.find("/nonexistent/m.json: cannot read the manifest"), std::string::npos)
       << result.output;
+}
+
+// A two-image text model in exactly the layout the COLMAP text writer produces.
+void WriteSmallTextModel(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "cameras.txt") << "# Camera list with one line of data per camera:\n"
+                                        "#   CAMERA_ID, MODEL, WIDTH, HEIGHT, PARAMS[]\n"
+                                        "# Number of cameras: 1\n"
+                                        "1 SIMPLE_RADIAL 640 480 500 320 240 0.01\n";
+  std::ofstream(dir / "images.txt") << "# Image list with two lines of data per image:\n"
+                                       "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
+                                       "#   POINTS2D[] as (X, Y, POINT3D_ID)\n"
+                                       "# Number of images: 2, mean observations per image: 1\n"
+                                       "1 1 0 0 0 0 0 0 1 a.jpg\n"
+                                       "320 240 7 10 10 -1\n"
+                                       "2 1 0 0 0 -1 0 0 1 b.jpg\n"
+                                       "220 240 7\n";
+  std::ofstream(dir / "points3D.txt")
+      << "# 3D point list with one line of data per point:\n"
+         "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"
+         "# Number of points: 1, mean track length: 2\n"
+         "7 0 0 5 255 128 0 0.5 1 0 2 0\n";
+}
+
+TEST(Cli, ExportWritesAModelWithAnyExporterAndBackAgain) {
+  testing::TemporaryDir dir;
+  WriteSmallTextModel(dir.path() / "text");
+  const auto to_binary =
+      RunTessera("export --model " + (dir.path() / "text").string() +
+                 " --format colmap_binary --output " + (dir.path() / "out").string());
+  ASSERT_EQ(to_binary.exit_code, 0) << to_binary.output;
+  EXPECT_NE(to_binary.output.find("export: 2 images, 1 points, 2 observations written with "
+                                  "'colmap_binary' to " +
+                                  (dir.path() / "out").string()),
+            std::string::npos)
+      << to_binary.output;
+  const auto binary_dir = dir.path() / "out" / "sparse" / "0";
+  ASSERT_TRUE(std::filesystem::is_regular_file(binary_dir / "points3D.bin"));
+
+  // Binary back to text, as model 3: the very same bytes.
+  const auto to_text =
+      RunTessera("-q export --model " + binary_dir.string() + " --format colmap_text --output " +
+                 (dir.path() / "out").string() + " --model-index 3");
+  ASSERT_EQ(to_text.exit_code, 0) << to_text.output;
+  EXPECT_EQ(to_text.output, "");
+  for (const char* name : {"cameras.txt", "images.txt", "points3D.txt"}) {
+    EXPECT_EQ(ReadFileContents(dir.path() / "out" / "sparse" / "3" / name),
+              ReadFileContents(dir.path() / "text" / name))
+        << name;
+  }
+
+  const auto ply =
+      RunTessera("export --model " + binary_dir.string() + " --format ply --output " +
+                 (dir.path() / "out").string() + R"( --options '{"camera_centers": true}')");
+  ASSERT_EQ(ply.exit_code, 0) << ply.output;
+  EXPECT_NE(ReadFileContents(binary_dir / "points3D.ply").find("element vertex 3\n"),
+            std::string::npos);
+}
+
+TEST(Cli, ExportOfABadModelIsOneLineNamingTheFile) {
+  testing::TemporaryDir dir;
+  WriteSmallTextModel(dir.path());
+  std::ofstream(dir.path() / "cameras.txt") << "1 PINHOLE 640 480 500 500 320\n";
+  const auto result =
+      RunTessera("export --model " + dir.path().string() + " --format colmap_binary --output " +
+                 (dir.path() / "out").string());
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_EQ(result.output, "[error] " + (dir.path() / "cameras.txt").string() +
+                               " line 1: PINHOLE takes 4 parameters, found 3.\n");
+  const auto missing = RunTessera("export --model " + (dir.path() / "none").string() +
+                                  " --format ply --output " + (dir.path() / "out").string());
+  EXPECT_EQ(missing.exit_code, 2) << missing.output;
+  EXPECT_NE(missing.output.find((dir.path() / "none").string() + " is not a COLMAP model"),
+            std::string::npos)
+      << missing.output;
+}
+
+TEST(Cli, ExportOfAnUnknownFormatSuggestsTheClosest) {
+  testing::TemporaryDir dir;
+  WriteSmallTextModel(dir.path());
+  const std::string command = "export --model " + dir.path().string() + " --output " +
+                              (dir.path() / "out").string() + " --format ";
+  const auto typo = RunTessera(command + "plyy");
+  EXPECT_EQ(typo.exit_code, 2) << typo.output;
+  EXPECT_NE(typo.output.find("exporter.plugin: no exporter plugin 'plyy'; did you mean 'ply'?"),
+            std::string::npos)
+      << typo.output;
+  const auto bad_option = RunTessera(command + R"(ply --options '{"camera_centres": true}')");
+  EXPECT_EQ(bad_option.exit_code, 2) << bad_option.output;
+  EXPECT_NE(bad_option.output.find("exporter.options.camera_centres: unknown key; did you mean "
+                                   "'camera_centers'?"),
+            std::string::npos)
+      << bad_option.output;
+  const auto bad_json = RunTessera(command + "ply --options '{camera_centers: true}'");
+  EXPECT_EQ(bad_json.exit_code, 2) << bad_json.output;
+  EXPECT_NE(bad_json.output.find("--options: not valid JSON"), std::string::npos)
+      << bad_json.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out"));
 }
 
 }  // namespace

@@ -3,9 +3,9 @@
 namespace tessera {
 
 std::vector<CommandRegistration> RegisterCommands(CLI::App& app, const GlobalOptions& global) {
-  return {RegisterRunCommand(app, global), RegisterExtractCommand(app, global),
-          RegisterMatchCommand(app, global), RegisterMapCommand(app, global),
-          RegisterEvalCommand(app, global),
+  return {RegisterRunCommand(app, global),    RegisterExtractCommand(app, global),
+          RegisterMatchCommand(app, global),  RegisterMapCommand(app, global),
+          RegisterExportCommand(app, global), RegisterEvalCommand(app, global),
           RegisterPluginsCommand(app, global)};
 }
 

@@ -27,5 +27,6 @@ CommandRegistration RegisterExtractCommand(CLI::App& app, const GlobalOptions& g
 CommandRegistration RegisterMatchCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera

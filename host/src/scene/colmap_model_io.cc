@@ -1,11 +1,8 @@
 #include "scene/colmap_model_io.h"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <charconv>
 #include <cstring>
-#include <fstream>
 #include <iterator>
 #include <locale>
 #include <set>
@@ -15,6 +12,7 @@
 #include <type_traits>
 
 #include "tessera/errors.h"
+#include "util/file_io.h"
 
 namespace tessera {
 namespace {
@@ -31,14 +29,6 @@ constexpr size_t kImageBinaryBytes = 4 + 7 * 8 + 4 + 1 + 8;  // .., name's NUL, 
 constexpr size_t kPoint2DBinaryBytes = 8 + 8 + 8;
 constexpr size_t kPoint3DBinaryBytes = 8 + 3 * 8 + 3 + 8 + 8;  // id, xyz, rgb, error, length
 constexpr size_t kTrackElementBinaryBytes = 4 + 4;
-
-std::string ReadFileContents(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  if (!file) throw InputError("Cannot open " + path.string() + ".");
-  std::string contents((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
-  if (file.bad()) throw InputError("Cannot read " + path.string() + ".");
-  return contents;
-}
 
 // COLMAP 3.8's NormalizeQuaternion on (w, x, y, z), computed the same way so that
 // normalizing a quaternion COLMAP wrote gives back the same bits.
@@ -499,30 +489,6 @@ size_t NumObservations(const Reconstruction& reconstruction) {
     for (const Point2D& point2D : image.points2D) num_observations += point2D.HasPoint3D();
   }
   return num_observations;
-}
-
-void WriteFileAtomically(const fs::path& path, const std::string& contents) {
-  const fs::path temporary = path.parent_path() / ("." + path.filename().string() + ".tmp-" +
-                                                   std::to_string(static_cast<long>(getpid())));
-  {
-    std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
-    if (!file)
-      throw InputError("Cannot create " + temporary.string() + " to write " + path.string() + ".");
-    file.write(contents.data(), static_cast<std::streamsize>(contents.size()));
-    file.close();
-    if (!file) {
-      std::error_code error;
-      fs::remove(temporary, error);
-      throw InputError("Cannot write " + temporary.string() + " (is the disk full?).");
-    }
-  }
-  std::error_code error;
-  fs::rename(temporary, path, error);
-  if (error) {
-    fs::remove(temporary, error);
-    throw InputError("Cannot rename " + temporary.string() + " to " + path.string() + ": " +
-                     error.message() + ".");
-  }
 }
 
 std::string CamerasBinary(const Reconstruction& reconstruction, const std::vector<camera_t>& ids) {

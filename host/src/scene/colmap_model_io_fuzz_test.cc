@@ -1,0 +1,181 @@
+// Fuzz-style tests of the COLMAP model reader on a small model: every truncation, every
+// single-byte change and many random changes of each file must either read or throw
+// InputError, never crash, hang, throw anything else or allocate more than the files
+// could justify. This executable counts allocations through its own operator new.
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <cstdlib>
+#include <new>
+#include <random>
+
+#include "scene/colmap_model_io.h"
+#include "tessera/errors.h"
+#include "test_support.h"
+#include "util/file_io.h"
+
+namespace {
+std::atomic<size_t> largest_allocation{0};
+}  // namespace
+
+// Kept out of line: inlined, GCC would pair `new` expressions with the free() inside and
+// warn of a mismatch (-Wmismatched-new-delete).
+__attribute__((noinline)) void* operator new(size_t size) {
+  size_t largest = largest_allocation.load(std::memory_order_relaxed);
+  while (size > largest && !largest_allocation.compare_exchange_weak(largest, size)) {
+  }
+  if (void* memory = std::malloc(size > 0 ? size : 1)) return memory;
+  throw std::bad_alloc();
+}
+__attribute__((noinline)) void operator delete(void* memory) noexcept { std::free(memory); }
+__attribute__((noinline)) void operator delete(void* memory, size_t) noexcept { std::free(memory); }
+
+namespace tessera {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Far above what a model of a few kilobytes needs, far below what a corrupt count
+// (up to 2^64 records) would ask for.
+constexpr size_t kMaxAllocationBytes = size_t{1} << 20;
+
+// Two cameras, three images with six keypoints each, four points seen twice or thrice.
+Reconstruction SmallModel() {
+  Reconstruction model;
+  model.cameras[1] = Camera::Create(1, CameraModelId::kPinhole, 400, 320, 240);
+  model.cameras[2] = Camera::Create(2, CameraModelId::kOpenCV, 500, 640, 480);
+  for (image_t image_id = 1; image_id <= 3; ++image_id) {
+    Image& image = model.images[image_id];
+    image.image_id = image_id;
+    image.camera_id = image_id == 3 ? 2 : 1;
+    image.name = "frame_" + std::to_string(image_id) + ".jpg";
+    image.registered = true;
+    image.cam_from_world.translation = Eigen::Vector3d(0.5 * image_id, 0, 0);
+    image.points2D.resize(6);
+    for (size_t i = 0; i < image.points2D.size(); ++i) {
+      image.points2D[i].xy = Eigen::Vector2d(10.25 * i + image_id, 20.5 * i);
+    }
+  }
+  for (point3D_t point3D_id = 1; point3D_id <= 4; ++point3D_id) {
+    Point3D& point3D = model.points3D[point3D_id];
+    point3D.xyz = Eigen::Vector3d(0.1 * point3D_id, -0.2, 4);
+    point3D.color = Eigen::Matrix<uint8_t, 3, 1>(200, 100, static_cast<uint8_t>(point3D_id));
+    point3D.error = 0.25;
+    for (image_t image_id = 1; image_id <= (point3D_id % 2 == 0 ? 3u : 2u); ++image_id) {
+      const auto idx = static_cast<point2D_t>(point3D_id);
+      point3D.track.push_back({image_id, idx});
+      model.images.at(image_id).points2D.at(idx).point3D_id = point3D_id;
+    }
+  }
+  return model;
+}
+
+// A model folder whose files the test rewrites one at a time.
+class CorruptModel {
+ public:
+  explicit CorruptModel(ColmapModelFormat format)
+      : extension_(format == ColmapModelFormat::kBinary ? ".bin" : ".txt") {
+    WriteColmapModel(SmallModel(), dir_.path(), format);
+  }
+  fs::path File(const std::string& name) const { return dir_.path() / (name + extension_); }
+
+  // Reads the model with `name` holding `bytes`; fails the test on anything but success
+  // or InputError, or on a large allocation. Returns whether the reader refused it.
+  bool Refuses(const std::string& name, const std::string& bytes, const std::string& what) {
+    WriteFileAtomically(File(name), bytes);
+    largest_allocation = 0;
+    bool refused = false;
+    try {
+      ReadColmapModel(dir_.path());
+    } catch (const InputError&) {
+      refused = true;
+    } catch (const std::exception& error) {
+      ADD_FAILURE() << name << extension_ << " " << what << ": " << error.what();
+    }
+    EXPECT_LE(largest_allocation.load(), kMaxAllocationBytes) << name << extension_ << " " << what;
+    return refused;
+  }
+
+ private:
+  testing::TemporaryDir dir_;
+  std::string extension_;
+};
+
+const std::vector<std::string>& FileNames() {
+  static const std::vector<std::string> names = {"cameras", "images", "points3D"};
+  return names;
+}
+
+TEST(ColmapModelFuzz, EveryTruncationOfEachFileIsRefused) {
+  for (const auto format : {ColmapModelFormat::kBinary, ColmapModelFormat::kText}) {
+    CorruptModel model(format);
+    for (const std::string& name : FileNames()) {
+      const std::string bytes = ReadFileContents(model.File(name));
+      ASSERT_GT(bytes.size(), 20u);
+      int refused = 0;
+      for (size_t length = 0; length < bytes.size(); ++length) {
+        refused += model.Refuses(name, bytes.substr(0, length), "cut to " + std::to_string(length));
+      }
+      EXPECT_FALSE(model.Refuses(name, bytes, "restored"));
+      EXPECT_GT(largest_allocation.load(), 0u) << "operator new is not counting";
+      if (format == ColmapModelFormat::kBinary) {
+        // A binary file is a count and fixed records: every cut is seen.
+        EXPECT_EQ(refused, static_cast<int>(bytes.size())) << name;
+      } else {
+        // A text file cut at a line end is a shorter valid file (or dangling references).
+        EXPECT_GT(refused, 0) << name;
+      }
+    }
+  }
+}
+
+TEST(ColmapModelFuzz, EverySingleByteChangeReadsOrIsRefused) {
+  for (const auto format : {ColmapModelFormat::kBinary, ColmapModelFormat::kText}) {
+    CorruptModel model(format);
+    for (const std::string& name : FileNames()) {
+      const std::string bytes = ReadFileContents(model.File(name));
+      for (size_t offset = 0; offset < bytes.size(); ++offset) {
+        for (const unsigned char value : {0x00, 0x7f, 0xff}) {
+          std::string corrupt = bytes;
+          corrupt[offset] = static_cast<char>(value);
+          model.Refuses(name, corrupt,
+                        "byte " + std::to_string(offset) + " = " + std::to_string(value));
+        }
+        std::string flipped = bytes;
+        flipped[offset] = static_cast<char>(~flipped[offset]);
+        model.Refuses(name, flipped, "byte " + std::to_string(offset) + " inverted");
+      }
+      model.Refuses(name, bytes, "restored");
+    }
+  }
+}
+
+// Up to eight random bytes changed, and one file in four cut short as well: counts,
+// ids, lengths and number syntax all get hit, most of them in a way that is refused.
+TEST(ColmapModelFuzz, RandomCorruptionOfEveryFile) {
+  std::mt19937 rng(2024);
+  int num_refused = 0, num_cases = 0;
+  for (const auto format : {ColmapModelFormat::kBinary, ColmapModelFormat::kText}) {
+    CorruptModel model(format);
+    for (const std::string& name : FileNames()) {
+      const std::string bytes = ReadFileContents(model.File(name));
+      for (int trial = 0; trial < 300; ++trial) {
+        std::string corrupt = bytes;
+        const int num_changes = 1 + static_cast<int>(rng() % 8);
+        for (int k = 0; k < num_changes; ++k) {
+          corrupt[rng() % corrupt.size()] = static_cast<char>(rng() % 256);
+        }
+        if (rng() % 4 == 0) corrupt.resize(rng() % corrupt.size());
+        num_refused += model.Refuses(name, corrupt, "trial " + std::to_string(trial));
+        ++num_cases;
+      }
+      model.Refuses(name, bytes, "restored");
+    }
+  }
+  EXPECT_EQ(num_cases, 1800);
+  EXPECT_GT(num_refused, 900);
+}
+
+}  // namespace
+}  // namespace tessera

@@ -1,0 +1,189 @@
+// The 3D points as a binary little-endian PLY (x y z red green blue), which MeshLab,
+// CloudCompare, Open3D and Blender open unchanged; optionally the camera centres as
+// extra vertices in their own colour.
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <map>
+#include <opencv2/core.hpp>
+#include <string>
+#include <vector>
+
+#include "common/exporter_paths.h"
+#include "image/image_io.h"
+#include "tessera/sdk.h"
+#include "util/file_io.h"
+
+namespace tessera {
+namespace {
+
+static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
+              "the PLY writer copies numbers as they lie in memory");
+
+using Color = Eigen::Matrix<uint8_t, 3, 1>;
+
+// Bilinear colour at COLMAP pixel coordinates (centre of the top-left pixel at (0.5,
+// 0.5)), clamped to the image, as COLMAP colours its points; `image` is 8-bit BGR.
+Eigen::Vector3d InterpolateRgb(const cv::Mat& image, const Eigen::Vector2d& xy) {
+  const double x = std::clamp(xy.x() - 0.5, 0.0, image.cols - 1.0);
+  const double y = std::clamp(xy.y() - 0.5, 0.0, image.rows - 1.0);
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const int x1 = std::min(x0 + 1, image.cols - 1), y1 = std::min(y0 + 1, image.rows - 1);
+  const double wx = x - x0, wy = y - y0;
+  Eigen::Vector3d rgb = Eigen::Vector3d::Zero();
+  const auto add = [&](int row, int col, double weight) {
+    const cv::Vec3b& bgr = image.at<cv::Vec3b>(row, col);
+    rgb += weight * Eigen::Vector3d(bgr[2], bgr[1], bgr[0]);
+  };
+  add(y0, x0, (1 - wx) * (1 - wy));
+  add(y0, x1, wx * (1 - wy));
+  add(y1, x0, (1 - wx) * wy);
+  add(y1, x1, wx * wy);
+  return rgb;
+}
+
+// Per point, the mean over its observations of the image colour there; points without
+// observations keep their model colour. Reads each registered image once.
+std::map<point3D_t, Color> SampleTrackColors(const Reconstruction& reconstruction,
+                                             const std::filesystem::path& image_dir) {
+  std::map<point3D_t, std::pair<Eigen::Vector3d, int>> sums;
+  for (const auto& [image_id, image] : reconstruction.images) {
+    if (!image.registered ||
+        std::none_of(image.points2D.begin(), image.points2D.end(),
+                     [](const Point2D& point2D) { return point2D.HasPoint3D(); })) {
+      continue;
+    }
+    const std::filesystem::path path = image_dir / image.name;
+    const cv::Mat pixels = ReadColorImage(path);
+    const Camera& camera = reconstruction.cameras.at(image.camera_id);
+    if (static_cast<size_t>(pixels.cols) != camera.width ||
+        static_cast<size_t>(pixels.rows) != camera.height) {
+      throw InputError(path.string() + ": the image is " + std::to_string(pixels.cols) + "x" +
+                       std::to_string(pixels.rows) + " but its camera " +
+                       std::to_string(camera.camera_id) + " is " + std::to_string(camera.width) +
+                       "x" + std::to_string(camera.height) + "; colours cannot be sampled");
+    }
+    for (const Point2D& point2D : image.points2D) {
+      if (!point2D.HasPoint3D() || reconstruction.points3D.count(point2D.point3D_id) == 0) continue;
+      auto& [sum, count] = sums[point2D.point3D_id];
+      if (count == 0) sum.setZero();
+      sum += InterpolateRgb(pixels, point2D.xy);
+      ++count;
+    }
+  }
+  std::map<point3D_t, Color> colors;
+  for (const auto& [point3D_id, point3D] : reconstruction.points3D) {
+    const auto it = sums.find(point3D_id);
+    if (it == sums.end()) {
+      colors[point3D_id] = point3D.color;
+      continue;
+    }
+    const Eigen::Vector3d mean = it->second.first / it->second.second;
+    colors[point3D_id] = mean.array().round().min(255.0).max(0.0).cast<uint8_t>().matrix();
+  }
+  return colors;
+}
+
+template <typename T>
+void Append(std::string* buffer, T value) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  buffer->append(bytes, sizeof(T));
+}
+
+}  // namespace
+
+class PlyExporter : public Exporter {
+ public:
+  explicit PlyExporter(const nlohmann::json& options) {
+    OptionReader reader(options);
+    double_precision_ = reader.GetString("precision", "float", {"float", "double"}) == "double";
+    colors_ = reader.GetString("colors", "auto", {"auto", "model", "images"});
+    camera_centers_ = reader.GetBool("camera_centers", false);
+    const nlohmann::json color = reader.GetJson("camera_center_color", {255, 0, 0});
+    bool valid = color.is_array() && color.size() == 3;
+    for (size_t i = 0; valid && i < 3; ++i) {
+      valid =
+          color[i].is_number_integer() && color[i].get<int>() >= 0 && color[i].get<int>() <= 255;
+      if (valid) camera_center_color_(i) = static_cast<uint8_t>(color[i].get<int>());
+    }
+    if (!valid) {
+      throw OptionError(
+          reader.KeyPath("camera_center_color"),
+          "expected [red, green, blue], each an integer in [0, 255], got " + color.dump());
+    }
+    reader.Finish();
+    effective_options_ = reader.Effective();
+  }
+
+  // Writes OUTPUT/sparse/<model_index>/points3D.ply.
+  void Export(const Reconstruction& reconstruction, const ExportContext& context) const override {
+    const std::filesystem::path path = SparseModelDir(context) / "points3D.ply";
+    const std::map<point3D_t, Color> colors = PointColors(reconstruction, context, path);
+    std::vector<Eigen::Vector3d> centers;
+    if (camera_centers_) {
+      for (const auto& [image_id, image] : reconstruction.images) {
+        if (image.registered) centers.push_back(image.ProjectionCenter());
+      }
+    }
+    const char* type = double_precision_ ? "double" : "float";
+    std::string ply = "ply\nformat binary_little_endian 1.0\ncomment Tessera: " +
+                      std::to_string(reconstruction.points3D.size()) + " 3D points, then " +
+                      std::to_string(centers.size()) + " camera centres\nelement vertex " +
+                      std::to_string(reconstruction.points3D.size() + centers.size()) + "\n";
+    for (const char* axis : {"x", "y", "z"})
+      ply += std::string("property ") + type + " " + axis + "\n";
+    ply += "property uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n";
+    const auto append_vertex = [&](const Eigen::Vector3d& xyz, const Color& color) {
+      for (int k = 0; k < 3; ++k) {
+        if (double_precision_) {
+          Append<double>(&ply, xyz(k));
+        } else {
+          Append<float>(&ply, static_cast<float>(xyz(k)));
+        }
+      }
+      for (int k = 0; k < 3; ++k) Append<uint8_t>(&ply, color(k));
+    };
+    for (const auto& [point3D_id, point3D] : reconstruction.points3D) {
+      append_vertex(point3D.xyz, colors.at(point3D_id));
+    }
+    for (const Eigen::Vector3d& center : centers) append_vertex(center, camera_center_color_);
+    CreateFolder(path.parent_path());
+    WriteFileAtomically(path, ply);
+  }
+
+ private:
+  std::map<point3D_t, Color> PointColors(const Reconstruction& reconstruction,
+                                         const ExportContext& context,
+                                         const std::filesystem::path& path) const {
+    const bool unset = std::all_of(reconstruction.points3D.begin(), reconstruction.points3D.end(),
+                                   [](const auto& item) { return item.second.color.isZero(); });
+    if (colors_ == "model" || (colors_ == "auto" && !unset) || reconstruction.points3D.empty()) {
+      std::map<point3D_t, Color> colors;
+      for (const auto& [point3D_id, point3D] : reconstruction.points3D) {
+        colors[point3D_id] = point3D.color;
+      }
+      return colors;
+    }
+    if (context.image_dir.empty()) {
+      throw InputError(path.string() + ": " +
+                       (colors_ == "auto" ? "every point's colour is unset and " : "") +
+                       "no image folder was given to sample colours from (tessera export "
+                       "--images DIR), or set the ply option colors to \"model\"");
+    }
+    return SampleTrackColors(reconstruction, context.image_dir);
+  }
+
+  bool double_precision_ = false;
+  std::string colors_;
+  bool camera_centers_ = false;
+  Color camera_center_color_ = Color(255, 0, 0);
+};
+
+}  // namespace tessera
+
+TESSERA_PLUGIN(exporter, tessera::PlyExporter, "ply", "1.0.0",
+               "3D points (and optionally camera centres) as a coloured binary PLY: "
+               "sparse/N/points3D.ply")

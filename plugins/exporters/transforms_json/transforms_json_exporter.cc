@@ -1,0 +1,136 @@
+// Camera poses and intrinsics as the transforms.json that instant-ngp and nerfstudio
+// read: per frame the camera-to-world matrix with OpenGL camera axes (x right, y up,
+// z backwards) and the image path relative to the JSON file; intrinsics as an OPENCV
+// camera (fl_x fl_y cx cy w h k1 k2 p1 p2), at the top when every frame shares one
+// camera, else in each frame.
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "common/exporter_paths.h"
+#include "tessera/sdk.h"
+#include "util/file_io.h"
+
+namespace tessera {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The camera as OPENCV intrinsics; models with one focal length give fl_x = fl_y, and
+// coefficients a model lacks are zero.
+nlohmann::json Intrinsics(const Camera& camera) {
+  double k1 = 0, k2 = 0, p1 = 0, p2 = 0;
+  const std::vector<double>& params = camera.params;
+  switch (camera.model_id) {
+    case CameraModelId::kSimpleRadial:
+      k1 = params[3];
+      break;
+    case CameraModelId::kRadial:
+      k1 = params[3];
+      k2 = params[4];
+      break;
+    case CameraModelId::kOpenCV:
+      k1 = params[4];
+      k2 = params[5];
+      p1 = params[6];
+      p2 = params[7];
+      break;
+    case CameraModelId::kSimplePinhole:
+    case CameraModelId::kPinhole:
+      break;
+    default:
+      throw InputError("camera " + std::to_string(camera.camera_id) + " has model '" +
+                       camera.ModelName() + "', which transforms.json cannot express");
+  }
+  return {{"fl_x", camera.FocalLengthX()},
+          {"fl_y", camera.FocalLengthY()},
+          {"cx", camera.PrincipalPointX()},
+          {"cy", camera.PrincipalPointY()},
+          {"w", camera.width},
+          {"h", camera.height},
+          {"k1", k1},
+          {"k2", k2},
+          {"p1", p1},
+          {"p2", p2}};
+}
+
+// 4x4 camera-to-world with OpenGL camera axes: the OpenCV camera's y and z flipped.
+nlohmann::json TransformMatrix(const Rigid3d& cam_from_world) {
+  const Rigid3d world_from_cam = cam_from_world.Inverse();
+  Eigen::Matrix4d matrix = Eigen::Matrix4d::Identity();
+  matrix.topLeftCorner<3, 3>() =
+      world_from_cam.rotation.toRotationMatrix() * Eigen::Vector3d(1, -1, -1).asDiagonal();
+  matrix.topRightCorner<3, 1>() = world_from_cam.translation;
+  nlohmann::json rows = nlohmann::json::array();
+  for (int row = 0; row < 4; ++row) {
+    rows.push_back({matrix(row, 0), matrix(row, 1), matrix(row, 2), matrix(row, 3)});
+  }
+  return rows;
+}
+
+// Where the image lies, relative to the folder of the JSON file, with '/' separators.
+std::string FilePath(const fs::path& json_dir, const fs::path& image_dir, const std::string& name) {
+  if (image_dir.empty()) return (fs::path("images") / name).generic_string();
+  const fs::path image = fs::absolute(image_dir / name).lexically_normal();
+  return image.lexically_relative(fs::absolute(json_dir).lexically_normal()).generic_string();
+}
+
+}  // namespace
+
+class TransformsJsonExporter : public Exporter {
+ public:
+  explicit TransformsJsonExporter(const nlohmann::json& options) {
+    OptionReader reader(options);
+    file_ = reader.GetString("file", "transforms.json");
+    reader.Finish();
+    if (file_.empty()) throw OptionError("file", "must not be empty");
+    effective_options_ = reader.Effective();
+  }
+
+  // Writes OUTPUT/<file> for model 0 and OUTPUT/<file stem>_<k>.json for model k.
+  void Export(const Reconstruction& reconstruction, const ExportContext& context) const override {
+    const fs::path path = PerModelPath(context, file_);
+    std::vector<const Image*> frames;
+    for (const auto& [image_id, image] : reconstruction.images) {
+      if (image.registered) frames.push_back(&image);
+    }
+    std::sort(frames.begin(), frames.end(),
+              [](const Image* a, const Image* b) { return a->name < b->name; });
+    const bool shared_camera =
+        !frames.empty() && std::all_of(frames.begin(), frames.end(), [&](const Image* image) {
+          return image->camera_id == frames.front()->camera_id;
+        });
+
+    nlohmann::json json = nlohmann::json::object();
+    try {
+      if (shared_camera) json = Intrinsics(reconstruction.cameras.at(frames.front()->camera_id));
+      // Both readers take the camera model from the top level only.
+      json["camera_model"] = "OPENCV";
+      json["frames"] = nlohmann::json::array();
+      for (const Image* image : frames) {
+        nlohmann::json frame = shared_camera
+                                   ? nlohmann::json::object()
+                                   : Intrinsics(reconstruction.cameras.at(image->camera_id));
+        frame["file_path"] = FilePath(path.parent_path(), context.image_dir, image->name);
+        frame["transform_matrix"] = TransformMatrix(image->cam_from_world);
+        frame["colmap_im_id"] = image->image_id;
+        json["frames"].push_back(frame);
+      }
+    } catch (const InputError& error) {
+      throw InputError(path.string() + ": " + error.what());
+    }
+    CreateFolder(path.parent_path());
+    WriteFileAtomically(path, json.dump(2) + "\n");
+  }
+
+ private:
+  std::string file_;
+};
+
+}  // namespace tessera
+
+TESSERA_PLUGIN(exporter, tessera::TransformsJsonExporter, "transforms_json", "1.0.0",
+               "Poses and OPENCV intrinsics as the transforms.json of instant-ngp and "
+               "nerfstudio (camera-to-world, OpenGL axes)")
