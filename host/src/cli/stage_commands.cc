@@ -147,6 +147,7 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
   nlohmann::json summary_json = {{"models", nlohmann::json::array()},
                                  {"unregistered", nlohmann::json::array()}};
   MappingSummary summary;
+  std::string first_export_error;
   summary.num_images = input.images.size();
   summary.num_models = result.models.size();
   for (size_t index = 0; index < result.models.size(); ++index) {
@@ -154,8 +155,16 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
     if (context.exporters.empty()) {
       WriteColmapModel(model, sparse_dir / std::to_string(index), ColmapModelFormat::kBinary);
     } else {
+      // One failing exporter does not stop the others; the first failure is reported
+      // once all have run, so that nothing computed is lost.
       for (const auto& exporter : context.exporters) {
-        exporter->Export(model, {output_dir, image_dir, static_cast<int>(index)});
+        try {
+          exporter->Export(model, {output_dir, image_dir, static_cast<int>(index)});
+        } catch (const std::exception& error) {
+          spdlog::error("map: exporter '{}' failed on model {}: {}", exporter.name(), index,
+                        error.what());
+          if (first_export_error.empty()) first_export_error = error.what();
+        }
       }
     }
     summary.num_registered += model.images.size();
@@ -196,6 +205,7 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
                "adjustments, {:.2f} s",
                summary.num_registered, summary.num_images, summary.num_models,
                result.num_global_ba, result.num_local_ba, summary.seconds);
+  if (!first_export_error.empty()) throw InputError(first_export_error);
   return summary;
 }
 

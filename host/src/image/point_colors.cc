@@ -1,6 +1,7 @@
 #include "image/point_colors.h"
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <map>
 #include <opencv2/core.hpp>
 
@@ -10,29 +11,24 @@
 namespace tessera {
 namespace {
 
-// Bilinear sample of a BGR image at a keypoint position; keypoints follow COLMAP's
-// convention that the centre of the top-left pixel is (0.5, 0.5).
-bool SampleBgr(const cv::Mat& image, const Eigen::Vector2d& xy, Eigen::Vector3d* rgb) {
-  const double x = xy.x() - 0.5;
-  const double y = xy.y() - 0.5;
-  if (x < 0 || y < 0 || x > image.cols - 1 || y > image.rows - 1) return false;
-  const int x0 = std::min(static_cast<int>(x), image.cols - 2 < 0 ? 0 : image.cols - 2);
-  const int y0 = std::min(static_cast<int>(y), image.rows - 2 < 0 ? 0 : image.rows - 2);
-  const int x1 = std::min(x0 + 1, image.cols - 1);
-  const int y1 = std::min(y0 + 1, image.rows - 1);
-  const double fx = x - x0;
-  const double fy = y - y0;
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  const auto add = [&](int px, int py, double weight) {
-    const cv::Vec3b& bgr = image.at<cv::Vec3b>(py, px);
-    sum += weight * Eigen::Vector3d(bgr[2], bgr[1], bgr[0]);
+// Bilinear colour at a keypoint position, clamped to the image; keypoints follow
+// COLMAP's convention that the centre of the top-left pixel is (0.5, 0.5).
+Eigen::Vector3d InterpolateRgb(const cv::Mat& image, const Eigen::Vector2d& xy) {
+  const double x = std::clamp(xy.x() - 0.5, 0.0, image.cols - 1.0);
+  const double y = std::clamp(xy.y() - 0.5, 0.0, image.rows - 1.0);
+  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+  const int x1 = std::min(x0 + 1, image.cols - 1), y1 = std::min(y0 + 1, image.rows - 1);
+  const double wx = x - x0, wy = y - y0;
+  Eigen::Vector3d rgb = Eigen::Vector3d::Zero();
+  const auto add = [&](int row, int col, double weight) {
+    const cv::Vec3b& bgr = image.at<cv::Vec3b>(row, col);
+    rgb += weight * Eigen::Vector3d(bgr[2], bgr[1], bgr[0]);
   };
-  add(x0, y0, (1 - fx) * (1 - fy));
-  add(x1, y0, fx * (1 - fy));
-  add(x0, y1, (1 - fx) * fy);
-  add(x1, y1, fx * fy);
-  *rgb = sum;
-  return true;
+  add(y0, x0, (1 - wx) * (1 - wy));
+  add(y0, x1, wx * (1 - wy));
+  add(y1, x0, (1 - wx) * wy);
+  add(y1, x1, wx * wy);
+  return rgb;
 }
 
 }  // namespace
@@ -42,23 +38,39 @@ std::vector<std::string> ColorPointsFromImages(const std::filesystem::path& imag
   std::vector<std::string> warnings;
   std::map<point3D_t, std::pair<Eigen::Vector3d, int>> sums;
   for (const auto& [image_id, image] : reconstruction->images) {
+    if (!image.registered ||
+        std::none_of(image.points2D.begin(), image.points2D.end(),
+                     [](const Point2D& point2D) { return point2D.HasPoint3D(); })) {
+      continue;
+    }
+    const std::filesystem::path path = image_dir / image.name;
     cv::Mat bgr;
     try {
-      bgr = ReadColorImage(image_dir / image.name);
+      bgr = ReadColorImage(path);
     } catch (const InputError& error) {
-      warnings.push_back(std::string(error.what()) + "; its points are coloured from the others");
+      warnings.push_back(error.what());
+      continue;
+    }
+    const auto camera_it = reconstruction->cameras.find(image.camera_id);
+    if (camera_it != reconstruction->cameras.end() &&
+        (static_cast<size_t>(bgr.cols) != camera_it->second.width ||
+         static_cast<size_t>(bgr.rows) != camera_it->second.height)) {
+      warnings.push_back(path.string() + ": the image is " + std::to_string(bgr.cols) + "x" +
+                         std::to_string(bgr.rows) + " but its camera " +
+                         std::to_string(image.camera_id) + " is " +
+                         std::to_string(camera_it->second.width) + "x" +
+                         std::to_string(camera_it->second.height) +
+                         "; colours cannot be sampled");
       continue;
     }
     for (const Point2D& point2D : image.points2D) {
-      if (!point2D.HasPoint3D()) continue;
-      Eigen::Vector3d rgb;
-      if (!SampleBgr(bgr, point2D.xy, &rgb)) continue;
+      if (!point2D.HasPoint3D() || reconstruction->points3D.count(point2D.point3D_id) == 0) {
+        continue;
+      }
       // Eigen leaves a default-constructed vector uninitialised: start from zero.
-      auto [it, inserted] =
-          sums.try_emplace(point2D.point3D_id, Eigen::Vector3d::Zero(), 0);
-      auto& [sum, count] = it->second;
-      sum += rgb;
-      ++count;
+      auto [it, inserted] = sums.try_emplace(point2D.point3D_id, Eigen::Vector3d::Zero(), 0);
+      it->second.first += InterpolateRgb(bgr, point2D.xy);
+      ++it->second.second;
     }
   }
   for (const auto& [point3D_id, sum_count] : sums) {

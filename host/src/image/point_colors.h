@@ -9,9 +9,10 @@
 namespace tessera {
 
 // Colours every 3D point with the mean, over its track, of the image colour at each
-// observation (bilinear, as COLMAP's ExtractColorsForAllImages). Images are read from
-// `image_dir` by their names; one that cannot be read is left out and named in the
-// returned warnings. Points seen by no readable image keep their colour.
+// observation (bilinear, clamped to the image, as COLMAP samples colours). Registered
+// images are read from `image_dir` by their names; one that cannot be read, or whose
+// size is not its camera's, is left out and named in the returned warnings (one line
+// each, starting with the file). Points seen by no usable image keep their colour.
 std::vector<std::string> ColorPointsFromImages(const std::filesystem::path& image_dir,
                                                Reconstruction* reconstruction);
 

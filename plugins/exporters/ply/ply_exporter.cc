@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "common/exporter_paths.h"
-#include "image/image_io.h"
+#include "image/point_colors.h"
 #include "tessera/sdk.h"
 #include "util/file_io.h"
 
@@ -24,65 +24,15 @@ static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__,
 
 using Color = Eigen::Matrix<uint8_t, 3, 1>;
 
-// Bilinear colour at COLMAP pixel coordinates (centre of the top-left pixel at (0.5,
-// 0.5)), clamped to the image, as COLMAP colours its points; `image` is 8-bit BGR.
-Eigen::Vector3d InterpolateRgb(const cv::Mat& image, const Eigen::Vector2d& xy) {
-  const double x = std::clamp(xy.x() - 0.5, 0.0, image.cols - 1.0);
-  const double y = std::clamp(xy.y() - 0.5, 0.0, image.rows - 1.0);
-  const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
-  const int x1 = std::min(x0 + 1, image.cols - 1), y1 = std::min(y0 + 1, image.rows - 1);
-  const double wx = x - x0, wy = y - y0;
-  Eigen::Vector3d rgb = Eigen::Vector3d::Zero();
-  const auto add = [&](int row, int col, double weight) {
-    const cv::Vec3b& bgr = image.at<cv::Vec3b>(row, col);
-    rgb += weight * Eigen::Vector3d(bgr[2], bgr[1], bgr[0]);
-  };
-  add(y0, x0, (1 - wx) * (1 - wy));
-  add(y0, x1, wx * (1 - wy));
-  add(y1, x0, (1 - wx) * wy);
-  add(y1, x1, wx * wy);
-  return rgb;
-}
-
-// Per point, the mean over its observations of the image colour there; points without
-// observations keep their model colour. Reads each registered image once.
+// Per point, the mean over its observations of the image colour there (the host's
+// sampler); any image that cannot be used is an error naming the file.
 std::map<point3D_t, Color> SampleTrackColors(const Reconstruction& reconstruction,
                                              const std::filesystem::path& image_dir) {
-  std::map<point3D_t, std::pair<Eigen::Vector3d, int>> sums;
-  for (const auto& [image_id, image] : reconstruction.images) {
-    if (!image.registered ||
-        std::none_of(image.points2D.begin(), image.points2D.end(),
-                     [](const Point2D& point2D) { return point2D.HasPoint3D(); })) {
-      continue;
-    }
-    const std::filesystem::path path = image_dir / image.name;
-    const cv::Mat pixels = ReadColorImage(path);
-    const Camera& camera = reconstruction.cameras.at(image.camera_id);
-    if (static_cast<size_t>(pixels.cols) != camera.width ||
-        static_cast<size_t>(pixels.rows) != camera.height) {
-      throw InputError(path.string() + ": the image is " + std::to_string(pixels.cols) + "x" +
-                       std::to_string(pixels.rows) + " but its camera " +
-                       std::to_string(camera.camera_id) + " is " + std::to_string(camera.width) +
-                       "x" + std::to_string(camera.height) + "; colours cannot be sampled");
-    }
-    for (const Point2D& point2D : image.points2D) {
-      if (!point2D.HasPoint3D() || reconstruction.points3D.count(point2D.point3D_id) == 0) continue;
-      auto& [sum, count] = sums[point2D.point3D_id];
-      if (count == 0) sum.setZero();
-      sum += InterpolateRgb(pixels, point2D.xy);
-      ++count;
-    }
-  }
+  Reconstruction colored = reconstruction;
+  const std::vector<std::string> warnings = ColorPointsFromImages(image_dir, &colored);
+  if (!warnings.empty()) throw InputError(warnings.front());
   std::map<point3D_t, Color> colors;
-  for (const auto& [point3D_id, point3D] : reconstruction.points3D) {
-    const auto it = sums.find(point3D_id);
-    if (it == sums.end()) {
-      colors[point3D_id] = point3D.color;
-      continue;
-    }
-    const Eigen::Vector3d mean = it->second.first / it->second.second;
-    colors[point3D_id] = mean.array().round().min(255.0).max(0.0).cast<uint8_t>().matrix();
-  }
+  for (const auto& [point3D_id, point3D] : colored.points3D) colors[point3D_id] = point3D.color;
   return colors;
 }
 
