@@ -32,7 +32,8 @@ echo "$listing" | grep -q '"name": "sift"' || { echo "bundled sift not found by 
 mkdir -p "$work/images"
 examples="$source_dir/../../examples/fountain-P11-small/images"
 cp "$examples/0004.jpg" "$examples/0005.jpg" "$examples/0006.jpg" "$work/images/"
-"$tessera" run --images "$work/images" --output "$work/out" --manifest "$work/manifest.json" \
+{ "$tessera" extract --images "$work/images" --output "$work/out" --manifest "$work/manifest.json" &&
+  "$tessera" match --output "$work/out" --manifest "$work/manifest.json"; } \
   2> "$work/run.log" || { cat "$work/run.log"; exit 1; }
 cat "$work/run.log"
 grep -q "3 detected with" "$work/run.log" || { echo "akaze did not detect 3 images"; exit 1; }
