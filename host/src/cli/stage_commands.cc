@@ -3,6 +3,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <fstream>
+
 #include "cli/commands.h"
 #include "cli/exit_codes.h"
 #include "cli/pipeline_context.h"
@@ -14,8 +16,6 @@
 #include "sfm/incremental_mapper.h"
 #include "sfm/mapper_input.h"
 #include "util/timer.h"
-
-#include <fstream>
 
 namespace tessera {
 namespace {
@@ -201,19 +201,21 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
     if (!stream) throw InputError(file.string() + ": cannot be written");
     std::filesystem::rename(temporary, file);
   }
-  spdlog::info("map: {} of {} images registered in {} model(s), {} global and {} local bundle "
-               "adjustments, {:.2f} s",
-               summary.num_registered, summary.num_images, summary.num_models,
-               result.num_global_ba, result.num_local_ba, summary.seconds);
+  spdlog::info(
+      "map: {} of {} images registered in {} model(s), {} global and {} local bundle "
+      "adjustments, {:.2f} s",
+      summary.num_registered, summary.num_images, summary.num_models, result.num_global_ba,
+      result.num_local_ba, summary.seconds);
   if (!first_export_error.empty()) throw InputError(first_export_error);
   return summary;
 }
 
 int MappingExitCode(const MappingSummary& summary, const std::filesystem::path& database) {
   if (summary.num_models > 0) return kExitSuccess;
-  spdlog::error("{}: no model could be built: no pair of images initialised a model "
-                "(see the warnings above)",
-                database.string());
+  spdlog::error(
+      "{}: no model could be built: no pair of images initialised a model "
+      "(see the warnings above)",
+      database.string());
   return kExitNoModel;
 }
 
@@ -228,8 +230,9 @@ CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
             context.Require("bundle_adjuster", "map");
             const std::filesystem::path database_file = PrepareWorkspace(options->output);
             if (!std::filesystem::exists(database_file)) {
-              throw InputError(database_file.string() + ": no workspace database; run extract "
-                                                        "and match first");
+              throw InputError(database_file.string() +
+                               ": no workspace database; run extract "
+                               "and match first");
             }
             Database database(database_file);
             const MappingSummary summary =

@@ -12,8 +12,9 @@ namespace {
 // pixels are our normalised coordinates.
 const cv::Matx33d kIdentityK = cv::Matx33d::eye();
 
-void ToCv(const std::vector<Eigen::Vector2d>& points2D, const std::vector<Eigen::Vector3d>& points3D,
-          std::vector<cv::Point2d>* image_points, std::vector<cv::Point3d>* object_points) {
+void ToCv(const std::vector<Eigen::Vector2d>& points2D,
+          const std::vector<Eigen::Vector3d>& points3D, std::vector<cv::Point2d>* image_points,
+          std::vector<cv::Point3d>* object_points) {
   image_points->resize(points2D.size());
   object_points->resize(points3D.size());
   for (size_t i = 0; i < points2D.size(); ++i) {

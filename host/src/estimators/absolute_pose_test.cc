@@ -58,7 +58,8 @@ TEST(P3PEstimator, OneOfTheSolutionsIsTheTruePose) {
     const auto models = P3PEstimator::Estimate(problem.points2D, problem.points3D);
     ASSERT_FALSE(models.empty()) << "seed " << seed;
     double best = std::numeric_limits<double>::max();
-    for (const auto& model : models) best = std::min(best, PoseDistance(model, problem.cam_from_world));
+    for (const auto& model : models)
+      best = std::min(best, PoseDistance(model, problem.cam_from_world));
     EXPECT_LT(best, 1e-6) << "seed " << seed;
   }
 }
@@ -102,10 +103,9 @@ TEST(AbsolutePose, LORANSACFindsEveryOutlierAndThePose) {
     }
   }
   RefineAbsolutePose(inlier_points2D, inlier_points3D, &cam_from_world);
-  const Eigen::Vector3d true_center = -problem.cam_from_world.leftCols<3>().transpose() *
-                                      problem.cam_from_world.col(3);
-  const Eigen::Vector3d center =
-      -cam_from_world.leftCols<3>().transpose() * cam_from_world.col(3);
+  const Eigen::Vector3d true_center =
+      -problem.cam_from_world.leftCols<3>().transpose() * problem.cam_from_world.col(3);
+  const Eigen::Vector3d center = -cam_from_world.leftCols<3>().transpose() * cam_from_world.col(3);
   EXPECT_LT((center - true_center).norm(), 0.01);
   EXPECT_LT(PoseDistance(cam_from_world, problem.cam_from_world), 0.01);
 }

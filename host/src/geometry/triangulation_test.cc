@@ -89,12 +89,12 @@ TEST(TriangulateMultiViewPoint, RecoversThePointFromManyNoisyViewsBetterThanFrom
   EXPECT_LT(error_all, 0.05);
   EXPECT_LT(error_all, error_two);
   // Two views give the two-view DLT's answer.
-  const Eigen::Vector3d two_views = TriangulateMultiViewPoint(
-      {cams_from_world[0], cams_from_world[3]}, {noisy[0], noisy[3]});
-  EXPECT_LT((two_views - TriangulatePoint(cams_from_world[0], cams_from_world[3], noisy[0],
-                                          noisy[3]))
-                .norm(),
-            1e-9);
+  const Eigen::Vector3d two_views =
+      TriangulateMultiViewPoint({cams_from_world[0], cams_from_world[3]}, {noisy[0], noisy[3]});
+  EXPECT_LT(
+      (two_views - TriangulatePoint(cams_from_world[0], cams_from_world[3], noisy[0], noisy[3]))
+          .norm(),
+      1e-9);
 }
 
 }  // namespace

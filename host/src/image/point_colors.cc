@@ -59,8 +59,7 @@ std::vector<std::string> ColorPointsFromImages(const std::filesystem::path& imag
                          std::to_string(bgr.rows) + " but its camera " +
                          std::to_string(image.camera_id) + " is " +
                          std::to_string(camera_it->second.width) + "x" +
-                         std::to_string(camera_it->second.height) +
-                         "; colours cannot be sampled");
+                         std::to_string(camera_it->second.height) + "; colours cannot be sampled");
       continue;
     }
     for (const Point2D& point2D : image.points2D) {

@@ -150,9 +150,8 @@ FeatureTracks BuildFeatureTracks(const std::vector<ImagePairMatches>& pairs,
     result.refused_links.emplace_back(std::min(track1, track2), std::max(track1, track2));
   }
   std::sort(result.refused_links.begin(), result.refused_links.end());
-  result.refused_links.erase(
-      std::unique(result.refused_links.begin(), result.refused_links.end()),
-      result.refused_links.end());
+  result.refused_links.erase(std::unique(result.refused_links.begin(), result.refused_links.end()),
+                             result.refused_links.end());
   return result;
 }
 

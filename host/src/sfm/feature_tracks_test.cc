@@ -30,8 +30,7 @@ TEST(FeatureTracks, AMatchJoiningTwoFeaturesOfOneImageIsRefusedAndKeptAsALink) {
   // The strongest pair is joined first, so which match is refused does not depend on
   // the input order.
   const std::vector<ImagePairMatches> pairs = {Pair(1, 2, {{0, 0}, {2, 2}, {3, 3}}),
-                                               Pair(2, 3, {{0, 0}, {2, 2}}),
-                                               Pair(1, 3, {{1, 0}})};
+                                               Pair(2, 3, {{0, 0}, {2, 2}}), Pair(1, 3, {{1, 0}})};
   const std::map<image_t, size_t> sizes = {{1, 4}, {2, 4}, {3, 4}};
   const FeatureTracks tracks = BuildFeatureTracks(pairs, sizes);
   EXPECT_EQ(tracks.num_refused_matches, 1u);

@@ -70,8 +70,7 @@ struct RunState {
 // One model, grown from an initial pair.
 class ModelBuilder {
  public:
-  explicit ModelBuilder(RunState* run)
-      : run_(*run), options_(run->options), tracks_(run->tracks) {
+  explicit ModelBuilder(RunState* run) : run_(*run), options_(run->options), tracks_(run->tracks) {
     rec_.cameras = run_.input.cameras;
     rec_.images = run_.input.images;
     for (auto& [image_id, image] : rec_.images) {
@@ -179,8 +178,7 @@ class ModelBuilder {
 // Points and observations
 ////////////////////////////////////////////////////////////////////////////////
 
-point3D_t ModelBuilder::AddPoint(track_t track_id, const Eigen::Vector3d& xyz,
-                                 const Track& track) {
+point3D_t ModelBuilder::AddPoint(track_t track_id, const Eigen::Vector3d& xyz, const Track& track) {
   const point3D_t point3D_id = next_point3D_id_++;
   Point3D& point3D = rec_.points3D[point3D_id];
   point3D.xyz = xyz;
@@ -319,8 +317,7 @@ bool ModelBuilder::Initialize() {
     if (!CanInitialize(pair->geometry) || run_.used_images.count(pair->image_id1) > 0 ||
         run_.used_images.count(pair->image_id2) > 0 ||
         run_.tried_initial_pairs.count({pair->image_id1, pair->image_id2}) > 0 ||
-        pair->geometry.inlier_matches.size() <
-            static_cast<size_t>(options_.init_min_num_inliers)) {
+        pair->geometry.inlier_matches.size() < static_cast<size_t>(options_.init_min_num_inliers)) {
       continue;
     }
     candidates.push_back(pair);
@@ -410,10 +407,9 @@ std::vector<image_t> ModelBuilder::NextImages() {
     }
     if (num_visible < static_cast<size_t>(options_.abs_pose_min_num_inliers)) {
       if (num_visible > 0) {
-        run_.failure_reasons[image_id] = "it sees only " + std::to_string(num_visible) +
-                                         " 3D points of the model (" +
-                                         std::to_string(options_.abs_pose_min_num_inliers) +
-                                         " needed)";
+        run_.failure_reasons[image_id] =
+            "it sees only " + std::to_string(num_visible) + " 3D points of the model (" +
+            std::to_string(options_.abs_pose_min_num_inliers) + " needed)";
       }
       continue;
     }
@@ -461,11 +457,11 @@ bool ModelBuilder::RegisterImage(image_t image_id) {
   ransac_options.confidence = 0.9999;
   ransac_options.min_inlier_ratio = std::max(options_.abs_pose_min_inlier_ratio, 0.01);
   ransac_options.max_num_trials = 10000;
-  const auto report = LORANSAC<P3PEstimator, EPnPEstimator>(
-                          ransac_options,
-                          DeriveSeed(run_.seed, kRegistrationStream * 0x100000000ull +
+  const auto report =
+      LORANSAC<P3PEstimator, EPnPEstimator>(
+          ransac_options, DeriveSeed(run_.seed, kRegistrationStream * 0x100000000ull +
                                                     static_cast<uint64_t>(image_id) * 64 + trial))
-                          .Estimate(points2D, points3D);
+          .Estimate(points2D, points3D);
   const size_t num_inliers = report.success ? report.support.num_inliers : 0;
   const std::string counts = std::to_string(num_inliers) + " of " +
                              std::to_string(points2D.size()) + " 2D-3D correspondences";
@@ -485,8 +481,7 @@ bool ModelBuilder::RegisterImage(image_t image_id) {
   Eigen::Matrix<double, 3, 4> cam_from_world = report.model;
   RefineAbsolutePose(inliers2D, inliers3D, &cam_from_world);
   const Eigen::Matrix3d rotation = cam_from_world.leftCols<3>();
-  image.cam_from_world =
-      Rigid3d(Eigen::Quaterniond(rotation).normalized(), cam_from_world.col(3));
+  image.cam_from_world = Rigid3d(Eigen::Quaterniond(rotation).normalized(), cam_from_world.col(3));
   image.registered = true;
   registered_.insert(image_id);
   for (size_t i = 0; i < correspondences.size(); ++i) {
@@ -585,8 +580,7 @@ void ModelBuilder::TriangulateImage(image_t image_id) {
     if (point3D_id == kInvalidPoint3DId) {
       TriangulateTrack(track_id, options_.tri_max_error);
     } else if (!TrackHasImage(rec_.points3D.at(point3D_id), image_id) &&
-               IsConsistent(image, idx, rec_.points3D.at(point3D_id).xyz,
-                            options_.tri_max_error)) {
+               IsConsistent(image, idx, rec_.points3D.at(point3D_id).xyz, options_.tri_max_error)) {
       AddObservation(point3D_id, {image_id, idx});  // PnP's threshold was looser
     }
   }
@@ -635,9 +629,9 @@ size_t ModelBuilder::MergeTracks() {
     bool consistent = true;
     for (const Point3D* point : {&point1, &point2}) {
       for (const TrackElement& element : point->track) {
-        consistent = consistent && IsConsistent(rec_.images.at(element.image_id),
-                                                element.point2D_idx, merged_xyz,
-                                                options_.tri_max_error);
+        consistent =
+            consistent && IsConsistent(rec_.images.at(element.image_id), element.point2D_idx,
+                                       merged_xyz, options_.tri_max_error);
       }
     }
     if (!consistent) continue;
@@ -753,7 +747,8 @@ bool ModelBuilder::LocalBundleAdjustment(image_t image_id) {
   }
   config.constant_poses = constant_images;
   config.max_num_iterations = options_.ba_local_max_num_iterations;
-  for (const point3D_t point3D_id : local_points) local.points3D[point3D_id] = rec_.points3D.at(point3D_id);
+  for (const point3D_t point3D_id : local_points)
+    local.points3D[point3D_id] = rec_.points3D.at(point3D_id);
 
   const BundleAdjustmentSummary summary = run_.bundle_adjuster.Adjust(config, &local);
   ++run_.num_local_ba;
@@ -849,10 +844,9 @@ void ModelBuilder::Finish() {
     const size_t num_observations_before = NumObservations(rec_);
     GlobalRefinement();
     const size_t num_observations_after = NumObservations(rec_);
-    const double change =
-        std::abs(static_cast<double>(num_observations_after) -
-                 static_cast<double>(num_observations_before)) /
-        std::max<double>(1.0, static_cast<double>(num_observations_before));
+    const double change = std::abs(static_cast<double>(num_observations_after) -
+                                   static_cast<double>(num_observations_before)) /
+                          std::max<double>(1.0, static_cast<double>(num_observations_before));
     if (change < 0.001) break;
   }
 }
@@ -868,8 +862,7 @@ Reconstruction ModelBuilder::TakeModel() {
   for (auto& [point3D_id, point3D] : model.points3D) {
     double sum = 0;
     for (const TrackElement& element : point3D.track) {
-      sum += ReprojectionError(model.images.at(element.image_id), element.point2D_idx,
-                               point3D.xyz);
+      sum += ReprojectionError(model.images.at(element.image_id), element.point2D_idx, point3D.xyz);
     }
     point3D.error = sum / static_cast<double>(point3D.track.size());
   }
@@ -908,10 +901,11 @@ MapperResult IncrementalMapper::Reconstruct(const MapperInput& input) const {
   MapperResult result;
   result.num_tracks = run.tracks.tracks.size();
   result.num_refused_matches = run.tracks.num_refused_matches;
-  spdlog::info("map: {} images, {} verified pairs, {} tracks ({} matches refused: they joined "
-               "two features of one image)",
-               input.images.size(), run.verified_pairs.size(), result.num_tracks,
-               result.num_refused_matches);
+  spdlog::info(
+      "map: {} images, {} verified pairs, {} tracks ({} matches refused: they joined "
+      "two features of one image)",
+      input.images.size(), run.verified_pairs.size(), result.num_tracks,
+      result.num_refused_matches);
 
   for (int attempt = 0; static_cast<int>(result.models.size()) < options_.max_num_models;
        ++attempt) {

@@ -8,11 +8,13 @@ IncrementalMapperOptions IncrementalMapperOptions::FromJson(const nlohmann::json
   IncrementalMapperOptions o;
   OptionReader reader(json, "mapper");
   o.min_num_matches = reader.Get<int>("min_num_matches", o.min_num_matches, 5, 100000);
-  o.init_min_num_inliers = reader.Get<int>("init_min_num_inliers", o.init_min_num_inliers, 8, 1000000);
+  o.init_min_num_inliers =
+      reader.Get<int>("init_min_num_inliers", o.init_min_num_inliers, 8, 1000000);
   o.init_min_tri_angle = reader.Get<double>("init_min_tri_angle", o.init_min_tri_angle, 0.0, 90.0);
   o.init_max_error = reader.Get<double>("init_max_error", o.init_max_error, 1e-3, 1000.0);
   o.init_max_num_trials = reader.Get<int>("init_max_num_trials", o.init_max_num_trials, 1, 100000);
-  o.abs_pose_max_error = reader.Get<double>("abs_pose_max_error", o.abs_pose_max_error, 1e-3, 1000.0);
+  o.abs_pose_max_error =
+      reader.Get<double>("abs_pose_max_error", o.abs_pose_max_error, 1e-3, 1000.0);
   o.abs_pose_min_num_inliers =
       reader.Get<int>("abs_pose_min_num_inliers", o.abs_pose_min_num_inliers, 4, 1000000);
   o.abs_pose_min_inlier_ratio =

@@ -26,8 +26,8 @@ struct IncrementalMapperOptions {
   int max_reg_trials = 3;
 
   // Triangulation of new points and completion of tracks.
-  double tri_max_error = 4.0;    // px, every observation
-  double tri_min_angle = 1.5;    // degrees, largest angle between two of the rays
+  double tri_max_error = 4.0;  // px, every observation
+  double tri_min_angle = 1.5;  // degrees, largest angle between two of the rays
 
   // Filtering after bundle adjustment.
   double filter_max_reproj_error = 4.0;  // px

@@ -4,8 +4,8 @@
 
 #include "eval/evaluation.h"
 #include "sfm/synthetic_scene_test_util.h"
-#include "test_support.h"
 #include "tessera/errors.h"
+#include "test_support.h"
 
 namespace tessera {
 namespace {
@@ -15,8 +15,8 @@ using testing::SyntheticScene;
 using testing::SyntheticSceneOptions;
 
 const BundleAdjuster& Adjuster() {
-  static const auto adjuster = testing::LoadBundledPlugin<BundleAdjuster>(
-      "bundle_adjuster", "ceres", {{"num_threads", 1}});
+  static const auto adjuster =
+      testing::LoadBundledPlugin<BundleAdjuster>("bundle_adjuster", "ceres", {{"num_threads", 1}});
   return *adjuster;
 }
 

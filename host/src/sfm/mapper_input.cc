@@ -11,9 +11,8 @@ MapperInput LoadMapperInput(const Database& database) {
   }
   for (Image& image : database.ReadAllImages()) {
     if (input.cameras.count(image.camera_id) == 0) {
-      throw InputError(database.path().string() + ": image '" + image.name +
-                       "' refers to camera " + std::to_string(image.camera_id) +
-                       ", which is not in the cameras table");
+      throw InputError(database.path().string() + ": image '" + image.name + "' refers to camera " +
+                       std::to_string(image.camera_id) + ", which is not in the cameras table");
     }
     const FeatureKeypoints keypoints = database.ReadKeypoints(image.image_id);
     image.points2D.resize(keypoints.size());

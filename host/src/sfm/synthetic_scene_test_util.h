@@ -86,13 +86,15 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
 
   for (int i = 0; i < options.num_images; ++i) {
     const image_t image_id = static_cast<image_t>(i + 1);
-    const double angle = (options.arc_deg * M_PI / 180) *
-                         (options.num_images > 1 ? static_cast<double>(i) / (options.num_images - 1) - 0.5 : 0);
+    const double angle =
+        (options.arc_deg * M_PI / 180) *
+        (options.num_images > 1 ? static_cast<double>(i) / (options.num_images - 1) - 0.5 : 0);
     // Centre on the arc (y is down, the arc lies in the x-z plane), looking at the origin
     // with a little random jitter of the viewing direction.
     const Eigen::Vector3d center(options.radius * std::sin(angle), 0.3 * unit(engine),
                                  -options.radius * std::cos(angle));
-    const Eigen::Vector3d z_axis = (-center + Eigen::Vector3d(0.2 * unit(engine), 0.2 * unit(engine), 0)).normalized();
+    const Eigen::Vector3d z_axis =
+        (-center + Eigen::Vector3d(0.2 * unit(engine), 0.2 * unit(engine), 0)).normalized();
     const Eigen::Vector3d x_axis = Eigen::Vector3d::UnitY().cross(z_axis).normalized();
     const Eigen::Vector3d y_axis = z_axis.cross(x_axis);
     Eigen::Matrix3d world_from_cam;
@@ -140,28 +142,33 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
     }
     for (const auto& [image_id2, image2] : scene.input.images) {
       if (image_id2 <= image_id1) continue;
-      if (options.max_pair_gap > 0 && static_cast<int>(image_id2 - image_id1) > options.max_pair_gap) {
+      if (options.max_pair_gap > 0 &&
+          static_cast<int>(image_id2 - image_id1) > options.max_pair_gap) {
         continue;
       }
       const std::vector<int>& true2 = scene.true_point_of_keypoint.at(image_id2);
       FeatureMatches matches;
       for (point2D_t idx2 = 0; idx2 < true2.size(); ++idx2) {
         const auto it = keypoint_of_point1.find(true2[idx2]);
-        if (true2[idx2] >= 0 && it != keypoint_of_point1.end()) matches.push_back({it->second, idx2});
+        if (true2[idx2] >= 0 && it != keypoint_of_point1.end())
+          matches.push_back({it->second, idx2});
       }
       if (matches.size() < static_cast<size_t>(options.min_num_matches)) continue;
       std::sort(matches.begin(), matches.end(), [](const FeatureMatch& a, const FeatureMatch& b) {
         return a.point2D_idx1 < b.point2D_idx1;
       });
-      std::uniform_int_distribution<point2D_t> any_keypoint2(0, static_cast<point2D_t>(true2.size() - 1));
-      const size_t num_outliers = static_cast<size_t>(std::round(options.outlier_ratio * matches.size()));
+      std::uniform_int_distribution<point2D_t> any_keypoint2(
+          0, static_cast<point2D_t>(true2.size() - 1));
+      const size_t num_outliers =
+          static_cast<size_t>(std::round(options.outlier_ratio * matches.size()));
       std::vector<size_t> order(matches.size());
       std::iota(order.begin(), order.end(), 0);
       std::shuffle(order.begin(), order.end(), engine);
       for (size_t k = 0; k < num_outliers; ++k) {
         FeatureMatch& match = matches[order[k]];
         point2D_t wrong = any_keypoint2(engine);
-        while (true2[wrong] >= 0 && true2[wrong] == true1[match.point2D_idx1]) wrong = any_keypoint2(engine);
+        while (true2[wrong] >= 0 && true2[wrong] == true1[match.point2D_idx1])
+          wrong = any_keypoint2(engine);
         match.point2D_idx2 = wrong;
         ++scene.num_outlier_matches;
       }
