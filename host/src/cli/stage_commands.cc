@@ -168,19 +168,21 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
       }
     }
     summary.num_registered += model.images.size();
+    const double mean_track_length = MeanTrackLength(model);
+    const double mean_reprojection_error = MeanReprojectionError(model);
     nlohmann::json images = nlohmann::json::array();
     for (const auto& [image_id, image] : model.images) images.push_back(image.name);
     spdlog::info(
         "map: model {}: {} images, {} points, mean track length {:.2f}, mean reprojection "
         "error {:.3f} px",
-        index, model.images.size(), model.points3D.size(), MeanTrackLength(model),
-        MeanReprojectionError(model));
+        index, model.images.size(), model.points3D.size(), mean_track_length,
+        mean_reprojection_error);
     summary_json["models"].push_back({{"index", index},
                                       {"folder", (sparse_dir / std::to_string(index)).string()},
                                       {"num_images", model.images.size()},
                                       {"num_points3D", model.points3D.size()},
-                                      {"mean_track_length", MeanTrackLength(model)},
-                                      {"mean_reprojection_error", MeanReprojectionError(model)},
+                                      {"mean_track_length", mean_track_length},
+                                      {"mean_reprojection_error", mean_reprojection_error},
                                       {"images", images}});
   }
   for (const auto& [image_id, reason] : result.unregistered_reasons) {

@@ -563,7 +563,8 @@ bool ModelBuilder::TriangulateTrack(track_t track_id, double max_error) {
     inliers = inliers_of(xyz);
     if (inliers.size() < 2) return false;
   }
-  const auto [sub_cams, sub_points, track] = subset(inliers);
+  Track track;
+  for (const size_t k : inliers) track.push_back(candidates[k]);
   if (MaxTriangulationAngle(track, xyz) < options_.tri_min_angle * kDegToRad) return false;
   AddPoint(track_id, xyz, track);
   return true;
