@@ -170,6 +170,24 @@ TEST(FlannMatcher, AgreesWithBruteForce) {
             0.95);
 }
 
+// With more checks than rows the k-means tree visits every leaf: the search is exact,
+// so the distances (summed by the matcher's own vectorised L2) and the cross check
+// (which searches back only from rows that some forward match points to) must give
+// exactly brute force's matches, with and without the cross check.
+TEST(FlannMatcher, ExhaustiveSearchGivesBruteForceMatchesExactly) {
+  const SyntheticPair pair = MakeL2Pair(400, 400, 30, 6);
+  for (const bool cross_check : {true, false}) {
+    const nlohmann::json options = {{"cross_check", cross_check}};
+    const auto brute_force = testing::LoadBundledPlugin<Matcher>("matcher", "brute_force", options);
+    const FeatureMatches expected = brute_force->Match(pair.descriptors1, pair.descriptors2);
+    ASSERT_GT(expected.size(), 100u);
+    EXPECT_EQ(Load({{"cross_check", cross_check}, {"checks", 100000}})
+                  ->Match(pair.descriptors1, pair.descriptors2),
+              expected)
+        << "cross_check " << cross_check;
+  }
+}
+
 TEST(FlannMatcher, RatioTestDropsAmbiguousMatches) {
   // Row 0 of set 1 lies exactly between rows 0 and 1 of set 2 (distance 5 to each);
   // row 1 has its neighbours at 10 and 20 (ratio 0.5).
