@@ -26,6 +26,10 @@ struct BundleAdjustmentConfig {
   // Iterations at most for this call (e.g. fewer for local BA); 0: the adjuster's own
   // setting.
   int max_num_iterations = 0;
+  // Stop once an iteration lowers the cost by less than this fraction; negative: the
+  // adjuster's own setting. Lets the mapper stop local adjustments, which only have
+  // to be good enough for the next registration, earlier than global ones.
+  double function_tolerance = -1;
 };
 
 struct BundleAdjustmentSummary {

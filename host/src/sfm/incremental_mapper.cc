@@ -14,6 +14,7 @@
 #include "estimators/ransac.h"
 #include "geometry/essential_matrix.h"
 #include "geometry/triangulation.h"
+#include "sfm/camera_plausibility.h"
 #include "util/random.h"
 
 namespace tessera {
@@ -114,6 +115,9 @@ class ModelBuilder {
   bool LocalBundleAdjustment(image_t image_id);
   void GlobalBundleAdjustment();
   void GlobalRefinement();
+  // Puts back at the image centre every principal point that BA moved further than
+  // max_principal_point_offset from it; true if one was.
+  bool ResetImplausiblePrincipalPoints();
   size_t CompleteTracks(const std::set<point3D_t>& point3D_ids);
   size_t MergeTracks();
   size_t Retriangulate();
@@ -170,6 +174,8 @@ class ModelBuilder {
   point3D_t next_point3D_id_ = 1;
   std::map<image_t, int> num_registration_trials_;
   size_t num_images_at_global_ba_ = 0;
+  // Whether BA moves the principal point now: only in the final global rounds.
+  bool refine_principal_point_ = false;
   size_t num_points_at_global_ba_ = 0;
   bool changed_since_global_ba_ = false;
 };
@@ -695,7 +701,7 @@ size_t ModelBuilder::FilterPoints(const std::set<point3D_t>& point3D_ids) {
 BundleAdjustmentConfig ModelBuilder::MakeBundleAdjustmentConfig() const {
   BundleAdjustmentConfig config;
   config.refine_focal_length = options_.ba_refine_focal_length;
-  config.refine_principal_point = options_.ba_refine_principal_point;
+  config.refine_principal_point = refine_principal_point_;
   config.refine_extra_params = options_.ba_refine_extra_params;
   config.fix_gauge = true;
   return config;
@@ -748,6 +754,7 @@ bool ModelBuilder::LocalBundleAdjustment(image_t image_id) {
   }
   config.constant_poses = constant_images;
   config.max_num_iterations = options_.ba_local_max_num_iterations;
+  config.function_tolerance = options_.ba_local_function_tolerance;
   for (const point3D_t point3D_id : local_points)
     local.points3D[point3D_id] = rec_.points3D.at(point3D_id);
 
@@ -776,6 +783,7 @@ void ModelBuilder::GlobalBundleAdjustment() {
   BundleAdjustmentConfig config = MakeBundleAdjustmentConfig();
   config.images = registered_;
   config.max_num_iterations = options_.ba_global_max_num_iterations;
+  config.function_tolerance = options_.ba_global_function_tolerance;
   const BundleAdjustmentSummary summary = run_.bundle_adjuster.Adjust(config, &rec_);
   ++run_.num_global_ba;
   spdlog::debug("map: global BA of {} images, {} points: {}", registered_.size(),
@@ -840,10 +848,36 @@ void ModelBuilder::Grow() {
   }
 }
 
+bool ModelBuilder::ResetImplausiblePrincipalPoints() {
+  bool any = false;
+  for (auto& [camera_id, camera] : rec_.cameras) {
+    if (!IsPrincipalPointPlausible(camera, options_.max_principal_point_offset)) {
+      spdlog::warn(
+          "map: camera {}'s principal point went to ({:.1f}, {:.1f}), more than {:.0f}% of "
+          "the image size from the centre of its {}x{} images; it is put back at the centre "
+          "and kept there",
+          camera_id, camera.PrincipalPointX(), camera.PrincipalPointY(),
+          100 * options_.max_principal_point_offset, camera.width, camera.height);
+      ResetPrincipalPoint(&camera);
+      any = true;
+    }
+  }
+  return any;
+}
+
 void ModelBuilder::Finish() {
+  // The principal point is only well determined by many registered views, and moving
+  // it while poses are still being found would only add a degree of freedom to drift:
+  // it is refined in the final rounds only.
+  refine_principal_point_ = options_.ba_refine_principal_point;
   for (int round = 0; round < options_.ba_global_max_refinements; ++round) {
     const size_t num_observations_before = NumObservations(rec_);
     GlobalRefinement();
+    if (refine_principal_point_ && ResetImplausiblePrincipalPoints()) {
+      refine_principal_point_ = false;
+      GlobalRefinement();
+      continue;
+    }
     const size_t num_observations_after = NumObservations(rec_);
     const double change = std::abs(static_cast<double>(num_observations_after) -
                                    static_cast<double>(num_observations_before)) /

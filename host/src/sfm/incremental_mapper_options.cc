@@ -31,6 +31,10 @@ IncrementalMapperOptions IncrementalMapperOptions::FromJson(const nlohmann::json
       reader.Get<int>("ba_local_max_num_iterations", o.ba_local_max_num_iterations, 1, 10000);
   o.ba_global_max_num_iterations =
       reader.Get<int>("ba_global_max_num_iterations", o.ba_global_max_num_iterations, 1, 10000);
+  o.ba_local_function_tolerance =
+      reader.Get<double>("ba_local_function_tolerance", o.ba_local_function_tolerance, 0.0, 1.0);
+  o.ba_global_function_tolerance =
+      reader.Get<double>("ba_global_function_tolerance", o.ba_global_function_tolerance, 0.0, 1.0);
   o.ba_global_images_ratio =
       reader.Get<double>("ba_global_images_ratio", o.ba_global_images_ratio, 1.0, 100.0);
   o.ba_global_points_ratio =
@@ -40,6 +44,8 @@ IncrementalMapperOptions IncrementalMapperOptions::FromJson(const nlohmann::json
   o.ba_refine_focal_length = reader.GetBool("ba_refine_focal_length", o.ba_refine_focal_length);
   o.ba_refine_principal_point =
       reader.GetBool("ba_refine_principal_point", o.ba_refine_principal_point);
+  o.max_principal_point_offset =
+      reader.Get<double>("max_principal_point_offset", o.max_principal_point_offset, 0.0, 0.5);
   o.ba_refine_extra_params = reader.GetBool("ba_refine_extra_params", o.ba_refine_extra_params);
   o.multiple_models = reader.GetBool("multiple_models", o.multiple_models);
   o.max_num_models = reader.Get<int>("max_num_models", o.max_num_models, 1, 100000);
@@ -65,11 +71,14 @@ nlohmann::json IncrementalMapperOptions::ToJson() const {
           {"local_ba_num_images", local_ba_num_images},
           {"ba_local_max_num_iterations", ba_local_max_num_iterations},
           {"ba_global_max_num_iterations", ba_global_max_num_iterations},
+          {"ba_local_function_tolerance", ba_local_function_tolerance},
+          {"ba_global_function_tolerance", ba_global_function_tolerance},
           {"ba_global_images_ratio", ba_global_images_ratio},
           {"ba_global_points_ratio", ba_global_points_ratio},
           {"ba_global_max_refinements", ba_global_max_refinements},
           {"ba_refine_focal_length", ba_refine_focal_length},
           {"ba_refine_principal_point", ba_refine_principal_point},
+          {"max_principal_point_offset", max_principal_point_offset},
           {"ba_refine_extra_params", ba_refine_extra_params},
           {"multiple_models", multiple_models},
           {"max_num_models", max_num_models},

@@ -31,6 +31,10 @@ struct SyntheticSceneOptions {
   double focal_length = 1000;  // px
   int width = 1600, height = 1200;
   double k1 = 0.0;  // SIMPLE_RADIAL distortion of the true camera
+  // Where the true principal point lies, in pixels from the image centre; the mapper is
+  // told it is at the centre.
+  double principal_point_offset_x = 0.0;
+  double principal_point_offset_y = 0.0;
   double noise_px = 0.5;
   // Fraction of each pair's matches replaced by a match to a random keypoint.
   double outlier_ratio = 0.0;
@@ -73,6 +77,8 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
                                       options.width, options.height);
   true_camera.params[3] = options.k1;
   Camera prior_camera = true_camera;
+  true_camera.params[1] += options.principal_point_offset_x;
+  true_camera.params[2] += options.principal_point_offset_y;
   prior_camera.params[0] = options.focal_length * options.prior_focal_factor;
   prior_camera.params[3] = 0;
   prior_camera.has_prior_focal_length = true;

@@ -303,6 +303,9 @@ class CeresBundleAdjuster : public BundleAdjuster {
       solver_options.max_num_iterations =
           std::min(solver_options.max_num_iterations, config.max_num_iterations);
     }
+    if (config.function_tolerance >= 0) {
+      solver_options.function_tolerance = config.function_tolerance;
+    }
     std::string error;
     if (!solver_options.IsValid(&error)) return InvalidProblem("invalid solver options: " + error);
     ceres::Solver::Summary ceres_summary;
