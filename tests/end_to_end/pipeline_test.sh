@@ -15,13 +15,10 @@ tessera=$1
 downscale=$2
 shared=$3
 dataset="$shared/datasets/fountain-P11"
-if [ ! -d "$dataset/images" ]; then
-  echo "SKIP: $dataset not found"
-  exit 77
-fi
+source "$(dirname "$0")/common.sh"
+require_dataset "$dataset"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
 
 # A copy at 1024 px: a third of full resolution; K scaled to match.
 scale=$("$downscale" "$dataset/images" "$work/images" 1024 95) || fail "downscale"
@@ -43,12 +40,8 @@ mean_inliers=$(sqlite3 "$work/full/database.db" \
 echo "verified pairs: $verified of 55, mean inliers per pair: $mean_inliers"
 [ "$verified" -eq 55 ] || fail "expected 55 verified pairs, got $verified"
 [ -f "$work/full/sparse/0/points3D.ply" ] || fail "the default manifest's PLY is missing"
-"$tessera" eval "$work/full/sparse/0" "$dataset/gt" --json > "$work/eval.json" ||
-  fail "tessera eval"
-read -r registered rel reproj < <(python3 -c '
-import json, sys
-e = json.load(open(sys.argv[1]))
-print(e["registered"], e["pos_mean_rel"], e["mean_reprojection_error_px"])' "$work/eval.json")
+scores=$(model_scores "$tessera" "$work/full/sparse/0" "$dataset/gt") || fail "tessera eval"
+read -r registered rel reproj <<< "$scores"
 echo "map: $registered of 11 registered, mean position error $rel of the scene extent," \
   "mean reprojection error $reproj px"
 [ "$registered" = "11" ] || fail "registered $registered of 11 images"

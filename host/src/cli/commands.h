@@ -28,5 +28,6 @@ CommandRegistration RegisterMatchCommand(CLI::App& app, const GlobalOptions& glo
 CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterBenchCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera

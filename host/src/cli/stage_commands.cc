@@ -15,6 +15,7 @@
 #include "scene/colmap_model_io.h"
 #include "sfm/incremental_mapper.h"
 #include "sfm/mapper_input.h"
+#include "util/file_io.h"
 #include "util/timer.h"
 
 namespace tessera {
@@ -293,9 +294,29 @@ CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions&) {
             LogMatching(matching);
             const MappingSummary mapping =
                 MapWorkspace(context, &database, options->output, options->images);
+            const double total_seconds = timer.ElapsedSeconds();
             spdlog::info("run: extract {:.2f} s, match {:.2f} s, map {:.2f} s, total {:.2f} s",
-                         extraction.seconds, matching.seconds, mapping.seconds,
-                         timer.ElapsedSeconds());
+                         extraction.seconds, matching.seconds, mapping.seconds, total_seconds);
+            // What `tessera bench` reads back; mapping_summary.json has the models.
+            const nlohmann::json run_summary = {{"extract",
+                                                 {{"seconds", extraction.seconds},
+                                                  {"num_images", extraction.num_images},
+                                                  {"num_detected", extraction.num_detected},
+                                                  {"num_reused", extraction.num_reused}}},
+                                                {"match",
+                                                 {{"seconds", matching.seconds},
+                                                  {"num_pairs", matching.num_pairs},
+                                                  {"num_matched", matching.num_matched},
+                                                  {"num_reused", matching.num_reused},
+                                                  {"num_verified", matching.num_verified}}},
+                                                {"map",
+                                                 {{"seconds", mapping.seconds},
+                                                  {"num_models", mapping.num_models},
+                                                  {"num_registered", mapping.num_registered},
+                                                  {"num_images", mapping.num_images}}},
+                                                {"total_seconds", total_seconds}};
+            WriteFileAtomically(std::filesystem::path(options->output) / "run_summary.json",
+                                run_summary.dump(2) + "\n");
             return MappingExitCode(mapping, database_file);
           }};
 }

@@ -1,0 +1,502 @@
+// `tessera bench --images DIR [--gt GT] MANIFEST...`: every manifest run on the same
+// images, each as its own `tessera run` child process (so that one plugin's crash loses
+// no other row, and each row's peak memory is its own), and optionally COLMAP 3.8 on the
+// CPU, in the same command on the same machine. Detection is shared: a manifest whose
+// detector and camera settings equal an earlier one's starts from a copy of that
+// workspace's features (not its matches), and its row says so. Prints a Markdown table; --json and
+// --csv write the same rows to files.
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <spdlog/spdlog.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <thread>
+
+#include "cli/commands.h"
+#include "cli/exit_codes.h"
+#include "database/database.h"
+#include "eval/evaluation.h"
+#include "eval/ground_truth.h"
+#include "scene/colmap_model_io.h"
+#include "tessera/errors.h"
+#include "util/file_io.h"
+#include "util/timer.h"
+
+extern char** environ;
+
+namespace tessera {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// One system on the images: a manifest, or COLMAP.
+struct BenchRow {
+  std::string name;     // the manifest's file stem, or "colmap"
+  std::string plugins;  // detector / pair_selector / matcher / bundle_adjuster
+  std::string workspace;
+  int exit_code = 0;
+  std::string extract_shared_with;  // the row whose features this one started from
+  double extract_seconds = kNaN;
+  double match_seconds = kNaN;
+  double map_seconds = kNaN;
+  double total_seconds = kNaN;
+  double peak_memory_mb = kNaN;
+  size_t num_pairs = 0;
+  size_t num_verified = 0;
+  double mean_inliers = kNaN;
+  size_t num_images = 0;
+  size_t num_registered = 0;  // in model 0
+  size_t num_models = 0;
+  size_t num_points = 0;
+  double mean_track_length = kNaN;
+  double mean_reprojection_error = kNaN;
+  // With --gt, model 0 against it.
+  double position_error_mean = kNaN;
+  double position_error_relative = kNaN;  // of the scene extent
+  double rotation_error_mean_deg = kNaN;
+};
+
+struct ChildResult {
+  int exit_code = 0;  // 127: could not be started; 128 + n: killed by signal n
+  double peak_memory_mb = kNaN;
+  double seconds = 0;
+};
+
+// Runs `argv` with stdout and stderr appended to `log`; waits for it.
+ChildResult RunChild(const std::vector<std::string>& argv, const fs::path& log) {
+  std::vector<char*> args;
+  for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
+  args.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
+                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  const Timer timer;
+  pid_t pid = 0;
+  const int error = posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ChildResult result;
+  if (error != 0) {
+    result.exit_code = 127;
+    return result;
+  }
+  int status = 0;
+  struct rusage usage {};
+  while (wait4(pid, &status, 0, &usage) < 0) {
+    if (errno != EINTR) throw std::runtime_error("waiting for " + argv[0] + " failed");
+  }
+  result.seconds = timer.ElapsedSeconds();
+  result.peak_memory_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss: KiB
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return result;
+}
+
+nlohmann::json ReadJsonFile(const fs::path& file) {
+  return nlohmann::json::parse(ReadFileContents(file), nullptr, /*allow_exceptions=*/true,
+                               /*ignore_comments=*/true);
+}
+
+// Pairs matched, pairs verified and their mean number of inliers, from a workspace.
+void ReadMatchingFigures(const fs::path& database_file, BenchRow* row) {
+  const Database database(database_file);
+  row->num_images = database.NumImages();
+  row->num_pairs = database.NumMatchedPairs();
+  size_t num_inliers = 0;
+  row->num_verified = 0;
+  for (const auto& [pair_id, geometry] : database.ReadAllTwoViewGeometries()) {
+    if (geometry.config == TwoViewGeometry::UNDEFINED ||
+        geometry.config == TwoViewGeometry::DEGENERATE) {
+      continue;
+    }
+    ++row->num_verified;
+    num_inliers += geometry.inlier_matches.size();
+  }
+  row->mean_inliers =
+      row->num_verified > 0 ? static_cast<double>(num_inliers) / row->num_verified : kNaN;
+}
+
+// Model 0 of `model_dir` scored against the ground truth, when there is one.
+void ScoreModel(const fs::path& model_dir, const std::string& ground_truth, BenchRow* row) {
+  if (ground_truth.empty() || !fs::exists(model_dir / "images.bin")) return;
+  const EvaluationResult result =
+      EvaluateReconstruction(ReadColmapModel(model_dir), ReadGroundTruth(ground_truth));
+  if (!result.aligned) {
+    spdlog::warn("bench: {}: {} cannot be scored: {}", row->name, model_dir.string(), result.error);
+    return;
+  }
+  row->position_error_mean = result.position_error_mean;
+  row->position_error_relative = result.position_error_mean / result.scene_extent;
+  row->rotation_error_mean_deg = result.rotation_error_mean_deg;
+}
+
+std::string SlotPlugin(const nlohmann::json& manifest, const std::string& slot) {
+  const auto pipeline = manifest.find("pipeline");
+  if (pipeline == manifest.end() || !pipeline->contains(slot)) return "-";
+  const nlohmann::json& value = pipeline->at(slot);
+  return value.contains("plugin") && value.at("plugin").is_string()
+             ? value.at("plugin").get<std::string>()
+             : "-";
+}
+
+struct BenchOptions {
+  std::string images;
+  std::string ground_truth;
+  std::string output;
+  std::string json_file;
+  std::string csv_file;
+  std::string camera_K;
+  bool with_colmap = false;
+  int threads = 0;
+  std::vector<std::string> manifests;
+};
+
+BenchRow RunManifest(const BenchOptions& options, const std::string& manifest_file,
+                     const std::string& name, const std::string& shared_from,
+                     const fs::path& workspace) {
+  BenchRow row;
+  row.name = name;
+  row.workspace = workspace.string();
+  const nlohmann::json manifest = ReadJsonFile(manifest_file);
+  row.plugins = SlotPlugin(manifest, "detector") + " / " + SlotPlugin(manifest, "pair_selector") +
+                " / " + SlotPlugin(manifest, "matcher") + " / " +
+                SlotPlugin(manifest, "bundle_adjuster");
+  fs::remove_all(workspace);
+  CreateFolder(workspace);
+  if (!shared_from.empty()) {
+    fs::copy_file(fs::path(options.output) / shared_from / "database.db",
+                  workspace / "database.db");
+    // Only the features are shared: a workspace keeps pairs matched under another pair
+    // selector, and those would make this row map pairs its own selector never chose.
+    Database(workspace / "database.db").ClearMatches();
+    row.extract_shared_with = shared_from;
+  }
+  std::vector<std::string> argv = {fs::read_symlink("/proc/self/exe").string(),
+                                   "run",
+                                   "--images",
+                                   options.images,
+                                   "--output",
+                                   workspace.string(),
+                                   "--manifest",
+                                   manifest_file};
+  if (options.threads > 0) argv.insert(argv.end(), {"--threads", std::to_string(options.threads)});
+  if (!options.camera_K.empty()) argv.insert(argv.end(), {"--camera-K", options.camera_K});
+  spdlog::info("bench: {} ({}) ...", name, row.plugins);
+  const ChildResult child = RunChild(argv, workspace / "run.log");
+  row.exit_code = child.exit_code;
+  row.peak_memory_mb = child.peak_memory_mb;
+  if (!fs::exists(workspace / "run_summary.json")) return row;  // failed before the end
+  const nlohmann::json run = ReadJsonFile(workspace / "run_summary.json");
+  row.extract_seconds = run.at("extract").at("seconds").get<double>();
+  row.match_seconds = run.at("match").at("seconds").get<double>();
+  row.map_seconds = run.at("map").at("seconds").get<double>();
+  row.total_seconds = run.at("total_seconds").get<double>();
+  row.num_models = run.at("map").at("num_models").get<size_t>();
+  ReadMatchingFigures(workspace / "database.db", &row);
+  const nlohmann::json mapping = ReadJsonFile(workspace / "mapping_summary.json");
+  if (!mapping.at("models").empty()) {
+    const nlohmann::json& model = mapping.at("models").at(0);
+    row.num_registered = model.at("num_images").get<size_t>();
+    row.num_points = model.at("num_points3D").get<size_t>();
+    row.mean_track_length = model.at("mean_track_length").get<double>();
+    row.mean_reprojection_error = model.at("mean_reprojection_error").get<double>();
+    ScoreModel(workspace / "sparse" / "0", options.ground_truth, &row);
+  }
+  return row;
+}
+
+// COLMAP 3.8 with its CPU defaults, one shared camera and exhaustive matching.
+BenchRow RunColmap(const BenchOptions& options, const fs::path& workspace) {
+  BenchRow row;
+  row.name = "colmap";
+  row.plugins = "COLMAP 3.8: sift / exhaustive / sift_matcher / mapper";
+  row.workspace = workspace.string();
+  fs::remove_all(workspace);
+  CreateFolder(workspace / "sparse");
+  setenv("QT_QPA_PLATFORM", "offscreen", 1);
+  const std::string database = (workspace / "database.db").string();
+  const std::string threads = std::to_string(options.threads > 0 ? options.threads : -1);
+  const std::vector<std::vector<std::string>> steps = {
+      {"colmap", "feature_extractor", "--database_path", database, "--image_path", options.images,
+       "--ImageReader.single_camera", "1", "--SiftExtraction.use_gpu", "0",
+       "--SiftExtraction.num_threads", threads},
+      {"colmap", "exhaustive_matcher", "--database_path", database, "--SiftMatching.use_gpu", "0",
+       "--SiftMatching.num_threads", threads},
+      {"colmap", "mapper", "--database_path", database, "--image_path", options.images,
+       "--output_path", (workspace / "sparse").string(), "--Mapper.num_threads", threads}};
+  spdlog::info("bench: colmap ...");
+  double* const seconds[] = {&row.extract_seconds, &row.match_seconds, &row.map_seconds};
+  row.peak_memory_mb = 0;
+  row.total_seconds = 0;
+  for (size_t i = 0; i < steps.size(); ++i) {
+    const ChildResult child = RunChild(steps[i], workspace / "colmap.log");
+    *seconds[i] = child.seconds;
+    row.total_seconds += child.seconds;
+    row.peak_memory_mb = std::max(row.peak_memory_mb, child.peak_memory_mb);
+    row.exit_code = child.exit_code;
+    if (child.exit_code != 0) return row;
+  }
+  ReadMatchingFigures(database, &row);
+  const fs::path model_dir = workspace / "sparse" / "0";
+  if (fs::exists(model_dir / "images.bin")) {
+    const Reconstruction model = ReadColmapModel(model_dir);
+    row.num_models = 1;
+    row.num_registered = model.images.size();
+    row.num_points = model.points3D.size();
+    size_t num_observations = 0;
+    double error_sum = 0;
+    for (const auto& [point3D_id, point3D] : model.points3D) {
+      num_observations += point3D.track.size();
+      error_sum += point3D.error * static_cast<double>(point3D.track.size());
+    }
+    if (!model.points3D.empty()) {
+      row.mean_track_length =
+          static_cast<double>(num_observations) / static_cast<double>(model.points3D.size());
+      row.mean_reprojection_error = error_sum / static_cast<double>(num_observations);
+    }
+    ScoreModel(model_dir, options.ground_truth, &row);
+  }
+  return row;
+}
+
+std::string Format(double value, int precision) {
+  if (std::isnan(value)) return "-";
+  std::ostringstream stream;
+  stream.setf(std::ios::fixed);
+  stream.precision(precision);
+  stream << value;
+  return stream.str();
+}
+
+const std::vector<std::string>& Columns() {
+  static const std::vector<std::string> columns = {"manifest",
+                                                   "plugins",
+                                                   "extract s",
+                                                   "match s",
+                                                   "map s",
+                                                   "total s",
+                                                   "peak MB",
+                                                   "pairs",
+                                                   "verified pairs",
+                                                   "mean inliers",
+                                                   "registered",
+                                                   "models",
+                                                   "points",
+                                                   "track length",
+                                                   "reproj px",
+                                                   "position error",
+                                                   "position error % of extent",
+                                                   "rotation error deg",
+                                                   "exit code"};
+  return columns;
+}
+
+std::vector<std::string> Cells(const BenchRow& row) {
+  std::string extract = Format(row.extract_seconds, 1);
+  if (!row.extract_shared_with.empty()) extract += " (features of " + row.extract_shared_with + ")";
+  return {row.name,
+          row.plugins,
+          extract,
+          Format(row.match_seconds, 1),
+          Format(row.map_seconds, 1),
+          Format(row.total_seconds, 1),
+          Format(row.peak_memory_mb, 0),
+          std::to_string(row.num_pairs),
+          std::to_string(row.num_verified),
+          Format(row.mean_inliers, 0),
+          std::to_string(row.num_registered) + "/" + std::to_string(row.num_images),
+          std::to_string(row.num_models),
+          std::to_string(row.num_points),
+          Format(row.mean_track_length, 2),
+          Format(row.mean_reprojection_error, 3),
+          Format(row.position_error_mean, 5),
+          Format(100 * row.position_error_relative, 3),
+          Format(row.rotation_error_mean_deg, 3),
+          std::to_string(row.exit_code)};
+}
+
+nlohmann::json ToJson(const BenchRow& row) {
+  const auto number = [](double value) -> nlohmann::json {
+    return std::isnan(value) ? nlohmann::json(nullptr) : nlohmann::json(value);
+  };
+  return {{"manifest", row.name},
+          {"plugins", row.plugins},
+          {"workspace", row.workspace},
+          {"exit_code", row.exit_code},
+          {"extract_shared_with", row.extract_shared_with},
+          {"extract_seconds", number(row.extract_seconds)},
+          {"match_seconds", number(row.match_seconds)},
+          {"map_seconds", number(row.map_seconds)},
+          {"total_seconds", number(row.total_seconds)},
+          {"peak_memory_mb", number(row.peak_memory_mb)},
+          {"num_pairs", row.num_pairs},
+          {"num_verified_pairs", row.num_verified},
+          {"mean_inliers_per_verified_pair", number(row.mean_inliers)},
+          {"num_images", row.num_images},
+          {"num_registered", row.num_registered},
+          {"num_models", row.num_models},
+          {"num_points3D", row.num_points},
+          {"mean_track_length", number(row.mean_track_length)},
+          {"mean_reprojection_error_px", number(row.mean_reprojection_error)},
+          {"position_error_mean", number(row.position_error_mean)},
+          {"position_error_mean_relative", number(row.position_error_relative)},
+          {"rotation_error_mean_deg", number(row.rotation_error_mean_deg)}};
+}
+
+std::string MarkdownTable(const std::vector<BenchRow>& rows) {
+  std::ostringstream out;
+  const std::vector<std::string>& columns = Columns();
+  out << "|";
+  for (const std::string& column : columns) out << " " << column << " |";
+  out << "\n|";
+  for (size_t i = 0; i < columns.size(); ++i) out << " --- |";
+  out << "\n";
+  for (const BenchRow& row : rows) {
+    out << "|";
+    for (const std::string& cell : Cells(row)) out << " " << cell << " |";
+    out << "\n";
+  }
+  return out.str();
+}
+
+std::string CsvCell(const std::string& cell) {
+  if (cell.find_first_of(",\"\n") == std::string::npos) return cell;
+  std::string quoted = "\"";
+  for (const char c : cell) quoted += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return quoted + "\"";
+}
+
+std::string Csv(const std::vector<BenchRow>& rows) {
+  std::ostringstream out;
+  const std::vector<std::string>& columns = Columns();
+  for (size_t i = 0; i < columns.size(); ++i) out << (i ? "," : "") << CsvCell(columns[i]);
+  out << "\n";
+  for (const BenchRow& row : rows) {
+    const std::vector<std::string> cells = Cells(row);
+    for (size_t i = 0; i < cells.size(); ++i) out << (i ? "," : "") << CsvCell(cells[i]);
+    out << "\n";
+  }
+  return out.str();
+}
+
+// The settings that decide what extraction produces, as text: equal keys, equal
+// features.
+std::string ExtractionKey(const nlohmann::json& manifest) {
+  const auto pipeline = manifest.find("pipeline");
+  if (pipeline == manifest.end() || !pipeline->contains("detector")) return "";
+  return pipeline->at("detector").dump() + "|" +
+         (manifest.contains("camera") ? manifest.at("camera").dump() : "");
+}
+
+int RunBench(const BenchOptions& options) {
+  if (!fs::is_directory(options.images)) {
+    throw InputError(options.images + ": --images is not a folder");
+  }
+  if (!options.ground_truth.empty() && !fs::exists(options.ground_truth)) {
+    throw InputError(options.ground_truth + ": --gt does not exist");
+  }
+  // Read every manifest first: a missing or malformed one fails before any run.
+  std::vector<std::string> names;
+  std::vector<std::string> keys;
+  for (const std::string& file : options.manifests) {
+    nlohmann::json manifest;
+    try {
+      manifest = ReadJsonFile(file);
+    } catch (const nlohmann::json::exception& error) {
+      throw InputError(file + ": not a JSON manifest: " + error.what());
+    }
+    std::string name = fs::path(file).stem().string();
+    for (int suffix = 2; std::find(names.begin(), names.end(), name) != names.end(); ++suffix) {
+      name = fs::path(file).stem().string() + "-" + std::to_string(suffix);
+    }
+    names.push_back(name);
+    keys.push_back(ExtractionKey(manifest));
+  }
+  CreateFolder(options.output);
+
+  std::vector<BenchRow> rows;
+  for (size_t i = 0; i < options.manifests.size(); ++i) {
+    std::string shared_from;
+    for (size_t j = 0; j < i && !keys[i].empty(); ++j) {
+      if (keys[j] == keys[i] && rows[j].exit_code == 0) {
+        shared_from = names[j];
+        break;
+      }
+    }
+    rows.push_back(RunManifest(options, options.manifests[i], names[i], shared_from,
+                               fs::path(options.output) / names[i]));
+  }
+  if (options.with_colmap) {
+    if (std::system("command -v colmap > /dev/null 2>&1") != 0) {
+      spdlog::warn("bench: colmap is not installed: no COLMAP row");
+    } else {
+      rows.push_back(RunColmap(options, fs::path(options.output) / "colmap"));
+    }
+  }
+
+  std::cout << MarkdownTable(rows);
+  if (options.with_colmap && rows.back().name == "colmap" && rows.back().exit_code == 0) {
+    const BenchRow& colmap = rows.back();
+    std::cout << "\nTime as a share of COLMAP's (end to end; extract + match):\n";
+    for (size_t i = 0; i + 1 < rows.size(); ++i) {
+      std::cout << "- " << rows[i].name << ": "
+                << Format(rows[i].total_seconds / colmap.total_seconds, 2) << "; "
+                << Format((rows[i].extract_seconds + rows[i].match_seconds) /
+                              (colmap.extract_seconds + colmap.match_seconds),
+                          2)
+                << "\n";
+    }
+  }
+  nlohmann::json json = {{"images", options.images},
+                         {"ground_truth", options.ground_truth},
+                         {"hardware_threads", std::thread::hardware_concurrency()},
+                         {"rows", nlohmann::json::array()}};
+  for (const BenchRow& row : rows) json["rows"].push_back(ToJson(row));
+  if (!options.json_file.empty()) WriteFileAtomically(options.json_file, json.dump(2) + "\n");
+  if (!options.csv_file.empty()) WriteFileAtomically(options.csv_file, Csv(rows));
+
+  // Every row is printed and written first; then the first failure decides the exit code.
+  for (const BenchRow& row : rows) {
+    if (row.exit_code != 0) {
+      spdlog::error(
+          "bench: {} ended with exit code {}; its log: {}", row.name, row.exit_code,
+          (fs::path(row.workspace) / (row.name == "colmap" ? "colmap.log" : "run.log")).string());
+      return row.exit_code == kExitBadInput ? kExitBadInput : kExitInternalError;
+    }
+  }
+  return kExitSuccess;
+}
+
+}  // namespace
+
+CommandRegistration RegisterBenchCommand(CLI::App& app, const GlobalOptions&) {
+  auto options = std::make_shared<BenchOptions>();
+  CLI::App* sub = app.add_subcommand(
+      "bench", "Run several manifests (and COLMAP) on the same images and compare them");
+  sub->add_option("--images", options->images, "Folder of input images")->required();
+  sub->add_option("--gt", options->ground_truth,
+                  "Ground truth to score model 0 against (as for eval)");
+  sub->add_option("--output", options->output, "Folder of the workspaces, one per manifest")
+      ->default_val("bench-output");
+  sub->add_option("--json", options->json_file, "Also write the rows as JSON to this file");
+  sub->add_option("--csv", options->csv_file, "Also write the rows as CSV to this file");
+  sub->add_option("--camera-K", options->camera_K, "Known intrinsics for every manifest");
+  sub->add_option("--threads", options->threads, "Worker threads of every run (default: all)")
+      ->check(CLI::NonNegativeNumber);
+  sub->add_flag("--with-colmap", options->with_colmap,
+                "Add a row for COLMAP 3.8 (CPU, exhaustive) on the same images");
+  sub->add_option("MANIFEST", options->manifests, "Manifests to compare")->required();
+  return {sub, [options]() { return RunBench(*options); }};
+}
+
+}  // namespace tessera

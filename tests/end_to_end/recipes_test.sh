@@ -1,0 +1,37 @@
+#!/bin/bash
+# Every recipe in manifests/ reconstructs a downscaled copy of fountain-P11 (made here, in
+# a temporary folder, at 1024 px; no K given): all 11 images in model 0, a mean camera
+# position error under 1% of the scene's extent, a mean reprojection error under 1 px.
+# Prints, per recipe, verified pairs, registered images and the errors.
+# usage: recipes_test.sh TESSERA DOWNSCALE SHARED_DIR MANIFEST_DIR
+set -uo pipefail
+tessera=$1
+downscale=$2
+shared=$3
+manifests=$4
+dataset="$shared/datasets/fountain-P11"
+source "$(dirname "$0")/common.sh"
+require_dataset "$dataset"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+"$downscale" "$dataset/images" "$work/images" 1024 95 > /dev/null || fail "downscale"
+num_recipes=0
+for manifest in "$manifests"/*.json; do
+  recipe=$(basename "$manifest" .json)
+  out="$work/$recipe"
+  "$tessera" run --images "$work/images" --output "$out" --manifest "$manifest" \
+    --threads 2 2> "$out.log" || { tail -20 "$out.log"; fail "$recipe: tessera run"; }
+  verified=$(sqlite3 "$out/database.db" \
+    "SELECT COUNT(*) FROM two_view_geometries WHERE rows >= 15 AND config NOT IN (0, 1)")
+  scores=$(model_scores "$tessera" "$out/sparse/0" "$dataset/gt") || fail "$recipe: tessera eval"
+  read -r registered rel reproj <<< "$scores"
+  echo "$recipe: $verified verified pairs, $registered of 11 registered," \
+    "mean position error $rel of the scene extent, mean reprojection error $reproj px"
+  [ "$registered" = "11" ] || fail "$recipe: registered $registered of 11 images"
+  awk -v r="$rel" 'BEGIN { exit !(r < 0.01) }' || fail "$recipe: position error $rel >= 1%"
+  awk -v r="$reproj" 'BEGIN { exit !(r < 1.0) }' || fail "$recipe: reprojection error $reproj px"
+  num_recipes=$((num_recipes + 1))
+done
+[ "$num_recipes" -ge 5 ] || fail "expected at least 5 recipes in $manifests, found $num_recipes"
+echo "PASS: $num_recipes recipes"
