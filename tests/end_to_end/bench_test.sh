@@ -3,7 +3,8 @@
 #  1. two ORB manifests that differ only in the pair selector: two rows, the second
 #     reusing the first's features (and only those: 55 exhaustive pairs, then 40 window
 #     pairs), every image registered, scored against the ground truth; the same rows in
-#     --json and --csv; with colmap installed, a COLMAP row that registers every image;
+#     --json and --csv, and an SVG chart of them; with colmap installed, a COLMAP row that
+#     registers every image;
 #  2. the same command again gives the same pairs, registered counts and errors;
 #  3. a manifest naming an unknown plugin gives its row an exit code of 2 and the bench
 #     exit code 2, after the other rows are printed; a missing manifest file fails
@@ -37,7 +38,7 @@ if command -v colmap > /dev/null; then colmap_flag=(--with-colmap); else
 
 # 1. Two manifests, shared features, every output.
 "$tessera" bench --images "$images" --gt "$gt" --output "$work/out1" --threads 2 \
-  --json "$work/1.json" --csv "$work/1.csv" "${colmap_flag[@]}" \
+  --json "$work/1.json" --csv "$work/1.csv" --chart "$work/1.svg" "${colmap_flag[@]}" \
   "$work/orb_exhaustive.json" "$work/orb_window.json" > "$work/1.md" 2> "$work/1.log" ||
   { cat "$work/1.log"; fail "tessera bench exited $?"; }
 cat "$work/1.md"
@@ -59,6 +60,9 @@ assert len(table) == 1 + len(rows) and table[0][0] == "manifest", table
 assert [line[0] for line in table[1:]] == [r["manifest"] for r in rows]
 print("json and csv: %d rows" % len(rows))
 PY
+
+grep -q "<svg" "$work/1.svg" && grep -q "orb_exhaustive" "$work/1.svg" &&
+  grep -q "orb_window" "$work/1.svg" || fail "the chart is not an SVG naming both rows"
 
 # 2. Reproducible: the same figures from a second run (times and memory aside).
 "$tessera" bench --images "$images" --gt "$gt" --output "$work/out2" --threads 2 \

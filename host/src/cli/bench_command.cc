@@ -3,8 +3,8 @@
 // no other row, and each row's peak memory is its own), and optionally COLMAP 3.8 on the
 // CPU, in the same command on the same machine. Detection is shared: a manifest whose
 // detector and camera settings equal an earlier one's starts from a copy of that
-// workspace's features (not its matches), and its row says so. Prints a Markdown table; --json and
-// --csv write the same rows to files.
+// workspace's features (not its matches), and its row says so. Prints a Markdown
+// table; --json and --csv write the same rows to files, --chart draws them (gnuplot).
 
 #include <fcntl.h>
 #include <spawn.h>
@@ -155,6 +155,7 @@ struct BenchOptions {
   std::string output;
   std::string json_file;
   std::string csv_file;
+  std::string chart_file;
   std::string camera_K;
   bool with_colmap = false;
   int threads = 0;
@@ -389,6 +390,54 @@ std::string Csv(const std::vector<BenchRow>& rows) {
   return out.str();
 }
 
+// An SVG chart drawn by gnuplot: seconds per stage per row, stacked, and (with ground
+// truth) each row's mean position error as a share of the scene extent. Its data and
+// script are kept next to it in the bench folder.
+void WriteChart(const BenchOptions& options, const std::vector<BenchRow>& rows) {
+  const fs::path dir(options.output);
+  const auto cell = [](double value) {
+    return std::isnan(value) ? std::string("-") : Format(value, 4);
+  };
+  std::ostringstream data;
+  data << "row\textract\tmatch\tmap\tposition_error_percent\n";
+  for (const BenchRow& row : rows) {
+    data << row.name << "\t" << cell(row.extract_seconds) << "\t" << cell(row.match_seconds) << "\t"
+         << cell(row.map_seconds) << "\t" << cell(100 * row.position_error_relative) << "\n";
+  }
+  WriteFileAtomically(dir / "chart.dat", data.str());
+  const bool has_errors = !options.ground_truth.empty();
+  std::ostringstream script;
+  script << "set terminal svg size " << (has_errors ? 1000 : 560) << ",440 font 'sans,11'\n"
+         << "set output '" << fs::absolute(options.chart_file).string() << "'\n"
+         << "set datafile separator '\\t'\n"
+         << "set datafile missing '-'\n"
+         << "set style fill solid 0.8 border -1\n"
+         << "set boxwidth 0.7\n"
+         << "set xtics rotate by -30 noenhanced\n"
+         << "set key top right noenhanced\n"
+         << "set grid ytics\n"
+         << "set yrange [0:*]\n";
+  if (has_errors) script << "set multiplot layout 1,2\n";
+  script << "set title 'time per stage (s)'\n"
+         << "set style data histograms\n"
+         << "set style histogram rowstacked\n"
+         << "plot '" << (dir / "chart.dat").string() << "' using 2:xtic(1) title columnheader(2), "
+         << "'' using 3 title columnheader(3), '' using 4 title columnheader(4)\n";
+  if (has_errors) {
+    script << "set title 'mean camera position error (% of the scene extent)'\n"
+           << "set style histogram clustered\n"
+           << "unset key\n"
+           << "plot '" << (dir / "chart.dat").string() << "' using 5:xtic(1) lc rgb '#b04040'\n"
+           << "unset multiplot\n";
+  }
+  WriteFileAtomically(dir / "chart.gp", script.str());
+  const ChildResult gnuplot = RunChild({"gnuplot", (dir / "chart.gp").string()}, dir / "chart.log");
+  if (gnuplot.exit_code != 0) {
+    throw InputError(options.chart_file + ": gnuplot failed (exit code " +
+                     std::to_string(gnuplot.exit_code) + "), see " + (dir / "chart.log").string());
+  }
+}
+
 // The settings that decide what extraction produces, as text: equal keys, equal
 // features.
 std::string ExtractionKey(const nlohmann::json& manifest) {
@@ -404,6 +453,10 @@ int RunBench(const BenchOptions& options) {
   }
   if (!options.ground_truth.empty() && !fs::exists(options.ground_truth)) {
     throw InputError(options.ground_truth + ": --gt does not exist");
+  }
+  if (!options.chart_file.empty() && std::system("command -v gnuplot > /dev/null 2>&1") != 0) {
+    throw InputError("--chart " + options.chart_file +
+                     ": needs gnuplot, which is not installed (Debian package gnuplot-nox)");
   }
   // Read every manifest first: a missing or malformed one fails before any run.
   std::vector<std::string> names;
@@ -464,6 +517,7 @@ int RunBench(const BenchOptions& options) {
   for (const BenchRow& row : rows) json["rows"].push_back(ToJson(row));
   if (!options.json_file.empty()) WriteFileAtomically(options.json_file, json.dump(2) + "\n");
   if (!options.csv_file.empty()) WriteFileAtomically(options.csv_file, Csv(rows));
+  if (!options.chart_file.empty()) WriteChart(options, rows);
 
   // Every row is printed and written first; then the first failure decides the exit code.
   for (const BenchRow& row : rows) {
@@ -490,6 +544,8 @@ CommandRegistration RegisterBenchCommand(CLI::App& app, const GlobalOptions&) {
       ->default_val("bench-output");
   sub->add_option("--json", options->json_file, "Also write the rows as JSON to this file");
   sub->add_option("--csv", options->csv_file, "Also write the rows as CSV to this file");
+  sub->add_option("--chart", options->chart_file,
+                  "Also draw time per stage and position error per row as SVG (gnuplot)");
   sub->add_option("--camera-K", options->camera_K, "Known intrinsics for every manifest");
   sub->add_option("--threads", options->threads, "Worker threads of every run (default: all)")
       ->check(CLI::NonNegativeNumber);
