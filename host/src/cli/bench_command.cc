@@ -427,7 +427,8 @@ void WriteChart(const BenchOptions& options, const std::vector<BenchRow>& rows) 
     script << "set title 'mean camera position error (% of the scene extent)'\n"
            << "set style histogram clustered\n"
            << "unset key\n"
-           << "plot '" << (dir / "chart.dat").string() << "' using 5:xtic(1) notitle lc rgb '#b04040'\n"
+           << "plot '" << (dir / "chart.dat").string()
+           << "' using 5:xtic(1) notitle lc rgb '#b04040'\n"
            << "unset multiplot\n";
   }
   WriteFileAtomically(dir / "chart.gp", script.str());
