@@ -19,7 +19,9 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 #include <thread>
 
@@ -29,6 +31,7 @@
 #include "eval/evaluation.h"
 #include "eval/ground_truth.h"
 #include "scene/colmap_model_io.h"
+#include "sfm/incremental_mapper.h"
 #include "tessera/errors.h"
 #include "util/file_io.h"
 #include "util/timer.h"
@@ -128,13 +131,14 @@ void ReadMatchingFigures(const fs::path& database_file, BenchRow* row) {
       row->num_verified > 0 ? static_cast<double>(num_inliers) / row->num_verified : kNaN;
 }
 
-// Model 0 of `model_dir` scored against the ground truth, when there is one.
-void ScoreModel(const fs::path& model_dir, const std::string& ground_truth, BenchRow* row) {
-  if (ground_truth.empty() || !fs::exists(model_dir / "images.bin")) return;
-  const EvaluationResult result =
-      EvaluateReconstruction(ReadColmapModel(model_dir), ReadGroundTruth(ground_truth));
+using GroundTruth = std::map<std::string, GroundTruthPose>;
+
+// A model scored against the ground truth, when there is one (nullptr: none).
+void ScoreModel(const Reconstruction& model, const GroundTruth* ground_truth, BenchRow* row) {
+  if (ground_truth == nullptr) return;
+  const EvaluationResult result = EvaluateReconstruction(model, *ground_truth);
   if (!result.aligned) {
-    spdlog::warn("bench: {}: {} cannot be scored: {}", row->name, model_dir.string(), result.error);
+    spdlog::warn("bench: {}: model 0 cannot be scored: {}", row->name, result.error);
     return;
   }
   row->position_error_mean = result.position_error_mean;
@@ -164,13 +168,13 @@ struct BenchOptions {
   std::vector<std::string> manifests;
 };
 
-BenchRow RunManifest(const BenchOptions& options, const std::string& manifest_file,
+BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_truth,
+                     const std::string& manifest_file, const nlohmann::json& manifest,
                      const std::string& name, const std::string& shared_from,
                      const fs::path& workspace) {
   BenchRow row;
   row.name = name;
   row.workspace = workspace.string();
-  const nlohmann::json manifest = ReadJsonFile(manifest_file);
   row.plugins = SlotPlugin(manifest, "detector") + " / " + SlotPlugin(manifest, "pair_selector") +
                 " / " + SlotPlugin(manifest, "matcher") + " / " +
                 SlotPlugin(manifest, "bundle_adjuster");
@@ -213,13 +217,17 @@ BenchRow RunManifest(const BenchOptions& options, const std::string& manifest_fi
     row.num_points = model.at("num_points3D").get<size_t>();
     row.mean_track_length = model.at("mean_track_length").get<double>();
     row.mean_reprojection_error = model.at("mean_reprojection_error").get<double>();
-    ScoreModel(workspace / "sparse" / "0", options.ground_truth, &row);
+    const fs::path model_dir = workspace / "sparse" / "0";
+    if (ground_truth != nullptr && fs::exists(model_dir / "images.bin")) {
+      ScoreModel(ReadColmapModel(model_dir), ground_truth, &row);
+    }
   }
   return row;
 }
 
 // COLMAP 3.8 with its CPU defaults, one shared camera and exhaustive matching.
-BenchRow RunColmap(const BenchOptions& options, const fs::path& workspace) {
+BenchRow RunColmap(const BenchOptions& options, const GroundTruth* ground_truth,
+                   const fs::path& workspace) {
   BenchRow row;
   row.name = "colmap";
   row.plugins = "COLMAP 3.8: sift / exhaustive / sift_matcher / mapper";
@@ -256,18 +264,10 @@ BenchRow RunColmap(const BenchOptions& options, const fs::path& workspace) {
     row.num_models = 1;
     row.num_registered = model.images.size();
     row.num_points = model.points3D.size();
-    size_t num_observations = 0;
-    double error_sum = 0;
-    for (const auto& [point3D_id, point3D] : model.points3D) {
-      num_observations += point3D.track.size();
-      error_sum += point3D.error * static_cast<double>(point3D.track.size());
-    }
-    if (!model.points3D.empty()) {
-      row.mean_track_length =
-          static_cast<double>(num_observations) / static_cast<double>(model.points3D.size());
-      row.mean_reprojection_error = error_sum / static_cast<double>(num_observations);
-    }
-    ScoreModel(model_dir, options.ground_truth, &row);
+    // The same figures, computed the same way, as Tessera's rows (mapping_summary.json).
+    row.mean_track_length = MeanTrackLength(model);
+    row.mean_reprojection_error = MeanReprojectionError(model);
+    ScoreModel(model, ground_truth, &row);
   }
   return row;
 }
@@ -461,7 +461,12 @@ int RunBench(const BenchOptions& options) {
     throw InputError("--chart " + options.chart_file +
                      ": needs gnuplot, which is not installed (Debian package gnuplot-nox)");
   }
-  // Read every manifest first: a missing or malformed one fails before any run.
+  // Read the ground truth and every manifest first: a missing or malformed one fails
+  // before any run.
+  std::optional<GroundTruth> ground_truth;
+  if (!options.ground_truth.empty()) ground_truth = ReadGroundTruth(options.ground_truth);
+  const GroundTruth* const gt = ground_truth ? &*ground_truth : nullptr;
+  std::vector<nlohmann::json> manifests;
   std::vector<std::string> names;
   std::vector<std::string> keys;
   for (const std::string& file : options.manifests) {
@@ -477,6 +482,7 @@ int RunBench(const BenchOptions& options) {
     }
     names.push_back(name);
     keys.push_back(ExtractionKey(manifest));
+    manifests.push_back(std::move(manifest));
   }
   CreateFolder(options.output);
 
@@ -489,14 +495,14 @@ int RunBench(const BenchOptions& options) {
         break;
       }
     }
-    rows.push_back(RunManifest(options, options.manifests[i], names[i], shared_from,
-                               fs::path(options.output) / names[i]));
+    rows.push_back(RunManifest(options, gt, options.manifests[i], manifests[i], names[i],
+                               shared_from, fs::path(options.output) / names[i]));
   }
   if (options.with_colmap) {
     if (std::system("command -v colmap > /dev/null 2>&1") != 0) {
       spdlog::warn("bench: colmap is not installed: no COLMAP row");
     } else {
-      rows.push_back(RunColmap(options, fs::path(options.output) / "colmap"));
+      rows.push_back(RunColmap(options, gt, fs::path(options.output) / "colmap"));
     }
   }
 
