@@ -1,24 +1,75 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "tessera/camera.h"
+#include "tessera/errors.h"
+#include "tessera/features.h"
+#include "tessera/ids.h"
+#include "tessera/image_metadata.h"
 #include "tessera/plugin.h"
 
 namespace tessera {
 
-// A candidate pair as indices into the image list given to SelectPairs, first < second.
+// A candidate pair as indices into PairSelectionInput::images, first < second.
 using ImageIndexPair = std::pair<size_t, size_t>;
 
-// Chooses which image pairs to match. Needs the image list only, never descriptors.
+// What a pair selector knows of one image before matching.
+struct PairSelectionImage {
+  image_t image_id = kInvalidImageId;
+  std::string name;  // path relative to the image folder, '/' separated
+  Camera camera;     // its camera (width and height are the image's, as detection saw it)
+  ImageMetadata metadata;
+};
+
+// Reads one image's features from the workspace on demand, by index into
+// PairSelectionInput::images. The host never holds every image's features at once,
+// and neither should a selector: read, reduce (e.g. to a global descriptor), drop.
+// Safe to call from several threads at once.
+class TESSERA_API FeatureReader {
+ public:
+  virtual ~FeatureReader() = default;
+  virtual FeatureKeypoints ReadKeypoints(size_t index) const = 0;
+  virtual FeatureDescriptors ReadDescriptors(size_t index) const = 0;
+  // How the workspace's descriptors are compared, and their width in bytes per row;
+  // known without reading any image.
+  virtual DescriptorMetric Metric() const = 0;
+  virtual int DescriptorDimension() const = 0;
+};
+
+struct PairSelectionInput {
+  // In capture order (natural sort of the names).
+  std::vector<PairSelectionImage> images;
+  // The workspace's features; null where there are none (a selector that needs them
+  // throws InputError then).
+  const FeatureReader* features = nullptr;
+  // Threads the selector may use.
+  int num_threads = 1;
+};
+
+// Chooses which image pairs to match, from the images' names, cameras, metadata and,
+// on demand, features.
 class TESSERA_API PairSelector : public Plugin {
  public:
-  // `image_names` are in capture order (natural sort of the file names). Returns
-  // each pair once, with first < second, in a deterministic order.
-  virtual std::vector<ImageIndexPair> SelectPairs(
-      const std::vector<std::string>& image_names) const = 0;
+  // Returns each pair once, with first < second, in a deterministic order.
+  virtual std::vector<ImageIndexPair> SelectPairs(const PairSelectionInput& input) const = 0;
+
+  // Throws OptionError when this selector cannot work with descriptors of this metric
+  // and width (e.g. a retrieval selector given binary descriptors). Called before any
+  // image is read, with the detector's metric; the default accepts everything.
+  virtual void CheckDescriptors(DescriptorMetric /*metric*/, int /*dimension*/) const {}
+
+  // Selectors that learn from images (a retrieval codebook) train on `input` and write
+  // what they learned to `output`, a file their options can name in later runs
+  // (`tessera vocab`). The default throws InputError: this selector does not train.
+  virtual void Train(const PairSelectionInput& /*input*/,
+                     const std::filesystem::path& /*output*/) const {
+    throw InputError("this pair selector does not train");
+  }
 };
 
 }  // namespace tessera

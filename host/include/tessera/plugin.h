@@ -16,7 +16,7 @@
 
 // Bumped whenever TesseraPluginInfo, a plugin interface or a type that crosses the
 // boundary changes; the host refuses a plugin built against another version.
-#define TESSERA_PLUGIN_ABI_VERSION 1
+#define TESSERA_PLUGIN_ABI_VERSION 2
 
 extern "C" {
 // The info record. `abi_version` stays the first member in every version so that
