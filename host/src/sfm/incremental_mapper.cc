@@ -31,6 +31,11 @@ constexpr uint64_t kInitialPairStream = 1;
 constexpr uint64_t kRegistrationStream = 2;
 constexpr uint64_t kMergeStream = 3;
 constexpr uint64_t kViewGraphStream = 4;
+// The first model that calibrates cameras without a focal prior: it needs this many
+// images at least, and grows to this many at most (its bundle adjustment determines
+// the focal length well long before, at a fraction of a whole model's cost).
+constexpr size_t kMinCalibrationImages = 5;
+constexpr size_t kMaxCalibrationImages = 20;
 // Rounds of growing again after the final refinement, while images still register.
 constexpr int kMaxFinalGrowRounds = 2;
 // See ModelBuilder::ConnectionStrength. The penalty puts weakly connected images after
@@ -101,7 +106,8 @@ class ModelBuilder {
   }
 
   bool Initialize();
-  void Grow();
+  // Registers images while any registers, or until the model has `max_images`.
+  void Grow(size_t max_images = std::numeric_limits<size_t>::max());
   void Finish();
   // Tries every unregistered image again, as after a global bundle adjustment; true if
   // one registered (the model then grew as far as it could).
@@ -990,9 +996,9 @@ void ModelBuilder::GlobalRefinement() {
 // The loop
 ////////////////////////////////////////////////////////////////////////////////
 
-void ModelBuilder::Grow() {
+void ModelBuilder::Grow(size_t max_images) {
   bool refined_since_failure = false;
-  while (true) {
+  while (registered_.size() < max_images) {
     image_t next_image = kInvalidImageId;
     for (const image_t candidate : NextImages()) {
       if (RegisterImage(candidate)) {
@@ -1316,12 +1322,12 @@ void EstimateFocalLengthsWithoutPrior(const RunState& run,
   ModelBuilder builder(&calibration);
   Reconstruction model;
   if (builder.Initialize()) {
-    builder.Grow();
+    builder.Grow(kMaxCalibrationImages);
     builder.Finish();
     model = builder.TakeModel();
   }
   spdlog::set_level(level);
-  constexpr size_t kMinCalibrationImages = 5;
+
   for (auto& [camera_id, report] : by_camera) {
     const auto it = model.cameras.find(camera_id);
     if (model.images.size() < kMinCalibrationImages || it == model.cameras.end()) {
