@@ -63,6 +63,7 @@ assert [(s["plugin"], s["json_path"], s["num_pairs"]) for s in rows[1]["pairs_pe
 for r in rows:
     assert r["exit_code"] == 0 and r["num_registered"] == 11, r
     assert r["position_error_mean_relative"] is not None and r["position_error_mean_relative"] < 0.01, r
+    assert r["num_wrongly_registered"] == 0, r
     assert r["peak_memory_mb"] > 0 and r["total_seconds"] > 0, r
 table = list(csv.reader(open(sys.argv[2])))
 assert len(table) == 1 + len(rows) and table[0][0] == "manifest", table

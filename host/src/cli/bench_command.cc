@@ -73,6 +73,8 @@ struct BenchRow {
   double position_error_mean = kNaN;
   double position_error_relative = kNaN;  // of the scene extent
   double rotation_error_mean_deg = kNaN;
+  // Registered images more than kWrongRegistrationDeg off; -1 without ground truth.
+  int num_wrongly_registered = -1;
 };
 
 struct ChildResult {
@@ -148,6 +150,7 @@ void ScoreModel(const Reconstruction& model, const GroundTruth* ground_truth, Be
   row->position_error_mean = result.position_error_mean;
   row->position_error_relative = result.position_error_mean / result.scene_extent;
   row->rotation_error_mean_deg = result.rotation_error_mean_deg;
+  row->num_wrongly_registered = static_cast<int>(result.num_wrongly_registered);
 }
 
 std::string SlotPlugin(const nlohmann::json& manifest, const std::string& slot) {
@@ -326,6 +329,7 @@ const std::vector<std::string>& Columns() {
                                                    "position error",
                                                    "position error % of extent",
                                                    "rotation error deg",
+                                                   "wrong (>5 deg)",
                                                    "exit code"};
   return columns;
 }
@@ -352,6 +356,8 @@ std::vector<std::string> Cells(const BenchRow& row) {
           Format(row.position_error_mean, 5),
           Format(100 * row.position_error_relative, 3),
           Format(row.rotation_error_mean_deg, 3),
+          row.num_wrongly_registered < 0 ? std::string("-")
+                                         : std::to_string(row.num_wrongly_registered),
           std::to_string(row.exit_code)};
 }
 
@@ -381,7 +387,10 @@ nlohmann::json ToJson(const BenchRow& row) {
           {"mean_reprojection_error_px", number(row.mean_reprojection_error)},
           {"position_error_mean", number(row.position_error_mean)},
           {"position_error_mean_relative", number(row.position_error_relative)},
-          {"rotation_error_mean_deg", number(row.rotation_error_mean_deg)}};
+          {"rotation_error_mean_deg", number(row.rotation_error_mean_deg)},
+          {"num_wrongly_registered", row.num_wrongly_registered < 0
+                                         ? nlohmann::json(nullptr)
+                                         : nlohmann::json(row.num_wrongly_registered)}};
 }
 
 std::string MarkdownTable(const std::vector<BenchRow>& rows) {

@@ -184,6 +184,16 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
     const double mean_reprojection_error = MeanReprojectionError(model);
     nlohmann::json images = nlohmann::json::array();
     for (const auto& [image_id, image] : model.images) images.push_back(image.name);
+    const ModelSelfCheck& check = result.self_checks.at(index);
+    nlohmann::json disagreeing = nlohmann::json::array();
+    for (const image_t image_id : check.disagreeing_images) {
+      disagreeing.push_back(model.images.at(image_id).name);
+    }
+    const nlohmann::json self_check = {{"verified_pairs", check.num_pairs},
+                                       {"agreeing_pairs", check.num_agreeing},
+                                       {"agreement", check.agreement},
+                                       {"possibly_folded", check.possibly_folded},
+                                       {"disagreeing_images", disagreeing}};
     spdlog::info(
         "map: model {}: {} images, {} points, mean track length {:.2f}, mean reprojection "
         "error {:.3f} px",
@@ -195,6 +205,7 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
                                       {"num_points3D", model.points3D.size()},
                                       {"mean_track_length", mean_track_length},
                                       {"mean_reprojection_error", mean_reprojection_error},
+                                      {"view_graph_check", self_check},
                                       {"images", images}});
   }
   for (const auto& [image_id, reason] : result.unregistered_reasons) {
@@ -202,6 +213,18 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
     spdlog::warn("map: {} is in no model: {}", name, reason);
     summary_json["unregistered"].push_back({{"image", name}, {"reason", reason}});
   }
+  summary_json["focal_lengths_estimated"] = nlohmann::json::array();
+  for (const FocalLengthReport& focal : result.focal_lengths) {
+    summary_json["focal_lengths_estimated"].push_back({{"camera_id", focal.camera_id},
+                                                       {"initial", focal.initial},
+                                                       {"estimated", focal.estimated},
+                                                       {"method", focal.method},
+                                                       {"num_pairs", focal.num_pairs},
+                                                       {"num_images", focal.num_images}});
+  }
+  summary_json["view_graph_pairs_dropped"] = result.num_pairs_dropped;
+  summary_json["registrations_refused"] = result.num_registrations_refused;
+  summary_json["merges"] = result.merges;
   summary.seconds = timer.ElapsedSeconds();
   summary_json["seconds"] = summary.seconds;
   summary_json["mapper_options"] = context.mapper_options.ToJson();

@@ -72,38 +72,6 @@ std::string FormatNumber(double value, const char* format) {
 
 }  // namespace
 
-Similarity3d EstimateSimilarity(const std::vector<Eigen::Vector3d>& src,
-                                const std::vector<Eigen::Vector3d>& dst) {
-  const size_t n = src.size();
-  Eigen::Vector3d mean_src = Eigen::Vector3d::Zero(), mean_dst = Eigen::Vector3d::Zero();
-  for (size_t i = 0; i < n; ++i) {
-    mean_src += src[i];
-    mean_dst += dst[i];
-  }
-  mean_src /= n;
-  mean_dst /= n;
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-  double variance_src = 0;
-  for (size_t i = 0; i < n; ++i) {
-    covariance += (dst[i] - mean_dst) * (src[i] - mean_src).transpose();
-    variance_src += (src[i] - mean_src).squaredNorm();
-  }
-  covariance /= n;
-  variance_src /= n;
-
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(covariance,
-                                              Eigen::ComputeFullU | Eigen::ComputeFullV);
-  // A reflection would fit better when the points are noisy or planar-degenerate; the
-  // sign fix keeps a proper rotation.
-  Eigen::Vector3d signs = Eigen::Vector3d::Ones();
-  if (svd.matrixU().determinant() * svd.matrixV().determinant() < 0) signs(2) = -1;
-  Similarity3d dst_from_src;
-  dst_from_src.rotation = svd.matrixU() * signs.asDiagonal() * svd.matrixV().transpose();
-  dst_from_src.scale = svd.singularValues().dot(signs) / variance_src;
-  dst_from_src.translation = mean_dst - dst_from_src.scale * dst_from_src.rotation * mean_src;
-  return dst_from_src;
-}
-
 EvaluationResult EvaluateReconstruction(
     const Reconstruction& model, const std::map<std::string, GroundTruthPose>& ground_truth) {
   EvaluationResult result;
@@ -148,6 +116,7 @@ EvaluationResult EvaluateReconstruction(
                          estimate.R_cam_from_world * result.gt_from_model.rotation.transpose());
     position_errors.push_back(row.position_error);
     rotation_errors.push_back(row.rotation_error_deg);
+    if (row.rotation_error_deg > kWrongRegistrationDeg) ++result.num_wrongly_registered;
   }
   result.position_error_mean = Mean(position_errors);
   result.position_error_median = Median(position_errors);
@@ -172,6 +141,7 @@ nlohmann::json EvaluationResult::ToJson() const {
   if (aligned) {
     json["rot_mean_deg"] = rotation_error_mean_deg;
     json["rot_max_deg"] = rotation_error_max_deg;
+    json["wrongly_registered"] = num_wrongly_registered;
     json["pos_mean"] = position_error_mean;
     json["pos_median"] = position_error_median;
     json["pos_max"] = position_error_max;
@@ -227,6 +197,9 @@ std::string EvaluationResult::ToTable() const {
              "): " + FormatNumber(100 * position_error_mean_relative, "%.4f") + "%\n";
     table += "rotation error (deg): mean " + FormatNumber(rotation_error_mean_deg, "%.4f") +
              ", max " + FormatNumber(rotation_error_max_deg, "%.4f") + "\n";
+    table += "wrongly registered (rotation error over " +
+             FormatNumber(kWrongRegistrationDeg, "%g") +
+             " deg): " + std::to_string(num_wrongly_registered) + "\n";
   }
   table += "3D points: " + std::to_string(num_points3D) + ", mean track length " +
            FormatNumber(mean_track_length, "%.4f") + ", mean reprojection error " +

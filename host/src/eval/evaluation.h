@@ -12,25 +12,13 @@
 #include <vector>
 
 #include "eval/ground_truth.h"
+#include "geometry/similarity_transform.h"
 #include "tessera/reconstruction.h"
 
 namespace tessera {
 
-// x_b = scale * rotation * x_a + translation.
-struct Similarity3d {
-  double scale = 1;
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
-  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
-
-  Eigen::Vector3d operator*(const Eigen::Vector3d& x) const {
-    return scale * rotation * x + translation;
-  }
-};
-
-// Least-squares similarity dst_from_src (Umeyama 1991, with the reflection fix).
-// Needs at least 3 pairs, not all collinear, for a unique answer.
-Similarity3d EstimateSimilarity(const std::vector<Eigen::Vector3d>& src,
-                                const std::vector<Eigen::Vector3d>& dst);
+// A registered image whose rotation is further than this off is registered wrongly.
+constexpr double kWrongRegistrationDeg = 5.0;
 
 struct ImageEvaluation {
   std::string name;         // basename, as in the ground truth
@@ -55,6 +43,9 @@ struct EvaluationResult {
   double position_error_max = std::numeric_limits<double>::quiet_NaN();
   double rotation_error_mean_deg = std::numeric_limits<double>::quiet_NaN();
   double rotation_error_max_deg = std::numeric_limits<double>::quiet_NaN();
+  // Registered images more than kWrongRegistrationDeg off their true orientation: put
+  // in the wrong place (on the mirror side of a symmetric object, say), not just noisy.
+  size_t num_wrongly_registered = 0;
   // Largest distance of an aligned ground-truth centre from their mean, and the mean
   // position error divided by it.
   double scene_extent = std::numeric_limits<double>::quiet_NaN();

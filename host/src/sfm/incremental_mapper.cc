@@ -1,5 +1,6 @@
 #include "sfm/incremental_mapper.h"
 
+#include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -7,6 +8,7 @@
 #include <cmath>
 #include <numeric>
 #include <set>
+#include <tuple>
 #include <utility>
 
 #include "estimators/absolute_pose.h"
@@ -15,6 +17,9 @@
 #include "geometry/essential_matrix.h"
 #include "geometry/triangulation.h"
 #include "sfm/camera_plausibility.h"
+#include "sfm/focal_length_estimation.h"
+#include "sfm/model_merger.h"
+#include "sfm/view_graph.h"
 #include "util/random.h"
 
 namespace tessera {
@@ -24,6 +29,19 @@ constexpr double kDegToRad = M_PI / 180.0;
 // Seed streams, so that no two random choices of a run share a seed.
 constexpr uint64_t kInitialPairStream = 1;
 constexpr uint64_t kRegistrationStream = 2;
+constexpr uint64_t kMergeStream = 3;
+constexpr uint64_t kViewGraphStream = 4;
+// The first model that calibrates cameras without a focal prior: it needs this many
+// images at least, and grows to this many at most (its bundle adjustment determines
+// the focal length well long before, at a fraction of a whole model's cost).
+constexpr size_t kMinCalibrationImages = 5;
+constexpr size_t kMaxCalibrationImages = 20;
+// Rounds of growing again after the final refinement, while images still register.
+constexpr int kMaxFinalGrowRounds = 2;
+// See ModelBuilder::ConnectionStrength. The penalty puts weakly connected images after
+// every strongly connected one in the next-best-view order (scores are below 300).
+constexpr double kMinConnectionStrength = 0.8;
+constexpr double kWeakConnectionPenalty = 1e6;
 // Pairs of observations tried when a track's observations disagree.
 constexpr size_t kMaxTriangulationPairs = 200;
 
@@ -66,13 +84,17 @@ struct RunState {
   std::map<image_t, std::string> failure_reasons;
   int num_global_ba = 0;
   int num_local_ba = 0;
+  // The cameras every model starts from: the input's, with estimated focal lengths.
+  std::map<camera_t, Camera> cameras;
+  ViewGraph view_graph;
+  size_t num_registrations_refused = 0;
 };
 
 // One model, grown from an initial pair.
 class ModelBuilder {
  public:
   explicit ModelBuilder(RunState* run) : run_(*run), options_(run->options), tracks_(run->tracks) {
-    rec_.cameras = run_.input.cameras;
+    rec_.cameras = run_.cameras;
     rec_.images = run_.input.images;
     for (auto& [image_id, image] : rec_.images) {
       image.registered = false;
@@ -84,8 +106,12 @@ class ModelBuilder {
   }
 
   bool Initialize();
-  void Grow();
+  // Registers images while any registers, or until the model has `max_images`.
+  void Grow(size_t max_images = std::numeric_limits<size_t>::max());
   void Finish();
+  // Tries every unregistered image again, as after a global bundle adjustment; true if
+  // one registered (the model then grew as far as it could).
+  bool GrowAgain();
 
   // The registered images, their cameras and the points.
   Reconstruction TakeModel();
@@ -107,7 +133,23 @@ class ModelBuilder {
 
   bool EvaluateInitialPair(const MapperInput::Pair& pair, InitialPair* result) const;
   std::vector<image_t> NextImages();
+  // The inliers of the image's strongest pair with a registered image, as a share of
+  // those of its strongest pair of all. The next best view is scored by coverage times
+  // this strength, and images below kMinConnectionStrength come after all others: an
+  // image seen by the model only through weaker pairs (repeated structure on the far
+  // side of a symmetric object, typically) waits for its strong neighbours to register.
+  double ConnectionStrength(image_t image_id) const;
   bool RegisterImage(image_t image_id);
+  // Whether a candidate rotation of an image agrees with the view graph (see
+  // IncrementalMapperOptions::check_registration); `why` says how it does not.
+  bool AgreesWithViewGraph(image_t image_id, const Eigen::Matrix3d& R_cam_from_world,
+                           std::string* why) const;
+  // After a refused registration: each registered neighbour's pair implies a rotation
+  // of the image; the heaviest group (by inliers) of neighbours that imply one rotation
+  // becomes the image's trusted neighbours, and its pairs to the other registered
+  // images are dropped from the view graph. Later tries use only points the trusted
+  // neighbours see.
+  void TrustStrongestAgreeingPairs(image_t image_id);
   void TriangulateImage(image_t image_id);
   bool TriangulateTrack(track_t track_id, double max_error);
   // Returns true when the local problem held every registered image with a free pose,
@@ -173,6 +215,7 @@ class ModelBuilder {
   std::vector<track_t> merged_into_;
   point3D_t next_point3D_id_ = 1;
   std::map<image_t, int> num_registration_trials_;
+  std::map<image_t, std::set<image_t>> trusted_neighbours_;
   size_t num_images_at_global_ba_ = 0;
   // Whether BA moves the principal point now: only in the final global rounds.
   bool refine_principal_point_ = false;
@@ -389,7 +432,7 @@ std::vector<image_t> ModelBuilder::NextImages() {
   // the image) by the keypoints that see a 3D point, finer levels weighted more, so that
   // points spread over the image beat as many points in one corner.
   constexpr int kNumLevels = 3;
-  std::vector<std::pair<double, image_t>> scored;
+  std::vector<std::tuple<double, size_t, image_t>> scored;
   for (const auto& [image_id, image] : rec_.images) {
     if (IsRegistered(image_id) || run_.used_images.count(image_id) > 0 ||
         num_registration_trials_[image_id] >= options_.max_reg_trials) {
@@ -423,14 +466,36 @@ std::vector<image_t> ModelBuilder::NextImages() {
     for (int level = 0; level < kNumLevels; ++level) {
       score += static_cast<double>(cells[level].size()) * (1 << level);
     }
-    scored.emplace_back(score, image_id);
+    const double strength = ConnectionStrength(image_id);
+    score *= strength;
+    if (strength < kMinConnectionStrength) score -= kWeakConnectionPenalty;
+    scored.push_back({score, num_visible, image_id});
   }
+  // Images strongly connected to the model first (see ConnectionStrength); then equal
+  // coverage (the grids fill up quickly): the image that sees most points first,
+  // not the lowest id. An image seen mostly through repeated structure (the far side of
+  // a symmetric object) sees fewer of the model's points than a true neighbour and so
+  // waits until its neighbours are registered, which keeps it from folding the model.
   std::sort(scored.begin(), scored.end(), [](const auto& a, const auto& b) {
-    return a.first != b.first ? a.first > b.first : a.second < b.second;
+    if (std::get<0>(a) != std::get<0>(b)) return std::get<0>(a) > std::get<0>(b);
+    if (std::get<1>(a) != std::get<1>(b)) return std::get<1>(a) > std::get<1>(b);
+    return std::get<2>(a) < std::get<2>(b);
   });
   std::vector<image_t> next;
-  for (const auto& [score, image_id] : scored) next.push_back(image_id);
+  for (const auto& [score, num_visible, image_id] : scored) next.push_back(image_id);
   return next;
+}
+
+double ModelBuilder::ConnectionStrength(image_t image_id) const {
+  size_t best = 0, best_registered = 0;
+  for (const size_t e : run_.view_graph.EdgesOf(image_id)) {
+    const ViewGraphEdge& edge = run_.view_graph.edges()[e];
+    if (edge.removed) continue;
+    const image_t other_id = edge.image_id1 == image_id ? edge.image_id2 : edge.image_id1;
+    best = std::max(best, edge.num_inliers);
+    if (IsRegistered(other_id)) best_registered = std::max(best_registered, edge.num_inliers);
+  }
+  return best > 0 ? static_cast<double>(best_registered) / static_cast<double>(best) : 0.0;
 }
 
 bool ModelBuilder::RegisterImage(image_t image_id) {
@@ -439,11 +504,20 @@ bool ModelBuilder::RegisterImage(image_t image_id) {
   std::vector<Eigen::Vector2d> points2D;
   std::vector<Eigen::Vector3d> points3D;
   std::vector<std::pair<point2D_t, point3D_t>> correspondences;
+  // After a refusal, only points that the image's trusted neighbours see.
+  const auto trusted = trusted_neighbours_.find(image_id);
   for (point2D_t idx = 0; idx < image.points2D.size(); ++idx) {
     const track_t track_id = tracks_.TrackOf(image_id, idx);
     if (track_id == kInvalidTrackId) continue;
     const point3D_t point3D_id = point3D_of_track_[CanonicalTrack(track_id)];
     if (point3D_id == kInvalidPoint3DId) continue;
+    if (trusted != trusted_neighbours_.end() &&
+        std::none_of(rec_.points3D.at(point3D_id).track.begin(),
+                     rec_.points3D.at(point3D_id).track.end(), [&](const TrackElement& element) {
+                       return trusted->second.count(element.image_id) > 0;
+                     })) {
+      continue;
+    }
     points2D.push_back(Normalized(image, idx));
     points3D.push_back(rec_.points3D.at(point3D_id).xyz);
     correspondences.emplace_back(idx, point3D_id);
@@ -487,6 +561,15 @@ bool ModelBuilder::RegisterImage(image_t image_id) {
   Eigen::Matrix<double, 3, 4> cam_from_world = report.model;
   RefineAbsolutePose(inliers2D, inliers3D, &cam_from_world);
   const Eigen::Matrix3d rotation = cam_from_world.leftCols<3>();
+  if (options_.check_registration) {
+    std::string disagreement;
+    if (!AgreesWithViewGraph(image_id, rotation, &disagreement)) {
+      ++run_.num_registrations_refused;
+      spdlog::info("map: refused {}: {}", image.name, disagreement);
+      TrustStrongestAgreeingPairs(image_id);
+      return fail(disagreement);
+    }
+  }
   image.cam_from_world = Rigid3d(Eigen::Quaterniond(rotation).normalized(), cam_from_world.col(3));
   image.registered = true;
   registered_.insert(image_id);
@@ -501,6 +584,103 @@ bool ModelBuilder::RegisterImage(image_t image_id) {
   spdlog::info("map: registered {} ({} images): PnP kept {}", image.name, registered_.size(),
                counts);
   return true;
+}
+
+bool ModelBuilder::AgreesWithViewGraph(image_t image_id, const Eigen::Matrix3d& R_cam_from_world,
+                                       std::string* why) const {
+  double weight_all = 0, weight_agreeing = 0;
+  size_t num_pairs = 0, num_disagreeing = 0;
+  double worst_error = 0;
+  image_t worst_image = kInvalidImageId;
+  for (const size_t e : run_.view_graph.EdgesOf(image_id)) {
+    const ViewGraphEdge& edge = run_.view_graph.edges()[e];
+    if (!edge.has_rotation || edge.removed) continue;
+    const image_t other_id = edge.image_id1 == image_id ? edge.image_id2 : edge.image_id1;
+    if (!IsRegistered(other_id)) continue;
+    const Eigen::Matrix3d R_other =
+        rec_.images.at(other_id).cam_from_world.rotation.toRotationMatrix();
+    const double error = edge.image_id1 == image_id
+                             ? ViewGraph::RotationErrorDeg(edge, R_cam_from_world, R_other)
+                             : ViewGraph::RotationErrorDeg(edge, R_other, R_cam_from_world);
+    const double weight = static_cast<double>(edge.num_inliers);
+    ++num_pairs;
+    weight_all += weight;
+    if (error <= options_.reg_max_rotation_error) {
+      weight_agreeing += weight;
+    } else {
+      ++num_disagreeing;
+      if (error > worst_error) {
+        worst_error = error;
+        worst_image = other_id;
+      }
+    }
+  }
+  if (weight_all == 0 || weight_agreeing >= options_.reg_min_agreement * weight_all) return true;
+  *why = fmt::format(
+      "its pose disagrees with {} of its {} verified pairs to registered images by more than "
+      "{:g} deg ({:.0f}% of their inliers agree, {:.0f}% needed; worst: {} at {:.0f} deg)",
+      num_disagreeing, num_pairs, options_.reg_max_rotation_error,
+      100 * weight_agreeing / weight_all, 100 * options_.reg_min_agreement,
+      rec_.images.at(worst_image).name, worst_error);
+  return false;
+}
+
+void ModelBuilder::TrustStrongestAgreeingPairs(image_t image_id) {
+  struct Vote {
+    size_t edge;
+    image_t neighbour;
+    Eigen::Matrix3d R_cam_from_world;  // implied for image_id
+    double weight;
+  };
+  std::vector<Vote> votes;
+  for (const size_t e : run_.view_graph.EdgesOf(image_id)) {
+    const ViewGraphEdge& edge = run_.view_graph.edges()[e];
+    if (!edge.has_rotation || edge.removed) continue;
+    const image_t other_id = edge.image_id1 == image_id ? edge.image_id2 : edge.image_id1;
+    if (!IsRegistered(other_id)) continue;
+    const Eigen::Matrix3d R_other =
+        rec_.images.at(other_id).cam_from_world.rotation.toRotationMatrix();
+    // cam_image_from_cam_other, then composed with the neighbour's pose.
+    const Eigen::Matrix3d R_image_from_other =
+        edge.image_id2 == image_id ? edge.R_cam2_from_cam1
+                                   : Eigen::Matrix3d(edge.R_cam2_from_cam1.transpose());
+    votes.push_back(
+        {e, other_id, R_image_from_other * R_other, static_cast<double>(edge.num_inliers)});
+  }
+  const auto angle_deg = [](const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+    const double cos_angle = std::clamp(((a * b.transpose()).trace() - 1) / 2, -1.0, 1.0);
+    return std::acos(cos_angle) / kDegToRad;
+  };
+  double best_weight = 0;
+  size_t best = 0;
+  for (size_t k = 0; k < votes.size(); ++k) {
+    double weight = 0;
+    for (const Vote& other : votes) {
+      if (angle_deg(votes[k].R_cam_from_world, other.R_cam_from_world) <=
+          options_.reg_max_rotation_error) {
+        weight += other.weight;
+      }
+    }
+    if (weight > best_weight) {
+      best_weight = weight;
+      best = k;
+    }
+  }
+  if (votes.empty()) return;
+  std::set<image_t>& trusted = trusted_neighbours_[image_id];
+  trusted.clear();
+  size_t num_dropped = 0;
+  for (const Vote& vote : votes) {
+    if (angle_deg(votes[best].R_cam_from_world, vote.R_cam_from_world) <=
+        options_.reg_max_rotation_error) {
+      trusted.insert(vote.neighbour);
+    } else {
+      run_.view_graph.RemoveEdge(vote.edge);
+      ++num_dropped;
+    }
+  }
+  spdlog::debug("map: {}: {} registered neighbours agree on its rotation; {} pairs dropped",
+                rec_.images.at(image_id).name, trusted.size(), num_dropped);
 }
 
 ////////////////////////////////////////////////////////////////////////////////
@@ -800,6 +980,8 @@ void ModelBuilder::GlobalBundleAdjustment() {
 }
 
 void ModelBuilder::GlobalRefinement() {
+  // Every unregistered image gets new chances against the refined model.
+  num_registration_trials_.clear();
   std::set<point3D_t> all_points;
   for (const auto& [point3D_id, point3D] : rec_.points3D) all_points.insert(point3D_id);
   const size_t num_completed = CompleteTracks(all_points);
@@ -814,9 +996,9 @@ void ModelBuilder::GlobalRefinement() {
 // The loop
 ////////////////////////////////////////////////////////////////////////////////
 
-void ModelBuilder::Grow() {
+void ModelBuilder::Grow(size_t max_images) {
   bool refined_since_failure = false;
-  while (true) {
+  while (registered_.size() < max_images) {
     image_t next_image = kInvalidImageId;
     for (const image_t candidate : NextImages()) {
       if (RegisterImage(candidate)) {
@@ -886,6 +1068,14 @@ void ModelBuilder::Finish() {
   }
 }
 
+bool ModelBuilder::GrowAgain() {
+  const size_t num_before = registered_.size();
+  num_registration_trials_.clear();
+  changed_since_global_ba_ = false;
+  Grow();
+  return registered_.size() > num_before;
+}
+
 Reconstruction ModelBuilder::TakeModel() {
   Reconstruction model;
   for (auto& [image_id, image] : rec_.images) {
@@ -915,25 +1105,281 @@ IncrementalMapper::IncrementalMapper(const IncrementalMapperOptions& options,
                                      const BundleAdjuster& bundle_adjuster, uint64_t seed)
     : options_(options), bundle_adjuster_(bundle_adjuster), seed_(seed) {}
 
+namespace {
+
+// Bundle adjustment of a whole model and the removal of observations it leaves too far
+// from their points, as after a merge.
+void AdjustWholeModel(const IncrementalMapperOptions& options,
+                      const BundleAdjuster& bundle_adjuster, Reconstruction* model) {
+  BundleAdjustmentConfig config;
+  config.refine_focal_length = options.ba_refine_focal_length;
+  config.refine_principal_point = options.ba_refine_principal_point;
+  config.refine_extra_params = options.ba_refine_extra_params;
+  config.fix_gauge = true;
+  config.max_num_iterations = options.ba_global_max_num_iterations;
+  config.function_tolerance = options.ba_global_function_tolerance;
+  for (const auto& [image_id, image] : model->images) config.images.insert(image_id);
+  const BundleAdjustmentSummary summary = bundle_adjuster.Adjust(config, model);
+  if (!summary.usable) {
+    spdlog::warn("map: bundle adjustment of a merged model failed: {}", summary.BriefReport());
+  }
+  for (auto it = model->points3D.begin(); it != model->points3D.end();) {
+    Point3D& point3D = it->second;
+    Track kept;
+    double sum = 0;
+    for (const TrackElement& element : point3D.track) {
+      Image& image = model->images.at(element.image_id);
+      const Eigen::Vector3d point_in_cam = image.cam_from_world * point3D.xyz;
+      const double error = point_in_cam.z() > 0
+                               ? (model->cameras.at(image.camera_id).ImgFromCam(point_in_cam) -
+                                  image.points2D[element.point2D_idx].xy)
+                                     .norm()
+                               : std::numeric_limits<double>::infinity();
+      if (error <= options.filter_max_reproj_error) {
+        kept.push_back(element);
+        sum += error;
+      } else {
+        image.points2D[element.point2D_idx].point3D_id = kInvalidPoint3DId;
+      }
+    }
+    if (kept.size() < 2) {
+      for (const TrackElement& element : kept) {
+        model->images.at(element.image_id).points2D[element.point2D_idx].point3D_id =
+            kInvalidPoint3DId;
+      }
+      it = model->points3D.erase(it);
+      continue;
+    }
+    point3D.error = sum / static_cast<double>(kept.size());
+    point3D.track = std::move(kept);
+    ++it;
+  }
+}
+
+ModelSelfCheck SelfCheck(const ViewGraph& view_graph, const Reconstruction& model,
+                         const IncrementalMapperOptions& options) {
+  const ModelAgreement agreement =
+      ComputeModelAgreement(view_graph, model, options.reg_max_rotation_error);
+  ModelSelfCheck check;
+  check.num_pairs = agreement.num_pairs;
+  check.num_agreeing = agreement.num_agreeing;
+  check.agreement = agreement.inlier_share;
+  for (const auto& image : agreement.disagreeing_images) {
+    check.disagreeing_images.push_back(image.image_id);
+  }
+  check.possibly_folded = agreement.inlier_share < options.min_model_agreement;
+  return check;
+}
+
+// Sorts models largest first (most images, then most points).
+void SortModels(std::vector<Reconstruction>* models) {
+  std::stable_sort(models->begin(), models->end(), [](const auto& a, const auto& b) {
+    if (a.images.size() != b.images.size()) return a.images.size() > b.images.size();
+    return a.points3D.size() > b.points3D.size();
+  });
+}
+
+// Merges every pair of models that aligns, largest first, until none does; a merge that
+// makes the model disagree more with the view graph than its parts is undone.
+void MergeAlignedModels(const IncrementalMapperOptions& options,
+                        const BundleAdjuster& bundle_adjuster, const ViewGraph& view_graph,
+                        const FeatureTracks& tracks, uint64_t seed,
+                        std::vector<Reconstruction>* models, std::vector<std::string>* log) {
+  ModelMergeOptions merge_options;
+  merge_options.min_num_shared_points = static_cast<size_t>(options.merge_min_shared_points);
+  merge_options.max_reproj_error = options.merge_max_reproj_error;
+  std::set<std::pair<std::set<image_t>, std::set<image_t>>> tried;
+  bool merged_any = true;
+  while (merged_any && models->size() > 1) {
+    merged_any = false;
+    SortModels(models);
+    for (size_t a = 0; a < models->size() && !merged_any; ++a) {
+      for (size_t b = a + 1; b < models->size() && !merged_any; ++b) {
+        std::set<image_t> images_a, images_b;
+        for (const auto& [image_id, image] : (*models)[a].images) images_a.insert(image_id);
+        for (const auto& [image_id, image] : (*models)[b].images) images_b.insert(image_id);
+        if (!tried.insert({images_a, images_b}).second) continue;
+        Reconstruction merged = (*models)[a];
+        const ModelMergeReport report = tessera::MergeModels(
+            tracks, merge_options,
+            DeriveSeed(seed, kMergeStream * 0x100000000ull + *images_b.begin()), (*models)[b],
+            &merged);
+        const std::string names =
+            fmt::format("models of {} and {} images", images_a.size(), images_b.size());
+        if (!report.merged) {
+          spdlog::info("map: {} not merged: {}", names, report.reason);
+          log->push_back(names + " not merged: " + report.reason);
+          continue;
+        }
+        AdjustWholeModel(options, bundle_adjuster, &merged);
+        const double agreement_a = SelfCheck(view_graph, (*models)[a], options).agreement;
+        const double agreement_b = SelfCheck(view_graph, (*models)[b], options).agreement;
+        const double agreement = SelfCheck(view_graph, merged, options).agreement;
+        constexpr double kMaxAgreementLoss = 0.05;
+        if (agreement < std::min(agreement_a, agreement_b) - kMaxAgreementLoss) {
+          const std::string why = fmt::format(
+              "{} align on {} of {} shared points, but the merged model agrees with pairs "
+              "holding {:.0f}% of its inliers (the parts: {:.0f}% and {:.0f}%); merge undone",
+              names, report.num_inliers, report.num_shared_points, 100 * agreement,
+              100 * agreement_a, 100 * agreement_b);
+          spdlog::info("map: {}", why);
+          log->push_back(why);
+          continue;
+        }
+        const std::string why = fmt::format(
+            "{} merged: one similarity aligns {} of their {} shared points within {:g} px; "
+            "it agrees with pairs holding {:.0f}% of its inliers",
+            names, report.num_inliers, report.num_shared_points, options.merge_max_reproj_error,
+            100 * agreement);
+        spdlog::info("map: {}", why);
+        log->push_back(why);
+        (*models)[a] = std::move(merged);
+        models->erase(models->begin() + static_cast<std::ptrdiff_t>(b));
+        merged_any = true;
+      }
+    }
+  }
+  SortModels(models);
+}
+
+}  // namespace
+
+namespace {
+
+// The view graph of the run's cameras, filtered, and the tracks of the pairs it keeps;
+// returns how many pairs the filter dropped.
+size_t PrepareRun(const std::vector<const MapperInput::Pair*>& verified_pairs, RunState* run) {
+  const IncrementalMapperOptions& options_ = run->options;
+  run->view_graph = ViewGraph::Build(run->input, run->cameras, verified_pairs,
+                                     DeriveSeed(run->seed, kViewGraphStream));
+  size_t num_dropped = 0;
+  if (options_.filter_view_graph) {
+    constexpr size_t kMinNumCycles = 3;
+    num_dropped =
+        run->view_graph.FilterByRotationCycles(options_.view_graph_max_cycle_error, kMinNumCycles);
+    spdlog::info(
+        "map: view graph: {} of {} verified pairs dropped: their relative rotations close none "
+        "of the {} or more rotation cycles (triangles of pairs) through them within {:g} deg",
+        num_dropped, verified_pairs.size(), kMinNumCycles, options_.view_graph_max_cycle_error);
+  }
+  std::vector<ImagePairMatches> pair_matches;
+  run->verified_pairs.clear();
+  for (size_t e = 0; e < verified_pairs.size(); ++e) {
+    if (run->view_graph.edges()[e].removed) continue;
+    const MapperInput::Pair& pair = *verified_pairs[e];
+    run->verified_pairs.push_back(&pair);
+    pair_matches.push_back({pair.image_id1, pair.image_id2, pair.geometry.inlier_matches});
+  }
+  std::map<image_t, size_t> num_points2D;
+  for (const auto& [image_id, image] : run->input.images) {
+    num_points2D[image_id] = image.points2D.size();
+  }
+  run->tracks = BuildFeatureTracks(pair_matches, num_points2D);
+  return num_dropped;
+}
+
+// Focal lengths of the cameras without a prior, in `cameras`: from the view graph where
+// it determines them, then refined in a first model.
+void EstimateFocalLengthsWithoutPrior(const RunState& run,
+                                      const std::vector<const MapperInput::Pair*>& verified_pairs,
+                                      std::map<camera_t, Camera>* cameras,
+                                      std::vector<FocalLengthReport>* reports) {
+  std::map<camera_t, FocalLengthReport> by_camera;
+  for (const auto& [camera_id, camera] : *cameras) {
+    if (camera.has_prior_focal_length) continue;
+    FocalLengthReport& report = by_camera[camera_id];
+    report.camera_id = camera_id;
+    report.initial = report.estimated = camera.MeanFocalLength();
+  }
+  if (by_camera.empty()) return;
+
+  // 1. From the fundamental matrices, where they determine it.
+  for (const auto& [camera_id, estimate] :
+       EstimateFocalLengths(run.input, verified_pairs, FocalLengthEstimationOptions())) {
+    if (estimate.at_search_bound) {
+      spdlog::info(
+          "map: camera {}: the image pairs do not determine its focal length (their best fit "
+          "lies at the end of the range searched, as when every camera aims at one point)",
+          camera_id);
+      continue;
+    }
+    cameras->at(camera_id).SetFocalLength(estimate.focal_length);
+    FocalLengthReport& report = by_camera.at(camera_id);
+    report.estimated = estimate.focal_length;
+    report.method = "view graph";
+    report.num_pairs = estimate.num_pairs;
+  }
+
+  // 2. Refined by bundle adjustment in a first model, mapped once for that alone: with
+  // the structure of many views the focal length is well determined even where pairs
+  // leave it open, and the view-graph checks of the real pass need it to be right.
+  RunState calibration{
+      run.input, run.options, run.bundle_adjuster, run.seed, {}, {}, {}, {}, {}, 0, 0, *cameras, {},
+      0};
+  const spdlog::level::level_enum level = spdlog::get_level();
+  if (level > spdlog::level::debug) spdlog::set_level(spdlog::level::warn);
+  PrepareRun(verified_pairs, &calibration);
+  ModelBuilder builder(&calibration);
+  Reconstruction model;
+  if (builder.Initialize()) {
+    builder.Grow(kMaxCalibrationImages);
+    builder.Finish();
+    model = builder.TakeModel();
+  }
+  spdlog::set_level(level);
+
+  for (auto& [camera_id, report] : by_camera) {
+    const auto it = model.cameras.find(camera_id);
+    if (model.images.size() < kMinCalibrationImages || it == model.cameras.end()) {
+      spdlog::info(
+          "map: camera {}: no first model of {} images or more to refine its focal length "
+          "from; mapping starts from {:.1f} px",
+          camera_id, kMinCalibrationImages, report.estimated);
+      continue;
+    }
+    const Camera& camera = cameras->at(camera_id);
+    const double side = static_cast<double>(std::max(camera.width, camera.height));
+    const double focal = it->second.MeanFocalLength();
+    if (!(focal > 0.25 * side && focal < 5 * side)) continue;
+    cameras->at(camera_id).SetFocalLength(focal);
+    report.estimated = focal;
+    report.method = report.method.empty() ? "first model" : report.method + ", first model";
+    report.num_images = model.images.size();
+  }
+  for (const auto& [camera_id, report] : by_camera) {
+    if (report.method.empty()) continue;
+    spdlog::info(
+        "map: camera {} has no focal-length prior: mapping starts from {:.1f} px (from the {}{}) "
+        "instead of the default {:.1f} px",
+        camera_id, report.estimated, report.method,
+        report.num_images > 0 ? fmt::format(" of {} images", report.num_images) : "",
+        report.initial);
+    reports->push_back(report);
+  }
+}
+
+}  // namespace
+
 MapperResult IncrementalMapper::Reconstruct(const MapperInput& input) const {
   const auto start_time = std::chrono::steady_clock::now();
-  RunState run{input, options_, bundle_adjuster_, seed_, {}, {}, {}, {}, {}, 0, 0};
+  RunState run{input, options_, bundle_adjuster_, seed_, {}, {}, {}, {}, {}, 0, 0, {}, {}, 0};
+  run.cameras = input.cameras;
+  MapperResult result;
 
-  std::vector<ImagePairMatches> pair_matches;
+  std::vector<const MapperInput::Pair*> verified_pairs;
   for (const MapperInput::Pair& pair : input.pairs) {
     if (!IsVerified(pair.geometry) ||
         pair.geometry.inlier_matches.size() < static_cast<size_t>(options_.min_num_matches) ||
         input.images.count(pair.image_id1) == 0 || input.images.count(pair.image_id2) == 0) {
       continue;
     }
-    run.verified_pairs.push_back(&pair);
-    pair_matches.push_back({pair.image_id1, pair.image_id2, pair.geometry.inlier_matches});
+    verified_pairs.push_back(&pair);
   }
-  std::map<image_t, size_t> num_points2D;
-  for (const auto& [image_id, image] : input.images) num_points2D[image_id] = image.points2D.size();
-  run.tracks = BuildFeatureTracks(pair_matches, num_points2D);
 
-  MapperResult result;
+  if (options_.estimate_focal_length) {
+    EstimateFocalLengthsWithoutPrior(run, verified_pairs, &run.cameras, &result.focal_lengths);
+  }
+  result.num_pairs_dropped = PrepareRun(verified_pairs, &run);
   result.num_tracks = run.tracks.tracks.size();
   result.num_refused_matches = run.tracks.num_refused_matches;
   spdlog::info(
@@ -949,6 +1395,9 @@ MapperResult IncrementalMapper::Reconstruct(const MapperInput& input) const {
     if (!builder.Initialize()) break;
     builder.Grow();
     builder.Finish();
+    for (int round = 0; round < kMaxFinalGrowRounds && builder.GrowAgain(); ++round) {
+      builder.Finish();
+    }
     const size_t num_registered = builder.NumRegisteredImages();
     Reconstruction model = builder.TakeModel();
     if (num_registered < static_cast<size_t>(options_.min_model_size)) {
@@ -962,18 +1411,48 @@ MapperResult IncrementalMapper::Reconstruct(const MapperInput& input) const {
     if (!options_.multiple_models) break;
   }
 
-  std::stable_sort(result.models.begin(), result.models.end(), [](const auto& a, const auto& b) {
-    if (a.images.size() != b.images.size()) return a.images.size() > b.images.size();
-    return a.points3D.size() > b.points3D.size();
-  });
+  if (options_.merge_models) {
+    MergeAlignedModels(options_, bundle_adjuster_, run.view_graph, run.tracks, seed_,
+                       &result.models, &result.merges);
+  } else {
+    SortModels(&result.models);
+  }
+  for (size_t m = 0; m < result.models.size(); ++m) {
+    ModelSelfCheck check = SelfCheck(run.view_graph, result.models[m], options_);
+    if (check.possibly_folded) {
+      std::string names;
+      for (size_t i = 0; i < check.disagreeing_images.size() && i < 10; ++i) {
+        names += (i > 0 ? ", " : "") + input.images.at(check.disagreeing_images[i]).name;
+      }
+      if (check.disagreeing_images.size() > 10) names += ", ...";
+      spdlog::warn(
+          "map: model {} may be folded by symmetric or repeated structure: its poses agree "
+          "within {:g} deg with {} of its {} verified pairs, which hold only {:.0f}% of their "
+          "inliers (min_model_agreement {:.0f}%); images whose pairs mostly disagree: {}",
+          m, options_.reg_max_rotation_error, check.num_agreeing, check.num_pairs,
+          100 * check.agreement, 100 * options_.min_model_agreement,
+          names.empty() ? "none" : names);
+    } else {
+      spdlog::info(
+          "map: model {}: its poses agree with {} of its {} verified pairs, {:.1f}% of their "
+          "inliers",
+          m, check.num_agreeing, check.num_pairs, 100 * check.agreement);
+    }
+    result.self_checks.push_back(std::move(check));
+  }
+  result.num_registrations_refused = run.num_registrations_refused;
 
   std::set<image_t> in_verified_pair;
   for (const MapperInput::Pair* pair : run.verified_pairs) {
     in_verified_pair.insert(pair->image_id1);
     in_verified_pair.insert(pair->image_id2);
   }
+  std::set<image_t> in_model;
+  for (const Reconstruction& model : result.models) {
+    for (const auto& [image_id, image] : model.images) in_model.insert(image_id);
+  }
   for (const auto& [image_id, image] : input.images) {
-    if (run.used_images.count(image_id) > 0) continue;
+    if (in_model.count(image_id) > 0) continue;
     std::string reason;
     if (in_verified_pair.count(image_id) == 0) {
       reason = "no verified pair with at least " + std::to_string(options_.min_num_matches) +

@@ -39,9 +39,44 @@ struct MapperInput {
   std::vector<Pair> pairs;
 };
 
+// What the mapper found out about a camera's focal length before mapping.
+struct FocalLengthReport {
+  camera_t camera_id = kInvalidCameraId;
+  double initial = 0;    // px, the default the camera came with
+  double estimated = 0;  // px, what mapping started from
+  // How: "view graph" (from the pairs' fundamental matrices) and "first model" (refined
+  // by bundle adjustment in a first mapping pass).
+  std::string method;
+  size_t num_pairs = 0;   // pairs that took part in the view-graph estimate
+  size_t num_images = 0;  // images of the first model
+};
+
+// How a model agrees with the view graph: its verified pairs whose relative rotation is
+// the model's within reg_max_rotation_error, their share of the pairs' inliers, and the
+// images most of whose pairs' inliers disagree.
+struct ModelSelfCheck {
+  size_t num_pairs = 0;
+  size_t num_agreeing = 0;
+  // Share of the pairs' inliers in agreeing pairs (see ModelAgreement::inlier_share).
+  double agreement = 1;
+  std::vector<image_t> disagreeing_images;
+  // agreement < min_model_agreement: the model may be folded by symmetric structure.
+  bool possibly_folded = false;
+};
+
 struct MapperResult {
   // Largest first (most registered images, then most points).
   std::vector<Reconstruction> models;
+  // One per model, in the same order.
+  std::vector<ModelSelfCheck> self_checks;
+  // Focal lengths estimated for cameras without a prior.
+  std::vector<FocalLengthReport> focal_lengths;
+  // Pairs dropped by view-graph filtering, of those verified.
+  size_t num_pairs_dropped = 0;
+  // Registrations refused because they disagreed with the view graph.
+  size_t num_registrations_refused = 0;
+  // One line per merge of two models, and per pair of models tried and not merged.
+  std::vector<std::string> merges;
   // Why each image that is in no model was left out.
   std::map<image_t, std::string> unregistered_reasons;
   size_t num_tracks = 0;

@@ -47,6 +47,21 @@ IncrementalMapperOptions IncrementalMapperOptions::FromJson(const nlohmann::json
   o.max_principal_point_offset =
       reader.Get<double>("max_principal_point_offset", o.max_principal_point_offset, 0.0, 0.5);
   o.ba_refine_extra_params = reader.GetBool("ba_refine_extra_params", o.ba_refine_extra_params);
+  o.estimate_focal_length = reader.GetBool("estimate_focal_length", o.estimate_focal_length);
+  o.filter_view_graph = reader.GetBool("filter_view_graph", o.filter_view_graph);
+  o.view_graph_max_cycle_error =
+      reader.Get<double>("view_graph_max_cycle_error", o.view_graph_max_cycle_error, 0.01, 180.0);
+  o.check_registration = reader.GetBool("check_registration", o.check_registration);
+  o.reg_max_rotation_error =
+      reader.Get<double>("reg_max_rotation_error", o.reg_max_rotation_error, 0.01, 180.0);
+  o.reg_min_agreement = reader.Get<double>("reg_min_agreement", o.reg_min_agreement, 0.0, 1.0);
+  o.min_model_agreement =
+      reader.Get<double>("min_model_agreement", o.min_model_agreement, 0.0, 1.0);
+  o.merge_models = reader.GetBool("merge_models", o.merge_models);
+  o.merge_min_shared_points =
+      reader.Get<int>("merge_min_shared_points", o.merge_min_shared_points, 3, 100000000);
+  o.merge_max_reproj_error =
+      reader.Get<double>("merge_max_reproj_error", o.merge_max_reproj_error, 1e-3, 1000.0);
   o.multiple_models = reader.GetBool("multiple_models", o.multiple_models);
   o.max_num_models = reader.Get<int>("max_num_models", o.max_num_models, 1, 100000);
   o.min_model_size = reader.Get<int>("min_model_size", o.min_model_size, 2, 1000000);
@@ -80,6 +95,16 @@ nlohmann::json IncrementalMapperOptions::ToJson() const {
           {"ba_refine_principal_point", ba_refine_principal_point},
           {"max_principal_point_offset", max_principal_point_offset},
           {"ba_refine_extra_params", ba_refine_extra_params},
+          {"estimate_focal_length", estimate_focal_length},
+          {"filter_view_graph", filter_view_graph},
+          {"view_graph_max_cycle_error", view_graph_max_cycle_error},
+          {"check_registration", check_registration},
+          {"reg_max_rotation_error", reg_max_rotation_error},
+          {"reg_min_agreement", reg_min_agreement},
+          {"min_model_agreement", min_model_agreement},
+          {"merge_models", merge_models},
+          {"merge_min_shared_points", merge_min_shared_points},
+          {"merge_max_reproj_error", merge_max_reproj_error},
           {"multiple_models", multiple_models},
           {"max_num_models", max_num_models},
           {"min_model_size", min_model_size}};

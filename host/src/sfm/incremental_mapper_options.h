@@ -22,7 +22,8 @@ struct IncrementalMapperOptions {
   double abs_pose_max_error = 12.0;  // px
   int abs_pose_min_num_inliers = 30;
   double abs_pose_min_inlier_ratio = 0.25;
-  // Failed registrations of one image before it is given up for the model.
+  // Failed registrations of one image before it is given up until the next global
+  // bundle adjustment (after which every unregistered image is tried again).
   int max_reg_trials = 3;
 
   // Triangulation of new points and completion of tracks.
@@ -59,6 +60,36 @@ struct IncrementalMapperOptions {
   // held there.
   double max_principal_point_offset = 0.1;
   bool ba_refine_extra_params = true;
+
+  // Focal length of cameras without a prior (no EXIF, no K) estimated from the
+  // fundamental matrices of the verified pairs before mapping, instead of starting
+  // from default_focal_length_factor x the image size.
+  bool estimate_focal_length = true;
+
+  // View-graph filtering before mapping: a pair in at least 3 rotation cycles
+  // (triangles of pairs) that closes none of them within view_graph_max_cycle_error
+  // degrees is dropped.
+  bool filter_view_graph = true;
+  double view_graph_max_cycle_error = 10.0;
+
+  // Each registration is checked against the view graph: the relative rotations its
+  // pose implies to the registered images it has a verified pair with must agree with
+  // the pairs' own within reg_max_rotation_error degrees, for at least
+  // reg_min_agreement of the pairs (weighted by their inliers). Else it is refused and
+  // the image tried again later.
+  bool check_registration = true;
+  double reg_max_rotation_error = 10.0;  // degrees
+  double reg_min_agreement = 0.6;
+  // A model whose agreeing pairs (rotation within reg_max_rotation_error) hold a smaller
+  // share of its pairs' inliers may be folded: it is flagged in the log and the summary.
+  double min_model_agreement = 0.75;
+
+  // Models sharing at least merge_min_shared_points points (one feature track in
+  // both) that one similarity aligns within merge_max_reproj_error px are merged and
+  // adjusted again.
+  bool merge_models = true;
+  int merge_min_shared_points = 30;
+  double merge_max_reproj_error = 4.0;
 
   // Further models from the images the first could not take.
   bool multiple_models = true;

@@ -188,6 +188,105 @@ TEST(IncrementalMapper, DisconnectedGroupsBecomeSeparateModelsLargestFirst) {
   EXPECT_EQ(Map(scene, single).models.size(), 1u);
 }
 
+// No image of `model` is more than `max_deg` off its true orientation, once aligned.
+void ExpectNoCameraOff(const SyntheticScene& scene, const Reconstruction& model, double max_deg) {
+  const EvaluationResult evaluation = EvaluateReconstruction(model, scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  for (const ImageEvaluation& row : evaluation.images) {
+    if (row.registered) {
+      EXPECT_LT(row.rotation_error_deg, max_deg) << row.name;
+    }
+  }
+}
+
+TEST(IncrementalMapper, EstimatesTheFocalLengthWhenThereIsNoPrior) {
+  SyntheticSceneOptions options;
+  options.focal_prior = false;
+  options.prior_focal_factor = 1.6;  // far off: 1.2 x 1600 px against 1000 px
+  options.seed = 11;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const MapperResult result = Map(scene);
+  ASSERT_EQ(result.focal_lengths.size(), 1u);
+  EXPECT_NEAR(result.focal_lengths[0].estimated, options.focal_length, 0.02 * options.focal_length);
+  ASSERT_EQ(result.models.size(), 1u);
+  EXPECT_EQ(result.models[0].images.size(), scene.input.images.size());
+  EXPECT_NEAR(result.models[0].cameras.at(1).FocalLengthX(), options.focal_length,
+              0.005 * options.focal_length);
+  ExpectNoCameraOff(scene, result.models[0], 0.1);
+}
+
+// An object seen from all around whose back half repeats its front half turned by half a
+// turn: pairs of images from nearly opposite sides match on the repeated half, and a
+// model that puts one side's cameras onto the other explains those matches exactly.
+SyntheticSceneOptions SymmetricObject() {
+  SyntheticSceneOptions options;
+  options.num_images = 36;
+  options.arc_deg = 350;
+  options.num_points = 3000;
+  options.max_view_angle_deg = 60;
+  options.symmetric_fraction = 0.3;
+  options.seed = 12;
+  return options;
+}
+
+TEST(IncrementalMapper, DoesNotFoldASymmetricObject) {
+  const SyntheticScene scene = MakeSyntheticScene(SymmetricObject());
+  ASSERT_GT(scene.num_mirror_pairs, 50u);
+  const MapperResult result = Map(scene);
+  ASSERT_EQ(result.models.size(), 1u);
+  EXPECT_EQ(result.models[0].images.size(), scene.input.images.size());
+  ExpectNoCameraOff(scene, result.models[0], 5);
+  ASSERT_EQ(result.self_checks.size(), 1u);
+  EXPECT_FALSE(result.self_checks[0].possibly_folded);
+}
+
+TEST(IncrementalMapper, FlagsAFoldedModel) {
+  // Without the view graph, the symmetric object folds; the self-check says so.
+  const SyntheticScene scene = MakeSyntheticScene(SymmetricObject());
+  IncrementalMapperOptions unchecked;
+  unchecked.filter_view_graph = false;
+  unchecked.check_registration = false;
+  const MapperResult result = Map(scene, unchecked);
+  ASSERT_FALSE(result.models.empty());
+  const EvaluationResult evaluation = EvaluateReconstruction(result.models[0], scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned);
+  EXPECT_GT(evaluation.num_wrongly_registered, 0u);
+  EXPECT_GT(evaluation.rotation_error_max_deg, 90);
+  EXPECT_TRUE(result.self_checks[0].possibly_folded);
+  EXPECT_FALSE(result.self_checks[0].disagreeing_images.empty());
+}
+
+TEST(IncrementalMapper, MergesTwoModelsOfOneScene) {
+  // Images 1-7 and 8-14 of an arc; across the cut only the pairs (6, 8), (7, 8) and
+  // (7, 9) match, on 40 points each: fewer than a registration needs (100 here), so the
+  // images split into two models, which share the tracks of those matches.
+  SyntheticSceneOptions options;
+  options.num_images = 14;
+  options.max_pair_gap = 2;
+  options.seed = 13;
+  SyntheticScene scene = MakeSyntheticScene(options);
+  for (MapperInput::Pair& pair : scene.input.pairs) {
+    if (pair.image_id1 <= 7 && pair.image_id2 >= 8) pair.geometry.inlier_matches.resize(40);
+  }
+  IncrementalMapperOptions mapper_options;
+  mapper_options.abs_pose_min_num_inliers = 100;
+  IncrementalMapperOptions unmerged = mapper_options;
+  unmerged.merge_models = false;
+  const MapperResult split = Map(scene, unmerged);
+  ASSERT_EQ(split.models.size(), 2u);
+  EXPECT_EQ(split.models[0].images.size() + split.models[1].images.size(),
+            scene.input.images.size());
+
+  const MapperResult result = Map(scene, mapper_options);
+  ASSERT_EQ(result.models.size(), 1u);
+  EXPECT_EQ(result.models[0].images.size(), scene.input.images.size());
+  ASSERT_EQ(result.merges.size(), 1u);
+  EXPECT_NE(result.merges[0].find("merged"), std::string::npos) << result.merges[0];
+  ExpectNoCameraOff(scene, result.models[0], 0.5);
+  const EvaluationResult evaluation = EvaluateReconstruction(result.models[0], scene.GroundTruth());
+  EXPECT_LT(evaluation.position_error_max, 0.05);
+}
+
 TEST(IncrementalMapper, SameSeedSameModel) {
   SyntheticSceneOptions options;
   options.outlier_ratio = 0.02;

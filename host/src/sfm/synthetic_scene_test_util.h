@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "eval/ground_truth.h"
+#include "geometry/essential_matrix.h"
 #include "sfm/incremental_mapper.h"
 #include "util/random.h"
 
@@ -44,12 +45,27 @@ struct SyntheticSceneOptions {
   int max_pair_gap = 0;
   // Focal length given to the mapper, as a factor of the true one (a wrong prior).
   double prior_focal_factor = 1.0;
+  // Without a prior the camera has has_prior_focal_length false and every pair is
+  // UNCALIBRATED with its fundamental matrix, as verification leaves photos without EXIF.
+  bool focal_prior = true;
+  // Points face outwards from the vertical axis: a point is seen only by cameras within
+  // this angle of its normal, as on the surface of an object (0: seen from everywhere).
+  double max_view_angle_deg = 0;
+  // Repeated structure: this fraction of the points has a twin, the point turned by 180
+  // degrees about the vertical axis, that looks the same. Pairs of images whose viewing
+  // directions differ by 180 degrees plus mirror_min_offset_deg to mirror_max_offset_deg
+  // are matched on the twins only: wrong matches that a folded model explains exactly.
+  double symmetric_fraction = 0;
+  double mirror_min_offset_deg = 15;
+  double mirror_max_offset_deg = 60;
   uint64_t seed = 1;
 };
 
 struct SyntheticScene {
   MapperInput input;
   std::map<image_t, Rigid3d> true_cam_from_world;
+  // Pairs matched on twins (see SyntheticSceneOptions::symmetric_fraction).
+  size_t num_mirror_pairs = 0;
   std::vector<Eigen::Vector3d> true_points3D;
   // For each image, the true point of each keypoint (-1 for clutter).
   std::map<image_t, std::vector<int>> true_point_of_keypoint;
@@ -81,7 +97,7 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
   true_camera.params[2] += options.principal_point_offset_y;
   prior_camera.params[0] = options.focal_length * options.prior_focal_factor;
   prior_camera.params[3] = 0;
-  prior_camera.has_prior_focal_length = true;
+  prior_camera.has_prior_focal_length = options.focal_prior;
   scene.input.cameras[1] = prior_camera;
 
   for (int i = 0; i < options.num_points; ++i) {
@@ -89,6 +105,24 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
                                      options.scene_size * unit(engine),
                                      options.scene_size * unit(engine));
   }
+  // The half-turn about the vertical (y) axis that maps each point to its twin.
+  const Eigen::Matrix3d half_turn = Eigen::Vector3d(-1, 1, -1).asDiagonal();
+  const int num_twins =
+      static_cast<int>(std::round(options.symmetric_fraction * options.num_points));
+  std::vector<int> twin_of(options.num_points + num_twins, -1);
+  for (int i = 0; i < num_twins; ++i) {
+    twin_of[i] = options.num_points + i;
+    twin_of[options.num_points + i] = i;
+    scene.true_points3D.push_back(half_turn * scene.true_points3D[i]);
+  }
+  const int num_all_points = static_cast<int>(scene.true_points3D.size());
+  const auto visible_from = [&](const Eigen::Vector3d& point, const Eigen::Vector3d& center) {
+    if (options.max_view_angle_deg <= 0) return true;
+    const Eigen::Vector3d normal = Eigen::Vector3d(point.x(), 0, point.z()).normalized();
+    const Eigen::Vector3d to_camera = (center - point).normalized();
+    return normal.dot(to_camera) >= std::cos(options.max_view_angle_deg * M_PI / 180);
+  };
+  std::map<image_t, double> viewing_angle_deg;
 
   for (int i = 0; i < options.num_images; ++i) {
     const image_t image_id = static_cast<image_t>(i + 1);
@@ -99,6 +133,7 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
     // with a little random jitter of the viewing direction.
     const Eigen::Vector3d center(options.radius * std::sin(angle), 0.3 * unit(engine),
                                  -options.radius * std::cos(angle));
+    viewing_angle_deg[image_id] = angle * 180 / M_PI;
     const Eigen::Vector3d z_axis =
         (-center + Eigen::Vector3d(0.2 * unit(engine), 0.2 * unit(engine), 0)).normalized();
     const Eigen::Vector3d x_axis = Eigen::Vector3d::UnitY().cross(z_axis).normalized();
@@ -114,7 +149,8 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
     image.camera_id = 1;
     image.name = "synthetic_" + std::to_string(image_id) + ".png";
     std::vector<std::pair<Eigen::Vector2d, int>> keypoints;
-    for (int p = 0; p < options.num_points; ++p) {
+    for (int p = 0; p < num_all_points; ++p) {
+      if (!visible_from(scene.true_points3D[p], center)) continue;
       const Eigen::Vector3d point_in_cam = cam_from_world * scene.true_points3D[p];
       if (point_in_cam.z() <= 0.1) continue;
       Eigen::Vector2d xy = true_camera.ImgFromCam(point_in_cam);
@@ -153,11 +189,18 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
         continue;
       }
       const std::vector<int>& true2 = scene.true_point_of_keypoint.at(image_id2);
+      // Directions 180 degrees apart, give or take the offset: the twins match.
+      const double apart = std::abs(
+          std::remainder(viewing_angle_deg.at(image_id2) - viewing_angle_deg.at(image_id1), 360.0));
+      const bool mirror_pair = num_twins > 0 && 180 - apart >= options.mirror_min_offset_deg &&
+                               180 - apart <= options.mirror_max_offset_deg;
       FeatureMatches matches;
       for (point2D_t idx2 = 0; idx2 < true2.size(); ++idx2) {
-        const auto it = keypoint_of_point1.find(true2[idx2]);
-        if (true2[idx2] >= 0 && it != keypoint_of_point1.end())
-          matches.push_back({it->second, idx2});
+        if (true2[idx2] < 0) continue;
+        const int point1 = mirror_pair ? twin_of[true2[idx2]] : true2[idx2];
+        if (point1 < 0) continue;
+        const auto it = keypoint_of_point1.find(point1);
+        if (it != keypoint_of_point1.end()) matches.push_back({it->second, idx2});
       }
       if (matches.size() < static_cast<size_t>(options.min_num_matches)) continue;
       std::sort(matches.begin(), matches.end(), [](const FeatureMatch& a, const FeatureMatch& b) {
@@ -181,7 +224,22 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
       MapperInput::Pair pair;
       pair.image_id1 = image_id1;
       pair.image_id2 = image_id2;
-      pair.geometry.config = TwoViewGeometry::CALIBRATED;
+      // The relative pose verification would find: for a mirror pair, that of image 2
+      // seeing the twins, i.e. posed as if the scene were turned by half a turn.
+      Rigid3d cam2_from_world = scene.true_cam_from_world.at(image_id2);
+      if (mirror_pair) {
+        cam2_from_world.rotation =
+            Eigen::Quaterniond(cam2_from_world.rotation.toRotationMatrix() * half_turn);
+        ++scene.num_mirror_pairs;
+      }
+      pair.geometry.cam2_from_cam1 =
+          cam2_from_world * scene.true_cam_from_world.at(image_id1).Inverse();
+      pair.geometry.cam2_from_cam1.translation.normalize();
+      pair.geometry.E = EssentialMatrixFromPose(pair.geometry.cam2_from_cam1);
+      const Eigen::Matrix3d K = true_camera.CalibrationMatrix();
+      pair.geometry.F = FundamentalFromEssentialMatrix(K, pair.geometry.E, K);
+      pair.geometry.config =
+          options.focal_prior ? TwoViewGeometry::CALIBRATED : TwoViewGeometry::UNCALIBRATED;
       pair.geometry.inlier_matches = std::move(matches);
       scene.input.pairs.push_back(std::move(pair));
     }

@@ -1,0 +1,161 @@
+#include "sfm/model_merger.h"
+
+#include <algorithm>
+#include <map>
+#include <random>
+#include <vector>
+
+#include "geometry/similarity_transform.h"
+#include "util/random.h"
+
+namespace tessera {
+namespace {
+
+// Each feature track with a point in the model, by the point's first element.
+std::map<track_t, point3D_t> PointOfTrack(const FeatureTracks& tracks,
+                                          const Reconstruction& model) {
+  std::map<track_t, point3D_t> point_of_track;
+  for (const auto& [point3D_id, point3D] : model.points3D) {
+    for (const TrackElement& element : point3D.track) {
+      const track_t track_id = tracks.TrackOf(element.image_id, element.point2D_idx);
+      if (track_id != kInvalidTrackId) point_of_track.emplace(track_id, point3D_id);
+    }
+  }
+  return point_of_track;
+}
+
+bool ProjectsWithin(const Reconstruction& model, const Point3D& point3D, const Eigen::Vector3d& xyz,
+                    double max_error) {
+  for (const TrackElement& element : point3D.track) {
+    const Image& image = model.images.at(element.image_id);
+    const Eigen::Vector3d point_in_cam = image.cam_from_world * xyz;
+    if (point_in_cam.z() <= 0) return false;
+    const Eigen::Vector2d projected = model.cameras.at(image.camera_id).ImgFromCam(point_in_cam);
+    if ((projected - image.points2D[element.point2D_idx].xy).squaredNorm() >
+        max_error * max_error) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+ModelMergeReport MergeModels(const FeatureTracks& tracks, const ModelMergeOptions& options,
+                             uint64_t seed, const Reconstruction& source, Reconstruction* target) {
+  ModelMergeReport report;
+  const std::map<track_t, point3D_t> source_points = PointOfTrack(tracks, source);
+  const std::map<track_t, point3D_t> target_points = PointOfTrack(tracks, *target);
+  std::vector<std::pair<point3D_t, point3D_t>> shared;  // source, target
+  for (const auto& [track_id, source_id] : source_points) {
+    const auto it = target_points.find(track_id);
+    if (it != target_points.end()) shared.emplace_back(source_id, it->second);
+  }
+  std::sort(shared.begin(), shared.end());
+  shared.erase(std::unique(shared.begin(), shared.end()), shared.end());
+  report.num_shared_points = shared.size();
+  if (shared.size() < std::max<size_t>(options.min_num_shared_points, 3)) {
+    report.reason = "they share " + std::to_string(shared.size()) + " points (" +
+                    std::to_string(options.min_num_shared_points) + " needed)";
+    return report;
+  }
+
+  const auto inliers_of = [&](const Similarity3d& target_from_source) {
+    std::vector<size_t> inliers;
+    for (size_t k = 0; k < shared.size(); ++k) {
+      const Eigen::Vector3d xyz = target_from_source * source.points3D.at(shared[k].first).xyz;
+      if (ProjectsWithin(*target, target->points3D.at(shared[k].second), xyz,
+                         options.max_reproj_error)) {
+        inliers.push_back(k);
+      }
+    }
+    return inliers;
+  };
+  const auto fit = [&](const std::vector<size_t>& indices) {
+    std::vector<Eigen::Vector3d> src, dst;
+    for (const size_t k : indices) {
+      src.push_back(source.points3D.at(shared[k].first).xyz);
+      dst.push_back(target->points3D.at(shared[k].second).xyz);
+    }
+    return EstimateSimilarity(src, dst);
+  };
+
+  RandomEngine engine(seed);
+  std::uniform_int_distribution<size_t> pick(0, shared.size() - 1);
+  std::vector<size_t> best_inliers;
+  Similarity3d best;
+  for (int trial = 0; trial < options.max_num_trials; ++trial) {
+    std::vector<size_t> sample;
+    while (sample.size() < 3) {
+      const size_t k = pick(engine);
+      if (std::find(sample.begin(), sample.end(), k) == sample.end()) sample.push_back(k);
+    }
+    const Similarity3d candidate = fit(sample);
+    if (!(candidate.scale > 0) || !candidate.rotation.allFinite()) continue;
+    std::vector<size_t> inliers = inliers_of(candidate);
+    if (inliers.size() > best_inliers.size()) {
+      // Local optimisation: refit on the inliers while that finds more.
+      Similarity3d refined = candidate;
+      while (inliers.size() >= 3) {
+        const Similarity3d refit = fit(inliers);
+        std::vector<size_t> refit_inliers = inliers_of(refit);
+        if (refit_inliers.size() <= inliers.size()) break;
+        refined = refit;
+        inliers = std::move(refit_inliers);
+      }
+      best = refined;
+      best_inliers = std::move(inliers);
+      if (best_inliers.size() == shared.size()) break;
+    }
+  }
+  report.num_inliers = best_inliers.size();
+  if (best_inliers.size() < options.min_num_shared_points ||
+      static_cast<double>(best_inliers.size()) <
+          options.min_inlier_ratio * static_cast<double>(shared.size())) {
+    report.reason = "an alignment explains " + std::to_string(best_inliers.size()) + " of their " +
+                    std::to_string(shared.size()) + " shared points";
+    return report;
+  }
+
+  // Source poses into the target frame: x_cam = R_c R^T (X_t - t) / s + t_c, scaled by s.
+  const Eigen::Matrix3d R_source_from_target = best.rotation.transpose();
+  for (const auto& [image_id, image] : source.images) {
+    Image moved = image;
+    const Eigen::Matrix3d R_cam_from_source = image.cam_from_world.rotation.toRotationMatrix();
+    const Eigen::Matrix3d R_cam_from_target = R_cam_from_source * R_source_from_target;
+    moved.cam_from_world = Rigid3d(
+        Eigen::Quaterniond(R_cam_from_target).normalized(),
+        best.scale * image.cam_from_world.translation - R_cam_from_target * best.translation);
+    for (Point2D& point2D : moved.points2D) point2D.point3D_id = kInvalidPoint3DId;
+    target->images[image_id] = std::move(moved);
+    target->cameras.emplace(image.camera_id, source.cameras.at(image.camera_id));
+  }
+  std::map<point3D_t, point3D_t> merged_into;  // source point -> target point
+  for (const size_t k : best_inliers) merged_into[shared[k].first] = shared[k].second;
+  point3D_t next_id = target->points3D.empty() ? 1 : target->points3D.rbegin()->first + 1;
+  for (const auto& [source_id, point3D] : source.points3D) {
+    const auto it = merged_into.find(source_id);
+    point3D_t point3D_id;
+    if (it != merged_into.end()) {
+      point3D_id = it->second;
+    } else {
+      point3D_id = next_id++;
+      Point3D& added = target->points3D[point3D_id];
+      added.xyz = best * point3D.xyz;
+      added.color = point3D.color;
+    }
+    Point3D& merged = target->points3D.at(point3D_id);
+    for (const TrackElement& element : point3D.track) {
+      const bool has_image = std::any_of(
+          merged.track.begin(), merged.track.end(),
+          [&](const TrackElement& other) { return other.image_id == element.image_id; });
+      if (has_image) continue;
+      merged.track.push_back(element);
+      target->images.at(element.image_id).points2D[element.point2D_idx].point3D_id = point3D_id;
+    }
+  }
+  report.merged = true;
+  return report;
+}
+
+}  // namespace tessera
