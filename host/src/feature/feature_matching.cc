@@ -7,6 +7,7 @@
 #include <mutex>
 
 #include "geometry/two_view_geometry_estimation.h"
+#include "plugin/plugin_crash_log.h"
 #include "util/parallel.h"
 #include "util/random.h"
 #include "util/strings.h"
@@ -77,7 +78,9 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
   std::map<camera_t, Camera> cameras;
   for (const Camera& camera : database->ReadAllCameras()) cameras[camera.camera_id] = camera;
 
-  const std::vector<ImageIndexPair> pairs = pair_selector->SelectPairs(names);
+  const std::vector<ImageIndexPair> pairs = CallPlugin(
+      pair_selector.name(), PluginStage::kSelectPairs, std::to_string(names.size()) + " images",
+      [&] { return pair_selector->SelectPairs(names); });
   summary.num_pairs = pairs.size();
   std::vector<ImageIndexPair> todo;
   for (const auto& [i, j] : pairs) {
@@ -89,6 +92,10 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
     const image_t id1 = images[i].image_id, id2 = images[j].image_id;
     if (database->ExistsMatches(id1, id2) && database->ExistsTwoViewGeometry(id1, id2)) {
       ++summary.num_reused;
+    } else if (IsQuarantined(matcher.name(), PluginStage::kMatch,
+                             PairSubject(images[i].name, images[j].name))) {
+      spdlog::warn("match: skipping {} and {}: they crashed matcher '{}' twice", images[i].name,
+                   images[j].name, matcher.name());
     } else {
       todo.emplace_back(i, j);
     }
@@ -122,7 +129,9 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
       std::lock_guard<std::mutex> lock(database_mutex);
       matches = database->ReadMatches(image1.image_id, image2.image_id);
     } else {
-      matches = matcher->Match(descriptors[i], descriptors[j]);
+      matches =
+          CallPlugin(matcher.name(), PluginStage::kMatch, PairSubject(image1.name, image2.name),
+                     [&] { return matcher->Match(descriptors[i], descriptors[j]); });
     }
     match_micros += static_cast<int64_t>(step.ElapsedSeconds() * 1e6);
     step.Restart();
