@@ -357,6 +357,28 @@ TEST(PluginBoundaryCli, AbortInDetectAndCrashInTheFactoryNameThePlugin) {
       << factory.output;
 }
 
+TEST(PluginBoundaryCli, CrashInMatchNamesThePairAndKeepsTheFeatures) {
+  testing::TemporaryDir dir;
+  WriteImages(dir.path());
+  ASSERT_EQ(RunTessera(Extract(dir.path(), WriteManifest(dir.path(), nlohmann::json::object())))
+                .exit_code,
+            0);
+  const auto manifest = WriteManifest(dir.path(), nlohmann::json::object(), {}, {{"fail", "segv"}});
+  const std::string match =
+      "match --output " + (dir.path() / "out").string() + " --manifest " + manifest.string();
+  const auto result = RunTessera(match);
+  EXPECT_EQ(result.exit_code, 4) << result.output;
+  EXPECT_TRUE(Contains(result.output,
+                       "[error] plugin 'failing_matcher' crashed (SIGSEGV) while matching images "
+                       "a.png and b.png\n"))
+      << result.output;
+  // The workspace is intact: extraction reuses every image.
+  const auto again = RunTessera(Extract(dir.path(), manifest));
+  EXPECT_EQ(again.exit_code, 0) << again.output;
+  EXPECT_TRUE(Contains(again.output, "0 to detect with 'failing_detector' (3 already done)"))
+      << again.output;
+}
+
 TEST(PluginBoundaryCli, ALibraryThatCrashesOnLoadIsRefusedAndTheRestListed) {
   const std::string folder = (kRoot / "crash_on_load").string();
   const auto result =

@@ -205,9 +205,11 @@ PluginError::PluginError(const std::string& plugin, PluginStage stage, const std
 PluginCallScope::PluginCallScope(const std::string& plugin, PluginStage stage,
                                  const std::string& subject)
     : outermost_(!t_record.active) {
-  if (!outermost_) return;  // a nested call keeps the outer record
+  if (!outermost_) return;    // a nested call keeps the outer record
+#ifndef __SANITIZE_ADDRESS__  // AddressSanitizer gives every thread an alternate stack
   static thread_local AltStack alt_stack;
   (void)alt_stack;
+#endif
   CallRecord& record = t_record;
   CopyField(plugin, record.plugin, sizeof(record.plugin));
   CopyField(PluginStageName(stage), record.stage, sizeof(record.stage));
