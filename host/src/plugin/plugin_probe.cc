@@ -13,8 +13,6 @@
 #include <cstring>
 #include <sstream>
 
-#include "plugin/plugin_registry.h"
-
 namespace tessera {
 namespace {
 
@@ -45,8 +43,8 @@ void WriteLine(int fd, const std::string& line) {
   }
   for (size_t i = first; i < files.size(); ++i) {
     WriteLine(fd, "begin " + std::to_string(i) + "\n");
-    { InspectPluginFile(files[i]); }  // opens, reads the record, closes
-    WriteLine(fd, "end " + std::to_string(i) + "\n");
+    const nlohmann::json record = InspectPluginFile(files[i]).ToJson();  // opens and closes
+    WriteLine(fd, "end " + std::to_string(i) + " " + record.dump() + "\n");
   }
   _exit(0);
 }
@@ -63,21 +61,38 @@ std::string Describe(int status) {
   return "ends the process on load (exit code " + std::to_string(WEXITSTATUS(status)) + ")";
 }
 
+// The record a child reported, as PluginRecord::ToJson wrote it.
+std::optional<PluginRecord> RecordFromJson(const std::filesystem::path& file,
+                                           const std::string& text) {
+  const nlohmann::json json = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (!json.is_object()) return std::nullopt;
+  PluginRecord record;
+  record.file = file;
+  record.abi_version = json.value("abi_version", 0u);
+  record.kind = json.value("kind", "");
+  record.name = json.value("name", "");
+  record.version = json.value("version", "");
+  record.description = json.value("description", "");
+  record.refusal = json.value("refused", "");
+  if (!json.value("usable", false) && record.refusal.empty()) return std::nullopt;
+  return record;
+}
+
 }  // namespace
 
-std::vector<std::string> ProbePluginFiles(const std::vector<std::filesystem::path>& files,
-                                          int timeout_seconds) {
-  std::vector<std::string> refusals(files.size());
+std::vector<std::optional<PluginRecord>> ProbePluginFiles(
+    const std::vector<std::filesystem::path>& files, int timeout_seconds) {
+  std::vector<std::optional<PluginRecord>> records(files.size());
   size_t next = 0;
   while (next < files.size()) {
     int pipe_fds[2];
-    if (pipe2(pipe_fds, O_CLOEXEC) != 0) return refusals;  // no probe: load as before
+    if (pipe2(pipe_fds, O_CLOEXEC) != 0) return records;  // no probe: load as before
     std::fflush(nullptr);  // a child that exits must not flush our buffers again
     const pid_t pid = fork();
     if (pid < 0) {
       close(pipe_fds[0]);
       close(pipe_fds[1]);
-      return refusals;
+      return records;
     }
     if (pid == 0) {
       close(pipe_fds[0]);
@@ -109,17 +124,23 @@ std::vector<std::string> ProbePluginFiles(const std::vector<std::filesystem::pat
       pending.append(buffer, static_cast<size_t>(n));
       size_t newline;
       while ((newline = pending.find('\n')) != std::string::npos) {
-        std::istringstream line(pending.substr(0, newline));
+        const std::string text = pending.substr(0, newline);
         pending.erase(0, newline + 1);
+        std::istringstream line(text);
         std::string word;
         long index = -1;
         line >> word >> index;
+        if (index < 0 || static_cast<size_t>(index) >= files.size()) continue;
         if (word == "begin") {
           current = index;
           deadline = std::chrono::steady_clock::now() + std::chrono::seconds(timeout_seconds);
         } else if (word == "end") {
           current = -1;
           next = static_cast<size_t>(index) + 1;
+          std::string json;
+          std::getline(line, json);
+          records[static_cast<size_t>(index)] =
+              RecordFromJson(files[static_cast<size_t>(index)], json);
         }
       }
     }
@@ -130,19 +151,22 @@ std::vector<std::string> ProbePluginFiles(const std::vector<std::filesystem::pat
     }
     if (current < 0) {
       if (next < files.size() && !(WIFEXITED(status) && WEXITSTATUS(status) == 0)) {
-        // Died between files: nothing to blame; load the rest in-process as before.
-        return refusals;
+        // Died between files: nothing to blame; the rest are inspected in-process.
+        return records;
       }
       continue;
     }
     const size_t index = static_cast<size_t>(current);
-    refusals[index] =
+    PluginRecord refused;
+    refused.file = files[index];
+    refused.refusal =
         files[index].string() + ": " +
         (timed_out ? "hangs on load (no answer in " + std::to_string(timeout_seconds) + " s)"
                    : Describe(status));
+    records[index] = std::move(refused);
     next = index + 1;
   }
-  return refusals;
+  return records;
 }
 
 }  // namespace tessera

@@ -110,17 +110,11 @@ PluginRegistry PluginRegistry::Discover(const std::vector<std::filesystem::path>
       if (entry.is_regular_file() && IsSharedObject(entry.path())) files.push_back(entry.path());
     }
     std::sort(files.begin(), files.end());
-    const std::vector<std::string> probe_refusals = ProbePluginFiles(files);
+    std::vector<std::optional<PluginRecord>> probed = ProbePluginFiles(files);
     for (size_t i = 0; i < files.size(); ++i) {
       const auto& file = files[i];
-      if (!probe_refusals[i].empty()) {
-        PluginRecord record;
-        record.file = file;
-        record.refusal = probe_refusals[i];
-        registry.records_.push_back(std::move(record));
-        continue;
-      }
-      PluginRecord record = InspectPluginFile(file);
+      // No child could inspect it: inspect it here, as before the probe existed.
+      PluginRecord record = probed[i] ? std::move(*probed[i]) : InspectPluginFile(file);
       if (record.usable()) {
         for (const auto& other : registry.records_) {
           if (other.usable() && other.name == record.name) {
@@ -180,6 +174,15 @@ const PluginRecord& PluginRegistry::Resolve(const std::string& kind, const std::
 std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
                                                      const nlohmann::json& options,
                                                      const std::string& json_path) const {
+  if (!record.library) {
+    // Inspected in a child process only: open it here now.
+    PluginRecord loaded = InspectPluginFile(record.file);
+    if (!loaded.usable()) throw InputError(json_path + ".plugin: " + loaded.refusal);
+    if (loaded.name != record.name || loaded.kind != record.kind) {
+      throw InputError(record.file.string() + ": the file changed while Tessera was running");
+    }
+    record.library = std::move(loaded.library);
+  }
   const auto& factory = record.library->get_alias<PluginFactory>(kFactorySymbol);
   std::unique_ptr<Plugin> plugin;
   try {
