@@ -170,10 +170,12 @@ TEST(PluginLoader, DiscoveryListsRefusedFilesWithoutThrowing) {
   const PluginRegistry registry = PluginRegistry::Discover(paths);
   size_t refused = 0;
   for (const auto& record : registry.records()) refused += record.usable() ? 0 : 1;
-  // no_info, wrong_abi, abi_one, unknown_kind, no_factory, the second twin.
-  EXPECT_EQ(refused, 6u);
+  // no_info, wrong_abi, abi_one, unknown_kind, no_factory, the second twin, and
+  // crash_on_load, which the probe refused without this process ever loading it.
+  EXPECT_EQ(refused, 7u);
   EXPECT_EQ(registry.NamesOfKind("pair_selector"),
-            (std::vector<std::string>{"consecutive", "float_only", "throws", "twin"}));
+            (std::vector<std::string>{"consecutive", "failing_pair_selector", "float_only",
+                                      "throws", "twin"}));
 }
 
 TEST(PluginLoader, ObjectsOutliveTheRegistryThatMadeThem) {

@@ -1,7 +1,12 @@
-// Deliberately broken plugins, one per way the loader must refuse a plugin. Each is
-// compiled into its own folder with one TESSERA_TEST_CASE_* macro defined; see
-// tests/CMakeLists.txt.
+// Deliberately broken plugins, one per way the loader must refuse a plugin, and one
+// plugin of every kind that fails on request (throws every kind of exception, crashes
+// or aborts). Each is compiled into its own folder with one TESSERA_TEST_CASE_* macro
+// defined; see tests/CMakeLists.txt.
 
+#include <algorithm>
+#include <cstdint>
+#include <cstdlib>
+#include <exception>
 #include <stdexcept>
 
 #include "tessera/sdk.h"
@@ -27,9 +32,172 @@ class TestPairSelector : public tessera::PairSelector {
   }
 };
 
+// An exception type that only this plugin knows.
+class LicenseError : public std::exception {
+ public:
+  const char* what() const noexcept override { return "the license has expired"; }
+};
+
+// Not derived from std::exception at all.
+struct NotAnException {
+  int code = 7;
+};
+
+[[maybe_unused]] void Crash() {
+  volatile uintptr_t address = 16;  // not null: sanitizers let the store through
+  *reinterpret_cast<volatile int*>(address) = 1;
+}
+
+// Options shared by the failing plugins: "fail" says how (none, input_error,
+// option_error, runtime_error, custom, non_std, segv, abort) and "in" where (call:
+// the kind's main method; factory: the constructor). A detector fails only on images
+// "on_width" pixels wide when that is not 0.
+struct Failure {
+  std::string how;
+  std::string where;
+  int on_width = 0;
+
+  explicit Failure(tessera::OptionReader* reader)
+      : how(reader->GetString("fail", "none",
+                              {"none", "input_error", "option_error", "runtime_error", "custom",
+                               "non_std", "segv", "abort"})),
+        where(reader->GetString("in", "call", {"call", "factory"})),
+        on_width(reader->Get<int>("on_width", 0, 0, 100000)) {}
+
+  void Trigger(const std::string& at) const {
+    if (at != where) return;
+    if (how == "input_error") throw tessera::InputError("this input is not acceptable");
+    if (how == "option_error") throw tessera::OptionError("threshold", "must be positive");
+    if (how == "runtime_error") throw std::runtime_error("out of detector memory");
+    if (how == "custom") throw LicenseError();
+    if (how == "non_std") throw NotAnException();
+    if (how == "segv") Crash();
+    if (how == "abort") std::abort();
+  }
+};
+
+[[maybe_unused]] Failure ReadFailure(const nlohmann::json& options, nlohmann::json* effective) {
+  tessera::OptionReader reader(options);
+  Failure failure(&reader);
+  reader.Finish();
+  *effective = reader.Effective();
+  failure.Trigger("factory");
+  return failure;
+}
+
+class FailingDetector : public tessera::Detector {
+ public:
+  explicit FailingDetector(const nlohmann::json& options)
+      : failure_(ReadFailure(options, &effective_options_)) {}
+  // Keypoints on a 4x4 grid, each described by the 16 pixels of its neighbourhood.
+  tessera::FeatureSet Detect(const tessera::ImageView& image) const override {
+    if (failure_.on_width == 0 || failure_.on_width == image.width) failure_.Trigger("call");
+    tessera::FeatureSet features;
+    if (image.width < 8 || image.height < 8) return features;
+    features.descriptors.data.resize(16, 16);
+    for (int k = 0; k < 16; ++k) {
+      const int x = (k % 4 + 1) * image.width / 5, y = (k / 4 + 1) * image.height / 5;
+      features.keypoints.emplace_back(x + 0.5f, y + 0.5f);
+      for (int d = 0; d < 16; ++d) {
+        const int px = std::min(image.width - 1, x + d % 4),
+                  py = std::min(image.height - 1, y + d / 4);
+        features.descriptors.data(k, d) = image.data[py * image.stride + px];
+      }
+    }
+    return features;
+  }
+  tessera::DescriptorMetric Metric() const override { return tessera::DescriptorMetric::kL2; }
+
+ private:
+  Failure failure_;
+};
+
+class FailingMatcher : public tessera::Matcher {
+ public:
+  explicit FailingMatcher(const nlohmann::json& options)
+      : failure_(ReadFailure(options, &effective_options_)) {}
+  tessera::FeatureMatches Match(const tessera::FeatureDescriptors& descriptors1,
+                                const tessera::FeatureDescriptors& descriptors2) const override {
+    failure_.Trigger("call");
+    tessera::FeatureMatches matches;
+    for (Eigen::Index i = 0; i < std::min(descriptors1.size(), descriptors2.size()); ++i) {
+      matches.push_back({static_cast<tessera::point2D_t>(i), static_cast<tessera::point2D_t>(i)});
+    }
+    return matches;
+  }
+
+ private:
+  Failure failure_;
+};
+
+class FailingPairSelector : public tessera::PairSelector {
+ public:
+  explicit FailingPairSelector(const nlohmann::json& options)
+      : failure_(ReadFailure(options, &effective_options_)) {}
+  std::vector<tessera::ImageIndexPair> SelectPairs(
+      const tessera::PairSelectionInput& input) const override {
+    failure_.Trigger("call");
+    std::vector<tessera::ImageIndexPair> pairs;
+    for (size_t i = 0; i + 1 < input.images.size(); ++i) pairs.emplace_back(i, i + 1);
+    return pairs;
+  }
+
+ private:
+  Failure failure_;
+};
+
+class FailingBundleAdjuster : public tessera::BundleAdjuster {
+ public:
+  explicit FailingBundleAdjuster(const nlohmann::json& options)
+      : failure_(ReadFailure(options, &effective_options_)) {}
+  tessera::BundleAdjustmentSummary Adjust(const tessera::BundleAdjustmentConfig&,
+                                          tessera::Reconstruction*) const override {
+    failure_.Trigger("call");
+    tessera::BundleAdjustmentSummary summary;
+    summary.usable = true;
+    return summary;
+  }
+
+ private:
+  Failure failure_;
+};
+
+class FailingExporter : public tessera::Exporter {
+ public:
+  explicit FailingExporter(const nlohmann::json& options)
+      : failure_(ReadFailure(options, &effective_options_)) {}
+  void Export(const tessera::Reconstruction&, const tessera::ExportContext&) const override {
+    failure_.Trigger("call");
+  }
+
+ private:
+  Failure failure_;
+};
+
 }  // namespace
 
-#if defined(TESSERA_TEST_CASE_NO_INFO)
+#if defined(TESSERA_TEST_CASE_FAILING_DETECTOR)
+TESSERA_PLUGIN(detector, FailingDetector, "failing_detector", "1.0.0", "Fails on request")
+#elif defined(TESSERA_TEST_CASE_FAILING_MATCHER)
+TESSERA_PLUGIN(matcher, FailingMatcher, "failing_matcher", "1.0.0", "Fails on request")
+#elif defined(TESSERA_TEST_CASE_FAILING_PAIR_SELECTOR)
+TESSERA_PLUGIN(pair_selector, FailingPairSelector, "failing_pair_selector", "1.0.0",
+               "Fails on request")
+#elif defined(TESSERA_TEST_CASE_FAILING_BUNDLE_ADJUSTER)
+TESSERA_PLUGIN(bundle_adjuster, FailingBundleAdjuster, "failing_bundle_adjuster", "1.0.0",
+               "Fails on request")
+#elif defined(TESSERA_TEST_CASE_FAILING_EXPORTER)
+TESSERA_PLUGIN(exporter, FailingExporter, "failing_exporter", "1.0.0", "Fails on request")
+
+#elif defined(TESSERA_TEST_CASE_CRASH_ON_LOAD)
+// A static initialiser that crashes as soon as the library is opened.
+[[maybe_unused]] static const int crash_on_load = [] {
+  Crash();
+  return 0;
+}();
+TESSERA_PLUGIN(pair_selector, TestPairSelector, "crash_on_load", "1.0.0", "Crashes when loaded")
+
+#elif defined(TESSERA_TEST_CASE_NO_INFO)
 // Exports a function, but no info record.
 extern "C" __attribute__((visibility("default"))) int tessera_unrelated_symbol() { return 42; }
 

@@ -571,7 +571,10 @@ int RunBench(const BenchOptions& options) {
       spdlog::error(
           "bench: {} ended with exit code {}; its log: {}", row.name, row.exit_code,
           (fs::path(row.workspace) / (row.name == "colmap" ? "colmap.log" : "run.log")).string());
-      return row.exit_code == kExitBadInput ? kExitBadInput : kExitInternalError;
+      // A documented exit code stays what it is; a signal or failure to start is 1.
+      const bool documented = row.exit_code == kExitBadInput || row.exit_code == kExitNoModel ||
+                              row.exit_code == kExitPluginCrash;
+      return documented ? row.exit_code : static_cast<int>(kExitInternalError);
     }
   }
   return kExitSuccess;

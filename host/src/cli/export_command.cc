@@ -63,7 +63,9 @@ CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions&) {
     context.image_dir = options->images;
     context.model_index = options->model_index;
     CreateFolder(context.output_dir);
-    exporter->Export(reconstruction, context);
+    CallPlugin(exporter.name(), PluginStage::kExport,
+               "model " + std::to_string(context.model_index),
+               [&] { exporter->Export(reconstruction, context); });
 
     size_t num_observations = 0;
     for (const auto& [point3D_id, point3D] : reconstruction.points3D) {

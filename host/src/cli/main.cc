@@ -9,10 +9,12 @@
 
 #include "cli/commands.h"
 #include "cli/exit_codes.h"
+#include "plugin/plugin_call.h"
 #include "tessera/errors.h"
 
 int main(int argc, char** argv) {
   using namespace tessera;
+  InstallPluginCrashHandler(kExitPluginCrash);
   CLI::App app{"Tessera: Structure-from-Motion whose every stage is a plugin"};
   app.require_subcommand(1);
   app.set_version_flag("--version", TESSERA_VERSION);
@@ -39,6 +41,9 @@ int main(int argc, char** argv) {
     if (!command.subcommand->parsed()) continue;
     try {
       return command.run();
+    } catch (const PluginError& error) {
+      spdlog::error("{}", error.what());
+      return error.input_error() ? kExitBadInput : kExitInternalError;
     } catch (const InputError& error) {
       spdlog::error("{}", error.what());
       return kExitBadInput;

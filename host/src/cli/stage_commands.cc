@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <fstream>
+#include <optional>
 
 #include "cli/commands.h"
 #include "cli/exit_codes.h"
@@ -12,6 +13,8 @@
 #include "feature/feature_extraction.h"
 #include "feature/feature_matching.h"
 #include "image/point_colors.h"
+#include "plugin/bundle_adjuster_guard.h"
+#include "plugin/plugin_crash_log.h"
 #include "scene/colmap_model_io.h"
 #include "sfm/incremental_mapper.h"
 #include "sfm/mapper_input.h"
@@ -61,6 +64,9 @@ std::filesystem::path PrepareWorkspace(const std::string& output) {
   std::filesystem::create_directories(dir, error);
   if (error)
     throw InputError(dir.string() + ": cannot create the output folder: " + error.message());
+  PluginCrashLog crash_log = PluginCrashLog::Open(dir);
+  for (const std::string& report : crash_log.NewCrashReports()) spdlog::warn("{}", report);
+  SetCurrentPluginCrashLog(std::move(crash_log));
   return dir / "database.db";
 }
 
@@ -139,8 +145,8 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
     throw InputError(database->path().string() +
                      ": no verified image pairs in the workspace; run match first");
   }
-  const IncrementalMapper mapper(context.mapper_options, *context.bundle_adjuster,
-                                 context.manifest.seed);
+  const BundleAdjusterGuard bundle_adjuster(context.bundle_adjuster);
+  const IncrementalMapper mapper(context.mapper_options, bundle_adjuster, context.manifest.seed);
   MapperResult result = mapper.Reconstruct(input);
 
   const std::filesystem::path image_dir = ImageFolder(image_dir_option, *database);
@@ -159,7 +165,7 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
   nlohmann::json summary_json = {{"models", nlohmann::json::array()},
                                  {"unregistered", nlohmann::json::array()}};
   MappingSummary summary;
-  std::string first_export_error;
+  std::optional<PluginError> first_export_error;
   summary.num_images = input.images.size();
   summary.num_models = result.models.size();
   for (size_t index = 0; index < result.models.size(); ++index) {
@@ -171,11 +177,12 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
       // once all have run, so that nothing computed is lost.
       for (const auto& exporter : context.exporters) {
         try {
-          exporter->Export(model, {output_dir, image_dir, static_cast<int>(index)});
-        } catch (const std::exception& error) {
-          spdlog::error("map: exporter '{}' failed on model {}: {}", exporter.name(), index,
-                        error.what());
-          if (first_export_error.empty()) first_export_error = error.what();
+          CallPlugin(exporter.name(), PluginStage::kExport, "model " + std::to_string(index), [&] {
+            exporter->Export(model, {output_dir, image_dir, static_cast<int>(index)});
+          });
+        } catch (const PluginError& error) {
+          spdlog::error("map: {}", error.what());
+          if (!first_export_error) first_export_error = error;
         }
       }
     }
@@ -243,7 +250,7 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
       "adjustments, {:.2f} s",
       summary.num_registered, summary.num_images, summary.num_models, result.num_global_ba,
       result.num_local_ba, summary.seconds);
-  if (!first_export_error.empty()) throw InputError(first_export_error);
+  if (first_export_error) throw *first_export_error;
   return summary;
 }
 

@@ -9,6 +9,7 @@
 #include "image/camera_assignment.h"
 #include "image/exif.h"
 #include "image/image_io.h"
+#include "plugin/plugin_crash_log.h"
 #include "util/parallel.h"
 #include "util/timer.h"
 
@@ -18,7 +19,8 @@ namespace {
 // What produced the features: a different value means they must be detected again.
 nlohmann::json FeaturesProvenance(const PluginInstance<Detector>& detector) {
   nlohmann::json provenance = detector.Provenance();
-  provenance["metric"] = DescriptorMetricName(detector->Metric());
+  provenance["metric"] = DescriptorMetricName(
+      CallPlugin(detector.name(), PluginStage::kOptions, "", [&] { return detector->Metric(); }));
   return provenance;
 }
 
@@ -117,6 +119,9 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
   for (size_t i = 0; i < images.size(); ++i) {
     if (database->ExistsKeypoints(images[i].image_id)) {
       ++summary.num_reused;
+    } else if (IsQuarantined(detector.name(), PluginStage::kDetect, ImageSubject(images[i].name))) {
+      spdlog::warn("extract: skipping {}: it crashed detector '{}' twice", images[i].name,
+                   detector.name());
     } else {
       todo.push_back(i);
     }
@@ -137,7 +142,9 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
     view.height = gray.rows;
     view.stride = gray.step[0];
     view.data = gray.data;
-    FeatureSet features = detector->Detect(view);
+    FeatureSet features =
+        CallPlugin(detector.name(), PluginStage::kDetect, ImageSubject(entry.name),
+                   [&] { return detector->Detect(view); });
     if (features.descriptors.size() != static_cast<Eigen::Index>(features.keypoints.size())) {
       throw std::runtime_error("detector '" + detector.name() + "' returned " +
                                std::to_string(features.keypoints.size()) + " keypoints but " +

@@ -12,6 +12,7 @@
 
 #include "feature/database_feature_reader.h"
 #include "geometry/two_view_geometry_estimation.h"
+#include "plugin/plugin_crash_log.h"
 #include "util/parallel.h"
 #include "util/random.h"
 #include "util/strings.h"
@@ -116,13 +117,22 @@ std::vector<ImageIndexPair> SelectPairs(
     const auto& selector = pair_selectors[s];
     const std::string json_path = SelectorSource(manifest, s);
     std::vector<ImageIndexPair> pairs;
+    const std::string subject = std::to_string(n) + " images";
     try {
+      const PluginCallScope scope(selector.name(), PluginStage::kSelectPairs, subject);
       pairs = selector->SelectPairs(input);
     } catch (const OptionError& error) {
       throw InputError(json_path + ".options" + (error.path().empty() ? "" : "." + error.path()) +
                        ": " + error.message() + " (pair selector '" + selector.name() + "')");
     } catch (const InputError& error) {
       throw InputError(json_path + ": pair selector '" + selector.name() + "': " + error.what());
+    } catch (const std::exception& error) {
+      throw PluginError(selector.name(), PluginStage::kSelectPairs, subject, error.what(),
+                        /*input_error=*/false);
+    } catch (...) {
+      throw PluginError(selector.name(), PluginStage::kSelectPairs, subject,
+                        "it threw an exception that is not a std::exception",
+                        /*input_error=*/false);
     }
     std::unordered_set<uint64_t> own;
     for (const auto& [i, j] : pairs) {
@@ -151,7 +161,9 @@ void CheckPairSelectors(const Manifest& manifest,
   for (size_t s = 0; s < pair_selectors.size(); ++s) {
     const std::string json_path = SelectorSource(manifest, s);
     const std::string name = pair_selectors[s].name();
+    const std::string subject = std::string(DescriptorMetricName(metric)) + " descriptors";
     try {
+      const PluginCallScope scope(name, PluginStage::kOptions, subject);
       pair_selectors[s]->CheckDescriptors(metric, dimension);
     } catch (const OptionError& error) {
       throw InputError(source + ": " + json_path + ".options" +
@@ -161,6 +173,12 @@ void CheckPairSelectors(const Manifest& manifest,
     } catch (const InputError& error) {
       throw InputError(source + ": " + json_path + ": pair selector '" + name +
                        "': " + error.what());
+    } catch (const std::exception& error) {
+      throw PluginError(name, PluginStage::kOptions, subject, error.what(), /*input_error=*/false);
+    } catch (...) {
+      throw PluginError(name, PluginStage::kOptions, subject,
+                        "it threw an exception that is not a std::exception",
+                        /*input_error=*/false);
     }
   }
 }
@@ -239,6 +257,10 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
     const image_t id1 = images[i].image_id, id2 = images[j].image_id;
     if (database->ExistsMatches(id1, id2) && database->ExistsTwoViewGeometry(id1, id2)) {
       ++summary.num_reused;
+    } else if (IsQuarantined(matcher.name(), PluginStage::kMatch,
+                             PairSubject(images[i].name, images[j].name))) {
+      spdlog::warn("match: skipping {} and {}: they crashed matcher '{}' twice", images[i].name,
+                   images[j].name, matcher.name());
     } else {
       todo.emplace_back(i, j);
     }
@@ -271,7 +293,10 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
       std::lock_guard<std::mutex> lock(database_mutex);
       matches = database->ReadMatches(image1.image_id, image2.image_id);
     } else {
-      matches = matcher->Match(features1->descriptors, features2->descriptors);
+      matches = CallPlugin(matcher.name(), PluginStage::kMatch,
+                           PairSubject(image1.name, image2.name), [&] {
+                             return matcher->Match(features1->descriptors, features2->descriptors);
+                           });
     }
     match_micros += static_cast<int64_t>(step.ElapsedSeconds() * 1e6);
     step.Restart();

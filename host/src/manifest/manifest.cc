@@ -144,6 +144,14 @@ Manifest Manifest::Load(const std::filesystem::path& file) {
   const auto absolute = std::filesystem::absolute(file);
   Manifest manifest = FromJson(json, absolute.parent_path(), absolute.string());
   manifest.file = absolute;
+  // A folder that is not there is most likely a typo: say so rather than skip it.
+  for (size_t i = 0; i < manifest.plugin_paths.size(); ++i) {
+    std::error_code error;
+    if (!std::filesystem::is_directory(manifest.plugin_paths[i], error)) {
+      throw InputError(absolute.string() + ": plugin_paths[" + std::to_string(i) +
+                       "]: " + manifest.plugin_paths[i].string() + " is not a folder");
+    }
+  }
   return manifest;
 }
 

@@ -66,7 +66,8 @@ struct Manifest {
   nlohmann::json mapper = nlohmann::json::object();
 
   // Parses a manifest file; relative paths inside are relative to its folder.
-  // Throws InputError (file unreadable, invalid JSON, unknown key, bad value).
+  // Throws InputError (file unreadable, invalid JSON, unknown key, bad value, a
+  // plugin_paths folder that does not exist).
   static Manifest Load(const std::filesystem::path& file);
   // Parses a manifest from JSON; `base_dir` resolves relative paths.
   static Manifest FromJson(const nlohmann::json& json, const std::filesystem::path& base_dir,

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <set>
 
+#include "plugin/plugin_probe.h"
+
 namespace tessera {
 namespace {
 
@@ -42,7 +44,11 @@ PluginRecord InspectPluginFile(const std::filesystem::path& file) {
 
   auto library = std::make_shared<boost::dll::shared_library>();
   boost::dll::fs::error_code error;
-  library->load(file, boost::dll::load_mode::rtld_now | boost::dll::load_mode::rtld_local, error);
+  {
+    // Static initialisers run here: a crash in them is the file's.
+    const PluginCallScope scope(file.string(), PluginStage::kLoad, "");
+    library->load(file, boost::dll::load_mode::rtld_now | boost::dll::load_mode::rtld_local, error);
+  }
   if (error || !library->is_loaded()) {
     const char* reason = dlerror();
     record.refusal = where + "cannot open the library: " +
@@ -104,8 +110,11 @@ PluginRegistry PluginRegistry::Discover(const std::vector<std::filesystem::path>
       if (entry.is_regular_file() && IsSharedObject(entry.path())) files.push_back(entry.path());
     }
     std::sort(files.begin(), files.end());
-    for (const auto& file : files) {
-      PluginRecord record = InspectPluginFile(file);
+    std::vector<std::optional<PluginRecord>> probed = ProbePluginFiles(files);
+    for (size_t i = 0; i < files.size(); ++i) {
+      const auto& file = files[i];
+      // No child could inspect it: inspect it here, as before the probe existed.
+      PluginRecord record = probed[i] ? std::move(*probed[i]) : InspectPluginFile(file);
       if (record.usable()) {
         for (const auto& other : registry.records_) {
           if (other.usable() && other.name == record.name) {
@@ -155,15 +164,29 @@ const PluginRecord& PluginRegistry::Resolve(const std::string& kind, const std::
     message += list.empty() ? " (no " + kind + " plugins were found on the plugin path)"
                             : " (available: " + list + ")";
   }
+  // Files refused before their name was known (e.g. one that crashes on load) may be it.
+  for (const auto& record : records_) {
+    if (!record.usable() && record.name.empty()) message += "; refused: " + record.refusal;
+  }
   throw InputError(message);
 }
 
 std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
                                                      const nlohmann::json& options,
                                                      const std::string& json_path) const {
+  if (!record.library) {
+    // Inspected in a child process only: open it here now.
+    PluginRecord loaded = InspectPluginFile(record.file);
+    if (!loaded.usable()) throw InputError(json_path + ".plugin: " + loaded.refusal);
+    if (loaded.name != record.name || loaded.kind != record.kind) {
+      throw InputError(record.file.string() + ": the file changed while Tessera was running");
+    }
+    record.library = std::move(loaded.library);
+  }
   const auto& factory = record.library->get_alias<PluginFactory>(kFactorySymbol);
   std::unique_ptr<Plugin> plugin;
   try {
+    const PluginCallScope scope(record.name, PluginStage::kCreate, "from " + record.file.string());
     plugin = factory(options);
   } catch (const OptionError& error) {
     // Plugins report paths relative to their options; anchor them in the manifest.

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "plugin/plugin_call.h"
 #include "tessera/sdk.h"
 
 namespace tessera {
@@ -25,8 +26,9 @@ struct PluginRecord {
   std::string description;
   // Why the host refuses this plugin; empty when it is usable.
   std::string refusal;
-  // Open while the record is usable; shared with every object made from it.
-  std::shared_ptr<boost::dll::shared_library> library;
+  // Opened when the host first makes an object of a usable record (discovery inspects
+  // files in a child process); shared with every object made from it.
+  mutable std::shared_ptr<boost::dll::shared_library> library;
 
   bool usable() const { return refusal.empty(); }
   nlohmann::json ToJson() const;
@@ -65,7 +67,9 @@ class PluginInstance {
   const std::filesystem::path& file() const { return file_; }
   // Name, version and effective options: what produced a result.
   nlohmann::json Provenance() const {
-    return {{"plugin", name_}, {"version", version_}, {"options", object_->EffectiveOptions()}};
+    nlohmann::json options =
+        CallPlugin(name_, PluginStage::kOptions, "", [&] { return object_->EffectiveOptions(); });
+    return {{"plugin", name_}, {"version", version_}, {"options", std::move(options)}};
   }
 
  private:
@@ -84,8 +88,10 @@ PluginRecord InspectPluginFile(const std::filesystem::path& file);
 // Every plugin found on a search path.
 class PluginRegistry {
  public:
-  // Scans the folders in order for shared objects (*.so). A name seen a second time
-  // is refused as a duplicate; the first one found wins. Missing folders are skipped.
+  // Scans the folders in order for shared objects (*.so). Each file is inspected in a
+  // child process (ProbePluginFiles): one that crashes, exits or hangs on load is
+  // refused with why, and no library is loaded here until Create needs it. A name seen a second
+  // time is refused as a duplicate; the first one found wins. Missing folders are skipped.
   static PluginRegistry Discover(const std::vector<std::filesystem::path>& search_paths);
 
   const std::vector<PluginRecord>& records() const { return records_; }

@@ -1,0 +1,245 @@
+#include "plugin/plugin_call.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cstdlib>
+#include <cstring>
+
+namespace tessera {
+namespace {
+
+// What the current thread is doing in a plugin. Plain characters only, so that the
+// signal handler can read it; tabs and newlines are replaced when it is filled.
+// Trivial, so that the thread-local copy needs no dynamic initialisation (zeroed).
+struct CallRecord {
+  volatile sig_atomic_t active;
+  char plugin[256];
+  char stage[32];
+  char activity[32];
+  char subject[1024];
+};
+
+// initial-exec: the handler may read it from any thread without allocating.
+__attribute__((tls_model("initial-exec"))) thread_local CallRecord t_record;
+// The record of the call started last, for a crash on a thread the plugin started
+// itself (e.g. a worker pool inside the plugin), which has no record of its own.
+std::atomic<CallRecord*> g_last_started{nullptr};
+
+char g_crash_file[4096] = {};
+volatile sig_atomic_t g_crash_exit_code = 4;
+
+// An alternate signal stack per thread that makes plugin calls, so that a stack
+// overflow in a plugin still reaches the handler.
+struct AltStack {
+  static constexpr size_t kSize = 64 * 1024;
+  void* memory = nullptr;
+  AltStack() {
+    memory = std::malloc(kSize);
+    if (memory == nullptr) return;
+    stack_t stack{};
+    stack.ss_sp = memory;
+    stack.ss_size = kSize;
+    if (sigaltstack(&stack, nullptr) != 0) {
+      std::free(memory);
+      memory = nullptr;
+    }
+  }
+  ~AltStack() {
+    if (memory == nullptr) return;
+    stack_t disable{};
+    disable.ss_flags = SS_DISABLE;
+    sigaltstack(&disable, nullptr);
+    std::free(memory);
+  }
+};
+
+void CopyField(const std::string& text, char* out, size_t size) {
+  const size_t n = std::min(text.size(), size - 1);
+  for (size_t i = 0; i < n; ++i) {
+    const char c = text[i];
+    out[i] = (c == '\t' || c == '\n' || c == '\r') ? ' ' : c;
+  }
+  out[n] = '\0';
+}
+
+void WriteAll(int fd, const char* text) {
+  size_t left = std::strlen(text);
+  while (left > 0) {
+    const ssize_t n = write(fd, text, left);
+    if (n <= 0) return;
+    text += n;
+    left -= static_cast<size_t>(n);
+  }
+}
+
+const char* SignalName(int signal_number) {
+  switch (signal_number) {
+    case SIGSEGV:
+      return "SIGSEGV";
+    case SIGBUS:
+      return "SIGBUS";
+    case SIGFPE:
+      return "SIGFPE";
+    case SIGILL:
+      return "SIGILL";
+    case SIGABRT:
+      return "SIGABRT";
+    default:
+      return "a fatal signal";
+  }
+}
+
+constexpr int kFatalSignals[] = {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
+
+void CrashHandler(int signal_number, siginfo_t*, void*) {
+  CallRecord* record = t_record.active ? &t_record : nullptr;
+  if (record == nullptr) {
+    CallRecord* last = g_last_started.load();
+    if (last != nullptr && last->active) record = last;
+  }
+  if (record == nullptr) {
+    // Not in a plugin: the host's own crash keeps its default action (core dump).
+    signal(signal_number, SIG_DFL);
+    raise(signal_number);
+    return;
+  }
+  static std::atomic<int> entered{0};
+  if (entered.fetch_add(1) != 0) {
+    for (;;) pause();  // another thread is reporting; it ends the process
+  }
+  const char* name = SignalName(signal_number);
+  WriteAll(STDERR_FILENO, "[error] plugin '");
+  WriteAll(STDERR_FILENO, record->plugin);
+  WriteAll(STDERR_FILENO, "' crashed (");
+  WriteAll(STDERR_FILENO, name);
+  WriteAll(STDERR_FILENO, ") while ");
+  WriteAll(STDERR_FILENO, record->activity);
+  if (record->subject[0] != '\0') {
+    WriteAll(STDERR_FILENO, " ");
+    WriteAll(STDERR_FILENO, record->subject);
+  }
+  WriteAll(STDERR_FILENO, "\n");
+  if (g_crash_file[0] != '\0') {
+    const int fd = open(g_crash_file, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+    if (fd >= 0) {
+      WriteAll(fd, name);
+      WriteAll(fd, "\t");
+      WriteAll(fd, record->plugin);
+      WriteAll(fd, "\t");
+      WriteAll(fd, record->stage);
+      WriteAll(fd, "\t");
+      WriteAll(fd, record->subject);
+      WriteAll(fd, "\n");
+      close(fd);
+    }
+  }
+  _exit(g_crash_exit_code);
+}
+
+}  // namespace
+
+const char* PluginStageName(PluginStage stage) {
+  switch (stage) {
+    case PluginStage::kLoad:
+      return "load";
+    case PluginStage::kCreate:
+      return "create";
+    case PluginStage::kOptions:
+      return "options";
+    case PluginStage::kDetect:
+      return "detect";
+    case PluginStage::kMatch:
+      return "match";
+    case PluginStage::kSelectPairs:
+      return "select_pairs";
+    case PluginStage::kAdjust:
+      return "adjust";
+    case PluginStage::kExport:
+      return "export";
+  }
+  return "call";
+}
+
+const char* PluginStageActivity(PluginStage stage) {
+  switch (stage) {
+    case PluginStage::kLoad:
+      return "loading";
+    case PluginStage::kCreate:
+      return "starting";
+    case PluginStage::kOptions:
+      return "reporting its settings";
+    case PluginStage::kDetect:
+      return "detecting";
+    case PluginStage::kMatch:
+      return "matching";
+    case PluginStage::kSelectPairs:
+      return "selecting pairs among";
+    case PluginStage::kAdjust:
+      return "adjusting";
+    case PluginStage::kExport:
+      return "exporting";
+  }
+  return "being called";
+}
+
+std::string ImageSubject(const std::string& image_name) { return "image " + image_name; }
+
+std::string PairSubject(const std::string& image_name1, const std::string& image_name2) {
+  return "images " + image_name1 + " and " + image_name2;
+}
+
+PluginError::PluginError(const std::string& plugin, PluginStage stage, const std::string& subject,
+                         const std::string& message, bool input_error)
+    : std::runtime_error("plugin '" + plugin + "' failed while " + PluginStageActivity(stage) +
+                         (subject.empty() ? "" : " " + subject) + ": " + message),
+      plugin_(plugin),
+      stage_(stage),
+      subject_(subject),
+      message_(message),
+      input_error_(input_error) {}
+
+PluginCallScope::PluginCallScope(const std::string& plugin, PluginStage stage,
+                                 const std::string& subject)
+    : outermost_(!t_record.active) {
+  if (!outermost_) return;    // a nested call keeps the outer record
+#ifndef __SANITIZE_ADDRESS__  // AddressSanitizer gives every thread an alternate stack
+  static thread_local AltStack alt_stack;
+  (void)alt_stack;
+#endif
+  CallRecord& record = t_record;
+  CopyField(plugin, record.plugin, sizeof(record.plugin));
+  CopyField(PluginStageName(stage), record.stage, sizeof(record.stage));
+  CopyField(PluginStageActivity(stage), record.activity, sizeof(record.activity));
+  CopyField(subject, record.subject, sizeof(record.subject));
+  std::atomic_signal_fence(std::memory_order_seq_cst);
+  record.active = 1;
+  g_last_started.store(&record);
+}
+
+PluginCallScope::~PluginCallScope() {
+  if (!outermost_) return;
+  t_record.active = 0;
+  CallRecord* expected = &t_record;
+  g_last_started.compare_exchange_strong(expected, nullptr);
+}
+
+void InstallPluginCrashHandler(int exit_code) {
+  g_crash_exit_code = exit_code;
+  struct sigaction action {};
+  action.sa_sigaction = CrashHandler;
+  action.sa_flags = SA_SIGINFO | SA_ONSTACK;
+  sigemptyset(&action.sa_mask);
+  for (const int signal_number : kFatalSignals) sigaction(signal_number, &action, nullptr);
+}
+
+void SetPluginCrashFile(const std::string& file) {
+  g_crash_file[0] = '\0';
+  if (file.size() >= sizeof(g_crash_file)) return;
+  std::memcpy(g_crash_file, file.c_str(), file.size() + 1);
+}
+
+}  // namespace tessera

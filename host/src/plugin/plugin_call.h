@@ -1,0 +1,106 @@
+#pragma once
+
+// The boundary between the host and plugin code. Every call into a plugin goes
+// through CallPlugin, which
+//  - turns whatever the plugin throws into a host-side PluginError while the plugin's
+//    library is still loaded: only the text is copied, never the plugin's exception
+//    object, whose type information lives in the plugin;
+//  - records, for the calling thread, what the host is about to do, so that a fatal
+//    signal in plugin code ends the run with one line naming the plugin, the stage and
+//    the image or pair (InstallPluginCrashHandler), and a crash record in the workspace.
+
+#include <stdexcept>
+#include <string>
+
+#include "tessera/errors.h"
+
+namespace tessera {
+
+// What the host calls a plugin for.
+enum class PluginStage {
+  kLoad,     // opening its library (static initialisers run)
+  kCreate,   // its factory
+  kOptions,  // EffectiveOptions (and a detector's Metric)
+  kDetect,
+  kMatch,
+  kSelectPairs,
+  kAdjust,
+  kExport,
+};
+
+// "detect", as stored in crash records.
+const char* PluginStageName(PluginStage stage);
+// "detecting", as in "while detecting image a.jpg".
+const char* PluginStageActivity(PluginStage stage);
+
+// The subjects of per-image and per-pair calls, as errors, crash lines and the
+// quarantine name them: "image a.jpg", "images a.jpg and b.jpg".
+std::string ImageSubject(const std::string& image_name);
+std::string PairSubject(const std::string& image_name1, const std::string& image_name2);
+
+// A plugin call that threw. Made by the host from the plugin's exception text, so it
+// outlives the plugin's library. `input_error`: the plugin threw tessera::InputError
+// (or OptionError), exit code 2; anything else is exit code 1.
+class PluginError : public std::runtime_error {
+ public:
+  PluginError(const std::string& plugin, PluginStage stage, const std::string& subject,
+              const std::string& message, bool input_error);
+
+  const std::string& plugin() const { return plugin_; }
+  PluginStage stage() const { return stage_; }
+  const std::string& subject() const { return subject_; }
+  const std::string& message() const { return message_; }
+  bool input_error() const { return input_error_; }
+
+ private:
+  std::string plugin_;
+  PluginStage stage_;
+  std::string subject_;
+  std::string message_;
+  bool input_error_;
+};
+
+// Records a plugin call for the crash handler while it lives (one per thread; the
+// fields are copied, truncated, into a fixed-size thread-local buffer).
+class PluginCallScope {
+ public:
+  PluginCallScope(const std::string& plugin, PluginStage stage, const std::string& subject);
+  ~PluginCallScope();
+  PluginCallScope(const PluginCallScope&) = delete;
+  PluginCallScope& operator=(const PluginCallScope&) = delete;
+
+ private:
+  bool outermost_;
+};
+
+// Calls `fn` (which calls into the plugin `plugin`) and returns its result. Anything it
+// throws is rethrown as a PluginError whose message names the plugin, what it was doing
+// and the subject, e.g. "plugin 'sift' failed while detecting image a.jpg: ...".
+template <typename Fn>
+auto CallPlugin(const std::string& plugin, PluginStage stage, const std::string& subject, Fn&& fn)
+    -> decltype(fn()) {
+  const PluginCallScope scope(plugin, stage, subject);
+  try {
+    return fn();
+  } catch (const InputError& error) {  // OptionError too
+    throw PluginError(plugin, stage, subject, error.what(), /*input_error=*/true);
+  } catch (const std::exception& error) {
+    throw PluginError(plugin, stage, subject, error.what(), /*input_error=*/false);
+  } catch (...) {
+    throw PluginError(plugin, stage, subject, "it threw an exception that is not a std::exception",
+                      /*input_error=*/false);
+  }
+}
+
+// Installs the handler of SIGSEGV, SIGBUS, SIGFPE, SIGILL and SIGABRT. During a plugin
+// call it writes one line to stderr, "[error] plugin 'X' crashed (SIGSEGV) while
+// detecting image Y", appends the crash to the file set by SetPluginCrashFile (if any)
+// and ends the process with `exit_code`, using async-signal-safe calls only. Outside
+// plugin calls the signal takes its default action.
+void InstallPluginCrashHandler(int exit_code);
+
+// Where the crash handler appends its record: one line "SIGNAL\tplugin\tstage\tsubject".
+// Empty: nowhere.
+void SetPluginCrashFile(const std::string& file);
+
+}  // namespace tessera

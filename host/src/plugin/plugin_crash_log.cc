@@ -1,0 +1,117 @@
+#include "plugin/plugin_crash_log.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "util/file_io.h"
+#include "util/strings.h"
+
+namespace tessera {
+namespace {
+
+constexpr PluginStage kStages[] = {
+    PluginStage::kLoad,  PluginStage::kCreate,      PluginStage::kOptions, PluginStage::kDetect,
+    PluginStage::kMatch, PluginStage::kSelectPairs, PluginStage::kAdjust,  PluginStage::kExport};
+
+// Lines "SIGNAL\tplugin\tstage\tsubject"; a line cut short by a crash is skipped.
+std::vector<PluginCrash> ParseCrashes(const std::string& text) {
+  std::vector<PluginCrash> crashes;
+  std::istringstream stream(text);
+  std::string line;
+  while (std::getline(stream, line)) {
+    const std::vector<std::string> fields = Split(line, '\t');
+    if (fields.size() != 4 || fields[0].rfind("SIG", 0) != 0) continue;
+    crashes.push_back({fields[0], fields[1], fields[2], fields[3]});
+  }
+  return crashes;
+}
+
+std::string FormatCrash(const PluginCrash& crash) {
+  return crash.signal + "\t" + crash.plugin + "\t" + crash.stage + "\t" + crash.subject + "\n";
+}
+
+PluginCrashLog& MutableCurrentLog() {
+  static PluginCrashLog log;
+  return log;
+}
+
+}  // namespace
+
+std::string PluginCrash::Describe() const {
+  std::string activity = "being called (" + stage + ")";
+  for (const PluginStage known : kStages) {
+    if (stage == PluginStageName(known)) activity = PluginStageActivity(known);
+  }
+  return "plugin '" + plugin + "' crashed (" + signal + ") while " + activity +
+         (subject.empty() ? "" : " " + subject);
+}
+
+std::filesystem::path PluginCrashLog::HistoryFile(const std::filesystem::path& workspace_dir) {
+  return workspace_dir / "plugin_crashes.tsv";
+}
+
+std::filesystem::path PluginCrashLog::PendingFile(const std::filesystem::path& workspace_dir) {
+  return workspace_dir / "plugin_crashes.new";
+}
+
+PluginCrashLog PluginCrashLog::Open(const std::filesystem::path& workspace_dir) {
+  PluginCrashLog log;
+  const std::filesystem::path history = HistoryFile(workspace_dir);
+  const std::filesystem::path pending = PendingFile(workspace_dir);
+  std::error_code error;
+  std::string history_text;
+  if (std::filesystem::exists(history, error)) history_text = ReadFileContents(history);
+  log.history_ = ParseCrashes(history_text);
+  if (std::filesystem::exists(pending, error)) {
+    log.new_crashes_ = ParseCrashes(ReadFileContents(pending));
+    for (const PluginCrash& crash : log.new_crashes_) {
+      history_text += FormatCrash(crash);
+      log.history_.push_back(crash);
+    }
+    // History first, then the pending file goes: a crash is never lost, at worst
+    // reported twice.
+    WriteFileAtomically(history, history_text);
+    std::filesystem::remove(pending, error);
+    if (error) {
+      throw InputError(pending.string() + ": cannot remove the crash record: " + error.message());
+    }
+  }
+  SetPluginCrashFile(std::filesystem::absolute(pending).string());
+  return log;
+}
+
+std::vector<std::string> PluginCrashLog::NewCrashReports() const {
+  std::vector<std::string> reports;
+  for (const PluginCrash& crash : new_crashes_) {
+    std::string report = "the previous run ended in a crash: " + crash.Describe();
+    const bool per_subject = crash.stage == PluginStageName(PluginStage::kDetect) ||
+                             crash.stage == PluginStageName(PluginStage::kMatch);
+    size_t count = 0;
+    for (const PluginCrash& other : history_) {
+      count += other.plugin == crash.plugin && other.stage == crash.stage &&
+               other.subject == crash.subject;
+    }
+    if (per_subject && count >= kQuarantineCrashes) {
+      report += " (" + std::to_string(count) + " crashes there: " + crash.subject +
+                " is skipped from now on)";
+    }
+    reports.push_back(report);
+  }
+  return reports;
+}
+
+size_t PluginCrashLog::NumCrashes(const std::string& plugin, PluginStage stage,
+                                  const std::string& subject) const {
+  size_t count = 0;
+  const std::string stage_name = PluginStageName(stage);
+  for (const PluginCrash& crash : history_) {
+    count += crash.plugin == plugin && crash.stage == stage_name && crash.subject == subject;
+  }
+  return count;
+}
+
+const PluginCrashLog& CurrentPluginCrashLog() { return MutableCurrentLog(); }
+
+void SetCurrentPluginCrashLog(PluginCrashLog log) { MutableCurrentLog() = std::move(log); }
+
+}  // namespace tessera
