@@ -105,7 +105,8 @@ void RetrievalPairSelector::CheckDescriptors(DescriptorMetric metric, int dimens
                               " (binary, e.g. ORB) ones: use a SIFT detector or another pair "
                               "selector");
   }
-  if (codebook_ && codebook_->descriptor_dimension != dimension) {
+  // Dimension 0: not known yet (before detection); the host asks again before matching.
+  if (codebook_ && dimension != 0 && codebook_->descriptor_dimension != dimension) {
     throw InputError(options_.codebook + ": the retrieval codebook is for descriptors of " +
                      std::to_string(codebook_->descriptor_dimension) +
                      " dimensions, the detector's have " + std::to_string(dimension));

@@ -186,6 +186,7 @@ TEST(RetrievalPairSelector, TrainedCodebookFileIsReadBackAndChecked) {
   auto user = testing::LoadBundledPlugin<PairSelector>(
       "pair_selector", "retrieval", {{"num_neighbors", 4}, {"codebook", file.string()}});
   user->CheckDescriptors(DescriptorMetric::kL2, 128);
+  user->CheckDescriptors(DescriptorMetric::kL2, 0);  // width not known yet
   EXPECT_EQ(user->SelectPairs(Input(15, &reader)), SameScenePairs(15, 3));
   try {
     user->CheckDescriptors(DescriptorMetric::kL2, 64);
