@@ -64,6 +64,7 @@ TEST(Cli, PluginsJsonListsEveryBundledPluginWithKindAndVersion) {
                                                        {"sequential", "pair_selector"},
                                                        {"window", "pair_selector"},
                                                        {"window_anchor", "pair_selector"},
+                                                       {"spatial", "pair_selector"},
                                                        {"ceres", "bundle_adjuster"},
                                                        {"colmap_binary", "exporter"},
                                                        {"colmap_text", "exporter"},
@@ -74,7 +75,7 @@ TEST(Cli, PluginsJsonListsEveryBundledPluginWithKindAndVersion) {
     ASSERT_TRUE(kinds.count(name)) << "bundled plugin '" << name << "' not listed";
     EXPECT_EQ(kinds[name], kind) << name;
   }
-  EXPECT_EQ(kinds.size(), 14u) << result.output;
+  EXPECT_EQ(kinds.size(), 15u) << result.output;
 }
 
 TEST(Cli, PluginsMarksRefusedFilesWithWhy) {
@@ -82,7 +83,7 @@ TEST(Cli, PluginsMarksRefusedFilesWithWhy) {
   const auto with_broken = RunTessera("plugins", "TESSERA_PLUGIN_PATH=" + path);
   EXPECT_EQ(with_broken.exit_code, 0);
   EXPECT_NE(with_broken.output.find("REFUSED " + path), std::string::npos) << with_broken.output;
-  EXPECT_NE(with_broken.output.find("got version 999, supported version is 1"), std::string::npos);
+  EXPECT_NE(with_broken.output.find("got version 999, supported version is 2"), std::string::npos);
 }
 
 TEST(Cli, MisspeltPluginFailsBeforeReadingImagesWithASuggestion) {
@@ -99,6 +100,28 @@ TEST(Cli, MisspeltPluginFailsBeforeReadingImagesWithASuggestion) {
   EXPECT_NE(result.output.find(manifest.string() +
                                ": pipeline.matcher.plugin: no matcher plugin 'flan'; did you mean "
                                "'flann'?"),
+            std::string::npos)
+      << result.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "database.db"));
+}
+
+TEST(Cli, PairSelectorRefusingTheDetectorsDescriptorsFailsBeforeExtraction) {
+  testing::TemporaryDir dir;
+  const auto manifest = dir.path() / "orb_float.json";
+  std::ofstream(manifest) << R"({"plugin_paths": [")" << TESSERA_TEST_PLUGIN_ROOT
+                          << R"(/float_only"],
+    "pipeline": {"detector": {"plugin": "orb"},
+                 "pair_selector": [{"plugin": "exhaustive"}, {"plugin": "float_only"}],
+                 "matcher": {"plugin": "brute_force"}, "bundle_adjuster": {"plugin": "ceres"}}})";
+  // The image folder does not exist: the selector's refusal must come first.
+  const auto result =
+      RunTessera("run --images " + (dir.path() / "no_such_folder").string() + " --output " +
+                 (dir.path() / "out").string() + " --manifest " + manifest.string());
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find(manifest.string() +
+                               ": pipeline.pair_selector[1].options: needs float (L2) "
+                               "descriptors, not binary ones (pair selector 'float_only', "
+                               "hamming descriptors)"),
             std::string::npos)
       << result.output;
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "database.db"));

@@ -38,7 +38,7 @@ TEST(Manifest, ParsesSlotsCameraVerificationAndPaths) {
   EXPECT_EQ(manifest.detector->plugin, "sift");
   EXPECT_EQ(manifest.detector->options["max_num_features"], 100);
   EXPECT_EQ(manifest.detector->json_path, "pipeline.detector");
-  EXPECT_FALSE(manifest.pair_selector);
+  EXPECT_TRUE(manifest.pair_selectors.empty());
   ASSERT_EQ(manifest.exporters.size(), 1u);
   EXPECT_EQ(manifest.exporters[0].json_path, "pipeline.exporters[0]");
   EXPECT_EQ(manifest.camera.model, "OPENCV");
@@ -66,6 +66,38 @@ TEST(Manifest, UnknownKeysNameTheirPathAndTheClosestKey) {
   EXPECT_EQ(ErrorOf({{"threads", "many"}}), "m.json: threads: expected an integer, got a string");
   EXPECT_EQ(ErrorOf({{"camera", {{"K", {1, 2, 3}}}}}),
             "m.json: camera.K: expected [fx, fy, cx, cy] in pixels");
+}
+
+TEST(Manifest, PairSelectorIsOneSlotOrAnArrayOfSlots) {
+  const Manifest one = Manifest::FromJson(
+      {{"pipeline", {{"pair_selector", {{"plugin", "window"}, {"options", {{"window", 3}}}}}}}},
+      "/base", "m.json");
+  ASSERT_EQ(one.pair_selectors.size(), 1u);
+  EXPECT_EQ(one.pair_selectors[0].plugin, "window");
+  EXPECT_EQ(one.pair_selectors[0].options, nlohmann::json({{"window", 3}}));
+  EXPECT_EQ(one.pair_selectors[0].json_path, "pipeline.pair_selector");
+
+  const Manifest two = Manifest::FromJson(
+      {{"pipeline",
+        {{"pair_selector",
+          {{{"plugin", "sequential"}}, {{"plugin", "spatial"}, {"options", {{"x", 1}}}}}}}}},
+      "/base", "m.json");
+  ASSERT_EQ(two.pair_selectors.size(), 2u);
+  EXPECT_EQ(two.pair_selectors[0].plugin, "sequential");
+  EXPECT_EQ(two.pair_selectors[0].json_path, "pipeline.pair_selector[0]");
+  EXPECT_EQ(two.pair_selectors[1].plugin, "spatial");
+  EXPECT_EQ(two.pair_selectors[1].json_path, "pipeline.pair_selector[1]");
+
+  EXPECT_EQ(ErrorOf({{"pipeline", {{"pair_selector", nlohmann::json::array()}}}}),
+            "m.json: pipeline.pair_selector: expected a slot object or a non-empty array of slot "
+            "objects");
+  EXPECT_EQ(ErrorOf({{"pipeline",
+                      {{"pair_selector", {{{"plugin", "window"}}, {{"plugn", "spatial"}}}}}}}),
+            "m.json: pipeline.pair_selector[1]: missing key 'plugin'");
+  EXPECT_EQ(ErrorOf({{"pipeline", {{"pair_selector", {{{"plugin", "window"}}, 3}}}}}),
+            "m.json: pipeline.pair_selector[1]: expected a JSON object, got a number");
+  EXPECT_EQ(ErrorOf({{"pipeline", {{"pair_selectr", {{"plugin", "window"}}}}}}),
+            "m.json: pipeline.pair_selectr: unknown key; did you mean 'pair_selector'?");
 }
 
 TEST(Manifest, ReadsKFileRelativeToTheManifest) {

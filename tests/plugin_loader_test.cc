@@ -29,7 +29,9 @@ TEST(PluginLoader, LoadsAGoodPluginAndReadsItsInfo) {
   const PluginRegistry registry = PluginRegistry::Discover({kRoot / "good"});
   auto selector = registry.Create<PairSelector>("pair_selector", "consecutive", {{"overlap", 2}},
                                                 "pipeline.pair_selector");
-  EXPECT_EQ(selector->SelectPairs({"a", "b", "c"}).size(), 2u);
+  PairSelectionInput input;
+  input.images.resize(3);
+  EXPECT_EQ(selector->SelectPairs(input).size(), 2u);
   EXPECT_EQ(selector->EffectiveOptions(), nlohmann::json({{"overlap", 2}}));
   EXPECT_EQ(selector.name(), "consecutive");
 }
@@ -57,6 +59,15 @@ TEST(PluginLoader, RefusesAnotherAbiVersionNamingBothNumbers) {
   EXPECT_EQ(InspectPluginFile(file).refusal,
             file.string() + ": wrong plugin ABI version: got version 999, supported version is " +
                 std::to_string(kPluginAbiVersion));
+}
+
+TEST(PluginLoader, RefusesAPluginBuiltAgainstAbiOne) {
+  ASSERT_EQ(kPluginAbiVersion, 2u);
+  const auto file = File("abi_one", "abi_one");
+  EXPECT_EQ(InspectPluginFile(file).refusal,
+            file.string() + ": wrong plugin ABI version: got version 1, supported version is 2");
+  const PluginRegistry registry = PluginRegistry::Discover({kRoot / "abi_one"});
+  EXPECT_TRUE(registry.NamesOfKind("pair_selector").empty());
 }
 
 TEST(PluginLoader, RefusesAnUnknownKindWithASuggestion) {
@@ -159,10 +170,10 @@ TEST(PluginLoader, DiscoveryListsRefusedFilesWithoutThrowing) {
   const PluginRegistry registry = PluginRegistry::Discover(paths);
   size_t refused = 0;
   for (const auto& record : registry.records()) refused += record.usable() ? 0 : 1;
-  // no_info, wrong_abi, unknown_kind, no_factory, the second twin.
-  EXPECT_EQ(refused, 5u);
+  // no_info, wrong_abi, abi_one, unknown_kind, no_factory, the second twin.
+  EXPECT_EQ(refused, 6u);
   EXPECT_EQ(registry.NamesOfKind("pair_selector"),
-            (std::vector<std::string>{"consecutive", "throws", "twin"}));
+            (std::vector<std::string>{"consecutive", "float_only", "throws", "twin"}));
 }
 
 TEST(PluginLoader, ObjectsOutliveTheRegistryThatMadeThem) {
@@ -172,7 +183,9 @@ TEST(PluginLoader, ObjectsOutliveTheRegistryThatMadeThem) {
     selector = registry.Create<PairSelector>("pair_selector", "consecutive", {}, "p");
   }
   // The instance holds the library open: calling into it after the registry is gone is safe.
-  EXPECT_EQ(selector->SelectPairs({"a", "b"}).size(), 1u);
+  PairSelectionInput input;
+  input.images.resize(2);
+  EXPECT_EQ(selector->SelectPairs(input).size(), 1u);
 }
 
 }  // namespace

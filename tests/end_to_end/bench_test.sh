@@ -1,8 +1,9 @@
 #!/bin/bash
 # `tessera bench` on the small fountain sample that ships in examples/:
 #  1. two ORB manifests that differ only in the pair selector: two rows, the second
-#     reusing the first's features (and only those: 55 exhaustive pairs, then 40 window
-#     pairs), every image registered, scored against the ground truth; the same rows in
+#     reusing the first's features (and only those: 55 exhaustive pairs, then 40 pairs
+#     of two selectors, window 40 united with sequential 19 that it contains, shown per
+#     selector), every image registered, scored against the ground truth; the same rows in
 #     --json and --csv, and an SVG chart of them; with colmap installed, a COLMAP row that
 #     registers every image;
 #  2. the same command again gives the same pairs, registered counts and errors;
@@ -26,7 +27,9 @@ import json, sys
 m = json.load(open(sys.argv[1]))
 m["pipeline"]["matcher"] = {"plugin": "flann"}
 json.dump(m, open(sys.argv[2] + "/orb_exhaustive.json", "w"))
-m["pipeline"]["pair_selector"] = {"plugin": "window", "options": {"window": 5}}
+m["pipeline"]["pair_selector"] = [
+    {"plugin": "window", "options": {"window": 5}},
+    {"plugin": "sequential", "options": {"overlap": 2, "quadratic_overlap": False}}]
 json.dump(m, open(sys.argv[2] + "/orb_window.json", "w"))
 m["pipeline"]["matcher"] = {"plugin": "no_such_matcher"}
 json.dump(m, open(sys.argv[2] + "/broken.json", "w"))
@@ -42,8 +45,10 @@ if command -v colmap > /dev/null; then colmap_flag=(--with-colmap); else
   "$work/orb_exhaustive.json" "$work/orb_window.json" > "$work/1.md" 2> "$work/1.log" ||
   { cat "$work/1.log"; fail "tessera bench exited $?"; }
 cat "$work/1.md"
-grep -q "^| orb_window | orb / window / flann / ceres | 0.0 (features of orb_exhaustive) |" \
+grep -q "^| orb_window | orb / window+sequential / flann / ceres | 0.0 (features of orb_exhaustive) |" \
   "$work/1.md" || fail "orb_window's row does not say it reused orb_exhaustive's features"
+grep -q "^| orb_window |.*| 40 | window 40 + sequential 19 = 40 |" "$work/1.md" ||
+  fail "orb_window's row does not show the pairs of each selector"
 python3 - "$work/1.json" "$work/1.csv" "${#colmap_flag[@]}" <<'PY' || fail "bench JSON/CSV"
 import csv, json, sys
 rows = json.load(open(sys.argv[1]))["rows"]
@@ -51,6 +56,10 @@ with_colmap = sys.argv[3] == "1"
 assert [r["manifest"] for r in rows] == ["orb_exhaustive", "orb_window"] + (["colmap"] if with_colmap else []), rows
 assert [r["num_pairs"] for r in rows[:2]] == [55, 40], [r["num_pairs"] for r in rows]
 assert rows[1]["extract_shared_with"] == "orb_exhaustive"
+assert rows[0]["pairs_per_selector"] == [
+    {"plugin": "exhaustive", "json_path": "pipeline.pair_selector", "num_pairs": 55}], rows[0]
+assert [(s["plugin"], s["json_path"], s["num_pairs"]) for s in rows[1]["pairs_per_selector"]] == [
+    ("window", "pipeline.pair_selector[0]", 40), ("sequential", "pipeline.pair_selector[1]", 19)], rows[1]
 for r in rows:
     assert r["exit_code"] == 0 and r["num_registered"] == 11, r
     assert r["position_error_mean_relative"] is not None and r["position_error_mean_relative"] < 0.01, r

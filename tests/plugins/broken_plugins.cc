@@ -20,9 +20,9 @@ class TestPairSelector : public tessera::PairSelector {
 #endif
   }
   std::vector<tessera::ImageIndexPair> SelectPairs(
-      const std::vector<std::string>& image_names) const override {
+      const tessera::PairSelectionInput& input) const override {
     std::vector<tessera::ImageIndexPair> pairs;
-    for (size_t i = 0; i + 1 < image_names.size(); ++i) pairs.emplace_back(i, i + 1);
+    for (size_t i = 0; i + 1 < input.images.size(); ++i) pairs.emplace_back(i, i + 1);
     return pairs;
   }
 };
@@ -43,6 +43,18 @@ static std::unique_ptr<tessera::Plugin> wrong_abi_create(const nlohmann::json& o
 }
 BOOST_DLL_ALIAS(wrong_abi_info, tessera_plugin_info)
 BOOST_DLL_ALIAS(wrong_abi_create, tessera_plugin_create)
+
+#elif defined(TESSERA_TEST_CASE_ABI_ONE)
+// A plugin built against ABI 1 (pair selectors saw only file names): its record says 1.
+extern "C" {
+const TesseraPluginInfo abi_one_info = {1, "pair_selector", "names_only", "1.0.0",
+                                        "Built against ABI 1"};
+}
+static std::unique_ptr<tessera::Plugin> abi_one_create(const nlohmann::json& options) {
+  return std::make_unique<TestPairSelector>(options);
+}
+BOOST_DLL_ALIAS(abi_one_info, tessera_plugin_info)
+BOOST_DLL_ALIAS(abi_one_create, tessera_plugin_create)
 
 #elif defined(TESSERA_TEST_CASE_UNKNOWN_KIND)
 extern "C" {
@@ -67,6 +79,23 @@ TESSERA_PLUGIN(pair_selector, TestPairSelector, "throws", "1.0.0", "Its factory 
 
 #elif defined(TESSERA_TEST_CASE_DUPLICATE_A) || defined(TESSERA_TEST_CASE_DUPLICATE_B)
 TESSERA_PLUGIN(pair_selector, TestPairSelector, "twin", "1.0.0", "Two files claim this name")
+
+#elif defined(TESSERA_TEST_CASE_FLOAT_ONLY)
+// Not broken: a pair selector that refuses binary descriptors, as a retrieval selector
+// with a float codebook does.
+namespace {
+class FloatOnlyPairSelector : public TestPairSelector {
+ public:
+  using TestPairSelector::TestPairSelector;
+  void CheckDescriptors(tessera::DescriptorMetric metric, int /*dimension*/) const override {
+    if (metric == tessera::DescriptorMetric::kHamming) {
+      throw tessera::OptionError("", "needs float (L2) descriptors, not binary ones");
+    }
+  }
+};
+}  // namespace
+TESSERA_PLUGIN(pair_selector, FloatOnlyPairSelector, "float_only", "1.0.0",
+               "Refuses binary descriptors")
 
 #elif defined(TESSERA_TEST_CASE_GOOD)
 TESSERA_PLUGIN(pair_selector, TestPairSelector, "consecutive", "1.2.3",

@@ -61,6 +61,8 @@ class TESSERA_API PairSelector : public Plugin {
   // Throws OptionError when this selector cannot work with descriptors of this metric
   // and width (e.g. a retrieval selector given binary descriptors). Called before any
   // image is read, with the detector's metric; the default accepts everything.
+  // `dimension` is 0 where the width is not known yet (before extraction: detectors do
+  // not declare it); the host calls again with the workspace's width before matching.
   virtual void CheckDescriptors(DescriptorMetric /*metric*/, int /*dimension*/) const {}
 
   // Selectors that learn from images (a retrieval codebook) train on `input` and write

@@ -57,6 +57,10 @@ struct BenchRow {
   double total_seconds = kNaN;
   double peak_memory_mb = kNaN;
   size_t num_pairs = 0;
+  // The pairs each pair selector chose, from run_summary.json: [{plugin, json_path,
+  // num_pairs}]; their union is the run's pair count.
+  nlohmann::json pairs_per_selector = nlohmann::json::array();
+  size_t num_selected_pairs = 0;
   size_t num_verified = 0;
   double mean_inliers = kNaN;
   size_t num_images = 0;
@@ -149,10 +153,29 @@ void ScoreModel(const Reconstruction& model, const GroundTruth* ground_truth, Be
 std::string SlotPlugin(const nlohmann::json& manifest, const std::string& slot) {
   const auto pipeline = manifest.find("pipeline");
   if (pipeline == manifest.end() || !pipeline->contains(slot)) return "-";
+  const auto plugin = [](const nlohmann::json& value) {
+    return value.is_object() && value.contains("plugin") && value.at("plugin").is_string()
+               ? value.at("plugin").get<std::string>()
+               : "-";
+  };
   const nlohmann::json& value = pipeline->at(slot);
-  return value.contains("plugin") && value.at("plugin").is_string()
-             ? value.at("plugin").get<std::string>()
-             : "-";
+  if (!value.is_array()) return plugin(value);
+  // Several pair selectors: "sequential+retrieval".
+  std::string names;
+  for (const nlohmann::json& item : value) names += (names.empty() ? "" : "+") + plugin(item);
+  return names.empty() ? "-" : names;
+}
+
+// "window 40", or "sequential 497 + retrieval 300 = 720" for several selectors.
+std::string PairsBySelector(const BenchRow& row) {
+  if (row.pairs_per_selector.empty()) return "-";
+  std::string text;
+  for (const nlohmann::json& selector : row.pairs_per_selector) {
+    text += (text.empty() ? "" : " + ") + selector.at("plugin").get<std::string>() + " " +
+            std::to_string(selector.at("num_pairs").get<size_t>());
+  }
+  if (row.pairs_per_selector.size() > 1) text += " = " + std::to_string(row.num_selected_pairs);
+  return text;
 }
 
 struct BenchOptions {
@@ -209,6 +232,8 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
   row.map_seconds = run.at("map").at("seconds").get<double>();
   row.total_seconds = run.at("total_seconds").get<double>();
   row.num_models = run.at("map").at("num_models").get<size_t>();
+  row.num_selected_pairs = run.at("match").at("num_pairs").get<size_t>();
+  row.pairs_per_selector = run.at("match").value("pairs_per_selector", nlohmann::json::array());
   ReadMatchingFigures(workspace / "database.db", &row);
   const nlohmann::json mapping = ReadJsonFile(workspace / "mapping_summary.json");
   if (!mapping.at("models").empty()) {
@@ -290,6 +315,7 @@ const std::vector<std::string>& Columns() {
                                                    "total s",
                                                    "peak MB",
                                                    "pairs",
+                                                   "pairs by selector",
                                                    "verified pairs",
                                                    "mean inliers",
                                                    "registered",
@@ -315,6 +341,7 @@ std::vector<std::string> Cells(const BenchRow& row) {
           Format(row.total_seconds, 1),
           Format(row.peak_memory_mb, 0),
           std::to_string(row.num_pairs),
+          PairsBySelector(row),
           std::to_string(row.num_verified),
           Format(row.mean_inliers, 0),
           std::to_string(row.num_registered) + "/" + std::to_string(row.num_images),
@@ -343,6 +370,7 @@ nlohmann::json ToJson(const BenchRow& row) {
           {"total_seconds", number(row.total_seconds)},
           {"peak_memory_mb", number(row.peak_memory_mb)},
           {"num_pairs", row.num_pairs},
+          {"pairs_per_selector", row.pairs_per_selector},
           {"num_verified_pairs", row.num_verified},
           {"mean_inliers_per_verified_pair", number(row.mean_inliers)},
           {"num_images", row.num_images},

@@ -1,5 +1,6 @@
 #include "cli/pipeline_context.h"
 
+#include "feature/feature_matching.h"
 #include "util/paths.h"
 
 namespace tessera {
@@ -19,10 +20,9 @@ PipelineContext PipelineContext::Create(Manifest manifest) {
       context.detector =
           context.registry.Create<Detector>("detector", slot.plugin, slot.options, slot.json_path);
     }
-    if (manifest.pair_selector) {
-      const auto& slot = *manifest.pair_selector;
-      context.pair_selector = context.registry.Create<PairSelector>("pair_selector", slot.plugin,
-                                                                    slot.options, slot.json_path);
+    for (const auto& slot : manifest.pair_selectors) {
+      context.pair_selectors.push_back(context.registry.Create<PairSelector>(
+          "pair_selector", slot.plugin, slot.options, slot.json_path));
     }
     if (manifest.matcher) {
       const auto& slot = *manifest.matcher;
@@ -48,13 +48,21 @@ PipelineContext PipelineContext::Create(Manifest manifest) {
 
 void PipelineContext::Require(const std::string& slot, const std::string& stage) const {
   const bool present =
-      (slot == "detector" && detector) || (slot == "pair_selector" && pair_selector) ||
+      (slot == "detector" && detector) || (slot == "pair_selector" && !pair_selectors.empty()) ||
       (slot == "matcher" && matcher) || (slot == "bundle_adjuster" && bundle_adjuster);
   if (!present) {
     const std::string source = manifest.file.empty() ? "manifest" : manifest.file.string();
     throw InputError(source + ": pipeline." + slot + ": missing; the " + stage + " stage needs a " +
                      slot + " plugin");
   }
+}
+
+}  // namespace tessera
+
+namespace tessera {
+
+void PipelineContext::CheckPairSelectorDescriptors(DescriptorMetric metric, int dimension) const {
+  CheckPairSelectors(manifest, pair_selectors, metric, dimension);
 }
 
 }  // namespace tessera

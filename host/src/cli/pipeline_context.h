@@ -2,6 +2,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "manifest/manifest.h"
 #include "plugin/plugin_registry.h"
@@ -17,7 +18,8 @@ struct PipelineContext {
   Manifest manifest;
   PluginRegistry registry;
   PluginInstance<Detector> detector;
-  PluginInstance<PairSelector> pair_selector;
+  // Every `pipeline.pair_selector`, in manifest order; their pairs are united.
+  std::vector<PluginInstance<PairSelector>> pair_selectors;
   PluginInstance<Matcher> matcher;
   PluginInstance<BundleAdjuster> bundle_adjuster;
   std::vector<PluginInstance<Exporter>> exporters;
@@ -30,6 +32,12 @@ struct PipelineContext {
 
   // Throws InputError naming the missing slot when a stage needs it.
   void Require(const std::string& slot, const std::string& stage) const;
+
+  // Asks every pair selector whether it works with descriptors of this metric and width
+  // (PairSelector::CheckDescriptors) before any image is read: `tessera run` calls it
+  // with the detector's metric (dimension 0: not known before detection); MatchFeatures
+  // checks again with the workspace's. Throws InputError naming the selector's JSON path.
+  void CheckPairSelectorDescriptors(DescriptorMetric metric, int dimension) const;
 };
 
 }  // namespace tessera

@@ -82,6 +82,17 @@ void LogMatching(const MatchingSummary& s) {
       s.num_inlier_matches, mean_inliers, s.match_seconds, s.verify_seconds, s.seconds);
 }
 
+// [{"plugin", "json_path", "num_pairs"}] for run_summary.json (read by `tessera bench`).
+nlohmann::json PairsPerSelectorJson(const MatchingSummary& s) {
+  nlohmann::json selectors = nlohmann::json::array();
+  for (const SelectorPairs& selector : s.pairs_per_selector) {
+    selectors.push_back({{"plugin", selector.plugin},
+                         {"json_path", selector.json_path},
+                         {"num_pairs", selector.num_pairs}});
+  }
+  return selectors;
+}
+
 // The image folder: the option, else the one extract recorded in the workspace.
 std::filesystem::path ImageFolder(const std::string& option, const Database& database) {
   if (!option.empty()) return option;
@@ -267,8 +278,8 @@ CommandRegistration RegisterMatchCommand(CLI::App& app, const GlobalOptions&) {
             context.Require("pair_selector", "match");
             context.Require("matcher", "match");
             Database database(PrepareWorkspace(options->output));
-            LogMatching(
-                MatchFeatures(context.manifest, context.pair_selector, context.matcher, &database));
+            LogMatching(MatchFeatures(context.manifest, context.pair_selectors, context.matcher,
+                                      &database));
             return static_cast<int>(kExitSuccess);
           }};
 }
@@ -284,12 +295,14 @@ CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions&) {
             context.Require("pair_selector", "match");
             context.Require("matcher", "match");
             context.Require("bundle_adjuster", "map");
+            // A selector that cannot use the detector's descriptors fails before extraction.
+            context.CheckPairSelectorDescriptors(context.detector->Metric(), 0);
             const std::filesystem::path database_file = PrepareWorkspace(options->output);
             Database database(database_file);
             const ExtractionSummary extraction =
                 ExtractFeatures(options->images, context.manifest, context.detector, &database);
             const MatchingSummary matching =
-                MatchFeatures(context.manifest, context.pair_selector, context.matcher, &database);
+                MatchFeatures(context.manifest, context.pair_selectors, context.matcher, &database);
             LogExtraction(extraction);
             LogMatching(matching);
             const MappingSummary mapping =
@@ -298,23 +311,25 @@ CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions&) {
             spdlog::info("run: extract {:.2f} s, match {:.2f} s, map {:.2f} s, total {:.2f} s",
                          extraction.seconds, matching.seconds, mapping.seconds, total_seconds);
             // What `tessera bench` reads back; mapping_summary.json has the models.
-            const nlohmann::json run_summary = {{"extract",
-                                                 {{"seconds", extraction.seconds},
-                                                  {"num_images", extraction.num_images},
-                                                  {"num_detected", extraction.num_detected},
-                                                  {"num_reused", extraction.num_reused}}},
-                                                {"match",
-                                                 {{"seconds", matching.seconds},
-                                                  {"num_pairs", matching.num_pairs},
-                                                  {"num_matched", matching.num_matched},
-                                                  {"num_reused", matching.num_reused},
-                                                  {"num_verified", matching.num_verified}}},
-                                                {"map",
-                                                 {{"seconds", mapping.seconds},
-                                                  {"num_models", mapping.num_models},
-                                                  {"num_registered", mapping.num_registered},
-                                                  {"num_images", mapping.num_images}}},
-                                                {"total_seconds", total_seconds}};
+            const nlohmann::json run_summary = {
+                {"extract",
+                 {{"seconds", extraction.seconds},
+                  {"num_images", extraction.num_images},
+                  {"num_detected", extraction.num_detected},
+                  {"num_reused", extraction.num_reused}}},
+                {"match",
+                 {{"seconds", matching.seconds},
+                  {"num_pairs", matching.num_pairs},
+                  {"pairs_per_selector", PairsPerSelectorJson(matching)},
+                  {"num_matched", matching.num_matched},
+                  {"num_reused", matching.num_reused},
+                  {"num_verified", matching.num_verified}}},
+                {"map",
+                 {{"seconds", mapping.seconds},
+                  {"num_models", mapping.num_models},
+                  {"num_registered", mapping.num_registered},
+                  {"num_images", mapping.num_images}}},
+                {"total_seconds", total_seconds}};
             WriteFileAtomically(std::filesystem::path(options->output) / "run_summary.json",
                                 run_summary.dump(2) + "\n");
             return MappingExitCode(mapping, database_file);

@@ -86,7 +86,10 @@ constexpr const char* kCreateTesseraTables =
     "    provenance  TEXT               NOT NULL);"
     "CREATE TABLE IF NOT EXISTS tessera_camera_priors"
     "   (camera_id  INTEGER  PRIMARY KEY  NOT NULL,"
-    "    source     TEXT                NOT NULL);";
+    "    source     TEXT                NOT NULL);"
+    "CREATE TABLE IF NOT EXISTS tessera_image_metadata"
+    "   (image_id  INTEGER  PRIMARY KEY  NOT NULL,"
+    "    metadata  TEXT               NOT NULL);";
 
 // COLMAP writes its version number here (3.8 -> 3800); later COLMAP versions read it
 // to decide which schema migrations a database needs.
@@ -104,6 +107,7 @@ const std::map<std::string, std::vector<std::string>>& RequiredColumns() {
       {"two_view_geometries", {"pair_id", "rows", "cols", "data", "config"}},
       {"tessera_stages", {"stage", "provenance"}},
       {"tessera_camera_priors", {"camera_id", "source"}},
+      {"tessera_image_metadata", {"image_id", "metadata"}},
   };
   return columns;
 }
@@ -176,7 +180,47 @@ FeatureMatches SwapMatches(const FeatureMatches& matches) {
   return swapped;
 }
 
+nlohmann::json OptionalToJson(const std::optional<double>& value) {
+  return value ? nlohmann::json(*value) : nlohmann::json(nullptr);
+}
+
+std::optional<double> OptionalFromJson(const nlohmann::json& json, const char* key) {
+  if (!json.contains(key) || json.at(key).is_null()) return std::nullopt;
+  return json.at(key).get<double>();
+}
+
 }  // namespace
+
+nlohmann::json ImageMetadataToJson(const ImageMetadata& metadata) {
+  nlohmann::json json = {{"make", metadata.make},
+                         {"model", metadata.model},
+                         {"focal_length_mm", OptionalToJson(metadata.focal_length_mm)},
+                         {"focal_length_35mm", OptionalToJson(metadata.focal_length_35mm)},
+                         {"gps", nullptr},
+                         {"capture_time_s", OptionalToJson(metadata.capture_time_s)}};
+  if (metadata.gps) {
+    json["gps"] = {{"latitude_deg", metadata.gps->latitude_deg},
+                   {"longitude_deg", metadata.gps->longitude_deg},
+                   {"altitude_m", OptionalToJson(metadata.gps->altitude_m)}};
+  }
+  return json;
+}
+
+ImageMetadata ImageMetadataFromJson(const nlohmann::json& json) {
+  ImageMetadata metadata;
+  metadata.make = json.value("make", "");
+  metadata.model = json.value("model", "");
+  metadata.focal_length_mm = OptionalFromJson(json, "focal_length_mm");
+  metadata.focal_length_35mm = OptionalFromJson(json, "focal_length_35mm");
+  metadata.capture_time_s = OptionalFromJson(json, "capture_time_s");
+  if (json.contains("gps") && !json.at("gps").is_null()) {
+    const nlohmann::json& gps = json.at("gps");
+    metadata.gps =
+        GpsPosition{gps.at("latitude_deg").get<double>(), gps.at("longitude_deg").get<double>(),
+                    OptionalFromJson(gps, "altitude_m")};
+  }
+  return metadata;
+}
 
 std::optional<CalibrationSource> CalibrationSourceFromName(const std::string& name) {
   for (const CalibrationSource source :
@@ -214,7 +258,7 @@ struct Database::Impl {
       exists_matches, write_matches, read_matches, read_matched_pair_ids, num_matched_pairs,
       exists_two_view_geometry, write_two_view_geometry, read_two_view_geometry,
       read_two_view_geometries, num_verified_pairs, read_stage, write_stage,
-      write_calibration_source;
+      write_calibration_source, write_image_metadata, read_image_metadata, descriptor_dimension;
 
   ~Impl() {
     // Statements first: a connection with live statements does not close.
@@ -246,7 +290,10 @@ struct Database::Impl {
                             &num_verified_pairs,
                             &read_stage,
                             &write_stage,
-                            &write_calibration_source}) {
+                            &write_calibration_source,
+                            &write_image_metadata,
+                            &read_image_metadata,
+                            &descriptor_dimension}) {
       statement->reset();
     }
     if (in_transaction) sqlite3_exec(db, "ROLLBACK;", nullptr, nullptr, nullptr);
@@ -602,6 +649,11 @@ void Database::Impl::PrepareStatements() {
   write_stage = Prepare("INSERT OR REPLACE INTO tessera_stages(stage, provenance) VALUES(?, ?);");
   write_calibration_source =
       Prepare("INSERT OR REPLACE INTO tessera_camera_priors(camera_id, source) VALUES(?, ?);");
+  write_image_metadata =
+      Prepare("INSERT OR REPLACE INTO tessera_image_metadata(image_id, metadata) VALUES(?, ?);");
+  read_image_metadata =
+      Prepare("SELECT image_id, metadata FROM tessera_image_metadata ORDER BY image_id;");
+  descriptor_dimension = Prepare("SELECT cols FROM descriptors WHERE rows > 0 LIMIT 1;");
 }
 
 Database::Database(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
@@ -1069,6 +1121,41 @@ void Database::WriteCalibrationSource(camera_t camera_id, CalibrationSource sour
   impl_->BindInt64(use.get(), 1, camera_id, operation);
   impl_->BindText(use.get(), 2, CalibrationSourceName(source), operation);
   impl_->Step(use.get(), operation);
+}
+
+void Database::WriteImageMetadata(image_t image_id, const ImageMetadata& metadata) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  const std::string operation = "write the metadata of image " + std::to_string(image_id);
+  StatementUse use(*impl_->write_image_metadata);
+  impl_->BindInt64(use.get(), 1, image_id, operation);
+  impl_->BindText(use.get(), 2, ImageMetadataToJson(metadata).dump(), operation);
+  impl_->Step(use.get(), operation);
+}
+
+std::map<image_t, ImageMetadata> Database::ReadAllImageMetadata() const {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  const std::string operation = "read the image metadata";
+  std::map<image_t, ImageMetadata> metadata;
+  StatementUse use(*impl_->read_image_metadata);
+  while (impl_->Step(use.get(), operation)) {
+    const auto image_id = static_cast<image_t>(sqlite3_column_int64(use.get(), 0));
+    const char* text = reinterpret_cast<const char*>(sqlite3_column_text(use.get(), 1));
+    try {
+      metadata[image_id] =
+          ImageMetadataFromJson(nlohmann::json::parse(text != nullptr ? text : ""));
+    } catch (const nlohmann::json::exception& error) {
+      throw InputError("Database '" + impl_->path.string() + "': the metadata of image " +
+                       std::to_string(image_id) + " is not valid: " + error.what());
+    }
+  }
+  return metadata;
+}
+
+std::optional<int> Database::DescriptorDimension() const {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  StatementUse use(*impl_->descriptor_dimension);
+  if (!impl_->Step(use.get(), "read the descriptor width")) return std::nullopt;
+  return static_cast<int>(sqlite3_column_int64(use.get(), 0));
 }
 
 }  // namespace tessera

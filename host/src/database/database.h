@@ -2,10 +2,11 @@
 
 // The workspace database: a SQLite file with COLMAP 3.8's `database.db` schema, so
 // that `colmap mapper` reads what Tessera wrote and Tessera reads what COLMAP wrote,
-// plus two tables of Tessera's own (prefixed `tessera_`, which COLMAP ignores).
+// plus tables of Tessera's own (prefixed `tessera_`, which COLMAP ignores).
 
 #include <cstddef>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <nlohmann/json.hpp>
@@ -17,6 +18,7 @@
 #include "tessera/camera.h"
 #include "tessera/features.h"
 #include "tessera/ids.h"
+#include "tessera/image_metadata.h"
 #include "tessera/reconstruction.h"
 #include "tessera/two_view_geometry.h"
 
@@ -100,6 +102,9 @@ class Database {
   bool ExistsDescriptors(image_t image_id) const;
   void WriteDescriptors(image_t image_id, const FeatureDescriptors& descriptors);
   FeatureDescriptors ReadDescriptors(image_t image_id, DescriptorMetric metric) const;
+  // The width (columns) of the stored descriptors, from one non-empty row's header
+  // without reading its data; nullopt when no image has descriptors.
+  std::optional<int> DescriptorDimension() const;
 
   // Matches of (image_id1, image_id2), point2D_idx1 indexing image_id1's keypoints
   // whatever the order of the ids. An empty list is written as rows=0 (the pair was
@@ -136,11 +141,23 @@ class Database {
 
   void WriteCalibrationSource(camera_t camera_id, CalibrationSource source);
 
+  // Each image's EXIF metadata (GPS, capture time, camera), stored at extraction in
+  // tessera_image_metadata as JSON, so that matching needs no image folder. Writes
+  // replace a row; images without a row (workspaces made before the table, or by
+  // COLMAP) are absent from the map.
+  void WriteImageMetadata(image_t image_id, const ImageMetadata& metadata);
+  std::map<image_t, ImageMetadata> ReadAllImageMetadata() const;
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
   mutable std::recursive_mutex mutex_;
 };
+
+// ImageMetadata as stored in tessera_image_metadata: every field, absent ones null.
+// FromJson throws nlohmann::json::exception for a malformed value.
+nlohmann::json ImageMetadataToJson(const ImageMetadata& metadata);
+ImageMetadata ImageMetadataFromJson(const nlohmann::json& json);
 
 // The inverse of CalibrationSourceName; nullopt for an unknown name.
 std::optional<CalibrationSource> CalibrationSourceFromName(const std::string& name);

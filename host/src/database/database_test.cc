@@ -589,6 +589,78 @@ TEST_F(DatabaseTest, StageProvenanceRoundTrip) {
   EXPECT_THROW(database.ReadStageProvenance("features"), InputError);
 }
 
+TEST_F(DatabaseTest, ImageMetadataRoundTripAndOldWorkspacesHaveNone) {
+  ImageMetadata full;
+  full.make = "Canon";
+  full.model = "EOS 5D";
+  full.focal_length_mm = 24.5;
+  full.focal_length_35mm = 24;
+  full.gps = GpsPosition{45.5123456789, -73.25, 31.5};
+  full.capture_time_s = 1262304000.25;
+  ImageMetadata no_altitude;
+  no_altitude.gps = GpsPosition{-33.9, 151.2, std::nullopt};
+  {
+    Database database(DatabasePath());
+    AddCamerasAndImages(&database);
+    // A workspace made before the metadata table: no rows, an empty map.
+    EXPECT_TRUE(database.ReadAllImageMetadata().empty());
+    database.WriteImageMetadata(1, ImageMetadata{});
+    database.WriteImageMetadata(2, full);
+    database.WriteImageMetadata(3, full);
+    database.WriteImageMetadata(3, no_altitude);  // replaces
+  }
+  Database database(DatabasePath());
+  const auto metadata = database.ReadAllImageMetadata();
+  ASSERT_EQ(metadata.size(), 3u);
+  EXPECT_TRUE(metadata.at(1).make.empty());
+  EXPECT_FALSE(metadata.at(1).gps);
+  EXPECT_FALSE(metadata.at(1).capture_time_s);
+  EXPECT_FALSE(metadata.at(1).focal_length_mm);
+  const ImageMetadata& read = metadata.at(2);
+  EXPECT_EQ(read.make, "Canon");
+  EXPECT_EQ(read.model, "EOS 5D");
+  EXPECT_EQ(read.focal_length_mm, 24.5);
+  EXPECT_EQ(read.focal_length_35mm, 24);
+  ASSERT_TRUE(read.gps);
+  EXPECT_EQ(read.gps->latitude_deg, 45.5123456789);  // JSON keeps every digit of a double
+  EXPECT_EQ(read.gps->longitude_deg, -73.25);
+  EXPECT_EQ(read.gps->altitude_m, 31.5);
+  EXPECT_EQ(read.capture_time_s, 1262304000.25);
+  ASSERT_TRUE(metadata.at(3).gps);
+  EXPECT_EQ(metadata.at(3).gps->latitude_deg, -33.9);
+  EXPECT_FALSE(metadata.at(3).gps->altitude_m);
+
+  // Clearing features keeps the metadata: it belongs to the images.
+  database.ClearKeypointsAndDescriptors();
+  EXPECT_EQ(database.ReadAllImageMetadata().size(), 3u);
+
+  RawDatabase raw(DatabasePath());
+  raw.Exec("UPDATE tessera_image_metadata SET metadata = '{\"gps\": 3}' WHERE image_id = 2;");
+  try {
+    database.ReadAllImageMetadata();
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("the metadata of image 2 is not valid"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
+TEST_F(DatabaseTest, DescriptorDimensionFromTheFirstNonEmptyRow) {
+  Database database(DatabasePath());
+  AddCamerasAndImages(&database);
+  EXPECT_FALSE(database.DescriptorDimension());
+  FeatureDescriptors empty;
+  empty.data.resize(0, 128);
+  database.WriteDescriptors(1, empty);
+  EXPECT_FALSE(database.DescriptorDimension());
+  FeatureDescriptors orb;
+  orb.metric = DescriptorMetric::kHamming;
+  orb.data.setConstant(5, 32, 7);
+  database.WriteDescriptors(2, orb);
+  EXPECT_EQ(database.DescriptorDimension(), 32);
+}
+
 TEST_F(DatabaseTest, TransactionsCommitOrRollBack) {
   Database database(DatabasePath());
   AddCamerasAndImages(&database);

@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "image/camera_assignment.h"
+#include "image/exif.h"
 #include "image/image_io.h"
 #include "util/parallel.h"
 #include "util/timer.h"
@@ -61,6 +62,26 @@ std::vector<Image> RegisterImages(const ImageScan& scan, const CameraSettings& s
   return images;
 }
 
+// Stores each image's EXIF metadata for pair selectors, so that matching needs no
+// image folder. Rewritten on every run: cheap, and a re-tagged image is seen.
+void WriteImageMetadata(const ImageScan& scan, const std::vector<Image>& images,
+                        Database* database) {
+  Database::Transaction transaction(database);
+  size_t num_with_gps = 0;
+  for (size_t i = 0; i < scan.images.size(); ++i) {
+    const ImageEntry& entry = scan.images[i];
+    for (const std::string& warning : entry.exif.warnings) {
+      spdlog::warn("'{}': {}", entry.name, warning);
+    }
+    if (entry.exif.gps) ++num_with_gps;
+    database->WriteImageMetadata(images[i].image_id, MetadataFromExif(entry.exif));
+  }
+  transaction.Commit();
+  if (num_with_gps > 0) {
+    spdlog::info("extract: {} of {} images have GPS positions", num_with_gps, scan.images.size());
+  }
+}
+
 }  // namespace
 
 ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const Manifest& manifest,
@@ -91,6 +112,7 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
       {{"folder", std::filesystem::absolute(image_dir).lexically_normal().string()}});
 
   const std::vector<Image> images = RegisterImages(scan, manifest.camera, database);
+  WriteImageMetadata(scan, images, database);
   std::vector<size_t> todo;
   for (size_t i = 0; i < images.size(); ++i) {
     if (database->ExistsKeypoints(images[i].image_id)) {

@@ -3,6 +3,9 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
+
+#include "tessera/image_metadata.h"
 
 namespace tessera {
 
@@ -16,6 +19,14 @@ struct ExifInfo {
   // refers to, so that a resized image still gets the right focal length.
   std::optional<int> pixel_x_dimension, pixel_y_dimension;
   int orientation = 1;  // EXIF Orientation 1..8 (TIFF: 1, as the decoder applies its own)
+  // GPSLatitude/Longitude/Altitude with their Ref tags; absent, or dropped with a
+  // warning when any of them is malformed.
+  std::optional<GpsPosition> gps;
+  // DateTimeOriginal (+ SubSecTimeOriginal), seconds since 1970 in the camera's local time.
+  std::optional<double> capture_time_s;
+  // Why a tag was ignored (malformed GPS or date), one sentence each, without the
+  // image's name: the caller logs them naming the image.
+  std::vector<std::string> warnings;
 };
 
 // One usable image of the input folder.

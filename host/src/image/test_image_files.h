@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <optional>
@@ -22,6 +23,8 @@ struct TestExif {
   std::optional<double> focal_length_mm;  // written as a rational with denominator 100
   std::optional<int> focal_length_35mm;
   std::optional<int> orientation;
+  // Adds further entries (GPS, dates) to the block before it is written.
+  std::function<void(ExifData*, ExifByteOrder)> more;
 };
 
 inline ExifEntry* AddExifEntry(ExifData* data, ExifIfd ifd, ExifTag tag, ExifFormat format,
@@ -69,6 +72,7 @@ inline std::vector<unsigned char> MakeExifBlock(const TestExif& tags) {
         AddExifEntry(data, EXIF_IFD_EXIF, EXIF_TAG_FOCAL_LENGTH_IN_35MM_FILM, EXIF_FORMAT_SHORT, 1);
     exif_set_short(entry->data, order, static_cast<ExifShort>(*tags.focal_length_35mm));
   }
+  if (tags.more) tags.more(data, order);
   unsigned char* buffer = nullptr;
   unsigned int size = 0;
   exif_data_save_data(data, &buffer, &size);

@@ -11,8 +11,7 @@
 namespace tessera {
 namespace {
 
-const std::vector<std::string> kSlotNames = {"detector", "pair_selector", "matcher",
-                                             "bundle_adjuster"};
+const std::vector<std::string> kSlotNames = {"detector", "matcher", "bundle_adjuster"};
 
 PluginSlot ParseSlot(const nlohmann::json& json, const std::string& path) {
   OptionReader reader(json, path);
@@ -28,6 +27,24 @@ PluginSlot ParseSlot(const nlohmann::json& json, const std::string& path) {
   }
   reader.Finish();
   return slot;
+}
+
+// `pipeline.pair_selector`: absent, one slot, or a non-empty array of slots.
+std::vector<PluginSlot> ParsePairSelectors(const nlohmann::json& json) {
+  const std::string path = "pipeline.pair_selector";
+  std::vector<PluginSlot> slots;
+  if (json.is_null()) return slots;
+  if (!json.is_array()) {
+    slots.push_back(ParseSlot(json, path));
+    return slots;
+  }
+  if (json.empty()) {
+    throw OptionError(path, "expected a slot object or a non-empty array of slot objects");
+  }
+  for (size_t i = 0; i < json.size(); ++i) {
+    slots.push_back(ParseSlot(json[i], path + "[" + std::to_string(i) + "]"));
+  }
+  return slots;
 }
 
 std::filesystem::path Resolve(const std::filesystem::path& base_dir, const std::string& path) {
@@ -154,8 +171,8 @@ Manifest Manifest::FromJson(const nlohmann::json& json, const std::filesystem::p
     }
 
     OptionReader slots(pipeline, "pipeline");
-    std::optional<PluginSlot>* targets[] = {&manifest.detector, &manifest.pair_selector,
-                                            &manifest.matcher, &manifest.bundle_adjuster};
+    std::optional<PluginSlot>* targets[] = {&manifest.detector, &manifest.matcher,
+                                            &manifest.bundle_adjuster};
     for (size_t i = 0; i < kSlotNames.size(); ++i) {
       if (slots.Has(kSlotNames[i])) {
         *targets[i] = ParseSlot(slots.GetJson(kSlotNames[i], nullptr), "pipeline." + kSlotNames[i]);
@@ -163,8 +180,10 @@ Manifest Manifest::FromJson(const nlohmann::json& json, const std::filesystem::p
         slots.GetJson(kSlotNames[i], nullptr);
       }
     }
+    const nlohmann::json pair_selector = slots.GetJson("pair_selector", nullptr);
     const nlohmann::json exporters = slots.GetJson("exporters", nlohmann::json::array());
     slots.Finish();
+    manifest.pair_selectors = ParsePairSelectors(pair_selector);
     if (!exporters.is_array()) throw OptionError("pipeline.exporters", "expected an array");
     for (size_t i = 0; i < exporters.size(); ++i) {
       manifest.exporters.push_back(

@@ -53,7 +53,9 @@ struct Manifest {
   int num_threads = 0;  // 0: all cores
 
   std::optional<PluginSlot> detector;
-  std::optional<PluginSlot> pair_selector;
+  // One or more: `pipeline.pair_selector` is a slot or an array of slots, whose pairs
+  // are united. Empty when the manifest names none.
+  std::vector<PluginSlot> pair_selectors;
   std::optional<PluginSlot> matcher;
   std::optional<PluginSlot> bundle_adjuster;
   std::vector<PluginSlot> exporters;

@@ -13,10 +13,9 @@ class ExhaustivePairSelector : public PairSelector {
     effective_options_ = reader.Effective();
   }
 
-  std::vector<ImageIndexPair> SelectPairs(
-      const std::vector<std::string>& image_names) const override {
+  std::vector<ImageIndexPair> SelectPairs(const PairSelectionInput& input) const override {
     std::vector<ImageIndexPair> pairs;
-    const size_t n = image_names.size();
+    const size_t n = input.images.size();
     pairs.reserve(n * (n > 0 ? n - 1 : 0) / 2);
     for (size_t i = 0; i < n; ++i) {
       for (size_t j = i + 1; j < n; ++j) pairs.emplace_back(i, j);

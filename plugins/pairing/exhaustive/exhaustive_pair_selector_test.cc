@@ -7,10 +7,15 @@
 namespace tessera {
 namespace {
 
-std::vector<std::string> Names(size_t n) {
-  std::vector<std::string> names;
-  for (size_t i = 0; i < n; ++i) names.push_back("image" + std::to_string(i) + ".jpg");
-  return names;
+// n images named in capture order, without metadata or features.
+PairSelectionInput Names(size_t n) {
+  PairSelectionInput input;
+  input.images.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    input.images[i].image_id = static_cast<image_t>(i + 1);
+    input.images[i].name = "image" + std::to_string(i) + ".jpg";
+  }
+  return input;
 }
 
 TEST(ExhaustivePairSelector, YieldsEveryPairOnceInOrder) {

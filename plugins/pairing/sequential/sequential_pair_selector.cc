@@ -24,9 +24,8 @@ class SequentialPairSelector : public PairSelector {
     effective_options_ = reader.Effective();
   }
 
-  std::vector<ImageIndexPair> SelectPairs(
-      const std::vector<std::string>& image_names) const override {
-    const size_t n = image_names.size();
+  std::vector<ImageIndexPair> SelectPairs(const PairSelectionInput& input) const override {
+    const size_t n = input.images.size();
     const std::vector<size_t> offsets = Offsets(n);
     std::vector<ImageIndexPair> pairs;
     pairs.reserve(n * offsets.size());

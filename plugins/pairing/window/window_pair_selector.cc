@@ -25,9 +25,8 @@ class WindowPairSelector : public PairSelector {
     effective_options_ = reader.Effective();
   }
 
-  std::vector<ImageIndexPair> SelectPairs(
-      const std::vector<std::string>& image_names) const override {
-    const size_t n = image_names.size();
+  std::vector<ImageIndexPair> SelectPairs(const PairSelectionInput& input) const override {
+    const size_t n = input.images.size();
     const size_t window = static_cast<size_t>(options_.window);
     std::vector<ImageIndexPair> pairs;
     pairs.reserve(n * std::min(n, (options_.loop ? 2 : 1) * window));

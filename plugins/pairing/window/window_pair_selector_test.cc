@@ -9,10 +9,15 @@
 namespace tessera {
 namespace {
 
-std::vector<std::string> Names(size_t n) {
-  std::vector<std::string> names;
-  for (size_t i = 0; i < n; ++i) names.push_back("pano" + std::to_string(i) + ".jpg");
-  return names;
+// n images named in capture order, without metadata or features.
+PairSelectionInput Names(size_t n) {
+  PairSelectionInput input;
+  input.images.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    input.images[i].image_id = static_cast<image_t>(i + 1);
+    input.images[i].name = "pano" + std::to_string(i) + ".jpg";
+  }
+  return input;
 }
 
 // Every pair (i, j), i < j, that `keep` accepts, ascending.

@@ -34,9 +34,8 @@ class WindowAnchorPairSelector : public PairSelector {
     effective_options_ = reader.Effective();
   }
 
-  std::vector<ImageIndexPair> SelectPairs(
-      const std::vector<std::string>& image_names) const override {
-    const size_t n = image_names.size();
+  std::vector<ImageIndexPair> SelectPairs(const PairSelectionInput& input) const override {
+    const size_t n = input.images.size();
     const size_t window = static_cast<size_t>(options_.window);
     const size_t anchor_every = static_cast<size_t>(options_.anchor_every);
     const size_t anchor_window = static_cast<size_t>(options_.anchor_window);
