@@ -6,7 +6,8 @@ std::vector<CommandRegistration> RegisterCommands(CLI::App& app, const GlobalOpt
   return {RegisterRunCommand(app, global),    RegisterExtractCommand(app, global),
           RegisterMatchCommand(app, global),  RegisterMapCommand(app, global),
           RegisterExportCommand(app, global), RegisterEvalCommand(app, global),
-          RegisterBenchCommand(app, global),  RegisterPluginsCommand(app, global)};
+          RegisterBenchCommand(app, global),  RegisterPluginsCommand(app, global),
+          RegisterVocabCommand(app, global)};
 }
 
 }  // namespace tessera

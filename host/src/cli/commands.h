@@ -29,5 +29,6 @@ CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions& globa
 CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterBenchCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterVocabCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera
