@@ -65,6 +65,7 @@ TEST(Cli, PluginsJsonListsEveryBundledPluginWithKindAndVersion) {
                                                        {"window", "pair_selector"},
                                                        {"window_anchor", "pair_selector"},
                                                        {"spatial", "pair_selector"},
+                                                       {"retrieval", "pair_selector"},
                                                        {"ceres", "bundle_adjuster"},
                                                        {"colmap_binary", "exporter"},
                                                        {"colmap_text", "exporter"},
@@ -75,7 +76,7 @@ TEST(Cli, PluginsJsonListsEveryBundledPluginWithKindAndVersion) {
     ASSERT_TRUE(kinds.count(name)) << "bundled plugin '" << name << "' not listed";
     EXPECT_EQ(kinds[name], kind) << name;
   }
-  EXPECT_EQ(kinds.size(), 15u) << result.output;
+  EXPECT_EQ(kinds.size(), 16u) << result.output;
 }
 
 TEST(Cli, PluginsMarksRefusedFilesWithWhy) {

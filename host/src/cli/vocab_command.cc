@@ -14,6 +14,7 @@
 #include "database/database.h"
 #include "feature/database_feature_reader.h"
 #include "feature/feature_extraction.h"
+#include "plugin/plugin_call.h"
 #include "util/paths.h"
 #include "util/strings.h"
 #include "util/timer.h"
@@ -139,8 +140,11 @@ CommandRegistration RegisterVocabCommand(CLI::App& app, const GlobalOptions&) {
         input.features = &reader;
         const auto& selector = context.pair_selectors.front();
         try {
-          selector->Train(input, options->output);
-        } catch (const InputError& train_error) {
+          CallPlugin(selector.name(), PluginStage::kTrain,
+                     std::to_string(input.images.size()) + " images",
+                     [&] { selector->Train(input, options->output); });
+        } catch (const PluginError& train_error) {
+          if (!train_error.input_error()) throw;
           throw InputError(options->images + ": cannot train a codebook: " + train_error.what());
         }
         spdlog::info(

@@ -293,10 +293,9 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
       std::lock_guard<std::mutex> lock(database_mutex);
       matches = database->ReadMatches(image1.image_id, image2.image_id);
     } else {
-      matches = CallPlugin(matcher.name(), PluginStage::kMatch,
-                           PairSubject(image1.name, image2.name), [&] {
-                             return matcher->Match(features1->descriptors, features2->descriptors);
-                           });
+      matches = CallPlugin(
+          matcher.name(), PluginStage::kMatch, PairSubject(image1.name, image2.name),
+          [&] { return matcher->Match(features1->descriptors, features2->descriptors); });
     }
     match_micros += static_cast<int64_t>(step.ElapsedSeconds() * 1e6);
     step.Restart();

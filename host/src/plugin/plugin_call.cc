@@ -160,6 +160,8 @@ const char* PluginStageName(PluginStage stage) {
       return "adjust";
     case PluginStage::kExport:
       return "export";
+    case PluginStage::kTrain:
+      return "train";
   }
   return "call";
 }
@@ -182,6 +184,8 @@ const char* PluginStageActivity(PluginStage stage) {
       return "adjusting";
     case PluginStage::kExport:
       return "exporting";
+    case PluginStage::kTrain:
+      return "training on";
   }
   return "being called";
 }

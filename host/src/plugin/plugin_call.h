@@ -26,6 +26,7 @@ enum class PluginStage {
   kSelectPairs,
   kAdjust,
   kExport,
+  kTrain,  // a pair selector learning from images (tessera vocab)
 };
 
 // "detect", as stored in crash records.

@@ -1322,8 +1322,9 @@ void EstimateFocalLengthsWithoutPrior(const RunState& run,
   ModelBuilder builder(&calibration);
   Reconstruction model;
   if (builder.Initialize()) {
+    // Global bundle adjustments as it grew refined the focal length; the final rounds
+    // of refinement would cost as much again for little more.
     builder.Grow(kMaxCalibrationImages);
-    builder.Finish();
     model = builder.TakeModel();
   }
   spdlog::set_level(level);
