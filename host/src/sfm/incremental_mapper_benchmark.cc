@@ -7,9 +7,13 @@
 // least-squares fit of CPU time ~ n^k over all sizes is printed.
 //
 //   incremental_mapper_benchmark                          # n = 100, 300, 1000
-//   incremental_mapper_benchmark --benchmark_filter='/(100|300)$'
+//   incremental_mapper_benchmark --benchmark_filter='Path/(100|300)/'
+//   SPDLOG_LEVEL=debug incremental_mapper_benchmark ...    # the mapper's log, each BA
+//                                                         # with its iterations and time
 
 #include <benchmark/benchmark.h>
+#include <spdlog/cfg/env.h>
+#include <spdlog/spdlog.h>
 
 #include <cmath>
 #include <cstdio>
@@ -117,6 +121,9 @@ class ExponentReporter : public benchmark::ConsoleReporter {
 }  // namespace tessera
 
 int main(int argc, char** argv) {
+  // The mapper logs each registration at info level; only warnings unless asked.
+  spdlog::set_level(spdlog::level::warn);
+  spdlog::cfg::load_env_levels();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   tessera::ExponentReporter reporter;
