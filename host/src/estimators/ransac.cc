@@ -28,6 +28,7 @@ void RANSACOptions::Check() const {
   CheckOption(max_num_trials > 0, "max_num_trials", max_num_trials, "> 0");
   CheckOption(max_num_trials >= min_num_trials, "max_num_trials", max_num_trials,
               ">= min_num_trials");
+  CheckOption(min_num_inliers >= 0, "min_num_inliers", min_num_inliers, ">= 0");
 }
 
 namespace ransac_internal {
@@ -56,6 +57,14 @@ size_t MaxNumTrials(const RANSACOptions& options, int sample_size) {
       ComputeNumTrials(static_cast<size_t>(options.min_inlier_ratio * kNumSamples), kNumSamples,
                        sample_size, options.confidence, options.dyn_num_trials_multiplier);
   return std::min(static_cast<size_t>(options.max_num_trials), a_priori);
+}
+
+size_t HopelessNumTrials(const RANSACOptions& options, size_t num_samples, int sample_size) {
+  const size_t min_num_inliers = static_cast<size_t>(std::max(options.min_num_inliers, 0));
+  if (min_num_inliers == 0 || min_num_inliers > num_samples) {
+    return std::numeric_limits<size_t>::max();
+  }
+  return ComputeNumTrials(min_num_inliers, num_samples, sample_size, options.confidence, 1.0);
 }
 
 RANSACSupport EvaluateSupport(const std::vector<double>& residuals, double max_residual) {

@@ -46,6 +46,14 @@ struct RANSACOptions {
   int min_num_trials = 0;
   // Trials at most.
   int max_num_trials = std::numeric_limits<int>::max();
+  // When > 0, RANSAC gives up early on data where no model reaches this many inliers:
+  // once the trials drawn would have found a model with min_num_inliers inliers with
+  // `confidence` (the stopping criterion above at the inlier ratio min_num_inliers /
+  // number of samples, without the multiplier), while the best so far has fewer, it
+  // stops. Runs whose best model reaches min_num_inliers before that are unchanged.
+  // For callers that drop models with fewer inliers anyway: hopeless data then costs
+  // a fraction of max_num_trials. 0: off.
+  int min_num_inliers = 0;
 
   // Throws InputError naming the first invalid field.
   void Check() const;
@@ -69,6 +77,8 @@ struct RANSACReport {
   bool success = false;
   // Number of random samples drawn.
   size_t num_trials = 0;
+  // Whether RANSAC gave up early because no model reached options.min_num_inliers.
+  bool hopeless = false;
   RANSACSupport support;
   // One entry per sample: 1 for inliers of `model`, else 0.
   std::vector<char> inlier_mask;
@@ -85,6 +95,12 @@ size_t ComputeNumTrials(size_t num_inliers, size_t num_samples, int sample_size,
 
 // The a-priori cap: options.max_num_trials, lowered to what min_inlier_ratio needs.
 size_t MaxNumTrials(const RANSACOptions& options, int sample_size);
+
+// Trials after which a run whose best model has fewer than options.min_num_inliers
+// inliers gives up: enough to have drawn one all-inlier sample of a model with that
+// many inliers among num_samples, with options.confidence. The maximum of size_t when
+// options.min_num_inliers is 0 (off) or exceeds num_samples (then RANSAC draws none).
+size_t HopelessNumTrials(const RANSACOptions& options, size_t num_samples, int sample_size);
 
 RANSACSupport EvaluateSupport(const std::vector<double>& residuals, double max_residual);
 
@@ -173,11 +189,18 @@ RANSACReport<typename Estimator::M_t> Run(const RANSACOptions& options, uint64_t
   RANSACReport<M_t> report;
   const size_t num_samples = X.size();
   if (num_samples < static_cast<size_t>(Estimator::kMinNumSamples)) return report;
+  if (static_cast<size_t>(std::max(options.min_num_inliers, 0)) > num_samples) {
+    report.hopeless = true;
+    return report;
+  }
 
   const double max_residual = options.max_error * options.max_error;
   const size_t max_num_trials = MaxNumTrials(options, Estimator::kMinNumSamples);
   const size_t min_num_trials = static_cast<size_t>(std::max(options.min_num_trials, 0));
   size_t dyn_max_num_trials = max_num_trials;
+  const size_t min_num_inliers = static_cast<size_t>(std::max(options.min_num_inliers, 0));
+  const size_t hopeless_num_trials =
+      HopelessNumTrials(options, num_samples, Estimator::kMinNumSamples);
 
   RandomSampler sampler(num_samples, seed);
   std::vector<typename Estimator::X_t> X_sample;
@@ -250,6 +273,13 @@ RANSACReport<typename Estimator::M_t> Run(const RANSACOptions& options, uint64_t
       }
     }
     if (abort) {
+      report.num_trials += 1;
+      break;
+    }
+    // Give up once a model with min_num_inliers inliers would have been found.
+    if (report.num_trials + 1 >= hopeless_num_trials && report.num_trials + 1 >= min_num_trials &&
+        best_support.num_inliers < min_num_inliers) {
+      report.hopeless = true;
       report.num_trials += 1;
       break;
     }

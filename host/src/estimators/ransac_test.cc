@@ -7,6 +7,9 @@
 #include <cmath>
 #include <random>
 
+#include "estimators/essential_matrix.h"
+#include "estimators/synthetic_scene_test_util.h"
+
 namespace tessera {
 namespace {
 
@@ -135,6 +138,83 @@ TEST(RANSAC, StopsAtMaxNumTrialsWithoutConsensus) {
   EXPECT_EQ(report.num_trials, 30u);
   EXPECT_TRUE(report.success);
   EXPECT_EQ(report.support.num_inliers, 2u);
+}
+
+// Points on no common line: every model has two inliers, whatever the pair drawn.
+void MakeParabola(int num_points, std::vector<double>* X, std::vector<double>* Y) {
+  for (int i = 0; i < num_points; ++i) {
+    X->push_back(i);
+    Y->push_back(i * i);
+  }
+}
+
+TEST(RANSAC, GivesUpEarlyWhenNoModelCanReachMinNumInliers) {
+  std::vector<double> X, Y;
+  MakeParabola(50, &X, &Y);
+  RANSACOptions options = LineOptions();
+  options.min_inlier_ratio = 0.01;  // no a-priori cap below max_num_trials
+  const auto full = RANSAC<LineEstimator>(options, 1).Estimate(X, Y);
+  EXPECT_EQ(full.num_trials, 1000u);
+  EXPECT_FALSE(full.hopeless);
+  options.min_num_inliers = 15;
+  const auto report = LORANSAC<LineEstimator, LineEstimator>(options, 1).Estimate(X, Y);
+  // A line with 15 of 50 inliers is drawn with probability 0.3^2 per trial:
+  // log(0.001) / log(1 - 0.09) = 73.2 -> 74 trials give it 0.999 confidence.
+  EXPECT_EQ(ransac_internal::HopelessNumTrials(options, 50, 2), 74u);
+  EXPECT_EQ(report.num_trials, 74u);
+  EXPECT_TRUE(report.hopeless);
+  EXPECT_EQ(report.support.num_inliers, 2u);
+  // More required inliers than samples: nothing is drawn.
+  options.min_num_inliers = 51;
+  const auto impossible = RANSAC<LineEstimator>(options, 1).Estimate(X, Y);
+  EXPECT_EQ(impossible.num_trials, 0u);
+  EXPECT_TRUE(impossible.hopeless);
+  EXPECT_FALSE(impossible.success);
+}
+
+TEST(RANSAC, MinNumInliersLeavesSuccessfulRunsUnchanged) {
+  // 20 inliers among 100: a line with 15 is drawn within 304 trials with 0.999
+  // confidence, but the true line is drawn long before (0.2^2 per trial), so the run
+  // goes on to the same ~500 trials its inlier ratio asks for, drawing the same samples.
+  for (const uint64_t seed : {1, 2, 3, 4, 5}) {
+    const LineData data = MakeLineData(100, 0.8, seed);
+    RANSACOptions options = LineOptions();
+    options.min_inlier_ratio = 0.01;
+    using Ransac = LORANSAC<LineEstimator, LineEstimator>;
+    const auto plain = Ransac(options, seed).Estimate(data.X, data.Y);
+    options.min_num_inliers = 15;
+    const auto early = Ransac(options, seed).Estimate(data.X, data.Y);
+    ASSERT_TRUE(plain.success);
+    EXPECT_EQ(plain.support.num_inliers, 20u);
+    EXPECT_GT(plain.num_trials, 304u);
+    EXPECT_FALSE(early.hopeless);
+    EXPECT_EQ(early.num_trials, plain.num_trials);
+    EXPECT_EQ(early.inlier_mask, plain.inlier_mask);
+    EXPECT_EQ(early.model, plain.model);
+  }
+}
+
+TEST(LORANSAC, RejectsRandomMatchesOfAnEssentialMatrixEarly) {
+  // Two images that do not overlap: 40 matches, all wrong.
+  testing::SyntheticTwoViewOptions scene_options;
+  scene_options.num_points = 40;
+  scene_options.outlier_ratio = 1.0;
+  const auto scene = testing::MakeSyntheticTwoViewScene(scene_options);
+  // The verification's defaults: 4 px, confidence 0.999, at most 10,000 trials.
+  RANSACOptions options;
+  options.max_error = 4.0 / scene_options.focal_length;
+  options.confidence = 0.999;
+  options.min_inlier_ratio = 0.25;
+  options.max_num_trials = 10000;
+  using Ransac = LORANSAC<EssentialMatrixFivePointEstimator, EssentialMatrixFivePointEstimator>;
+  const auto full = Ransac(options, 3).Estimate(scene.normalized1, scene.normalized2);
+  EXPECT_EQ(full.num_trials, 10000u);
+  options.min_num_inliers = 15;
+  const auto report = Ransac(options, 3).Estimate(scene.normalized1, scene.normalized2);
+  EXPECT_TRUE(report.hopeless);
+  EXPECT_LT(report.support.num_inliers, 15u);
+  // log(0.001) / log(1 - (15 / 40)^5) = 928.04 -> 929 trials.
+  EXPECT_EQ(report.num_trials, 929u);
 }
 
 TEST(RANSAC, ComputeNumTrials) {

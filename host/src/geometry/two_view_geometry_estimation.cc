@@ -34,6 +34,10 @@ RANSACOptions MakeRansacOptions(const VerificationSettings& settings, double max
   options.min_num_trials = settings.min_num_trials;
   options.max_num_trials = settings.max_num_trials;
   options.min_inlier_ratio = settings.min_inlier_ratio;
+  // A model with fewer inliers is dropped anyway: RANSAC gives up once one with
+  // min_num_inliers would have been found, which is what non-overlapping pairs
+  // (most of the candidates in large sets) cost instead of max_num_trials.
+  options.min_num_inliers = std::max(settings.min_num_inliers, 0);
   return options;
 }
 
@@ -109,6 +113,10 @@ RANSACOptions HomographyRansacOptions(const VerificationSettings& settings,
                                   static_cast<double>(min_num_epipolar_inliers) /
                                   static_cast<double>(num_matches);
     options.min_inlier_ratio = std::clamp(decisive_ratio, options.min_inlier_ratio, 1.0);
+    // H is then only compared with the epipolar inliers, whose cap above already
+    // bounds its trials; giving up below min_num_inliers would change the H stored
+    // for pairs that verify.
+    options.min_num_inliers = 0;
   }
   return options;
 }

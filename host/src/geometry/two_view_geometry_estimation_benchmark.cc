@@ -1,5 +1,8 @@
 // Time per pair of EstimateTwoViewGeometry on synthetic scenes: ~3,000 matches with
-// 30% outliers and 0.5 px noise, calibrated (E, F, H) and uncalibrated (F, H).
+// 30% outliers and 0.5 px noise, calibrated (E, F, H) and uncalibrated (F, H); small
+// overlapping pairs (60 matches, half of them wrong); and hopeless pairs, whose
+// matches are all wrong (images that do not overlap), of 30 to 300 matches. Arguments:
+// number of matches, percentage of wrong ones.
 //
 //   two_view_geometry_estimation_benchmark --benchmark_min_time=2
 
@@ -67,8 +70,19 @@ BENCHMARK(BM_Calibrated)
     ->Args({3000, 30})
     ->Args({3000, 50})
     ->Args({1000, 30})
+    ->Args({60, 50})
+    ->Args({30, 100})
+    ->Args({60, 100})
+    ->Args({100, 100})
+    ->Args({300, 100})
     ->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_Uncalibrated)->Args({3000, 30})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_Uncalibrated)
+    ->Args({3000, 30})
+    ->Args({60, 50})
+    ->Args({30, 100})
+    ->Args({60, 100})
+    ->Args({100, 100})
+    ->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CalibratedPlanar)->Args({3000, 30})->Unit(benchmark::kMillisecond);
 
 }  // namespace

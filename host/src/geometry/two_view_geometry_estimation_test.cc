@@ -171,6 +171,38 @@ TEST(EstimateTwoViewGeometry, TooFewTrueMatchesIsDegenerate) {
   EXPECT_TRUE(geometry.inlier_matches.empty());
 }
 
+// Small overlapping pairs, where giving up on hopeless pairs early could cut a good
+// one short: 30 true matches among 60, and 20 among 40. The inlier matches and models
+// are the ones found before RANSAC learnt to give up (recorded at commit 2428a1b).
+TEST(EstimateTwoViewGeometry, SmallOverlappingPairsVerifyAsBefore) {
+  struct Case {
+    int num_points;
+    double outlier_ratio;
+    bool calibrated;
+    int config;
+    size_t num_inliers;
+    size_t num_true_inliers;
+  };
+  // With 60 matches E keeps fewer than 95% of F's 33 inliers: the pair is UNCALIBRATED
+  // even with calibrated cameras.
+  for (const Case& c : {Case{60, 0.5, true, TwoViewGeometry::UNCALIBRATED, 33, 30},
+                        Case{60, 0.5, false, TwoViewGeometry::UNCALIBRATED, 33, 30},
+                        Case{40, 0.5, true, TwoViewGeometry::CALIBRATED, 22, 19},
+                        Case{40, 0.5, false, TwoViewGeometry::UNCALIBRATED, 22, 19}}) {
+    const SyntheticTwoViewOptions options = NoisyOptions(c.num_points, c.outlier_ratio);
+    const auto scene = MakeSyntheticTwoViewScene(options);
+    const TwoViewGeometry geometry =
+        Estimate(MakeInput(scene, options, c.calibrated), VerificationSettings(), 7);
+    size_t num_true_inliers = 0;
+    for (const FeatureMatch& match : geometry.inlier_matches) {
+      num_true_inliers += !scene.is_outlier[match.point2D_idx1];
+    }
+    EXPECT_EQ(geometry.config, c.config) << c.num_points << " " << c.calibrated;
+    EXPECT_EQ(geometry.inlier_matches.size(), c.num_inliers) << c.num_points << " " << c.calibrated;
+    EXPECT_EQ(num_true_inliers, c.num_true_inliers) << c.num_points << " " << c.calibrated;
+  }
+}
+
 TEST(EstimateTwoViewGeometry, SameSeedSameInliersOtherSeedStillSucceeds) {
   const SyntheticTwoViewOptions options = NoisyOptions(800, 0.4);
   const auto scene = MakeSyntheticTwoViewScene(options);

@@ -212,6 +212,9 @@ class ModelBuilder {
   std::set<image_t> registered_;
   std::vector<point3D_t> point3D_of_track_;
   std::map<point3D_t, track_t> track_of_point3D_;
+  // Every image with a feature in a track that has (or had) a 3D point: a superset of
+  // the images that see one, in id order.
+  std::set<image_t> images_seeing_points_;
   std::vector<track_t> merged_into_;
   point3D_t next_point3D_id_ = 1;
   std::map<image_t, int> num_registration_trials_;
@@ -234,6 +237,9 @@ point3D_t ModelBuilder::AddPoint(track_t track_id, const Eigen::Vector3d& xyz, c
   point3D.track = track;
   for (const TrackElement& element : track) {
     rec_.images.at(element.image_id).points2D[element.point2D_idx].point3D_id = point3D_id;
+  }
+  for (const TrackElement& element : tracks_.tracks[track_id]) {
+    images_seeing_points_.insert(element.image_id);
   }
   point3D_of_track_[track_id] = point3D_id;
   track_of_point3D_[point3D_id] = track_id;
@@ -433,7 +439,10 @@ std::vector<image_t> ModelBuilder::NextImages() {
   // points spread over the image beat as many points in one corner.
   constexpr int kNumLevels = 3;
   std::vector<std::tuple<double, size_t, image_t>> scored;
-  for (const auto& [image_id, image] : rec_.images) {
+  // An image outside images_seeing_points_ sees no point and would be skipped below:
+  // scanning only these keeps each step local to the model's frontier.
+  for (const image_t image_id : images_seeing_points_) {
+    const Image& image = rec_.images.at(image_id);
     if (IsRegistered(image_id) || run_.used_images.count(image_id) > 0 ||
         num_registration_trials_[image_id] >= options_.max_reg_trials) {
       continue;

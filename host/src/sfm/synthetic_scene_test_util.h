@@ -1,7 +1,8 @@
 #pragma once
 
 // Test helper (header only): a synthetic multi-view scene with known truth for the
-// mapper. Cameras on an arc around a cloud of points, all looking at its centre; the
+// mapper. Cameras on an arc around a cloud of points, all looking at its centre, or
+// along a straight path past a long wall of points, each seeing a stretch of it; the
 // keypoints are the projected points (with Gaussian noise, in shuffled order, plus
 // unmatched clutter) and every pair of images gets the matches of the points both see,
 // a chosen fraction of them replaced by wrong matches.
@@ -24,9 +25,19 @@
 namespace tessera::testing {
 
 struct SyntheticSceneOptions {
+  // kArc: cameras on an arc around a cube of points, all seeing nearly all of them.
+  // kPath: cameras path_step apart on a straight line (the x axis), looking ahead (+z)
+  // at a slab of points as long as the path and path_min_depth to path_max_depth
+  // away: each image sees a local stretch, so a long path has few overlapping pairs,
+  // as a walk along a street has.
+  enum class Layout { kArc, kPath };
+  Layout layout = Layout::kArc;
   int num_images = 12;
-  int num_points = 1500;
-  double arc_deg = 120;        // the cameras' spread around the scene
+  int num_points = 1500;  // in all, whatever the layout
+  double arc_deg = 120;   // the cameras' spread around the scene
+  double path_step = 1.0;
+  double path_min_depth = 6.0;
+  double path_max_depth = 10.0;
   double radius = 10;          // distance of the cameras from the scene centre
   double scene_size = 4;       // side of the cube of points
   double focal_length = 1000;  // px
@@ -100,7 +111,21 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
   prior_camera.has_prior_focal_length = options.focal_prior;
   scene.input.cameras[1] = prior_camera;
 
+  const bool path = options.layout == SyntheticSceneOptions::Layout::kPath;
+  // kPath: the slab reaches past both ends of the path by what the first and last
+  // camera see of it.
+  const double path_length = options.path_step * std::max(options.num_images - 1, 0);
+  const double path_margin = options.path_max_depth * options.width / 2 / options.focal_length;
+  const double path_slab_height = options.path_min_depth * options.height / options.focal_length;
   for (int i = 0; i < options.num_points; ++i) {
+    if (path) {
+      const double x = (path_length + 2 * path_margin) * (unit(engine) + 0.5) - path_margin;
+      const double y = path_slab_height * unit(engine);
+      const double z = options.path_min_depth +
+                       (options.path_max_depth - options.path_min_depth) * (unit(engine) + 0.5);
+      scene.true_points3D.emplace_back(x, y, z);
+      continue;
+    }
     scene.true_points3D.emplace_back(options.scene_size * unit(engine),
                                      options.scene_size * unit(engine),
                                      options.scene_size * unit(engine));
@@ -131,11 +156,16 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
         (options.num_images > 1 ? static_cast<double>(i) / (options.num_images - 1) - 0.5 : 0);
     // Centre on the arc (y is down, the arc lies in the x-z plane), looking at the origin
     // with a little random jitter of the viewing direction.
-    const Eigen::Vector3d center(options.radius * std::sin(angle), 0.3 * unit(engine),
-                                 -options.radius * std::cos(angle));
-    viewing_angle_deg[image_id] = angle * 180 / M_PI;
-    const Eigen::Vector3d z_axis =
-        (-center + Eigen::Vector3d(0.2 * unit(engine), 0.2 * unit(engine), 0)).normalized();
+    Eigen::Vector3d center, z_axis;
+    if (path) {
+      center = Eigen::Vector3d(options.path_step * i, 0.3 * unit(engine), 0);
+      z_axis = Eigen::Vector3d(0.05 * unit(engine), 0.05 * unit(engine), 1).normalized();
+    } else {
+      center = Eigen::Vector3d(options.radius * std::sin(angle), 0.3 * unit(engine),
+                               -options.radius * std::cos(angle));
+      z_axis = (-center + Eigen::Vector3d(0.2 * unit(engine), 0.2 * unit(engine), 0)).normalized();
+    }
+    viewing_angle_deg[image_id] = path ? 0.0 : angle * 180 / M_PI;
     const Eigen::Vector3d x_axis = Eigen::Vector3d::UnitY().cross(z_axis).normalized();
     const Eigen::Vector3d y_axis = z_axis.cross(x_axis);
     Eigen::Matrix3d world_from_cam;
