@@ -101,10 +101,21 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
   std::vector<FeatureDescriptors> descriptors(images.size());
   std::vector<bool> needed(images.size(), false);
   for (const auto& [i, j] : todo) needed[i] = needed[j] = true;
+  // Every descriptor read is checked to have the width of all others: features of
+  // two detectors must never meet in a matcher.
+  const std::vector<int64_t> widths = database->DescriptorWidths();
+  if (widths.size() > 1) {
+    std::string list;
+    for (const int64_t width : widths) list += (list.empty() ? "" : ", ") + std::to_string(width);
+    throw InputError(database->path().string() + ": the workspace holds descriptors of " +
+                     std::to_string(widths.size()) + " widths (" + list +
+                     " bytes), features of different detectors; run `tessera extract` again");
+  }
+  const int64_t width = widths.empty() ? -1 : widths.front();
   for (size_t i = 0; i < images.size(); ++i) {
     if (!needed[i]) continue;
     keypoints[i] = database->ReadKeypoints(images[i].image_id);
-    descriptors[i] = database->ReadDescriptors(images[i].image_id, metric);
+    descriptors[i] = database->ReadDescriptors(images[i].image_id, metric, width);
   }
 
   std::mutex database_mutex;
