@@ -164,7 +164,7 @@ disk_code=$?
 check "disk full (ulimit -f), then a rerun" 0 "" '[ "$disk_code" = 2 ] && grep -q "full_disk/.*disk full" "$work/disk.log" && [ "$(registered "$work/full_disk")" = 5 ]' -- \
   run_m --images "$work/w" --output "$work/full_disk"
 subset "$work/c" 11
-run_m --images "$work/c" --output "$work/c_out" > "$work/first.log" 2>&1 &
+"$tessera" run --manifest "$work/m.json" --threads 2 --images "$work/c" --output "$work/c_out" > "$work/first.log" 2>&1 &
 first=$!
 for _ in $(seq 1 200); do [ -s "$work/c_out/.tessera.lock" ] && break; sleep 0.05; done
 check "a second writer on the same output" 2 "workspace $work/c_out is in use by process $first \(since " "" -- \

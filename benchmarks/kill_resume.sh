@@ -47,7 +47,7 @@ identical=0 redetected_total=0 rematched_total=0 detected_total=0 matched_total=
 for trial in $(seq 1 "$kills"); do
   moment=$(echo "scale=3; $wall * (0.02 + 0.96 * $RANDOM / 32767)" | bc)
   workspace="$work/trial_$trial"
-  run "$workspace" > "$work/killed_$trial.log" 2>&1 &
+  "$tessera" run --images "$images" --output "$workspace" --manifest "$manifest" --threads 2 > "$work/killed_$trial.log" 2>&1 &
   pid=$!
   sleep "$moment"
   kill -9 $pid 2> /dev/null

@@ -153,7 +153,8 @@ tess "$work/g2.log" run --images "$work/d" --output "$work/out_g" || { cat "$wor
 echo "disk full: exit 2 naming $(grep -o "$work/out_g/[^ ']*" "$work/g1.log" | head -1 | sed "s|$work/||"), rerun completes"
 
 # 7. Two writers.
-tess "$work/h1.log" run --images "$work/all" --output "$work/out_h" &
+"$tessera" run --images "$work/all" --output "$work/out_h" --manifest "$work/m.json" \
+  --threads 2 > "$work/h1.log" 2>&1 &
 first=$!
 for _ in $(seq 1 200); do [ -s "$work/out_h/.tessera.lock" ] && break; sleep 0.05; done
 "$tessera" run --images "$work/all" --output "$work/out_h" > "$work/h2.log" 2>&1
@@ -164,7 +165,8 @@ grep -q "workspace $work/out_h is in use by process $first (since " "$work/h2.lo
 wait $first || { cat "$work/h1.log"; fail "the first writer failed"; }
 [ "$(registered "$work/out_h")" = 11 ] || fail "the first writer registered $(registered "$work/out_h") of 11"
 echo "two writers: the second refused naming the first, the first registered 11 of 11"
-tess "$work/i1.log" run --images "$work/all" --output "$work/out_i" &
+"$tessera" run --images "$work/all" --output "$work/out_i" --manifest "$work/m.json" \
+  --threads 2 > "$work/i1.log" 2>&1 &
 victim=$!
 for _ in $(seq 1 400); do
   [ -s "$work/out_i/.tessera.lock" ] && grep -q "features" "$work/i1.log" && break
