@@ -154,11 +154,11 @@ TEST(TransformsJsonExporter, PerFrameIntrinsicsForSeveralCamerasAndModelIndex) {
 
 TEST(TransformsJsonExporter, TheFileMustStayInsideTheOutputFolder) {
   for (const auto& [file, why] : std::vector<std::pair<std::string, std::string>>{
-           {"../../escape.json", "leaves the output folder"},
-           {"nerf/../../escape.json", "leaves the output folder"},
+           {"../../escape.json", "leaves the output folder (\"..\")"},
+           {"nerf/../../escape.json", "leaves the output folder (\"..\")"},
            {"/tmp/escape.json", "is absolute"},
            {"", "is empty"},
-           {"a\nb.json", "contains a line break"}}) {
+           {"a\nb.json", "contains a line break or NUL"}}) {
     try {
       testing::LoadBundledPlugin<Exporter>("exporter", "transforms_json", {{"file", file}});
       ADD_FAILURE() << "'" << file << "' was accepted";
