@@ -266,7 +266,7 @@ TEST(Cli, ANumberTooLargeForADoubleNamesItsKeyAndLine) {
 
 TEST(Cli, ExporterPathsMustStayInsideTheOutputFolder) {
   testing::TemporaryDir dir;
-  const auto manifest = dir.path() / "escape.json";
+  const auto manifest = dir.path() / "exporters.json";
   const auto run = [&](const std::string& exporter) {
     std::ofstream(manifest) << R"({"pipeline": {"exporters": [)" << exporter << "]}}";
     return RunTessera("run --images " + (dir.path() / "none").string() + " --output " +
@@ -303,8 +303,8 @@ TEST(Cli, ASecondWriterOfAWorkspaceIsRefusedNamingTheFirst) {
   testing::TemporaryDir dir;
   const auto workspace = dir.path() / "out";
   const WorkspaceLock lock(workspace);
-  for (const std::string verb : {"extract --images " + dir.path().string(), std::string("match"),
-                                 std::string("map"), "run --images " + dir.path().string()}) {
+  for (const std::string& verb : {"extract --images " + dir.path().string(), std::string("match"),
+                                  std::string("map"), "run --images " + dir.path().string()}) {
     const auto result = RunTessera(verb + " --output " + workspace.string());
     EXPECT_EQ(result.exit_code, 2) << verb << ": " << result.output;
     EXPECT_NE(result.output.find("workspace " + workspace.string() + " is in use by process " +
