@@ -10,6 +10,7 @@ packages=(
   libglfw3-dev libimgui-dev libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libspdlog-dev python3-numpy gnuplot-nox
   libfaiss-dev
+  libxxhash-dev
 )
 # The reference system, for the interoperability tests and benchmarks, and Open3D, an
 # independent PLY reader for the ply exporter's test; optional.

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -9,6 +10,7 @@
 
 #include "test_support.h"
 #include "util/file_io.h"
+#include "util/workspace_lock.h"
 
 namespace tessera {
 namespace {
@@ -258,6 +260,83 @@ TEST(Cli, ExportOfAnUnknownFormatSuggestsTheClosest) {
   EXPECT_NE(bad_json.output.find("--options: not valid JSON"), std::string::npos)
       << bad_json.output;
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "out"));
+}
+
+TEST(Cli, AManifestThatIsAFolderIsExitCode2NamingIt) {
+  testing::TemporaryDir dir;
+  const auto result =
+      RunTessera("run --images " + dir.path().string() + " --output " +
+                 (dir.path() / "out").string() + " --manifest " + dir.path().string());
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find(dir.path().string() +
+                               ": cannot read the manifest: it is a folder, not a file"),
+            std::string::npos)
+      << result.output;
+}
+
+TEST(Cli, ANumberTooLargeForADoubleNamesItsKeyAndLine) {
+  testing::TemporaryDir dir;
+  const auto manifest = dir.path() / "huge.json";
+  std::ofstream(manifest) << "{\"pipeline\": {},\n \"verification\": {\"max_error_px\": 1e400}}\n";
+  const auto result = RunTessera("match --output " + (dir.path() / "out").string() +
+                                 " --manifest " + manifest.string());
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find(manifest.string() +
+                               ": invalid JSON at line 2 (key 'max_error_px'): the number "
+                               "'1e400' is out of range"),
+            std::string::npos)
+      << result.output;
+}
+
+TEST(Cli, ExporterPathsMustStayInsideTheOutputFolder) {
+  testing::TemporaryDir dir;
+  const auto manifest = dir.path() / "exporters.json";
+  const auto run = [&](const std::string& exporter) {
+    std::ofstream(manifest) << R"({"pipeline": {"exporters": [)" << exporter << "]}}";
+    return RunTessera("run --images " + (dir.path() / "none").string() + " --output " +
+                      (dir.path() / "a" / "b").string() + " --manifest " + manifest.string());
+  };
+  const auto up = run(R"({"plugin": "transforms_json", "options": {"file": "../../escape.json"}})");
+  EXPECT_EQ(up.exit_code, 2) << up.output;
+  EXPECT_NE(up.output.find("pipeline.exporters[0].options.file: '../../escape.json' leaves the "
+                           "output folder (\"..\"); it must be a relative path inside the output "
+                           "folder"),
+            std::string::npos)
+      << up.output;
+  const auto absolute =
+      run(R"({"plugin": "gaussian_splatting", "options": {"folder": "/tmp/splat"}})");
+  EXPECT_EQ(absolute.exit_code, 2) << absolute.output;
+  EXPECT_NE(absolute.output.find("pipeline.exporters[0].options.folder: '/tmp/splat' is absolute"),
+            std::string::npos)
+      << absolute.output;
+  const auto inside = run(R"({"plugin": "transforms_json", "options": {"file": "a/..x/t.json"}})");
+  EXPECT_EQ(inside.output.find("options.file"), std::string::npos) << inside.output;
+  // The export verb uses the same exporters, so the same check.
+  WriteSmallTextModel(dir.path() / "model");
+  const auto exported = RunTessera(
+      "export --model " + (dir.path() / "model").string() + " --format transforms_json --output " +
+      (dir.path() / "out").string() + R"( --options '{"file": "../escape.json"}')");
+  EXPECT_EQ(exported.exit_code, 2) << exported.output;
+  EXPECT_NE(exported.output.find("exporter.options.file: '../escape.json' leaves"),
+            std::string::npos)
+      << exported.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "escape.json"));
+}
+
+TEST(Cli, ASecondWriterOfAWorkspaceIsRefusedNamingTheFirst) {
+  testing::TemporaryDir dir;
+  const auto workspace = dir.path() / "out";
+  const WorkspaceLock lock(workspace);
+  for (const std::string& verb : {"extract --images " + dir.path().string(), std::string("match"),
+                                  std::string("map"), "run --images " + dir.path().string()}) {
+    const auto result = RunTessera(verb + " --output " + workspace.string());
+    EXPECT_EQ(result.exit_code, 2) << verb << ": " << result.output;
+    EXPECT_NE(result.output.find("workspace " + workspace.string() + " is in use by process " +
+                                 std::to_string(getpid()) + " (since "),
+              std::string::npos)
+        << verb << ": " << result.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(workspace / "database.db"));
 }
 
 }  // namespace

@@ -136,6 +136,30 @@ class OptionReader {
     return value;
   }
 
+  // A file or folder path that must stay inside the folder it is relative to (an
+  // exporter's output folder): not empty, not absolute, no ".." component, no line
+  // break. Anything else is an OptionError naming the key.
+  std::string GetRelativePath(const std::string& key, const std::string& default_value) {
+    const std::string value = GetString(key, default_value);
+    const auto fail = [&](const std::string& why) {
+      throw OptionError(KeyPath(key), "'" + value + "' " + why +
+                                          "; it must be a relative path inside the output folder");
+    };
+    if (value.empty()) fail("is empty");
+    if (value.find_first_of("\r\n") != std::string::npos || value.find('\0') != std::string::npos) {
+      fail("contains a line break or NUL");
+    }
+    if (value.front() == '/') fail("is absolute");
+    size_t start = 0;
+    while (start <= value.size()) {
+      size_t end = value.find('/', start);
+      if (end == std::string::npos) end = value.size();
+      if (value.compare(start, end - start, "..") == 0) fail("leaves the output folder (\"..\")");
+      start = end + 1;
+    }
+    return value;
+  }
+
   // Any JSON value, unchecked; for nested objects that are read by another reader.
   nlohmann::json GetJson(const std::string& key, const nlohmann::json& default_value) {
     known_.push_back(key);

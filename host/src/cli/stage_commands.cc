@@ -4,6 +4,8 @@
 #include <spdlog/spdlog.h>
 
 #include <fstream>
+#include <map>
+#include <memory>
 #include <optional>
 
 #include "cli/commands.h"
@@ -12,6 +14,7 @@
 #include "database/database.h"
 #include "feature/feature_extraction.h"
 #include "feature/feature_matching.h"
+#include "image/image_io.h"
 #include "image/point_colors.h"
 #include "plugin/bundle_adjuster_guard.h"
 #include "plugin/plugin_crash_log.h"
@@ -20,6 +23,7 @@
 #include "sfm/mapper_input.h"
 #include "util/file_io.h"
 #include "util/timer.h"
+#include "util/workspace_lock.h"
 
 namespace tessera {
 namespace {
@@ -70,11 +74,34 @@ std::filesystem::path PrepareWorkspace(const std::string& output) {
   return dir / "database.db";
 }
 
+// One writer per workspace: every verb that writes it holds this for its whole run.
+std::unique_ptr<WorkspaceLock> LockWorkspace(const std::string& output) {
+  std::string stale;
+  auto lock = std::make_unique<WorkspaceLock>(output, &stale);
+  if (!stale.empty()) {
+    spdlog::info(
+        "workspace {}: taking over the lock left by {}, which ended without releasing it "
+        "(killed?); its last committed work is kept",
+        output, stale);
+  }
+  return lock;
+}
+
+// The scan leaves the run's own output folder out: output never feeds input.
+ImageScanOptions ScanOptions(const StageOptions& options, const Manifest& manifest) {
+  ImageScanOptions scan;
+  scan.excluded_folders.push_back(options.output);
+  scan.max_image_pixels = manifest.max_image_pixels;
+  return scan;
+}
+
 void LogExtraction(const ExtractionSummary& s) {
   spdlog::info(
       "extract: {} images ({} skipped files), {} detected with {} features, {} reused, "
+      "{} skipped at decoding or detection, {} changed and {} removed since the last run, "
       "{:.2f} s",
-      s.num_images, s.num_skipped_files, s.num_detected, s.num_features, s.num_reused, s.seconds);
+      s.num_images, s.num_skipped_files, s.num_detected, s.num_features, s.num_reused, s.num_failed,
+      s.num_changed, s.num_removed, s.seconds);
 }
 
 void LogMatching(const MatchingSummary& s) {
@@ -107,6 +134,31 @@ std::filesystem::path ImageFolder(const std::string& option, const Database& dat
     return provenance->at("folder").get<std::string>();
   }
   return {};
+}
+
+// `map` on its own: the images the points are coloured from (and the exporters read)
+// must be the very files the workspace's features came from.
+void CheckImagesUnchanged(const std::string& image_dir_option, const StageOptions& options,
+                          const Manifest& manifest, const Database& database) {
+  const std::filesystem::path image_dir = ImageFolder(image_dir_option, database);
+  const std::vector<Database::ImageFile> files = database.ReadImageFiles();
+  std::error_code error;
+  if (image_dir.empty() || files.empty()) return;
+  if (image_dir_option.empty() && !std::filesystem::is_directory(image_dir, error)) return;
+  const ImageScan scan = ScanImageFolder(image_dir, ScanOptions(options, manifest));
+  std::map<std::string, const ImageEntry*> scanned;
+  for (const ImageEntry& entry : scan.images) scanned[entry.name] = &entry;
+  for (const Database::ImageFile& file : files) {
+    if (!file.image_id) continue;
+    const auto it = scanned.find(file.name);
+    if (it == scanned.end() || it->second->content_hash != file.content_hash ||
+        it->second->file_size != file.size) {
+      throw InputError(
+          (image_dir / file.name).string() + ": " +
+          (it == scanned.end() ? "missing" : "changed since the workspace ingested it") +
+          "; run `tessera extract --images " + image_dir.string() + "` (or `tessera run`) again");
+    }
+  }
 }
 
 // Removes sparse/<k> folders of an earlier run for k >= num_models, so that the
@@ -142,8 +194,17 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
   const Timer timer;
   const MapperInput input = LoadMapperInput(*database);
   if (input.pairs.empty()) {
-    throw InputError(database->path().string() +
-                     ": no verified image pairs in the workspace; run match first");
+    if (!database->ReadStageProvenance(Database::kTwoViewGeometriesStage)) {
+      throw InputError(database->path().string() +
+                       ": no verified image pairs in the workspace; run match first");
+    }
+    // Matching ran and verified no pair: no model can be built (exit 3).
+    spdlog::error("map: {}: matching verified none of the {} matched image pairs",
+                  database->path().string(), database->NumMatchedPairs());
+    MappingSummary summary;
+    summary.num_images = database->NumImages();
+    summary.seconds = timer.ElapsedSeconds();
+    return summary;
   }
   const BundleAdjusterGuard bundle_adjuster(context.bundle_adjuster);
   const IncrementalMapper mapper(context.mapper_options, bundle_adjuster, context.manifest.seed);
@@ -273,12 +334,14 @@ CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
             PipelineContext context = LoadContext(*options);
             context.Require("bundle_adjuster", "map");
             const std::filesystem::path database_file = PrepareWorkspace(options->output);
+            const auto lock = LockWorkspace(options->output);
             if (!std::filesystem::exists(database_file)) {
               throw InputError(database_file.string() +
                                ": no workspace database; run extract "
                                "and match first");
             }
             Database database(database_file);
+            CheckImagesUnchanged(options->images, *options, context.manifest, database);
             const MappingSummary summary =
                 MapWorkspace(context, &database, options->output, options->images);
             return MappingExitCode(summary, database_file);
@@ -292,9 +355,10 @@ CommandRegistration RegisterExtractCommand(CLI::App& app, const GlobalOptions&) 
   return {sub, [options]() {
             PipelineContext context = LoadContext(*options);
             context.Require("detector", "extract");
+            const auto lock = LockWorkspace(options->output);
             Database database(PrepareWorkspace(options->output));
-            LogExtraction(
-                ExtractFeatures(options->images, context.manifest, context.detector, &database));
+            LogExtraction(ExtractFeatures(options->images, context.manifest, context.detector,
+                                          &database, ScanOptions(*options, context.manifest)));
             return static_cast<int>(kExitSuccess);
           }};
 }
@@ -307,6 +371,7 @@ CommandRegistration RegisterMatchCommand(CLI::App& app, const GlobalOptions&) {
             PipelineContext context = LoadContext(*options);
             context.Require("pair_selector", "match");
             context.Require("matcher", "match");
+            const auto lock = LockWorkspace(options->output);
             Database database(PrepareWorkspace(options->output));
             LogMatching(MatchFeatures(context.manifest, context.pair_selectors, context.matcher,
                                       &database));
@@ -328,9 +393,11 @@ CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions&) {
             // A selector that cannot use the detector's descriptors fails before extraction.
             context.CheckPairSelectorDescriptors(context.detector->Metric(), 0);
             const std::filesystem::path database_file = PrepareWorkspace(options->output);
+            const auto lock = LockWorkspace(options->output);
             Database database(database_file);
             const ExtractionSummary extraction =
-                ExtractFeatures(options->images, context.manifest, context.detector, &database);
+                ExtractFeatures(options->images, context.manifest, context.detector, &database,
+                                ScanOptions(*options, context.manifest));
             const MatchingSummary matching =
                 MatchFeatures(context.manifest, context.pair_selectors, context.matcher, &database);
             LogExtraction(extraction);
@@ -346,7 +413,10 @@ CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions&) {
                  {{"seconds", extraction.seconds},
                   {"num_images", extraction.num_images},
                   {"num_detected", extraction.num_detected},
-                  {"num_reused", extraction.num_reused}}},
+                  {"num_reused", extraction.num_reused},
+                  {"num_failed", extraction.num_failed},
+                  {"num_changed", extraction.num_changed},
+                  {"num_removed", extraction.num_removed}}},
                 {"match",
                  {{"seconds", matching.seconds},
                   {"num_pairs", matching.num_pairs},

@@ -89,7 +89,13 @@ constexpr const char* kCreateTesseraTables =
     "    source     TEXT                NOT NULL);"
     "CREATE TABLE IF NOT EXISTS tessera_image_metadata"
     "   (image_id  INTEGER  PRIMARY KEY  NOT NULL,"
-    "    metadata  TEXT               NOT NULL);";
+    "    metadata  TEXT               NOT NULL);"
+    "CREATE TABLE IF NOT EXISTS tessera_images"
+    "   (name         TEXT     PRIMARY KEY  NOT NULL,"
+    "    image_id     INTEGER,"
+    "    size         INTEGER               NOT NULL,"
+    "    hash         TEXT                  NOT NULL,"
+    "    skip_reason  TEXT);";
 
 // COLMAP writes its version number here (3.8 -> 3800); later COLMAP versions read it
 // to decide which schema migrations a database needs.
@@ -108,6 +114,7 @@ const std::map<std::string, std::vector<std::string>>& RequiredColumns() {
       {"tessera_stages", {"stage", "provenance"}},
       {"tessera_camera_priors", {"camera_id", "source"}},
       {"tessera_image_metadata", {"image_id", "metadata"}},
+      {"tessera_images", {"name", "image_id", "size", "hash", "skip_reason"}},
   };
   return columns;
 }
@@ -258,7 +265,8 @@ struct Database::Impl {
       exists_matches, write_matches, read_matches, read_matched_pair_ids, num_matched_pairs,
       exists_two_view_geometry, write_two_view_geometry, read_two_view_geometry,
       read_two_view_geometries, num_verified_pairs, read_stage, write_stage,
-      write_calibration_source, write_image_metadata, read_image_metadata, descriptor_dimension;
+      write_calibration_source, write_image_metadata, read_image_metadata, descriptor_dimension,
+      read_image_files, write_image_file, delete_image_file, descriptor_widths;
 
   ~Impl() {
     // Statements first: a connection with live statements does not close.
@@ -293,7 +301,11 @@ struct Database::Impl {
                             &write_calibration_source,
                             &write_image_metadata,
                             &read_image_metadata,
-                            &descriptor_dimension}) {
+                            &descriptor_dimension,
+                            &read_image_files,
+                            &write_image_file,
+                            &delete_image_file,
+                            &descriptor_widths}) {
       statement->reset();
     }
     if (in_transaction) sqlite3_exec(db, "ROLLBACK;", nullptr, nullptr, nullptr);
@@ -309,6 +321,13 @@ struct Database::Impl {
     if (primary == SQLITE_NOTADB || primary == SQLITE_CORRUPT) {
       throw InputError("Database file '" + path.string() + "' is not a valid SQLite database (" +
                        message + ") while trying to " + operation + ".");
+    }
+    // A full disk (or a file size limit) is the user's to fix; SQLite rolled the
+    // transaction back, so the workspace stays valid and a later run resumes.
+    if (primary == SQLITE_FULL || rc == SQLITE_IOERR_WRITE || rc == SQLITE_IOERR_FSYNC ||
+        rc == SQLITE_IOERR_TRUNCATE || rc == SQLITE_IOERR_SHMSIZE) {
+      throw InputError("Database file '" + path.string() + "': cannot " + operation + ": " +
+                       message + " (is the disk full?).");
     }
     throw std::runtime_error("Database '" + path.string() + "': cannot " + operation + ": " +
                              message + ".");
@@ -654,6 +673,14 @@ void Database::Impl::PrepareStatements() {
   read_image_metadata =
       Prepare("SELECT image_id, metadata FROM tessera_image_metadata ORDER BY image_id;");
   descriptor_dimension = Prepare("SELECT cols FROM descriptors WHERE rows > 0 LIMIT 1;");
+  read_image_files =
+      Prepare("SELECT name, image_id, size, hash, skip_reason FROM tessera_images ORDER BY name;");
+  write_image_file = Prepare(
+      "INSERT OR REPLACE INTO tessera_images(name, image_id, size, hash, skip_reason) "
+      "VALUES(?, ?, ?, ?, ?);");
+  delete_image_file = Prepare("DELETE FROM tessera_images WHERE name = ?;");
+  descriptor_widths =
+      Prepare("SELECT DISTINCT cols FROM descriptors WHERE rows > 0 ORDER BY cols;");
 }
 
 Database::Database(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
@@ -909,7 +936,8 @@ void Database::WriteDescriptors(image_t image_id, const FeatureDescriptors& desc
   impl_->Step(stmt, operation);
 }
 
-FeatureDescriptors Database::ReadDescriptors(image_t image_id, DescriptorMetric metric) const {
+FeatureDescriptors Database::ReadDescriptors(image_t image_id, DescriptorMetric metric,
+                                             int64_t expected_cols) const {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   const std::string what = "the descriptors of image " + std::to_string(image_id);
   StatementUse use(*impl_->read_descriptors);
@@ -923,6 +951,12 @@ FeatureDescriptors Database::ReadDescriptors(image_t image_id, DescriptorMetric 
   if (rows < 0 || cols < 0) {
     throw InputError("Database '" + impl_->path.string() + "': " + what + " have " +
                      std::to_string(rows) + " rows and " + std::to_string(cols) + " columns.");
+  }
+  if (expected_cols >= 0 && rows > 0 && cols != expected_cols) {
+    throw InputError("Database '" + impl_->path.string() + "': " + what + " are " +
+                     std::to_string(cols) + " bytes wide, expected " +
+                     std::to_string(expected_cols) +
+                     " (features of another detector); run `tessera extract` again.");
   }
   descriptors.data.resize(rows, cols);
   if (descriptors.data.size() > 0) {
@@ -1156,6 +1190,88 @@ std::optional<int> Database::DescriptorDimension() const {
   StatementUse use(*impl_->descriptor_dimension);
   if (!impl_->Step(use.get(), "read the descriptor width")) return std::nullopt;
   return static_cast<int>(sqlite3_column_int64(use.get(), 0));
+std::vector<Database::ImageFile> Database::ReadImageFiles() const {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  StatementUse use(*impl_->read_image_files);
+  sqlite3_stmt* stmt = use.get();
+  std::vector<ImageFile> files;
+  while (impl_->Step(stmt, "read the image files")) {
+    ImageFile file;
+    const auto* name = reinterpret_cast<const char*>(sqlite3_column_text(stmt, 0));
+    file.name = name != nullptr ? name : "";
+    if (sqlite3_column_type(stmt, 1) != SQLITE_NULL) {
+      file.image_id = static_cast<image_t>(sqlite3_column_int64(stmt, 1));
+    }
+    file.size = static_cast<uint64_t>(sqlite3_column_int64(stmt, 2));
+    const auto* hash = reinterpret_cast<const char*>(sqlite3_column_text(stmt, 3));
+    file.content_hash = hash != nullptr ? hash : "";
+    const auto* reason = reinterpret_cast<const char*>(sqlite3_column_text(stmt, 4));
+    file.skip_reason = reason != nullptr ? reason : "";
+    files.push_back(std::move(file));
+  }
+  return files;
+}
+
+void Database::WriteImageFile(const ImageFile& file) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  const std::string operation = "write the image file record of '" + file.name + "'";
+  StatementUse use(*impl_->write_image_file);
+  sqlite3_stmt* stmt = use.get();
+  impl_->BindText(stmt, 1, file.name, operation);
+  if (file.image_id) {
+    impl_->BindInt64(stmt, 2, *file.image_id, operation);
+  } else {
+    impl_->Check(sqlite3_bind_null(stmt, 2), operation);
+  }
+  impl_->BindInt64(stmt, 3, static_cast<int64_t>(file.size), operation);
+  impl_->BindText(stmt, 4, file.content_hash, operation);
+  if (file.skip_reason.empty()) {
+    impl_->Check(sqlite3_bind_null(stmt, 5), operation);
+  } else {
+    impl_->BindText(stmt, 5, file.skip_reason, operation);
+  }
+  impl_->Step(stmt, operation);
+}
+
+void Database::DeleteImageFile(const std::string& name) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  const std::string operation = "delete the image file record of '" + name + "'";
+  StatementUse use(*impl_->delete_image_file);
+  impl_->BindText(use.get(), 1, name, operation);
+  impl_->Step(use.get(), operation);
+}
+
+void Database::DeleteImage(image_t image_id) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  const std::string id = std::to_string(image_id);
+  const std::string operation = "delete image " + id;
+  // pair_id = id1 * kMaxNumImages + id2 with id1 < id2.
+  const std::string max = std::to_string(kMaxNumImages);
+  const std::string pairs =
+      "(pair_id / " + max + " = " + id + " OR pair_id % " + max + " = " + id + ")";
+  impl_->Atomically(operation, [&] {
+    impl_->Exec(("DELETE FROM two_view_geometries WHERE " + pairs + "; DELETE FROM matches WHERE " +
+                 pairs + "; DELETE FROM descriptors WHERE image_id = " + id +
+                 "; DELETE FROM keypoints WHERE image_id = " + id +
+                 "; DELETE FROM tessera_images WHERE image_id = " + id +
+                 "; DELETE FROM tessera_image_metadata WHERE image_id = " + id +
+                 "; DELETE FROM images WHERE image_id = " + id +
+                 "; DELETE FROM tessera_camera_priors WHERE camera_id NOT IN "
+                 "(SELECT camera_id FROM images); DELETE FROM cameras WHERE camera_id NOT IN "
+                 "(SELECT camera_id FROM images);")
+                    .c_str(),
+                operation);
+  });
+}
+
+std::vector<int64_t> Database::DescriptorWidths() const {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  StatementUse use(*impl_->descriptor_widths);
+  std::vector<int64_t> widths;
+  while (impl_->Step(use.get(), "read the descriptor widths")) {
+    widths.push_back(sqlite3_column_int64(use.get(), 0));
+  }
+  return widths;
 }
 
 }  // namespace tessera

@@ -105,6 +105,10 @@ class Database {
   // The width (columns) of the stored descriptors, from one non-empty row's header
   // without reading its data; nullopt when no image has descriptors.
   std::optional<int> DescriptorDimension() const;
+  // `expected_cols` >= 0: a non-empty row of another width is an InputError naming the
+  // image (features of two detectors must never meet in a matcher).
+  FeatureDescriptors ReadDescriptors(image_t image_id, DescriptorMetric metric,
+                                     int64_t expected_cols = -1) const;
 
   // Matches of (image_id1, image_id2), point2D_idx1 indexing image_id1's keypoints
   // whatever the order of the ids. An empty list is written as rows=0 (the pair was
@@ -147,6 +151,29 @@ class Database {
   // COLMAP) are absent from the map.
   void WriteImageMetadata(image_t image_id, const ImageMetadata& metadata);
   std::map<image_t, ImageMetadata> ReadAllImageMetadata() const;
+  // The image files the images table was made from (table tessera_images): one row per
+  // file name, with its size and content hash, so that a changed file is detected
+  // again. A file skipped at detection has no image_id and says why it was skipped,
+  // so that a later run skips it again without decoding it unless it changed.
+  struct ImageFile {
+    std::string name;
+    std::optional<image_t> image_id;  // nullopt: skipped
+    uint64_t size = 0;
+    std::string content_hash;
+    std::string skip_reason;  // empty unless skipped
+  };
+  std::vector<ImageFile> ReadImageFiles() const;  // sorted by name
+  void WriteImageFile(const ImageFile& file);     // replaces the row of the same name
+  void DeleteImageFile(const std::string& name);
+
+  // Removes an image and everything made from it: its keypoints, descriptors, the
+  // matches and two-view geometries of its pairs, its tessera_images row, and its
+  // camera when no other image uses it.
+  void DeleteImage(image_t image_id);
+
+  // The distinct widths (columns) of the non-empty descriptor rows, sorted: one value
+  // in a consistent workspace.
+  std::vector<int64_t> DescriptorWidths() const;
 
  private:
   struct Impl;

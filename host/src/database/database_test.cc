@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sqlite3.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -982,6 +983,112 @@ TEST_F(DatabaseTest, ReadsColmapsAnchorDatabase) {
   EXPECT_EQ(geometry21.F, geometry12.F.transpose());
   EXPECT_EQ(geometry21.inlier_matches.front().point2D_idx1,
             geometry12.inlier_matches.front().point2D_idx2);
+}
+
+TEST_F(DatabaseTest, ImageFilesRoundTripAndDeleteImageRemovesAllItsRows) {
+  Database database(DatabasePath());
+  AddCamerasAndImages(&database);  // a, b on camera 1; c on camera 2
+  database.WriteImageFile({"a.jpg", 1, 100, "aa", ""});
+  database.WriteImageFile({"c.jpg", 3, 300, "cc", ""});
+  database.WriteImageFile({"bad.png", std::nullopt, 7, "ff", "cannot decode the image"});
+  const auto files = database.ReadImageFiles();
+  ASSERT_EQ(files.size(), 3u);
+  EXPECT_EQ(files[0].name, "a.jpg");
+  EXPECT_EQ(files[0].image_id, std::optional<image_t>(1));
+  EXPECT_EQ(files[0].size, 100u);
+  EXPECT_EQ(files[0].content_hash, "aa");
+  EXPECT_EQ(files[1].name, "bad.png");
+  EXPECT_FALSE(files[1].image_id.has_value());
+  EXPECT_EQ(files[1].skip_reason, "cannot decode the image");
+  for (const image_t image_id : {1u, 2u, 3u}) {
+    database.WriteKeypoints(image_id, {FeatureKeypoint(1, 2)});
+    FeatureDescriptors descriptors;
+    descriptors.data = FeatureDescriptors::Matrix::Constant(1, 32, 7);
+    database.WriteDescriptors(image_id, descriptors);
+  }
+  TwoViewGeometry geometry;
+  geometry.config = TwoViewGeometry::UNCALIBRATED;
+  geometry.inlier_matches = {{0, 0}};
+  for (const auto& [id1, id2] : std::vector<std::pair<image_t, image_t>>{{1, 2}, {2, 3}, {3, 1}}) {
+    database.WriteMatches(id1, id2, {{0, 0}});
+    database.WriteTwoViewGeometry(id1, id2, geometry);
+  }
+
+  database.DeleteImage(3);  // the only image of camera 2, in pairs (2, 3) and (1, 3)
+  EXPECT_EQ(database.NumImages(), 2u);
+  EXPECT_FALSE(database.ExistsKeypoints(3));
+  EXPECT_FALSE(database.ExistsDescriptors(3));
+  EXPECT_EQ(database.ReadMatchedPairIds(), std::vector<image_pair_t>{ImagePairToPairId(1, 2)});
+  EXPECT_EQ(database.ReadAllTwoViewGeometries().size(), 1u);
+  EXPECT_EQ(database.NumCameras(), 1u);
+  EXPECT_EQ(database.ReadImageFiles().size(), 2u);  // a.jpg and bad.png
+  database.DeleteImage(1);                          // camera 1 still has b.jpg
+  EXPECT_EQ(database.NumCameras(), 1u);
+  EXPECT_EQ(database.NumMatchedPairs(), 0u);
+  database.DeleteImageFile("bad.png");
+  EXPECT_TRUE(database.ReadImageFiles().empty());
+}
+
+TEST_F(DatabaseTest, DescriptorWidthsAreCheckedOnRead) {
+  Database database(DatabasePath());
+  AddCamerasAndImages(&database);
+  FeatureDescriptors orb, sift;
+  orb.data = FeatureDescriptors::Matrix::Constant(2, 32, 1);
+  sift.data = FeatureDescriptors::Matrix::Constant(2, 128, 1);
+  database.WriteDescriptors(1, orb);
+  EXPECT_EQ(database.DescriptorWidths(), std::vector<int64_t>{32});
+  database.WriteDescriptors(2, sift);
+  EXPECT_EQ(database.DescriptorWidths(), (std::vector<int64_t>{32, 128}));
+  EXPECT_EQ(database.ReadDescriptors(1, DescriptorMetric::kHamming, 32).data.cols(), 32);
+  try {
+    database.ReadDescriptors(2, DescriptorMetric::kHamming, 32);
+    FAIL() << "a descriptor row of the wrong width was read";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("the descriptors of image 2 are 128 bytes wide, "
+                        "expected 32"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
+// A full disk (here a file size limit, as `ulimit -f`) is an InputError naming the
+// file, and the database keeps its last committed state.
+TEST_F(DatabaseTest, AFullDiskIsAnInputErrorAndKeepsTheCommittedState) {
+  {
+    Database database(DatabasePath());
+    AddCamerasAndImages(&database);
+  }
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit = {256 * 1024, 256 * 1024};
+    if (setrlimit(RLIMIT_FSIZE, &limit) != 0) _exit(3);
+    try {
+      Database database(DatabasePath());
+      FeatureDescriptors descriptors;
+      descriptors.data = FeatureDescriptors::Matrix::Constant(20000, 128, 1);  // 2.5 MB
+      Database::Transaction transaction(&database);
+      database.WriteDescriptors(1, descriptors);
+      transaction.Commit();
+      _exit(4);  // written past the limit
+    } catch (const InputError& error) {
+      const std::string message = error.what();
+      const bool named = message.find(DatabasePath().string()) != std::string::npos &&
+                         message.find("is the disk full?") != std::string::npos;
+      _exit(named ? 0 : 5);
+    } catch (...) {
+      _exit(6);
+    }
+  }
+  int status = 0;
+  ASSERT_EQ(waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << "3: setrlimit, 4: no error, 5: message, 6: other error";
+  Database database(DatabasePath());
+  EXPECT_EQ(database.NumImages(), 3u);
+  EXPECT_FALSE(database.ExistsDescriptors(1));
 }
 
 }  // namespace

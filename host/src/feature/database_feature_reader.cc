@@ -27,7 +27,7 @@ FeatureKeypoints DatabaseFeatureReader::ReadKeypoints(size_t index) const {
 }
 
 FeatureDescriptors DatabaseFeatureReader::ReadDescriptors(size_t index) const {
-  return database_->ReadDescriptors(ImageId(index), metric_);
+  return database_->ReadDescriptors(ImageId(index), metric_, dimension_ > 0 ? dimension_ : -1);
 }
 
 }  // namespace tessera

@@ -2,7 +2,9 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
+#include <map>
 #include <mutex>
 #include <opencv2/core.hpp>
 
@@ -24,14 +26,73 @@ nlohmann::json FeaturesProvenance(const PluginInstance<Detector>& detector) {
   return provenance;
 }
 
-// Adds the scanned images (and their cameras) that the database does not have yet.
-// Returns the database image of each scanned image, in scan order.
+// Brings the workspace's image list in line with the scanned folder: an image no
+// longer there, or whose file changed, is removed with everything made from it (a
+// changed one is then ingested again as new). Returns the names of files skipped at
+// detection by an earlier run and unchanged since, with the reason.
+std::map<std::string, std::string> ReconcileImages(const ImageScan& scan, Database* database,
+                                                   ExtractionSummary* summary) {
+  std::map<std::string, const ImageEntry*> scanned;
+  for (const ImageEntry& entry : scan.images) scanned[entry.name] = &entry;
+  std::map<std::string, Database::ImageFile> records;
+  for (Database::ImageFile& file : database->ReadImageFiles()) records[file.name] = file;
+
+  std::map<std::string, std::string> skipped_before;
+  for (const auto& [name, record] : records) {
+    if (record.image_id) continue;  // an image's record goes with the image below
+    const auto it = scanned.find(name);
+    if (it != scanned.end() && it->second->content_hash == record.content_hash &&
+        it->second->file_size == record.size) {
+      skipped_before[name] = record.skip_reason;
+    } else {
+      database->DeleteImageFile(name);  // gone, or changed: tried again as a new file
+    }
+  }
+  for (const Image& image : database->ReadAllImages()) {
+    const auto scan_it = scanned.find(image.name);
+    const auto record_it = records.find(image.name);
+    const bool recorded =
+        record_it != records.end() && record_it->second.image_id == image.image_id;
+    std::string why;
+    if (scan_it == scanned.end()) {
+      why = "is no longer in the image folder";
+      ++summary->num_removed;
+    } else if (!recorded) {
+      why = "has no recorded content hash (a workspace of another program or version)";
+      ++summary->num_changed;
+    } else if (record_it->second.content_hash != scan_it->second->content_hash ||
+               record_it->second.size != scan_it->second->file_size) {
+      why = "changed since it was ingested (size " + std::to_string(record_it->second.size) +
+            " -> " + std::to_string(scan_it->second->file_size) + " bytes, content hash " +
+            record_it->second.content_hash.substr(0, 12) + " -> " +
+            scan_it->second->content_hash.substr(0, 12) + ")";
+      ++summary->num_changed;
+    } else {
+      continue;
+    }
+    const bool again = scan_it != scanned.end();
+    spdlog::info(
+        "extract: invalidated '{}': it {}; removing its features, matches and "
+        "geometries{}",
+        image.name, why, again ? ", to detect and match it again" : "");
+    database->DeleteImage(image.image_id);
+    if (again) database->DeleteImageFile(image.name);
+  }
+  return skipped_before;
+}
+
+// Adds the scanned images (and their cameras) that the database does not have yet,
+// each with its file record. Returns the database image of each scanned image, in scan
+// order (image_id kInvalidImageId for one skipped by an earlier run).
 std::vector<Image> RegisterImages(const ImageScan& scan, const CameraSettings& settings,
+                                  const std::map<std::string, std::string>& skipped_before,
                                   Database* database) {
   std::vector<Image> images(scan.images.size());
   std::vector<ImageEntry> new_entries;
   std::vector<size_t> new_indices;
   for (size_t i = 0; i < scan.images.size(); ++i) {
+    images[i].image_id = kInvalidImageId;
+    if (skipped_before.count(scan.images[i].name)) continue;
     if (auto existing = database->ReadImageWithName(scan.images[i].name)) {
       images[i] = *existing;
     } else {
@@ -43,9 +104,24 @@ std::vector<Image> RegisterImages(const ImageScan& scan, const CameraSettings& s
 
   const CameraAssignment assignment = AssignCameras(new_entries, settings);
   for (const auto& warning : assignment.warnings) spdlog::warn("{}", warning);
+  // With one camera per image size, an image added to a workspace (new, or ingested
+  // again after a change) joins the workspace's camera identical to its own.
+  std::vector<Camera> existing_cameras;
+  if (settings.single_camera) existing_cameras = database->ReadAllCameras();
   Database::Transaction transaction(database);
   std::map<camera_t, camera_t> database_camera_ids;
   for (const Camera& camera : assignment.cameras) {
+    const auto same = std::find_if(
+        existing_cameras.begin(), existing_cameras.end(), [&](const Camera& existing) {
+          return existing.model_id == camera.model_id && existing.width == camera.width &&
+                 existing.height == camera.height && existing.params == camera.params &&
+                 existing.has_prior_focal_length == camera.has_prior_focal_length &&
+                 existing.calibration_source == camera.calibration_source;
+        });
+    if (same != existing_cameras.end()) {
+      database_camera_ids[camera.camera_id] = same->camera_id;
+      continue;
+    }
     const camera_t id = database->WriteCamera(camera);
     database->WriteCalibrationSource(id, camera.calibration_source);
     database_camera_ids[camera.camera_id] = id;
@@ -58,6 +134,8 @@ std::vector<Image> RegisterImages(const ImageScan& scan, const CameraSettings& s
     image.name = new_entries[k].name;
     image.camera_id = database_camera_ids.at(assignment.image_camera_ids[k]);
     image.image_id = database->WriteImage(image);
+    database->WriteImageFile(
+        {image.name, image.image_id, new_entries[k].file_size, new_entries[k].content_hash, ""});
     images[new_indices[k]] = image;
   }
   transaction.Commit();
@@ -87,11 +165,13 @@ void WriteImageMetadata(const ImageScan& scan, const std::vector<Image>& images,
 }  // namespace
 
 ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const Manifest& manifest,
-                                  const PluginInstance<Detector>& detector, Database* database) {
+                                  const PluginInstance<Detector>& detector, Database* database,
+                                  const ImageScanOptions& scan_options) {
   const Timer timer;
   ExtractionSummary summary;
 
-  const ImageScan scan = ScanImageFolder(image_dir);
+  const ImageScan scan = ScanImageFolder(image_dir, scan_options);
+  for (const auto& line : scan.skipped_folders) spdlog::info("extract: {}", line);
   for (const auto& warning : scan.warnings) spdlog::warn("{}", warning);
   summary.num_images = scan.images.size();
   summary.num_skipped_files = scan.warnings.size();
@@ -107,17 +187,28 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
         "extract: the detector or its options changed; discarding old features, matches "
         "and geometries");
     database->ClearKeypointsAndDescriptors();
+  } else if (database->DescriptorWidths().size() > 1) {
+    spdlog::info(
+        "extract: the workspace holds descriptors of different widths; discarding old "
+        "features, matches and geometries");
+    database->ClearKeypointsAndDescriptors();
   }
   database->WriteStageProvenance(Database::kFeaturesStage, provenance);
   database->WriteStageProvenance(
       Database::kImagesStage,
       {{"folder", std::filesystem::absolute(image_dir).lexically_normal().string()}});
 
-  const std::vector<Image> images = RegisterImages(scan, manifest.camera, database);
+  const std::map<std::string, std::string> skipped_before =
+      ReconcileImages(scan, database, &summary);
+  const std::vector<Image> images = RegisterImages(scan, manifest.camera, skipped_before, database);
   WriteImageMetadata(scan, images, database);
   std::vector<size_t> todo;
   for (size_t i = 0; i < images.size(); ++i) {
-    if (database->ExistsKeypoints(images[i].image_id)) {
+    if (images[i].image_id == kInvalidImageId) {
+      spdlog::warn("Skipped '{}' (as in an earlier run, the file is unchanged): {}",
+                   scan.images[i].name, skipped_before.at(scan.images[i].name));
+      ++summary.num_failed;
+    } else if (database->ExistsKeypoints(images[i].image_id)) {
       ++summary.num_reused;
     } else if (IsQuarantined(detector.name(), PluginStage::kDetect, ImageSubject(images[i].name))) {
       spdlog::warn("extract: skipping {}: it crashed detector '{}' twice", images[i].name,
@@ -132,24 +223,52 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
   std::mutex database_mutex;
   std::atomic<size_t> done{0};
   std::atomic<size_t> num_features{0};
+  std::atomic<size_t> num_failed{0};
   const Timer detect_timer;
   ParallelFor(todo.size(), manifest.EffectiveNumThreads(), [&](size_t k) {
     const ImageEntry& entry = scan.images[todo[k]];
     const Image& image = images[todo[k]];
-    const cv::Mat gray = ReadGrayImage(entry.path);
-    ImageView view;
-    view.width = gray.cols;
-    view.height = gray.rows;
-    view.stride = gray.step[0];
-    view.data = gray.data;
-    FeatureSet features =
-        CallPlugin(detector.name(), PluginStage::kDetect, ImageSubject(entry.name),
-                   [&] { return detector->Detect(view); });
-    if (features.descriptors.size() != static_cast<Eigen::Index>(features.keypoints.size())) {
-      throw std::runtime_error("detector '" + detector.name() + "' returned " +
-                               std::to_string(features.keypoints.size()) + " keypoints but " +
-                               std::to_string(features.descriptors.size()) + " descriptors for " +
-                               entry.name);
+    // Any failure before mapping skips the image, never the run: the reason is
+    // recorded with the file's hash, so the next run skips it too unless it changes.
+    FeatureSet features;
+    std::string failure;
+    std::string stage;  // "" while decoding
+    try {
+      const cv::Mat gray = ReadGrayImage(entry.path);
+      stage = "detector '" + detector.name() + "' failed: ";
+      ImageView view;
+      view.width = gray.cols;
+      view.height = gray.rows;
+      view.stride = gray.step[0];
+      view.data = gray.data;
+      features = CallPlugin(detector.name(), PluginStage::kDetect, ImageSubject(entry.name),
+                            [&] { return detector->Detect(view); });
+      if (features.descriptors.size() != static_cast<Eigen::Index>(features.keypoints.size())) {
+        failure = "detector '" + detector.name() + "' returned " +
+                  std::to_string(features.keypoints.size()) + " keypoints but " +
+                  std::to_string(features.descriptors.size()) + " descriptors";
+      }
+    } catch (const PluginError& error) {
+      failure = error.what();  // names the plugin, the stage and the image
+    } catch (const std::exception& error) {
+      failure = error.what();
+      // "PATH: why" from the decoder: the warning names the image once.
+      const std::string prefix = entry.path.string() + ": ";
+      if (failure.rfind(prefix, 0) == 0) failure = failure.substr(prefix.size());
+      const std::string::size_type newline = failure.find('\n');
+      if (newline != std::string::npos) failure = failure.substr(0, newline);
+      failure = stage + failure;
+    }
+    if (!failure.empty()) {
+      spdlog::warn("Skipped '{}': {}", entry.name, failure);
+      std::lock_guard<std::mutex> lock(database_mutex);
+      Database::Transaction transaction(database);
+      database->DeleteImage(image.image_id);
+      database->WriteImageFile(
+          {entry.name, std::nullopt, entry.file_size, entry.content_hash, failure});
+      transaction.Commit();
+      ++num_failed;
+      return;
     }
     {
       std::lock_guard<std::mutex> lock(database_mutex);
@@ -163,8 +282,15 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
     spdlog::info("extract: [{}/{}] {}: {} features ({:.2f} images/s)", n, todo.size(), entry.name,
                  features.keypoints.size(), n / std::max(1e-9, detect_timer.ElapsedSeconds()));
   });
-  summary.num_detected = todo.size();
+  summary.num_failed += num_failed;
+  summary.num_detected = todo.size() - num_failed;
   summary.num_features = num_features;
+  if (scan.images.size() - summary.num_failed < 2) {
+    throw InputError(image_dir.string() + ": " +
+                     std::to_string(scan.images.size() - summary.num_failed) +
+                     " usable image(s) after " + std::to_string(summary.num_failed) +
+                     " could not be decoded or detected; at least 2 are needed");
+  }
   summary.seconds = timer.ElapsedSeconds();
   return summary;
 }

@@ -54,8 +54,10 @@ struct ImageFeatures {
 // outlives its eviction through its shared_ptr.
 class FeatureCache {
  public:
-  FeatureCache(const Database* database, DescriptorMetric metric, size_t max_bytes)
-      : database_(database), metric_(metric), max_bytes_(max_bytes) {}
+  // `dimension` > 0: every descriptor row read must have that width.
+  FeatureCache(const Database* database, DescriptorMetric metric, int dimension, size_t max_bytes)
+      : database_(database), metric_(metric), dimension_(dimension > 0 ? dimension : -1),
+        max_bytes_(max_bytes) {}
 
   std::shared_ptr<const ImageFeatures> Get(image_t image_id) {
     {
@@ -69,7 +71,7 @@ class FeatureCache {
     // different images do not wait for each other's decoding.
     auto features = std::make_shared<ImageFeatures>();
     features->keypoints = database_->ReadKeypoints(image_id);
-    features->descriptors = database_->ReadDescriptors(image_id, metric_);
+    features->descriptors = database_->ReadDescriptors(image_id, metric_, dimension_);
     std::lock_guard<std::mutex> lock(mutex_);
     if (auto it = entries_.find(image_id); it != entries_.end()) return it->second.features;
     order_.push_front(image_id);
@@ -91,6 +93,7 @@ class FeatureCache {
   };
   const Database* database_;
   DescriptorMetric metric_;
+  int64_t dimension_;
   size_t max_bytes_;
   std::mutex mutex_;
   std::list<image_t> order_;  // most recently used first
@@ -201,7 +204,17 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
                      "extract` (or `tessera run`) first");
   }
   const DescriptorMetric metric = MetricFromName(features->value("metric", "l2"));
-  const int dimension = database->DescriptorDimension().value_or(0);
+  // Every descriptor read is checked to have the width of all others: features of two
+  // detectors must never meet in a matcher.
+  const std::vector<int64_t> widths = database->DescriptorWidths();
+  if (widths.size() > 1) {
+    std::string list;
+    for (const int64_t width : widths) list += (list.empty() ? "" : ", ") + std::to_string(width);
+    throw InputError(database->path().string() + ": the workspace holds descriptors of " +
+                     std::to_string(widths.size()) + " widths (" + list +
+                     " bytes), features of different detectors; run `tessera extract` again");
+  }
+  const int dimension = widths.empty() ? 0 : static_cast<int>(widths.front());
   CheckPairSelectors(manifest, pair_selectors, metric, dimension);
 
   // Matches depend on the features and on how pairs were matched; geometries on the
@@ -275,7 +288,7 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
   spdlog::info("match: {}, {} to match with '{}' ({} already done)", chosen, todo.size(),
                matcher.name(), summary.num_reused);
 
-  FeatureCache feature_cache(database, metric, kFeatureCacheBytes);
+  FeatureCache feature_cache(database, metric, dimension, kFeatureCacheBytes);
   std::mutex database_mutex;
   std::atomic<size_t> done{0}, putative{0}, inliers{0};
   std::atomic<int64_t> match_micros{0}, verify_micros{0};

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -35,6 +36,8 @@ struct ImageEntry {
   std::filesystem::path path;  // absolute
   int width = 0, height = 0;   // AFTER applying the EXIF orientation (as detection sees it)
   ExifInfo exif;
+  uintmax_t file_size = 0;   // bytes
+  std::string content_hash;  // XXH3-128 of the file's bytes, 32 hex digits
 };
 
 }  // namespace tessera

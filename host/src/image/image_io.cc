@@ -1,7 +1,10 @@
 #include "image/image_io.h"
 
+#include <xxhash.h>
+
 #include <algorithm>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -246,7 +249,21 @@ cv::Mat DecodeImage(const fs::path& path) {
   return ApplyExifOrientation(ToEightBit(image, path), header.exif.orientation);
 }
 
+std::string ContentHash(const Bytes& bytes) {
+  const XXH128_hash_t hash = XXH3_128bits(bytes.data(), bytes.size());
+  char text[33];
+  std::snprintf(text, sizeof(text), "%016llx%016llx", static_cast<unsigned long long>(hash.high64),
+                static_cast<unsigned long long>(hash.low64));
+  return text;
+}
+
 }  // namespace
+
+bool IsTesseraWorkspace(const fs::path& dir) {
+  std::error_code error;
+  return fs::is_regular_file(dir / "database.db", error) ||
+         fs::is_regular_file(dir / ".tessera.lock", error);
+}
 
 cv::Mat ApplyExifOrientation(const cv::Mat& stored, int orientation) {
   cv::Mat displayed;
@@ -278,7 +295,7 @@ cv::Mat ApplyExifOrientation(const cv::Mat& stored, int orientation) {
   }
 }
 
-ImageScan ScanImageFolder(const fs::path& dir) {
+ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) {
   std::error_code error;
   if (!fs::exists(dir, error)) {
     throw InputError(dir.string() + ": the image folder does not exist");
@@ -287,7 +304,20 @@ ImageScan ScanImageFolder(const fs::path& dir) {
     throw InputError(dir.string() + ": the image folder path is not a folder");
   }
   const fs::path root = fs::absolute(dir).lexically_normal();
+  std::vector<fs::path> excluded;
+  for (const fs::path& folder : options.excluded_folders) {
+    std::error_code canonical_error;
+    const fs::path canonical = fs::weakly_canonical(fs::absolute(folder), canonical_error);
+    excluded.push_back(canonical_error ? fs::absolute(folder).lexically_normal() : canonical);
+    std::error_code root_error;
+    if (excluded.back() == fs::weakly_canonical(root, root_error)) {
+      throw InputError(dir.string() +
+                       ": the image folder is the output folder of this run; choose another "
+                       "output folder (a sub-folder of the image folder is fine)");
+    }
+  }
 
+  ImageScan scan;
   std::vector<std::pair<std::string, fs::path>> candidates;
   fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, error);
   if (error)
@@ -300,6 +330,21 @@ ImageScan ScanImageFolder(const fs::path& dir) {
       if (it->is_directory(entry_error)) it.disable_recursion_pending();
       continue;
     }
+    if (it->is_directory(entry_error)) {
+      const std::string name = path.lexically_relative(root).generic_string();
+      std::error_code canonical_error;
+      const fs::path canonical = fs::weakly_canonical(path, canonical_error);
+      if (std::find(excluded.begin(), excluded.end(), canonical) != excluded.end()) {
+        scan.skipped_folders.push_back("Skipped the folder '" + name +
+                                       "': it is the output folder of this run.");
+        it.disable_recursion_pending();
+      } else if (IsTesseraWorkspace(path)) {
+        scan.skipped_folders.push_back("Skipped the folder '" + name +
+                                       "': it is a Tessera workspace.");
+        it.disable_recursion_pending();
+      }
+      continue;
+    }
     if (!it->is_regular_file(entry_error) || !HasImageExtension(path)) continue;
     candidates.emplace_back(path.lexically_relative(root).generic_string(), path);
   }
@@ -309,12 +354,25 @@ ImageScan ScanImageFolder(const fs::path& dir) {
   std::sort(candidates.begin(), candidates.end(),
             [](const auto& a, const auto& b) { return NaturalLess(a.first, b.first); });
 
-  ImageScan scan;
   for (const auto& [name, path] : candidates) {
+    if (name.find_first_of("\r\n") != std::string::npos) {
+      std::string shown;  // one line: the breaks written as \n and \r
+      for (const char c : name) shown += c == '\n' ? "\\n" : c == '\r' ? "\\r" : std::string(1, c);
+      scan.warnings.push_back("Skipped '" + shown +
+                              "': the name contains a line break, which a COLMAP text model "
+                              "cannot hold.");
+      continue;
+    }
     const std::optional<Bytes> bytes = ReadFileBytes(path);
     ImageHeader header;
-    const std::string problem =
+    std::string problem =
         bytes ? InspectImage(*bytes, &header, nullptr) : "the file cannot be read";
+    if (problem.empty() && static_cast<int64_t>(header.stored_width) * header.stored_height >
+                               options.max_image_pixels) {
+      problem = std::to_string(header.stored_width) + "x" + std::to_string(header.stored_height) +
+                " pixels is over the limit of " + std::to_string(options.max_image_pixels) +
+                " (max_image_pixels)";
+    }
     if (!problem.empty()) {
       scan.warnings.push_back("Skipped '" + name + "': " + problem + ".");
       continue;
@@ -326,6 +384,8 @@ ImageScan ScanImageFolder(const fs::path& dir) {
     const bool swap = OrientationSwapsAxes(header.exif.orientation);
     entry.width = swap ? header.stored_height : header.stored_width;
     entry.height = swap ? header.stored_width : header.stored_height;
+    entry.file_size = bytes->size();
+    entry.content_hash = ContentHash(*bytes);
     scan.images.push_back(std::move(entry));
   }
   return scan;

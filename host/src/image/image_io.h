@@ -3,6 +3,7 @@
 // Finding the input images, reading their sizes and EXIF without decoding them, and
 // decoding them the way detection and colouring see them (EXIF orientation applied).
 
+#include <cstdint>
 #include <filesystem>
 #include <opencv2/core.hpp>
 #include <string>
@@ -10,13 +11,24 @@
 
 #include "image/camera_assignment.h"  // the pipeline makes cameras right after the scan
 #include "image/image_entry.h"
+#include "manifest/manifest.h"
 
 namespace tessera {
 
 struct ImageScan {
-  std::vector<ImageEntry> images;     // usable images, natural-sorted by name
-  std::vector<std::string> warnings;  // one sentence per skipped file, naming it and why
+  std::vector<ImageEntry> images;            // usable images, natural-sorted by name
+  std::vector<std::string> warnings;         // one sentence per skipped file, naming it and why
+  std::vector<std::string> skipped_folders;  // one sentence per folder left out, and why
 };
+
+struct ImageScanOptions {
+  // Folders never scanned (the run's own output folder): output never feeds input.
+  std::vector<std::filesystem::path> excluded_folders;
+  int64_t max_image_pixels = Manifest().max_image_pixels;  // refused before decoding
+};
+
+// A folder holding a Tessera workspace (a database.db or a .tessera.lock file).
+bool IsTesseraWorkspace(const std::filesystem::path& dir);
 
 // Scans `dir` and its sub-folders (hidden files and folders excepted) for files ending
 // in .jpg, .jpeg, .png, .tif or .tiff in any case; names are relative to `dir`. The
@@ -25,8 +37,12 @@ struct ImageScan {
 // (JPEG: an end-of-image marker after the image data; PNG: an IEND chunk), so that
 // a truncated file is skipped here rather than decoded to grey later. TIFF files
 // are decoded. Throws InputError naming the folder if it does not exist. Files that
-// are not usable images are skipped with a warning each.
-ImageScan ScanImageFolder(const std::filesystem::path& dir);
+// are not usable images are skipped with a warning each, and so are images of more
+// than options.max_image_pixels pixels and names with a line break (which a COLMAP
+// text model cannot hold). The excluded folders and every Tessera workspace below
+// `dir` are left out, each with a line in skipped_folders. Every image gets its size
+// and content hash.
+ImageScan ScanImageFolder(const std::filesystem::path& dir, const ImageScanOptions& options = {});
 
 // Decodes to 8-bit grey with the EXIF orientation applied (16-bit data scaled by
 // 255/65535, floating point by 255). Throws InputError naming the file when it

@@ -291,5 +291,48 @@ TEST(ScanImageFolder, ReadsSceauxCastleHeaders) {
   }
 }
 
+TEST(ScanImageFolder, LeavesOutTheOutputFolderAndWorkspacesAndSaysSo) {
+  TemporaryDir dir;
+  Write(dir.path() / "a.png", Pattern(32, 24));
+  Write(dir.path() / "out" / "gaussian_splatting" / "images" / "a.png", Pattern(32, 24));
+  Write(dir.path() / "old" / "sparse" / "b.png", Pattern(32, 24));
+  std::ofstream(dir.path() / "old" / "database.db") << "";
+  Write(dir.path() / "sub" / "c.png", Pattern(32, 24));
+  ImageScanOptions options;
+  options.excluded_folders = {dir.path() / "out"};
+  ImageScan scan = ScanImageFolder(dir.path(), options);
+  EXPECT_EQ(Names(scan), (std::vector<std::string>{"a.png", "sub/c.png"}));
+  std::sort(scan.skipped_folders.begin(), scan.skipped_folders.end());  // listing order
+  EXPECT_EQ(scan.skipped_folders,
+            (std::vector<std::string>{"Skipped the folder 'old': it is a Tessera workspace.",
+                                      "Skipped the folder 'out': it is the output folder of this "
+                                      "run."}));
+  options.excluded_folders = {dir.path()};
+  EXPECT_THROW(ScanImageFolder(dir.path(), options), InputError);
+}
+
+TEST(ScanImageFolder, RecordsSizeAndContentHashAndRefusesOversizedOrLineBrokenNames) {
+  TemporaryDir dir;
+  Write(dir.path() / "a.png", Pattern(40, 30));
+  fs::copy_file(dir.path() / "a.png", dir.path() / "b.png");
+  Write(dir.path() / "c.png", Pattern(40, 30));
+  fs::copy_file(dir.path() / "a.png", dir.path() / "line\nbreak.png");
+  Write(dir.path() / "big.png", Pattern(50, 30));
+  ImageScanOptions options;
+  options.max_image_pixels = 1200;  // 40x30 passes, 50x30 does not
+  const ImageScan scan = ScanImageFolder(dir.path(), options);
+  ASSERT_EQ(Names(scan), (std::vector<std::string>{"a.png", "b.png", "c.png"}));
+  EXPECT_EQ(scan.images[0].file_size, fs::file_size(dir.path() / "a.png"));
+  EXPECT_EQ(scan.images[0].content_hash.size(), 32u);
+  EXPECT_EQ(scan.images[0].content_hash, scan.images[1].content_hash);  // same bytes
+  EXPECT_NE(scan.images[0].content_hash, scan.images[2].content_hash);
+  ASSERT_EQ(scan.warnings.size(), 2u);
+  EXPECT_EQ(scan.warnings[0],
+            "Skipped 'big.png': 50x30 pixels is over the limit of 1200 (max_image_pixels).");
+  EXPECT_EQ(scan.warnings[1],
+            "Skipped 'line\\nbreak.png': the name contains a line break, which a COLMAP text "
+            "model cannot hold.");
+}
+
 }  // namespace
 }  // namespace tessera

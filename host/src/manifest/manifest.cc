@@ -1,6 +1,8 @@
 #include "manifest/manifest.h"
 
+#include <algorithm>
 #include <fstream>
+#include <iterator>
 #include <sstream>
 #include <thread>
 
@@ -128,11 +130,18 @@ Eigen::Matrix3d ReadCalibrationMatrixFile(const std::filesystem::path& file) {
 }
 
 Manifest Manifest::Load(const std::filesystem::path& file) {
+  std::error_code error_code;
+  if (std::filesystem::is_directory(file, error_code)) {
+    throw InputError(file.string() + ": cannot read the manifest: it is a folder, not a file");
+  }
   std::ifstream stream(file);
   if (!stream) throw InputError(file.string() + ": cannot read the manifest");
+  const std::string text((std::istreambuf_iterator<char>(stream)),
+                         std::istreambuf_iterator<char>());
+  if (stream.bad()) throw InputError(file.string() + ": cannot read the manifest");
   nlohmann::json json;
   try {
-    json = nlohmann::json::parse(stream, nullptr, true, /*ignore_comments=*/true);
+    json = nlohmann::json::parse(text, nullptr, true, /*ignore_comments=*/true);
   } catch (const nlohmann::json::parse_error& error) {
     std::string what = error.what();
     // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." -> the part after
@@ -140,6 +149,34 @@ Manifest Manifest::Load(const std::filesystem::path& file) {
     const auto bracket = what.find("] ");
     throw InputError(file.string() + ": invalid JSON: " +
                      (bracket == std::string::npos ? what : what.substr(bracket + 2)));
+  } catch (const nlohmann::json::exception& error) {
+    // A number too large for a double ("number overflow parsing '1e400'") comes without
+    // a position: find the number in the text and name the key before it.
+    const std::string what = error.what();
+    const auto quote = what.find('\'');
+    const auto end_quote = quote == std::string::npos ? quote : what.find('\'', quote + 1);
+    const std::string token =
+        end_quote == std::string::npos ? "" : what.substr(quote + 1, end_quote - quote - 1);
+    std::string where;
+    const auto at = token.empty() ? std::string::npos : text.find(token);
+    if (at != std::string::npos) {
+      const size_t line =
+          1 + static_cast<size_t>(std::count(text.begin(), text.begin() + at, '\n'));
+      where = " at line " + std::to_string(line);
+      // The last "key": before the number.
+      const auto colon = text.rfind(':', at);
+      const auto key_end = colon == std::string::npos ? colon : text.rfind('"', colon);
+      const auto key_start = key_end == std::string::npos || key_end == 0
+                                 ? std::string::npos
+                                 : text.rfind('"', key_end - 1);
+      if (key_start != std::string::npos) {
+        where = " at line " + std::to_string(line) + " (key '" +
+                text.substr(key_start + 1, key_end - key_start - 1) + "')";
+      }
+    }
+    throw InputError(file.string() + ": invalid JSON" + where + ": the number " +
+                     (token.empty() ? what : "'" + token + "'") +
+                     " is out of range (more than a double can hold)");
   }
   const auto absolute = std::filesystem::absolute(file);
   Manifest manifest = FromJson(json, absolute.parent_path(), absolute.string());
@@ -163,6 +200,8 @@ Manifest Manifest::FromJson(const nlohmann::json& json, const std::filesystem::p
     const nlohmann::json plugin_paths = top.GetJson("plugin_paths", nlohmann::json::array());
     manifest.seed = top.Get<uint64_t>("seed", 0);
     manifest.num_threads = top.Get<int>("threads", 0, 0, 1024);
+    manifest.max_image_pixels =
+        top.Get<int64_t>("max_image_pixels", manifest.max_image_pixels, 1, int64_t{1} << 40);
     const nlohmann::json pipeline = top.GetJson("pipeline", nlohmann::json::object());
     const nlohmann::json camera = top.GetJson("camera", nlohmann::json::object());
     const nlohmann::json verification = top.GetJson("verification", nlohmann::json::object());

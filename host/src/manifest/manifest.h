@@ -51,6 +51,9 @@ struct Manifest {
   std::vector<std::filesystem::path> plugin_paths;  // absolute
   uint64_t seed = 0;    // seeds every random choice (RANSAC sampling, tie-breaks)
   int num_threads = 0;  // 0: all cores
+  // Images whose header claims more pixels are skipped before decoding, so that a
+  // lying header cannot ask for gigabytes. Enough for 100-megapixel photos.
+  int64_t max_image_pixels = 250'000'000;
 
   std::optional<PluginSlot> detector;
   // One or more: `pipeline.pair_selector` is a slot or an array of slots, whose pairs

@@ -33,7 +33,7 @@ void WriteFileAtomically(const fs::path& path, const std::string& contents) {
     if (!file) {
       std::error_code error;
       fs::remove(temporary, error);
-      throw InputError("Cannot write " + temporary.string() + " (is the disk full?).");
+      throw InputError("Cannot write " + path.string() + " (is the disk full?).");
     }
   }
   std::error_code error;

@@ -14,7 +14,8 @@ inline std::filesystem::path SparseModelDir(const ExportContext& context) {
   return context.output_dir / "sparse" / std::to_string(context.model_index);
 }
 
-// `name` (a file or folder, relative to the output folder unless absolute) for model 0,
+// `name` (a file or folder, relative to the output folder and inside it: options read
+// with OptionReader::GetRelativePath) for model 0,
 // and name_<k> (before the extension) for model k, so that models never overwrite
 // each other: transforms.json, transforms_1.json, ...
 inline std::filesystem::path PerModelPath(const ExportContext& context,

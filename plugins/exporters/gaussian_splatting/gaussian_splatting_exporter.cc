@@ -81,10 +81,9 @@ class GaussianSplattingExporter : public Exporter {
  public:
   explicit GaussianSplattingExporter(const nlohmann::json& options) {
     OptionReader reader(options);
-    folder_ = reader.GetString("folder", "gaussian_splatting");
+    folder_ = reader.GetRelativePath("folder", "gaussian_splatting");
     jpeg_quality_ = reader.Get<int>("jpeg_quality", 95, 1, 100);
     reader.Finish();
-    if (folder_.empty()) throw OptionError("folder", "must not be empty");
     effective_options_ = reader.Effective();
   }
 

@@ -104,6 +104,12 @@ TEST(GaussianSplattingExporter, FolderOptionAndErrorsNameTheFile) {
   const Camera camera = Camera::Create(1, CameraModelId::kSimplePinhole, 50, 40, 30);
   const Reconstruction model = testing::MakeSyntheticModel(camera, 2, 40);
   testing::TemporaryDir images, output;
+  for (const char* outside : {"../3dgs", "/tmp/3dgs", "a/../../3dgs"}) {
+    EXPECT_THROW(testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting",
+                                                      {{"folder", outside}}),
+                 InputError)
+        << outside;
+  }
   auto exporter =
       testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting", {{"folder", "3dgs"}});
   ExportContext context;

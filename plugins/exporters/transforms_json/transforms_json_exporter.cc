@@ -83,9 +83,8 @@ class TransformsJsonExporter : public Exporter {
  public:
   explicit TransformsJsonExporter(const nlohmann::json& options) {
     OptionReader reader(options);
-    file_ = reader.GetString("file", "transforms.json");
+    file_ = reader.GetRelativePath("file", "transforms.json");
     reader.Finish();
-    if (file_.empty()) throw OptionError("file", "must not be empty");
     effective_options_ = reader.Effective();
   }
 

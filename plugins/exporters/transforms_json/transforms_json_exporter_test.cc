@@ -152,5 +152,27 @@ TEST(TransformsJsonExporter, PerFrameIntrinsicsForSeveralCamerasAndModelIndex) {
   ExpectSamePoses(PosesByBasename(model), ReadTransformsJson(file));
 }
 
+TEST(TransformsJsonExporter, TheFileMustStayInsideTheOutputFolder) {
+  for (const auto& [file, why] : std::vector<std::pair<std::string, std::string>>{
+           {"../../escape.json", "leaves the output folder (\"..\")"},
+           {"nerf/../../escape.json", "leaves the output folder (\"..\")"},
+           {"/tmp/escape.json", "is absolute"},
+           {"", "is empty"},
+           {"a\nb.json", "contains a line break or NUL"}}) {
+    try {
+      testing::LoadBundledPlugin<Exporter>("exporter", "transforms_json", {{"file", file}});
+      ADD_FAILURE() << "'" << file << "' was accepted";
+    } catch (const InputError& error) {
+      const std::string message = error.what();
+      EXPECT_NE(message.find("pipeline.test.options.file: '" + file + "' " + why +
+                             "; it must be a relative path inside the output folder"),
+                std::string::npos)
+          << message;
+    }
+  }
+  EXPECT_NO_THROW(testing::LoadBundledPlugin<Exporter>("exporter", "transforms_json",
+                                                       {{"file", "a/..b/transforms.json"}}));
+}
+
 }  // namespace
 }  // namespace tessera

@@ -1,0 +1,187 @@
+#!/bin/bash
+# Runs Tessera on a collection of bad inputs and classifies each outcome:
+#   crash               exit code other than 0, 2 and 3 (1 = internal error, or a signal)
+#   silent wrong output exit 0 (or the expected code) but the result is wrong: a bad
+#                       file not named in a warning, a wrong image list, stale features
+#   unclear message     the expected failure, but the error line does not name the file,
+#                       key or folder at fault
+#   other mismatch      the wrong exit code without a crash
+# On a 512 px copy of examples/fountain-P11-small with ORB (seconds per case).
+# usage: benchmarks/bad_inputs.sh [TESSERA]
+set -uo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+tessera=${1:-$root/build/bin/tessera}
+make_image="python3 $root/tests/tools/make_test_image.py"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+"$root/build/bin/tessera_test_downscale" "$root/examples/fountain-P11-small/images" "$work/all" 512 90 \
+  > /dev/null || { echo "downscale failed (build tessera_test_downscale)"; exit 1; }
+cat > "$work/m.json" <<'JSON'
+{"pipeline": {"detector": {"plugin": "orb", "options": {"max_num_features": 1500}},
+              "pair_selector": {"plugin": "exhaustive"},
+              "matcher": {"plugin": "brute_force", "options": {"ratio": 0.8, "cross_check": true}},
+              "bundle_adjuster": {"plugin": "ceres"},
+              "exporters": [{"plugin": "colmap_binary"}]},
+ "camera": {"model": "SIMPLE_RADIAL", "single_camera": true},
+ "verification": {"max_error_px": 4.0, "min_num_inliers": 15}}
+JSON
+tried=0 crashes=0 silent=0 unclear=0 other=0
+subset() {  # subset DIR N: the first N images of the sample
+  mkdir -p "$1"
+  for f in $(ls "$work/all" | sort | head -n "$2"); do cp "$work/all/$f" "$1/"; done
+}
+registered() {
+  python3 -c 'import json,sys; print(sum(m["num_images"] for m in json.load(open(sys.argv[1]))["models"]))' \
+    "$1/mapping_summary.json" 2> /dev/null || echo 0
+}
+# check NAME EXPECTED_CODE MESSAGE_REGEX RESULT_CHECK -- COMMAND...
+#   MESSAGE_REGEX: must match the output (an error line naming what is wrong, or the
+#   warning naming the skipped file); RESULT_CHECK: a shell test of the result, "" none.
+check() {
+  local name=$1 expected=$2 pattern=$3 result_check=$4
+  shift 5
+  tried=$((tried + 1))
+  "$@" > "$work/case.log" 2>&1
+  local code=$?
+  local verdict=ok
+  if [ "$code" != 0 ] && [ "$code" != 2 ] && [ "$code" != 3 ]; then
+    verdict=crash; crashes=$((crashes + 1))
+  elif [ "$code" != "$expected" ]; then
+    if [ "$code" = 0 ]; then verdict="silent wrong output"; silent=$((silent + 1));
+    else verdict="other mismatch"; other=$((other + 1)); fi
+  elif ! grep -qE -- "$pattern" "$work/case.log"; then
+    if [ "$expected" = 0 ]; then verdict="silent wrong output"; silent=$((silent + 1));
+    else verdict="unclear message"; unclear=$((unclear + 1)); fi
+  elif [ -n "$result_check" ] && ! eval "$result_check"; then
+    verdict="silent wrong output"; silent=$((silent + 1))
+  fi
+  printf "%-44s exit %s  %s\n" "$name" "$code" "$verdict"
+  [ "$verdict" = ok ] || sed 's/^/    /' "$work/case.log" | tail -3
+}
+t() { "$tessera" "$@" --threads 2; }
+run_m() { t run --manifest "$work/m.json" "$@"; }
+
+# Manifests.
+mkdir -p "$work/manifest_dir"
+check "manifest is a folder" 2 "manifest_dir: cannot read the manifest: it is a folder" "" -- \
+  t run --images "$work/all" --output "$work/o1" --manifest "$work/manifest_dir"
+echo '{"verification": {"max_error_px": 1e400}}' > "$work/overflow.json"
+check "number 1e400" 2 "overflow.json: invalid JSON at line 1 \(key 'max_error_px'\)" "" -- \
+  t run --images "$work/all" --output "$work/o2" --manifest "$work/overflow.json"
+echo '{"pipeline": {' > "$work/broken.json"
+check "truncated JSON" 2 "broken.json: invalid JSON: .*line 2" "" -- \
+  t run --images "$work/all" --output "$work/o3" --manifest "$work/broken.json"
+echo '{"pipeline": {"detector": {"plugin": "sfit"}}}' > "$work/typo.json"
+check "misspelt plugin" 2 "pipeline.detector.plugin: no detector plugin 'sfit'; did you mean 'sift'" "" -- \
+  t run --images "$work/all" --output "$work/o4" --manifest "$work/typo.json"
+check "missing manifest" 2 "nonexistent.json: cannot read the manifest" "" -- \
+  t run --images "$work/all" --output "$work/o5" --manifest "$work/nonexistent.json"
+echo '{"threads": -3}' > "$work/threads.json"
+check "negative threads" 2 "threads.json: threads: = -3 is out of range" "" -- \
+  t run --images "$work/all" --output "$work/o6" --manifest "$work/threads.json"
+
+# Exporter paths.
+mkdir -p "$work/x/y"
+echo '{"pipeline": {"exporters": [{"plugin": "transforms_json", "options": {"file": "../../escape.json"}}]}}' > "$work/escape_manifest.json"
+check "exporter file ../../escape.json" 2 "pipeline.exporters\[0\].options.file: '../../escape.json' leaves the output folder" \
+  '[ ! -e "$work/x/escape.json" ] && [ ! -e "$work/escape.json" ]' -- \
+  t run --images "$work/all" --output "$work/x/y/out" --manifest "$work/escape_manifest.json"
+echo '{"pipeline": {"exporters": [{"plugin": "gaussian_splatting", "options": {"folder": "/tmp/tessera_escape"}}]}}' > "$work/absolute.json"
+check "exporter folder absolute" 2 "pipeline.exporters\[0\].options.folder: '/tmp/tessera_escape' is absolute" "" -- \
+  t run --images "$work/all" --output "$work/o7" --manifest "$work/absolute.json"
+
+# Image folders.
+check "image folder missing" 2 "no_such_folder: the image folder does not exist" "" -- \
+  run_m --images "$work/no_such_folder" --output "$work/o8"
+subset "$work/one" 1
+check "one image" 2 "one: 1 usable image\(s\); at least 2 are needed" "" -- \
+  run_m --images "$work/one" --output "$work/o9"
+mkdir -p "$work/empty_folder"
+check "no images" 2 "empty_folder: 0 usable image\(s\)" "" -- \
+  run_m --images "$work/empty_folder" --output "$work/o10"
+check "images = output" 2 "the image folder is the output folder of this run" "" -- \
+  run_m --images "$work/all" --output "$work/all"
+
+# Bad image files beside 5 good ones: each named in a warning, the 5 mapped.
+bad_file_case() {  # NAME FILE MAKE_COMMAND WARNING_REGEX
+  local dir="$work/bad_$tried"
+  subset "$dir" 5
+  eval "$3"
+  check "$1" 0 "$4" '[ "$(registered "$dir/out")" = 5 ]' -- run_m --images "$dir" --output "$dir/out"
+}
+bad_file_case "undecodable PNG (valid chunks)" corrupt.png '$make_image corrupt "$dir/corrupt.png"' "Skipped 'corrupt.png': cannot decode"
+bad_file_case "1 px wide image" thin.png '$make_image thin "$dir/thin.png"' "Skipped 'thin.png'"
+bad_file_case "1 px high image" thin.png '$make_image thin-h "$dir/thin.png"' "Skipped 'thin.png'"
+bad_file_case "header claims 10 gigapixels" huge.png '$make_image huge "$dir/huge.png"' "Skipped 'huge.png': 100000x100000 pixels is over the limit"
+bad_file_case "line break in a name" "" 'cp "$work/all/0010.jpg" "$dir/a
+b.jpg"' "Skipped 'a..b.jpg': the name contains a line break"
+bad_file_case "empty .jpg" "" ': > "$dir/empty.jpg"' "Skipped 'empty.jpg': the file is empty"
+bad_file_case "text named .jpg" "" 'echo text > "$dir/notes.jpg"' "Skipped 'notes.jpg': not a JPEG, PNG or TIFF"
+bad_file_case "truncated JPEG" "" 'head -c 9000 "$work/all/0010.jpg" > "$dir/cut.jpg"' "Skipped 'cut.jpg': truncated JPEG"
+bad_file_case "noise image" "" '$make_image noise "$dir/noise.png"' "noise.png is in no model|Skipped 'noise.png'"
+
+# Nothing verifies: exit 3.
+mkdir -p "$work/flat"
+$make_image flat "$work/flat/a.png"; $make_image flat "$work/flat/b.png"
+check "no verified pair (flat images)" 3 "no model could be built" "" -- \
+  run_m --images "$work/flat" --output "$work/flat_out"
+
+# Workspaces.
+subset "$work/w" 5
+run_m --images "$work/w" --output "$work/w_out" > /dev/null 2>&1
+mv "$work/w/0001.jpg" "$work/t.jpg"; mv "$work/w/0002.jpg" "$work/w/0001.jpg"; mv "$work/t.jpg" "$work/w/0002.jpg"
+fresh_keypoints() { sqlite3 "$1/database.db" "SELECT name, hex(data) FROM keypoints JOIN images USING (image_id) ORDER BY name" | md5sum; }
+run_m --images "$work/w" --output "$work/w_fresh" > /dev/null 2>&1
+check "swapped file contents" 0 "invalidated '0001.jpg'" \
+  '[ "$(fresh_keypoints "$work/w_out")" = "$(fresh_keypoints "$work/w_fresh")" ]' -- \
+  run_m --images "$work/w" --output "$work/w_out"
+subset "$work/w2" 8
+rm "$work"/w2/000[0-2].jpg
+check "folder with other names" 0 "invalidated '0000.jpg': it is no longer in the image folder" \
+  '[ "$(sqlite3 "$work/w_out/database.db" "SELECT COUNT(*) FROM images")" = 5 ]' -- \
+  run_m --images "$work/w2" --output "$work/w_out"
+subset "$work/nested" 5
+run_m --images "$work/nested" --output "$work/nested/out" > /dev/null 2>&1
+check "output inside the image folder" 0 "Skipped the folder 'out': it is the output folder" \
+  '[ "$(sqlite3 "$work/nested/out/database.db" "SELECT COUNT(*) FROM images")" = 5 ]' -- \
+  run_m --images "$work/nested" --output "$work/nested/out"
+mkdir -p "$work/garbage_db"; head -c 5000 /dev/urandom > "$work/garbage_db/database.db"
+check "database.db not SQLite" 2 "garbage_db/database.db' is not a valid SQLite database" "" -- \
+  run_m --images "$work/w" --output "$work/garbage_db"
+cp -r "$work/w_out" "$work/mixed"
+sqlite3 "$work/mixed/database.db" "DELETE FROM matches; DELETE FROM two_view_geometries;
+  UPDATE descriptors SET cols = 128, rows = rows / 4 WHERE image_id = (SELECT MIN(image_id) FROM images)"
+check "descriptors of two widths (match)" 2 "mixed/database.db: the workspace holds descriptors of 2 widths \(32, 128 bytes\)" "" -- \
+  t match --output "$work/mixed" --manifest "$work/m.json"
+check "map without a workspace" 2 "no_workspace/database.db: no workspace database" "" -- \
+  t map --output "$work/no_workspace" --manifest "$work/m.json"
+echo "1 2 3" > "$work/K_bad.txt"
+check "malformed --camera-K" 2 "K_bad.txt: expected 9 numbers" "" -- \
+  run_m --images "$work/w" --output "$work/o11" --camera-K "$work/K_bad.txt"
+( trap '' XFSZ; ulimit -f 200; exec "$tessera" run --images "$work/w" --output "$work/full_disk" \
+    --manifest "$work/m.json" --threads 2 ) > "$work/disk.log" 2>&1
+disk_code=$?
+check "disk full (ulimit -f), then a rerun" 0 "" '[ "$disk_code" = 2 ] && grep -q "full_disk/.*disk full" "$work/disk.log" && [ "$(registered "$work/full_disk")" = 5 ]' -- \
+  run_m --images "$work/w" --output "$work/full_disk"
+subset "$work/c" 11
+"$tessera" run --manifest "$work/m.json" --threads 2 --images "$work/c" --output "$work/c_out" > "$work/first.log" 2>&1 &
+first=$!
+for _ in $(seq 1 200); do [ -s "$work/c_out/.tessera.lock" ] && break; sleep 0.05; done
+check "a second writer on the same output" 2 "workspace $work/c_out is in use by process $first \(since " "" -- \
+  t run --images "$work/c" --output "$work/c_out"
+wait $first; first_code=$?
+tried=$((tried + 1))
+if [ "$first_code" != 0 ] || [ "$(registered "$work/c_out")" != 11 ]; then
+  echo "the first writer: exit $first_code, $(registered "$work/c_out") registered  silent wrong output"
+  silent=$((silent + 1))
+else
+  printf "%-44s exit %s  %s\n" "the first writer, meanwhile" 0 ok
+fi
+
+echo
+echo "inputs tried: $tried"
+echo "crashes: $crashes"
+echo "silent wrong outputs: $silent"
+echo "unclear messages: $unclear"
+echo "other mismatches: $other"
+[ $((crashes + silent + unclear + other)) = 0 ]
