@@ -9,6 +9,7 @@ packages=(
   nlohmann-json3-dev libflann-dev libsqlite3-dev sqlite3 bc libexif-dev
   libglfw3-dev libimgui-dev libgtest-dev libgmock-dev libbenchmark-dev
   libcli11-dev libspdlog-dev python3-numpy gnuplot-nox
+  clang libclang-rt-dev
 )
 # The reference system, for the interoperability tests and benchmarks, and Open3D, an
 # independent PLY reader for the ply exporter's test; optional.
