@@ -1083,7 +1083,7 @@ std::optional<nlohmann::json> Database::ReadStageProvenance(const std::string& s
   const char* text = reinterpret_cast<const char*>(sqlite3_column_text(use.get(), 0));
   try {
     return nlohmann::json::parse(text != nullptr ? text : "");
-  } catch (const nlohmann::json::parse_error& error) {
+  } catch (const nlohmann::json::exception& error) {  // parse_error, out_of_range (406)
     throw InputError("Database '" + impl_->path.string() + "': the provenance of stage '" + stage +
                      "' is not valid JSON: " + error.what());
   }

@@ -116,7 +116,7 @@ Manifest Manifest::Load(const std::filesystem::path& file) {
   nlohmann::json json;
   try {
     json = nlohmann::json::parse(stream, nullptr, true, /*ignore_comments=*/true);
-  } catch (const nlohmann::json::parse_error& error) {
+  } catch (const nlohmann::json::exception& error) {  // parse_error, out_of_range (406)
     std::string what = error.what();
     // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." -> the part after
     // "]".
