@@ -11,6 +11,7 @@ packages=(
   libcli11-dev libspdlog-dev python3-numpy gnuplot-nox
   libfaiss-dev
   libxxhash-dev
+  clang libclang-rt-dev
 )
 # The reference system, for the interoperability tests and benchmarks, and Open3D, an
 # independent PLY reader for the ply exporter's test; optional.

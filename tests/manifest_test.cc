@@ -127,6 +127,22 @@ TEST(Manifest, ReportsInvalidJsonWithTheFileAndPosition) {
   EXPECT_THROW(Manifest::Load(dir.path() / "missing.json"), InputError);
 }
 
+// Found by tests/fuzz (manifest target): a number too large for a double is an
+// out_of_range error of the JSON parser, not a parse_error; it is invalid JSON all the same.
+TEST(Manifest, ReportsANumberOutOfRangeAsInvalidJson) {
+  testing::TemporaryDir dir;
+  std::ofstream(dir.path() / "m.json") << "{\"seed\": 1E+4440}\n";
+  try {
+    Manifest::Load(dir.path() / "m.json");
+    FAIL();
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              (dir.path() / "m.json").string() +
+                  ": invalid JSON at line 1 (key 'seed'): the number '1E+4440' is out of range "
+                  "(more than a double can hold)");
+  }
+}
+
 TEST(Manifest, BadKFileIsAnInputError) {
   testing::TemporaryDir dir;
   std::ofstream(dir.path() / "K.txt") << "1 2 3\n";

@@ -257,6 +257,10 @@ TwoViewGeometry InvertTwoViewGeometry(const TwoViewGeometry& geometry) {
 struct Database::Impl {
   std::filesystem::path path;
   sqlite3* db = nullptr;
+  // While the file is opened and its schema checked, an SQL error comes from what the
+  // file holds (a file format SQLite does not know, a malformed schema), so it is bad
+  // input like a file that is no database at all.
+  bool opening = false;
   bool in_transaction = false;
 
   std::unique_ptr<Statement> write_camera, update_camera, read_cameras, read_camera, write_image,
@@ -318,7 +322,8 @@ struct Database::Impl {
     const std::string message =
         std::string(db != nullptr ? sqlite3_errmsg(db) : sqlite3_errstr(rc));
     const int primary = rc & 0xff;
-    if (primary == SQLITE_NOTADB || primary == SQLITE_CORRUPT) {
+    if (primary == SQLITE_NOTADB || primary == SQLITE_CORRUPT ||
+        (opening && primary == SQLITE_ERROR)) {
       throw InputError("Database file '" + path.string() + "' is not a valid SQLite database (" +
                        message + ") while trying to " + operation + ".");
     }
@@ -403,6 +408,28 @@ struct Database::Impl {
     return data;
   }
 
+  // Checks that a blob column holds `rows` x `cols` elements of `element_bytes`, before
+  // anything is allocated for them: a corrupt row count is refused, not allocated.
+  void CheckColumnArray(sqlite3_stmt* stmt, int column, int64_t rows, int64_t cols,
+                        size_t element_bytes, const std::string& what) const {
+    const auto num_bytes = static_cast<uint64_t>(sqlite3_column_bytes(stmt, column));
+    // rows x cols x element_bytes == num_bytes, tested without overflowing.
+    const uint64_t max_rows =
+        cols > 0 ? num_bytes / element_bytes / static_cast<uint64_t>(cols) : 0;
+    const bool fits =
+        rows >= 0 && cols >= 0 &&
+        (rows == 0 || cols == 0
+             ? num_bytes == 0
+             : static_cast<uint64_t>(rows) <= max_rows &&
+                   static_cast<uint64_t>(rows) * static_cast<uint64_t>(cols) * element_bytes ==
+                       num_bytes);
+    if (fits) return;
+    throw InputError("Database '" + path.string() + "': " + what + " has " +
+                     std::to_string(num_bytes) + " bytes of data, not " + std::to_string(rows) +
+                     " x " + std::to_string(cols) + " elements of " +
+                     std::to_string(element_bytes) + " bytes.");
+  }
+
   Eigen::Matrix3d ColumnMatrix3d(sqlite3_stmt* stmt, int column, const std::string& what) const {
     if (sqlite3_column_bytes(stmt, column) == 0) return Eigen::Matrix3d::Zero();
     Matrix3dRowMajor matrix;
@@ -447,11 +474,16 @@ struct Database::Impl {
     return camera;
   }
 
-  static Image ImageFromRow(sqlite3_stmt* stmt) {
+  Image ImageFromRow(sqlite3_stmt* stmt) const {
     // image_id, name, camera_id
     Image image;
     image.image_id = static_cast<image_t>(sqlite3_column_int64(stmt, 0));
-    image.name = reinterpret_cast<const char*>(sqlite3_column_text(stmt, 1));
+    const unsigned char* name = sqlite3_column_text(stmt, 1);
+    if (name == nullptr) {
+      throw InputError("Database '" + path.string() + "': image " + std::to_string(image.image_id) +
+                       " has no name.");
+    }
+    image.name = reinterpret_cast<const char*>(name);
     image.camera_id = static_cast<camera_t>(sqlite3_column_int64(stmt, 2));
     return image;
   }
@@ -466,8 +498,9 @@ struct Database::Impl {
                        std::to_string(rows) + " rows of " + std::to_string(cols) +
                        " columns, expected rows of 2 columns.");
     }
+    if (rows == 0) return {};
+    CheckColumnArray(stmt, first_column + 2, rows, 2, sizeof(point2D_t), what);
     FeatureMatches matches(static_cast<size_t>(rows));
-    if (rows == 0) return matches;
     const auto* data = static_cast<const point2D_t*>(ColumnBlob(
         stmt, first_column + 2, sizeof(point2D_t) * 2 * static_cast<size_t>(rows), what));
     for (size_t i = 0; i < matches.size(); ++i) {
@@ -685,9 +718,11 @@ void Database::Impl::PrepareStatements() {
 
 Database::Database(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
+  impl_->opening = true;
   impl_->Open();
   impl_->CreateAndCheckSchema();
   impl_->PrepareStatements();
+  impl_->opening = false;
 }
 
 Database::~Database() = default;
@@ -833,7 +868,7 @@ std::optional<Image> Database::ReadImageWithName(const std::string& name) const 
   StatementUse use(*impl_->read_image_with_name);
   impl_->BindText(use.get(), 1, name, operation);
   if (!impl_->Step(use.get(), operation)) return std::nullopt;
-  return Impl::ImageFromRow(use.get());
+  return impl_->ImageFromRow(use.get());
 }
 
 std::vector<Image> Database::ReadAllImages() const {
@@ -841,7 +876,7 @@ std::vector<Image> Database::ReadAllImages() const {
   StatementUse use(*impl_->read_images);
   std::vector<Image> images;
   while (impl_->Step(use.get(), "read the images")) {
-    images.push_back(Impl::ImageFromRow(use.get()));
+    images.push_back(impl_->ImageFromRow(use.get()));
   }
   return images;
 }
@@ -888,8 +923,9 @@ FeatureKeypoints Database::ReadKeypoints(image_t image_id) const {
     throw InputError("Database '" + impl_->path.string() + "': " + what + " have " +
                      std::to_string(cols) + " columns, expected 2, 4 or 6.");
   }
+  if (rows == 0) return {};
+  impl_->CheckColumnArray(stmt, 2, rows, cols, sizeof(float), what);
   FeatureKeypoints keypoints(static_cast<size_t>(rows));
-  if (rows == 0) return keypoints;
   std::vector<float> blob(static_cast<size_t>(rows * cols));
   std::memcpy(blob.data(), impl_->ColumnBlob(stmt, 2, sizeof(float) * blob.size(), what),
               sizeof(float) * blob.size());
@@ -958,6 +994,7 @@ FeatureDescriptors Database::ReadDescriptors(image_t image_id, DescriptorMetric 
                      std::to_string(expected_cols) +
                      " (features of another detector); run `tessera extract` again.");
   }
+  if (rows > 0 && cols > 0) impl_->CheckColumnArray(stmt, 2, rows, cols, 1, what);
   descriptors.data.resize(rows, cols);
   if (descriptors.data.size() > 0) {
     std::memcpy(descriptors.data.data(),
@@ -1132,7 +1169,7 @@ std::optional<nlohmann::json> Database::ReadStageProvenance(const std::string& s
   const char* text = reinterpret_cast<const char*>(sqlite3_column_text(use.get(), 0));
   try {
     return nlohmann::json::parse(text != nullptr ? text : "");
-  } catch (const nlohmann::json::parse_error& error) {
+  } catch (const nlohmann::json::exception& error) {  // parse_error, out_of_range (406)
     throw InputError("Database '" + impl_->path.string() + "': the provenance of stage '" + stage +
                      "' is not valid JSON: " + error.what());
   }

@@ -804,6 +804,65 @@ TEST_F(DatabaseTest, ForeignSchemaIsAnInputError) {
   }
 }
 
+// Found by tests/fuzz (database target): a file SQLite refuses to read ("unsupported
+// file format": a schema format number above 4) is bad input, not an internal failure.
+TEST_F(DatabaseTest, UnsupportedSchemaFormatIsAnInputError) {
+  { Database database(DatabasePath()); }
+  {
+    std::fstream file(DatabasePath(), std::ios::in | std::ios::out | std::ios::binary);
+    file.seekp(44);  // the schema format number, big-endian
+    file.write("\0\0\0\x09", 4);
+  }
+  try {
+    Database database(DatabasePath());
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("unsupported file format"), std::string::npos)
+        << error.what();
+  }
+}
+
+// Found by tests/fuzz (database target): a NULL image name and row counts far beyond
+// the stored bytes are refused, not dereferenced or allocated.
+TEST_F(DatabaseTest, CorruptRowsAreInputErrors) {
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(DatabasePath().c_str(), &db), SQLITE_OK);
+    // An images table without COLMAP's NOT NULL, as a damaged file may hold.
+    sqlite3_exec(db,
+                 "CREATE TABLE images (image_id INTEGER PRIMARY KEY, name TEXT, camera_id "
+                 "INTEGER);"
+                 "INSERT INTO images VALUES(4, NULL, 1);",
+                 nullptr, nullptr, nullptr);
+    sqlite3_close(db);
+  }
+  {
+    Database database(DatabasePath());
+    try {
+      database.ReadAllImages();
+      FAIL() << "expected an error";
+    } catch (const InputError& error) {
+      EXPECT_EQ(std::string(error.what()),
+                "Database '" + DatabasePath().string() + "': image 4 has no name.");
+    }
+    database.WriteKeypoints(4, {FeatureKeypoint(1, 2)});
+    FeatureDescriptors descriptors;
+    descriptors.data = FeatureDescriptors::Matrix::Constant(1, 32, 7);
+    database.WriteDescriptors(4, descriptors);
+    database.WriteMatches(4, 5, {{0, 0}});
+  }
+  // 2^61 rows: the byte count of the matches wraps to zero in 64 bits.
+  RawDatabase(DatabasePath())
+      .Exec(
+          "UPDATE keypoints SET rows = 4611686018427387904; "
+          "UPDATE descriptors SET rows = 1099511627776, cols = 1099511627776; "
+          "UPDATE matches SET rows = 2305843009213693952;");
+  Database database(DatabasePath());
+  EXPECT_THROW(database.ReadKeypoints(4), InputError);
+  EXPECT_THROW(database.ReadDescriptors(4, DescriptorMetric::kHamming), InputError);
+  EXPECT_THROW(database.ReadMatches(4, 5), InputError);
+}
+
 TEST_F(DatabaseTest, OldColmapGeometryTableGainsItsColumns) {
   {
     sqlite3* db = nullptr;

@@ -9,6 +9,9 @@
 #include <cstdlib>
 #include <new>
 #include <random>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "scene/colmap_model_io.h"
 #include "tessera/errors.h"
@@ -130,23 +133,44 @@ TEST(ColmapModelFuzz, EveryTruncationOfEachFileIsRefused) {
   }
 }
 
+// Every byte set to 0x00, 0x7f and 0xff and inverted, one at a time: each change reads
+// or is refused with InputError (Refuses fails the test on anything else). A binary
+// file's leading record count is checked against the records that follow, so every
+// change of it is refused; changes of coordinates and comments read.
 TEST(ColmapModelFuzz, EverySingleByteChangeReadsOrIsRefused) {
   for (const auto format : {ColmapModelFormat::kBinary, ColmapModelFormat::kText}) {
     CorruptModel model(format);
     for (const std::string& name : FileNames()) {
       const std::string bytes = ReadFileContents(model.File(name));
+      int num_changes = 0, num_refused = 0, num_count_changes = 0, num_count_refused = 0;
       for (size_t offset = 0; offset < bytes.size(); ++offset) {
+        std::vector<std::pair<char, std::string>> changes;
         for (const unsigned char value : {0x00, 0x7f, 0xff}) {
-          std::string corrupt = bytes;
-          corrupt[offset] = static_cast<char>(value);
-          model.Refuses(name, corrupt,
-                        "byte " + std::to_string(offset) + " = " + std::to_string(value));
+          changes.emplace_back(static_cast<char>(value), "= " + std::to_string(value));
         }
-        std::string flipped = bytes;
-        flipped[offset] = static_cast<char>(~flipped[offset]);
-        model.Refuses(name, flipped, "byte " + std::to_string(offset) + " inverted");
+        changes.emplace_back(static_cast<char>(~bytes[offset]), "inverted");
+        for (const auto& [value, what] : changes) {
+          if (value == bytes[offset]) continue;  // no change
+          std::string corrupt = bytes;
+          corrupt[offset] = value;
+          const bool refused =
+              model.Refuses(name, corrupt, "byte " + std::to_string(offset) + " " + what);
+          ++num_changes;
+          num_refused += refused;
+          if (format == ColmapModelFormat::kBinary && offset < sizeof(uint64_t)) {
+            ++num_count_changes;
+            num_count_refused += refused;
+          }
+        }
       }
-      model.Refuses(name, bytes, "restored");
+      const std::string file = model.File(name).filename().string();
+      EXPECT_FALSE(model.Refuses(name, bytes, "restored")) << file;
+      EXPECT_GT(num_refused, 0) << file;
+      EXPECT_LT(num_refused, num_changes) << file << ": no change read";
+      if (format == ColmapModelFormat::kBinary) {
+        EXPECT_GE(num_count_changes, 3 * static_cast<int>(sizeof(uint64_t))) << file;
+        EXPECT_EQ(num_count_refused, num_count_changes) << file;
+      }
     }
   }
 }
