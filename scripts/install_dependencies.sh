@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake pkg-config clang-format
+  build-essential cmake pkg-config clang-format ccache
   libopencv-dev libceres-dev libeigen3-dev libboost-dev libboost-filesystem-dev
   nlohmann-json3-dev libflann-dev libsqlite3-dev sqlite3 bc libexif-dev
   libglfw3-dev libimgui-dev libgtest-dev libgmock-dev libbenchmark-dev

@@ -6,14 +6,21 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 ./scripts/install_dependencies.sh
 jobs=$(nproc)
+# ccache (installed above) keeps compiled objects between runs and checkouts: paths are
+# hashed relative to the checkout, so another clone of the same sources hits the cache.
+launcher=()
+if command -v ccache > /dev/null; then
+  launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
+  export CCACHE_BASEDIR=$PWD CCACHE_NOHASHDIR=1
+fi
 
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DTESSERA_WERROR=ON > /dev/null
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DTESSERA_WERROR=ON "${launcher[@]}" > /dev/null
 cmake --build build -j"$jobs"
 ctest --test-dir build --output-on-failure -j"$jobs"
 
 if [ "${TESSERA_SKIP_SANITIZERS:-0}" != "1" ]; then
   cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=RelWithDebInfo -DTESSERA_WERROR=ON \
-        -DTESSERA_SANITIZE=ON -DTESSERA_BUILD_BENCHMARKS=OFF > /dev/null
+        -DTESSERA_SANITIZE=ON -DTESSERA_BUILD_BENCHMARKS=OFF "${launcher[@]}" > /dev/null
   cmake --build build-asan -j"$jobs"
   ASAN_OPTIONS=detect_leaks=0 UBSAN_OPTIONS=print_stacktrace=1 \
     ctest --test-dir build-asan --output-on-failure -j"$jobs" -LE "slow|install"

@@ -1227,6 +1227,8 @@ std::optional<int> Database::DescriptorDimension() const {
   StatementUse use(*impl_->descriptor_dimension);
   if (!impl_->Step(use.get(), "read the descriptor width")) return std::nullopt;
   return static_cast<int>(sqlite3_column_int64(use.get(), 0));
+}
+
 std::vector<Database::ImageFile> Database::ReadImageFiles() const {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   StatementUse use(*impl_->read_image_files);

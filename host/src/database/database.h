@@ -101,7 +101,6 @@ class Database {
   // the caller says which one the stage's detector produced.
   bool ExistsDescriptors(image_t image_id) const;
   void WriteDescriptors(image_t image_id, const FeatureDescriptors& descriptors);
-  FeatureDescriptors ReadDescriptors(image_t image_id, DescriptorMetric metric) const;
   // The width (columns) of the stored descriptors, from one non-empty row's header
   // without reading its data; nullopt when no image has descriptors.
   std::optional<int> DescriptorDimension() const;
