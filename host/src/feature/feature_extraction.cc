@@ -111,8 +111,8 @@ std::vector<Image> RegisterImages(const ImageScan& scan, const CameraSettings& s
   Database::Transaction transaction(database);
   std::map<camera_t, camera_t> database_camera_ids;
   for (const Camera& camera : assignment.cameras) {
-    const auto same = std::find_if(
-        existing_cameras.begin(), existing_cameras.end(), [&](const Camera& existing) {
+    const auto same =
+        std::find_if(existing_cameras.begin(), existing_cameras.end(), [&](const Camera& existing) {
           return existing.model_id == camera.model_id && existing.width == camera.width &&
                  existing.height == camera.height && existing.params == camera.params &&
                  existing.has_prior_focal_length == camera.has_prior_focal_length &&

@@ -56,7 +56,9 @@ class FeatureCache {
  public:
   // `dimension` > 0: every descriptor row read must have that width.
   FeatureCache(const Database* database, DescriptorMetric metric, int dimension, size_t max_bytes)
-      : database_(database), metric_(metric), dimension_(dimension > 0 ? dimension : -1),
+      : database_(database),
+        metric_(metric),
+        dimension_(dimension > 0 ? dimension : -1),
         max_bytes_(max_bytes) {}
 
   std::shared_ptr<const ImageFeatures> Get(image_t image_id) {
