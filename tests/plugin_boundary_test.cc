@@ -170,24 +170,10 @@ TEST(PluginBoundary, CrashLogMovesTheLastRunsCrashesIntoTheHistoryAndQuarantines
 
 // --- The command line -----------------------------------------------------------------
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;  // stdout and stderr together
-};
+using testing::CommandResult;
 
 CommandResult RunTessera(const std::string& arguments, const std::string& environment = "") {
-  const std::string command =
-      environment + " " + std::string(TESSERA_TEST_EXECUTABLE) + " " + arguments + " 2>&1";
-  CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  std::array<char, 4096> buffer;
-  size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-    result.output.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
+  return testing::RunCommand(TESSERA_TEST_EXECUTABLE, arguments, environment);
 }
 
 bool Contains(const std::string& text, const std::string& part) {

@@ -3,6 +3,10 @@
 // Helpers shared by the tests: loading bundled plugins through the real loader, and
 // finding the shared datasets.
 
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -62,5 +66,30 @@ class TemporaryDir {
  private:
   std::filesystem::path path_;
 };
+
+// What a command printed (stdout and stderr together) and its exit code (-1 when it
+// did not exit normally).
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;
+};
+
+// Runs `executable arguments` through the shell; `environment` is prepended to the
+// command, e.g. "TESSERA_PLUGIN_PATH=/x".
+inline CommandResult RunCommand(const std::string& executable, const std::string& arguments,
+                                const std::string& environment = "") {
+  const std::string command = environment + " " + executable + " " + arguments + " 2>&1";
+  CommandResult result;
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return result;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) {
+    result.output.append(buffer.data(), n);
+  }
+  const int status = pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
 
 }  // namespace tessera::testing
