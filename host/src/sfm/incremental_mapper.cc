@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <set>
 #include <tuple>
@@ -139,6 +140,8 @@ class ModelBuilder {
   // image seen by the model only through weaker pairs (repeated structure on the far
   // side of a symmetric object, typically) waits for its strong neighbours to register.
   double ConnectionStrength(image_t image_id) const;
+  // Registered images that the image has an unremoved pair with, and all of them.
+  std::pair<size_t, size_t> NumRegisteredNeighbours(image_t image_id) const;
   bool RegisterImage(image_t image_id);
   // Whether a candidate rotation of an image agrees with the view graph (see
   // IncrementalMapperOptions::check_registration); `why` says how it does not.
@@ -150,6 +153,20 @@ class ModelBuilder {
   // images are dropped from the view graph. Later tries use only points the trusted
   // neighbours see.
   void TrustStrongestAgreeingPairs(image_t image_id);
+  // Each unremoved pair of an image with a registered neighbour votes for the image's
+  // rotation: the neighbour's rotation composed with the pair's relative rotation.
+  struct RotationVote {
+    size_t edge = 0;
+    image_t neighbour = kInvalidImageId;
+    Eigen::Matrix3d R_cam_from_world;  // implied for the image
+    double weight = 0;                 // the pair's inliers
+  };
+  std::vector<RotationVote> RotationVotes(image_t image_id) const;
+  // The vote with the most weight of votes within reg_max_rotation_error of it, among
+  // the votes `eligible` accepts; returns that weight (0 without eligible votes).
+  double HeaviestVoteGroup(const std::vector<RotationVote>& votes,
+                           const std::function<bool(const RotationVote&)>& eligible,
+                           size_t* best) const;
   void TriangulateImage(image_t image_id);
   bool TriangulateTrack(track_t track_id, double max_error);
   // Returns true when the local problem held every registered image with a free pose,
@@ -219,6 +236,12 @@ class ModelBuilder {
   point3D_t next_point3D_id_ = 1;
   std::map<image_t, int> num_registration_trials_;
   std::map<image_t, std::set<image_t>> trusted_neighbours_;
+  // Images refused by the view-graph check, with how many registered neighbours (images
+  // they have a pair with) they had then: they wait until they have more.
+  std::map<image_t, size_t> refused_with_neighbours_;
+  // Set by GrowAgain: no image waits for neighbours any more, and a refused one is
+  // retried with its trusted neighbours only.
+  bool final_rounds_ = false;
   size_t num_images_at_global_ba_ = 0;
   // Whether BA moves the principal point now: only in the final global rounds.
   bool refine_principal_point_ = false;
@@ -447,6 +470,11 @@ std::vector<image_t> ModelBuilder::NextImages() {
         num_registration_trials_[image_id] >= options_.max_reg_trials) {
       continue;
     }
+    const auto refused = refused_with_neighbours_.find(image_id);
+    if (refused != refused_with_neighbours_.end() &&
+        NumRegisteredNeighbours(image_id).first <= refused->second) {
+      continue;
+    }
     const Camera& camera = rec_.cameras.at(image.camera_id);
     std::set<std::pair<int, int>> cells[kNumLevels];
     size_t num_visible = 0;
@@ -505,6 +533,18 @@ double ModelBuilder::ConnectionStrength(image_t image_id) const {
     if (IsRegistered(other_id)) best_registered = std::max(best_registered, edge.num_inliers);
   }
   return best > 0 ? static_cast<double>(best_registered) / static_cast<double>(best) : 0.0;
+}
+
+std::pair<size_t, size_t> ModelBuilder::NumRegisteredNeighbours(image_t image_id) const {
+  std::set<image_t> registered, all;
+  for (const size_t e : run_.view_graph.EdgesOf(image_id)) {
+    const ViewGraphEdge& edge = run_.view_graph.edges()[e];
+    if (edge.removed) continue;
+    const image_t other_id = edge.image_id1 == image_id ? edge.image_id2 : edge.image_id1;
+    all.insert(other_id);
+    if (IsRegistered(other_id)) registered.insert(other_id);
+  }
+  return {registered.size(), all.size()};
 }
 
 bool ModelBuilder::RegisterImage(image_t image_id) {
@@ -575,7 +615,16 @@ bool ModelBuilder::RegisterImage(image_t image_id) {
     if (!AgreesWithViewGraph(image_id, rotation, &disagreement)) {
       ++run_.num_registrations_refused;
       spdlog::info("map: refused {}: {}", image.name, disagreement);
-      TrustStrongestAgreeingPairs(image_id);
+      // Pairs whose two-view rotation is wrong are common where the scene barely
+      // constrains it: first wait for more of the image's neighbours (its strongest
+      // pairs may be to images not registered yet); only when none will come, trust the
+      // neighbours that agree among themselves.
+      const auto [num_registered, num_neighbours] = NumRegisteredNeighbours(image_id);
+      if (final_rounds_ || num_registered == num_neighbours) {
+        TrustStrongestAgreeingPairs(image_id);
+      } else {
+        refused_with_neighbours_[image_id] = num_registered;
+      }
       return fail(disagreement);
     }
   }
@@ -595,53 +644,8 @@ bool ModelBuilder::RegisterImage(image_t image_id) {
   return true;
 }
 
-bool ModelBuilder::AgreesWithViewGraph(image_t image_id, const Eigen::Matrix3d& R_cam_from_world,
-                                       std::string* why) const {
-  double weight_all = 0, weight_agreeing = 0;
-  size_t num_pairs = 0, num_disagreeing = 0;
-  double worst_error = 0;
-  image_t worst_image = kInvalidImageId;
-  for (const size_t e : run_.view_graph.EdgesOf(image_id)) {
-    const ViewGraphEdge& edge = run_.view_graph.edges()[e];
-    if (!edge.has_rotation || edge.removed) continue;
-    const image_t other_id = edge.image_id1 == image_id ? edge.image_id2 : edge.image_id1;
-    if (!IsRegistered(other_id)) continue;
-    const Eigen::Matrix3d R_other =
-        rec_.images.at(other_id).cam_from_world.rotation.toRotationMatrix();
-    const double error = edge.image_id1 == image_id
-                             ? ViewGraph::RotationErrorDeg(edge, R_cam_from_world, R_other)
-                             : ViewGraph::RotationErrorDeg(edge, R_other, R_cam_from_world);
-    const double weight = static_cast<double>(edge.num_inliers);
-    ++num_pairs;
-    weight_all += weight;
-    if (error <= options_.reg_max_rotation_error) {
-      weight_agreeing += weight;
-    } else {
-      ++num_disagreeing;
-      if (error > worst_error) {
-        worst_error = error;
-        worst_image = other_id;
-      }
-    }
-  }
-  if (weight_all == 0 || weight_agreeing >= options_.reg_min_agreement * weight_all) return true;
-  *why = fmt::format(
-      "its pose disagrees with {} of its {} verified pairs to registered images by more than "
-      "{:g} deg ({:.0f}% of their inliers agree, {:.0f}% needed; worst: {} at {:.0f} deg)",
-      num_disagreeing, num_pairs, options_.reg_max_rotation_error,
-      100 * weight_agreeing / weight_all, 100 * options_.reg_min_agreement,
-      rec_.images.at(worst_image).name, worst_error);
-  return false;
-}
-
-void ModelBuilder::TrustStrongestAgreeingPairs(image_t image_id) {
-  struct Vote {
-    size_t edge;
-    image_t neighbour;
-    Eigen::Matrix3d R_cam_from_world;  // implied for image_id
-    double weight;
-  };
-  std::vector<Vote> votes;
+std::vector<ModelBuilder::RotationVote> ModelBuilder::RotationVotes(image_t image_id) const {
+  std::vector<RotationVote> votes;
   for (const size_t e : run_.view_graph.EdgesOf(image_id)) {
     const ViewGraphEdge& edge = run_.view_graph.edges()[e];
     if (!edge.has_rotation || edge.removed) continue;
@@ -656,31 +660,104 @@ void ModelBuilder::TrustStrongestAgreeingPairs(image_t image_id) {
     votes.push_back(
         {e, other_id, R_image_from_other * R_other, static_cast<double>(edge.num_inliers)});
   }
-  const auto angle_deg = [](const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
-    const double cos_angle = std::clamp(((a * b.transpose()).trace() - 1) / 2, -1.0, 1.0);
-    return std::acos(cos_angle) / kDegToRad;
-  };
+  return votes;
+}
+
+namespace {
+
+double AngleBetweenDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  const double cos_angle = std::clamp(((a * b.transpose()).trace() - 1) / 2, -1.0, 1.0);
+  return std::acos(cos_angle) / kDegToRad;
+}
+
+}  // namespace
+
+double ModelBuilder::HeaviestVoteGroup(const std::vector<RotationVote>& votes,
+                                       const std::function<bool(const RotationVote&)>& eligible,
+                                       size_t* best) const {
   double best_weight = 0;
-  size_t best = 0;
   for (size_t k = 0; k < votes.size(); ++k) {
+    if (!eligible(votes[k])) continue;
     double weight = 0;
-    for (const Vote& other : votes) {
-      if (angle_deg(votes[k].R_cam_from_world, other.R_cam_from_world) <=
-          options_.reg_max_rotation_error) {
+    for (const RotationVote& other : votes) {
+      if (eligible(other) && AngleBetweenDeg(votes[k].R_cam_from_world, other.R_cam_from_world) <=
+                                 options_.reg_max_rotation_error) {
         weight += other.weight;
       }
     }
     if (weight > best_weight) {
       best_weight = weight;
-      best = k;
+      *best = k;
     }
   }
-  if (votes.empty()) return;
+  return best_weight;
+}
+
+bool ModelBuilder::AgreesWithViewGraph(image_t image_id, const Eigen::Matrix3d& R_cam_from_world,
+                                       std::string* why) const {
+  const std::vector<RotationVote> votes = RotationVotes(image_id);
+  double weight_all = 0, weight_agreeing = 0;
+  size_t num_disagreeing = 0;
+  double worst_error = 0;
+  image_t worst_image = kInvalidImageId;
+  for (const RotationVote& vote : votes) {
+    const double error = AngleBetweenDeg(R_cam_from_world, vote.R_cam_from_world);
+    weight_all += vote.weight;
+    if (error <= options_.reg_max_rotation_error) {
+      weight_agreeing += vote.weight;
+    } else {
+      ++num_disagreeing;
+      if (error > worst_error) {
+        worst_error = error;
+        worst_image = vote.neighbour;
+      }
+    }
+  }
+  if (weight_all == 0 || weight_agreeing >= options_.reg_min_agreement * weight_all) return true;
+  // Most pairs disagree. A fold has an alternative: the pairs it contradicts agree with
+  // each other on another rotation. Pairs whose two-view rotation is merely wrong (a
+  // near-planar scene, a narrow field of view on a small object, where E fits the
+  // inliers as well with a wrong rotation) scatter instead: their largest group that
+  // agrees on one rotation other than the pose's must outweigh the pose's own.
+  size_t best = 0;
+  const double weight_alternative = HeaviestVoteGroup(
+      votes,
+      [&](const RotationVote& vote) {
+        return AngleBetweenDeg(R_cam_from_world, vote.R_cam_from_world) >
+               options_.reg_max_rotation_error;
+      },
+      &best);
+  if (weight_alternative <= weight_agreeing) {
+    spdlog::debug(
+        "map: {}: {:.0f}% of the inliers of its pairs agree with its pose, but those that "
+        "disagree do not agree among themselves (at most {:.0f}% on one rotation)",
+        rec_.images.at(image_id).name, 100 * weight_agreeing / weight_all,
+        100 * weight_alternative / weight_all);
+    return true;
+  }
+  *why = fmt::format(
+      "its pose disagrees with {} of its {} verified pairs to registered images by more than "
+      "{:g} deg ({:.0f}% of their inliers agree, {:.0f}% needed, and {:.0f}% agree on another "
+      "rotation {:.0f} deg away; worst: {} at {:.0f} deg)",
+      num_disagreeing, votes.size(), options_.reg_max_rotation_error,
+      100 * weight_agreeing / weight_all, 100 * options_.reg_min_agreement,
+      100 * weight_alternative / weight_all,
+      AngleBetweenDeg(R_cam_from_world, votes[best].R_cam_from_world),
+      rec_.images.at(worst_image).name, worst_error);
+  return false;
+}
+
+void ModelBuilder::TrustStrongestAgreeingPairs(image_t image_id) {
+  const std::vector<RotationVote> votes = RotationVotes(image_id);
+  size_t best = 0;
+  if (HeaviestVoteGroup(
+          votes, [](const RotationVote&) { return true; }, &best) == 0)
+    return;
   std::set<image_t>& trusted = trusted_neighbours_[image_id];
   trusted.clear();
   size_t num_dropped = 0;
-  for (const Vote& vote : votes) {
-    if (angle_deg(votes[best].R_cam_from_world, vote.R_cam_from_world) <=
+  for (const RotationVote& vote : votes) {
+    if (AngleBetweenDeg(votes[best].R_cam_from_world, vote.R_cam_from_world) <=
         options_.reg_max_rotation_error) {
       trusted.insert(vote.neighbour);
     } else {
@@ -1080,6 +1157,8 @@ void ModelBuilder::Finish() {
 bool ModelBuilder::GrowAgain() {
   const size_t num_before = registered_.size();
   num_registration_trials_.clear();
+  refused_with_neighbours_.clear();
+  final_rounds_ = true;
   changed_since_global_ba_ = false;
   Grow();
   return registered_.size() > num_before;

@@ -75,8 +75,11 @@ struct IncrementalMapperOptions {
   // Each registration is checked against the view graph: the relative rotations its
   // pose implies to the registered images it has a verified pair with must agree with
   // the pairs' own within reg_max_rotation_error degrees, for at least
-  // reg_min_agreement of the pairs (weighted by their inliers). Else it is refused and
-  // the image tried again later.
+  // reg_min_agreement of the pairs (weighted by their inliers), unless the pairs that
+  // disagree do not agree among themselves on another rotation more than the agreeing
+  // ones do (wrong two-view rotations that scatter are no fold). Else it is refused and
+  // the image waits until more of its neighbours are registered; in the final rounds, or
+  // once all are, it is retried with the neighbours that agree on its rotation.
   bool check_registration = true;
   double reg_max_rotation_error = 10.0;  // degrees
   double reg_min_agreement = 0.6;

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "eval/evaluation.h"
+#include "geometry/essential_matrix.h"
 #include "sfm/synthetic_scene_test_util.h"
 #include "tessera/errors.h"
 #include "test_support.h"
@@ -254,6 +255,69 @@ TEST(IncrementalMapper, FlagsAFoldedModel) {
   EXPECT_GT(evaluation.rotation_error_max_deg, 90);
   EXPECT_TRUE(result.self_checks[0].possibly_folded);
   EXPECT_FALSE(result.self_checks[0].disagreeing_images.empty());
+}
+
+// Gives the pairs of `image_id` with every image more than one position away on the arc
+// a wrong relative rotation (their E): the true one turned by 40 degrees about an axis
+// that differs per pair (`scattered`), or the one a pose of the image turned by 40
+// degrees about the vertical would give (one wrong rotation that they all agree on).
+void CorruptRotationsOfPairs(image_t image_id, bool scattered, SyntheticScene* scene) {
+  const std::vector<Eigen::Vector3d> axes = {{1, 0, 0},  {0, 1, 0}, {0, 0, 1},  {1, 1, 0},
+                                             {1, -1, 0}, {0, 1, 1}, {0, 1, -1}, {1, 0, 1},
+                                             {1, 0, -1}, {1, 1, 1}, {-1, 1, 1}};
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(40 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  size_t k = 0;
+  for (MapperInput::Pair& pair : scene->input.pairs) {
+    if (pair.image_id1 != image_id && pair.image_id2 != image_id) continue;
+    const image_t other = pair.image_id1 == image_id ? pair.image_id2 : pair.image_id1;
+    if (std::abs(static_cast<int>(other) - static_cast<int>(image_id)) <= 1) continue;
+    const Eigen::Matrix3d R1 =
+        scene->true_cam_from_world.at(pair.image_id1).rotation.toRotationMatrix();
+    const Eigen::Matrix3d R2 =
+        scene->true_cam_from_world.at(pair.image_id2).rotation.toRotationMatrix();
+    Eigen::Matrix3d R_cam2_from_cam1;
+    if (scattered) {
+      const Eigen::Matrix3d wrong =
+          Eigen::AngleAxisd(40 * M_PI / 180, axes[k++ % axes.size()].normalized())
+              .toRotationMatrix();
+      R_cam2_from_cam1 = wrong * R2 * R1.transpose();
+    } else if (pair.image_id1 == image_id) {
+      R_cam2_from_cam1 = R2 * (turn * R1).transpose();
+    } else {
+      R_cam2_from_cam1 = turn * R2 * R1.transpose();
+    }
+    Rigid3d cam2_from_cam1 = pair.geometry.cam2_from_cam1;
+    cam2_from_cam1.rotation = Eigen::Quaterniond(R_cam2_from_cam1);
+    pair.geometry.E = EssentialMatrixFromPose(cam2_from_cam1);
+  }
+}
+
+TEST(IncrementalMapper, KeepsAnImageWhosePairsDisagreeWithoutAnAlternative) {
+  // Where the scene barely constrains two-view rotations (a small object filmed with a
+  // narrow field of view, a near-planar scene), many pairs give a wrong one, each wrong
+  // in its own way: that is no fold, and the image's pose is kept. Pairs that agree on
+  // one other rotation are the sign of a fold, and the pose is refused.
+  SyntheticSceneOptions options;
+  options.seed = 14;
+  const image_t image_id = 6;
+  IncrementalMapperOptions mapper_options;
+  mapper_options.filter_view_graph = false;  // the registration check alone
+
+  SyntheticScene scattered = MakeSyntheticScene(options);
+  CorruptRotationsOfPairs(image_id, /*scattered=*/true, &scattered);
+  const MapperResult kept = Map(scattered, mapper_options);
+  ASSERT_EQ(kept.models.size(), 1u);
+  EXPECT_EQ(kept.models[0].images.size(), scattered.input.images.size());
+  EXPECT_EQ(kept.num_registrations_refused, 0u);
+  ExpectNoCameraOff(scattered, kept.models[0], 0.5);
+
+  SyntheticScene coherent = MakeSyntheticScene(options);
+  CorruptRotationsOfPairs(image_id, /*scattered=*/false, &coherent);
+  const MapperResult refused = Map(coherent, mapper_options);
+  EXPECT_GT(refused.num_registrations_refused, 0u);
+  ASSERT_FALSE(refused.models.empty());
+  ExpectNoCameraOff(coherent, refused.models[0], 5);
 }
 
 TEST(IncrementalMapper, MergesTwoModelsOfOneScene) {
