@@ -5,15 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <numeric>
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
-#include <tuple>
 #include <vector>
 
-#include "common/scaled_image.h"
+#include "tessera/keypoint_selection.h"
+#include "tessera/scaled_image.h"
 #include "tessera/sdk.h"
 
 namespace tessera {
@@ -53,20 +52,6 @@ cv::Point2d OrbKeypointPosition(const cv::KeyPoint& kp, const cv::Size& image_si
           (kp.pt.y / level_scale + 0.5) * image_size.height / level_height};
 }
 
-// Indices of at most `max_count` keypoints, strongest first. Ties are broken by
-// position, size and angle so that the choice does not depend on OpenCV's order.
-std::vector<int> StrongestFirst(const std::vector<cv::KeyPoint>& keypoints, int max_count) {
-  std::vector<int> order(keypoints.size());
-  std::iota(order.begin(), order.end(), 0);
-  auto key = [&](int i) {
-    const cv::KeyPoint& kp = keypoints[i];
-    return std::make_tuple(-kp.response, kp.pt.y, kp.pt.x, kp.size, kp.angle, kp.octave, i);
-  };
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
-  if (order.size() > static_cast<size_t>(max_count)) order.resize(max_count);
-  return order;
-}
-
 class OrbDetector : public Detector {
  public:
   explicit OrbDetector(const nlohmann::json& options) {
@@ -84,8 +69,7 @@ class OrbDetector : public Detector {
   }
 
   FeatureSet Detect(const ImageView& view) const override {
-    const detector_common::ScaledImage scaled =
-        detector_common::ScaleToMaxSize(view, options_.max_image_size, "orb");
+    const ScaledImage scaled = ScaleToMaxSize(view, options_.max_image_size, "orb");
 
     // A detector per call: sharing one cv::ORB across threads is not documented as safe.
     const cv::Ptr<cv::ORB> orb = cv::ORB::create(

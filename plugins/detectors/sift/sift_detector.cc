@@ -6,15 +6,14 @@
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
-#include <tuple>
 #include <vector>
 
-#include "common/scaled_image.h"
+#include "tessera/keypoint_selection.h"
+#include "tessera/scaled_image.h"
 #include "tessera/sdk.h"
 
 namespace tessera {
@@ -45,20 +44,6 @@ struct SiftOptions {
   bool root_sift = true;
 };
 
-// Indices of at most `max_count` keypoints, strongest first. Ties are broken by
-// position, size and angle so that the choice does not depend on OpenCV's order.
-std::vector<int> StrongestFirst(const std::vector<cv::KeyPoint>& keypoints, int max_count) {
-  std::vector<int> order(keypoints.size());
-  std::iota(order.begin(), order.end(), 0);
-  auto key = [&](int i) {
-    const cv::KeyPoint& kp = keypoints[i];
-    return std::make_tuple(-kp.response, kp.pt.y, kp.pt.x, kp.size, kp.angle, kp.octave, i);
-  };
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
-  if (order.size() > static_cast<size_t>(max_count)) order.resize(max_count);
-  return order;
-}
-
 class SiftDetector : public Detector {
  public:
   explicit SiftDetector(const nlohmann::json& options) {
@@ -80,8 +65,7 @@ class SiftDetector : public Detector {
   }
 
   FeatureSet Detect(const ImageView& view) const override {
-    const detector_common::ScaledImage scaled =
-        detector_common::ScaleToMaxSize(view, options_.max_image_size, "sift");
+    const ScaledImage scaled = ScaleToMaxSize(view, options_.max_image_size, "sift");
 
     // A detector per call: sharing one cv::SIFT across threads is not documented as safe.
     const cv::Ptr<cv::SIFT> sift =

@@ -1,8 +1,9 @@
 #pragma once
 
-// Shared by the bundled OpenCV detectors (header only; not part of the SDK, which does
-// not depend on OpenCV): the image a detector works on, downscaled to its
-// max_image_size, and the factors that bring keypoints back to full resolution.
+// For detectors built on OpenCV (header only): the image a detector works on, downscaled
+// to its max_image_size, and the factors that bring keypoints back to full resolution.
+// The SDK itself does not depend on OpenCV and sdk.h does not include this header: a
+// plugin that includes it links OpenCV (core and imgproc) itself.
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +14,7 @@
 #include "tessera/errors.h"
 #include "tessera/image_view.h"
 
-namespace tessera::detector_common {
+namespace tessera {
 
 struct ScaledImage {
   cv::Mat image;
@@ -21,7 +22,9 @@ struct ScaledImage {
   double scale_y = 1;  // and vertically
 };
 
-// `detector` names the plugin in the error about a malformed view.
+// `view` scaled by area averaging so that its longer side is at most `max_image_size`
+// pixels; the view itself, not copied, when it is small enough already. `detector` names
+// the plugin in the InputError about an empty or malformed view.
 inline ScaledImage ScaleToMaxSize(const ImageView& view, int max_image_size,
                                   const std::string& detector) {
   if (view.data == nullptr || view.width <= 0 || view.height <= 0 ||
@@ -47,4 +50,4 @@ inline ScaledImage ScaleToMaxSize(const ImageView& view, int max_image_size,
   return scaled;
 }
 
-}  // namespace tessera::detector_common
+}  // namespace tessera
