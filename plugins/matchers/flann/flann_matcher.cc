@@ -22,18 +22,15 @@
 #include <string>
 #include <type_traits>
 
+#include "tessera/match_filter.h"
 #include "tessera/sdk.h"
 
 namespace tessera {
 
 struct FlannMatchOptions {
-  // Lowe's ratio test: keep a match if best < ratio * second-best distance (not squared).
-  double ratio = 0.8;
-  // Keep a match a -> b only if a is also b's (approximate) nearest neighbour.
-  bool cross_check = true;
-  // Largest distance of a kept match: Euclidean in uint8 descriptor units for l2, bits for
-  // hamming. 0 turns the threshold off.
-  double max_distance = 0;
+  // Ratio test, distance threshold and cross check (against the approximate nearest
+  // neighbour), as every matcher reads them.
+  MatchFilterOptions filter;
   // Index for l2 descriptors: "kmeans" (deterministic) or "kdtree" (randomized kd-trees).
   std::string l2_index = "kmeans";
   // Index for binary descriptors: "hierarchical" (deterministic) or "lsh".
@@ -63,14 +60,6 @@ struct FlannMatchOptions {
 
 namespace {
 
-// Nearest neighbours of each query row among the indexed rows; -1 where there is none.
-struct Neighbors {
-  std::vector<int> best;
-  std::vector<int> second;
-  std::vector<float> best_distance;
-  std::vector<float> second_distance;
-};
-
 // std::rand() is process-wide: builds that must replay one seeded sequence take turns.
 std::mutex& SeededBuildMutex() {
   static std::mutex mutex;
@@ -87,17 +76,13 @@ flann::Matrix<unsigned char> WrapDescriptors(const FeatureDescriptors& descripto
 // The concrete index type is used (not NNIndex) because LshIndex hides knnSearch with a
 // version that keeps a descriptor found in several tables from filling both slots.
 template <typename Index>
-Neighbors Search(const Index& index, const FeatureDescriptors& query, size_t k,
-                 const flann::SearchParams& params, bool squared_distances) {
+NearestNeighbors Search(const Index& index, const FeatureDescriptors& query, size_t k,
+                        const flann::SearchParams& params, bool squared_distances) {
   std::vector<std::vector<size_t>> indices;
   std::vector<std::vector<typename Index::DistanceType>> distances;
   index.knnSearch(WrapDescriptors(query), indices, distances, k, params);
   const size_t num_queries = static_cast<size_t>(query.size());
-  Neighbors neighbors;
-  neighbors.best.assign(num_queries, -1);
-  neighbors.second.assign(num_queries, -1);
-  neighbors.best_distance.assign(num_queries, 0);
-  neighbors.second_distance.assign(num_queries, 0);
+  NearestNeighbors neighbors(num_queries);
   const auto to_distance = [squared_distances](double value) {
     return static_cast<float>(squared_distances ? std::sqrt(value) : value);
   };
@@ -265,13 +250,7 @@ class FlannMatcher : public Matcher {
  public:
   explicit FlannMatcher(const nlohmann::json& options) {
     OptionReader reader(options);
-    options_.ratio = reader.Get<double>("ratio", options_.ratio);
-    if (!(options_.ratio > 0 && options_.ratio <= 1)) {
-      throw OptionError(reader.KeyPath("ratio"), "= " + nlohmann::json(options_.ratio).dump() +
-                                                     " is out of range; must be in (0, 1]");
-    }
-    options_.cross_check = reader.GetBool("cross_check", options_.cross_check);
-    options_.max_distance = reader.Get<double>("max_distance", options_.max_distance, 0.0, 1e9);
+    options_.filter = ReadMatchFilterOptions(reader);
     options_.l2_index = reader.GetString("l2_index", options_.l2_index, {"kmeans", "kdtree"});
     options_.hamming_index =
         reader.GetString("hamming_index", options_.hamming_index, {"hierarchical", "lsh"});
@@ -303,25 +282,18 @@ class FlannMatcher : public Matcher {
     CheckCompatible(descriptors1, descriptors2);
     // Forward: the two nearest rows of set 2 for each row of set 1. Backward (cross
     // check): the nearest row of set 1 for each row of set 2.
-    const Neighbors forward = FindNeighbors(descriptors2, descriptors1, 2);
-    Neighbors backward;
-    if (options_.cross_check) backward = FindBackwardNeighbors(forward, descriptors1, descriptors2);
-    return SelectMatches(forward, backward, descriptors2.size());
+    const NearestNeighbors forward = FindNeighbors(descriptors2, descriptors1, 2);
+    NearestNeighbors backward;
+    if (options_.filter.cross_check) {
+      backward = FindBackwardNeighbors(forward, descriptors1, descriptors2);
+    }
+    return FilterMatches(options_.filter, forward, backward, descriptors2.size());
   }
 
  private:
   void CheckCompatible(const FeatureDescriptors& descriptors1,
                        const FeatureDescriptors& descriptors2) const {
-    if (descriptors1.metric != descriptors2.metric) {
-      throw InputError(std::string("Cannot match ") + DescriptorMetricName(descriptors1.metric) +
-                       " descriptors against " + DescriptorMetricName(descriptors2.metric) +
-                       " descriptors: both images must be described by the same detector.");
-    }
-    if (descriptors1.dimension() != descriptors2.dimension()) {
-      throw InputError("Cannot match descriptors of " + std::to_string(descriptors1.dimension()) +
-                       " bytes against descriptors of " + std::to_string(descriptors2.dimension()) +
-                       " bytes: both images must be described by the same detector.");
-    }
+    CheckDescriptorsMatchable(descriptors1, descriptors2);
     if (descriptors1.metric == DescriptorMetric::kHamming && options_.hamming_index == "lsh" &&
         options_.lsh_key_size > 8 * descriptors1.dimension()) {
       throw InputError("The flann matcher's lsh_key_size of " +
@@ -346,8 +318,8 @@ class FlannMatcher : public Matcher {
     return index;
   }
 
-  Neighbors FindNeighbors(const FeatureDescriptors& data, const FeatureDescriptors& query,
-                          size_t k) const {
+  NearestNeighbors FindNeighbors(const FeatureDescriptors& data, const FeatureDescriptors& query,
+                                 size_t k) const {
     k = std::min(k, static_cast<size_t>(data.size()));
     flann::SearchParams search_params(options_.checks);
     search_params.cores = 1;  // the host parallelises over pairs
@@ -399,19 +371,21 @@ class FlannMatcher : public Matcher {
   // matched to; -1 for the others, which the cross check can never accept. Searching
   // only those (typically a third of set 2) gives the same matches as searching all:
   // each query's neighbours do not depend on the other queries.
-  Neighbors FindBackwardNeighbors(const Neighbors& forward, const FeatureDescriptors& descriptors1,
-                                  const FeatureDescriptors& descriptors2) const {
+  NearestNeighbors FindBackwardNeighbors(const NearestNeighbors& forward,
+                                         const FeatureDescriptors& descriptors1,
+                                         const FeatureDescriptors& descriptors2) const {
     std::vector<int> candidates;
     std::vector<char> is_candidate(static_cast<size_t>(descriptors2.size()), 0);
     for (size_t i = 0; i < forward.best.size(); ++i) {
       const int j = forward.best[i];
-      if (j >= 0 && PassesRatioAndDistance(forward, i, descriptors2.size()) && !is_candidate[j]) {
+      if (j >= 0 && PassesRatioAndDistance(options_.filter, forward, i, descriptors2.size()) &&
+          !is_candidate[j]) {
         is_candidate[j] = 1;
         candidates.push_back(j);
       }
     }
     std::sort(candidates.begin(), candidates.end());
-    Neighbors backward;
+    NearestNeighbors backward;
     backward.best.assign(static_cast<size_t>(descriptors2.size()), -1);
     if (candidates.empty()) return backward;
     FeatureDescriptors queries;
@@ -420,42 +394,11 @@ class FlannMatcher : public Matcher {
     for (size_t row = 0; row < candidates.size(); ++row) {
       queries.data.row(static_cast<Eigen::Index>(row)) = descriptors2.data.row(candidates[row]);
     }
-    const Neighbors found = FindNeighbors(descriptors1, queries, 1);
+    const NearestNeighbors found = FindNeighbors(descriptors1, queries, 1);
     for (size_t row = 0; row < candidates.size(); ++row) {
       backward.best[static_cast<size_t>(candidates[row])] = found.best[row];
     }
     return backward;
-  }
-
-  // Whether the forward neighbours of row i pass the distance threshold and the ratio
-  // test.
-  bool PassesRatioAndDistance(const Neighbors& forward, size_t i, Eigen::Index num_train) const {
-    if (options_.max_distance > 0 && forward.best_distance[i] > options_.max_distance) return false;
-    if (forward.second[i] >= 0) {
-      // Strict, so that two equally close neighbours (ambiguous) always fail.
-      return forward.best_distance[i] < options_.ratio * forward.second_distance[i];
-    }
-    // LSH saw no second candidate although there are others: the ratio test cannot be
-    // evaluated, and a lone candidate in a sparse bucket is often a wrong one. With a
-    // single row in set 2 there is no second neighbour and the ratio test passes.
-    return num_train <= 1;
-  }
-
-  // a -> b matches that pass the ratio test, the distance threshold and, when asked,
-  // the cross check; in ascending order of the first index.
-  FeatureMatches SelectMatches(const Neighbors& forward, const Neighbors& backward,
-                               Eigen::Index num_train) const {
-    FeatureMatches matches;
-    for (size_t i = 0; i < forward.best.size(); ++i) {
-      const int j = forward.best[i];
-      if (j < 0 || !PassesRatioAndDistance(forward, i, num_train)) continue;
-      if (options_.cross_check && backward.best[j] != static_cast<int>(i)) continue;
-      FeatureMatch match;
-      match.point2D_idx1 = static_cast<point2D_t>(i);
-      match.point2D_idx2 = static_cast<point2D_t>(j);
-      matches.push_back(match);
-    }
-    return matches;
   }
 
   FlannMatchOptions options_;
