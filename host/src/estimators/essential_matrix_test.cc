@@ -3,12 +3,12 @@
 #include <gtest/gtest.h>
 
 #include "estimators/ransac.h"
-#include "estimators/synthetic_scene_test_util.h"
+#include "geometry/essential_matrix.h"
+#include "synthetic_scene.h"
 
 namespace tessera {
 namespace {
 
-using testing::EssentialMatrixOf;
 using testing::MakeSyntheticTwoViewScene;
 using testing::ScaleInvariantDistance;
 using testing::SyntheticTwoViewOptions;
@@ -30,7 +30,7 @@ TEST(EssentialMatrixFivePointEstimator, MinimalSampleContainsTheTruth) {
         EssentialMatrixFivePointEstimator::Estimate(scene.normalized1, scene.normalized2);
     ASSERT_FALSE(models.empty()) << "seed " << seed;
     EXPECT_LE(models.size(), 10u);
-    EXPECT_LT(BestDistance(models, EssentialMatrixOf(scene.cam2_from_cam1)), 1e-6)
+    EXPECT_LT(BestDistance(models, EssentialMatrixFromPose(scene.cam2_from_cam1)), 1e-6)
         << "seed " << seed;
     // Every solution is an essential matrix: rank 2, two equal singular values.
     for (const Eigen::Matrix3d& E : models) {
@@ -47,7 +47,7 @@ TEST(EssentialMatrixFivePointEstimator, LeastSquaresOnManyNoiseFreePoints) {
   const auto scene = MakeSyntheticTwoViewScene(options);
   const auto models =
       EssentialMatrixFivePointEstimator::Estimate(scene.normalized1, scene.normalized2);
-  EXPECT_LT(BestDistance(models, EssentialMatrixOf(scene.cam2_from_cam1)), 1e-8);
+  EXPECT_LT(BestDistance(models, EssentialMatrixFromPose(scene.cam2_from_cam1)), 1e-8);
 }
 
 TEST(EssentialMatrixFivePointEstimator, ResidualIsSquaredSampsonError) {
@@ -77,7 +77,8 @@ TEST(EssentialMatrixFivePointEstimator, LORANSACFlagsOutliers) {
                                                                                      17)
           .Estimate(scene.normalized1, scene.normalized2);
   ASSERT_TRUE(report.success);
-  EXPECT_LT(ScaleInvariantDistance(report.model, EssentialMatrixOf(scene.cam2_from_cam1)), 0.02);
+  EXPECT_LT(ScaleInvariantDistance(report.model, EssentialMatrixFromPose(scene.cam2_from_cam1)),
+            0.02);
   size_t num_outliers = 0, num_flagged = 0, num_inliers_kept = 0;
   for (size_t i = 0; i < scene.is_outlier.size(); ++i) {
     if (scene.is_outlier[i]) {

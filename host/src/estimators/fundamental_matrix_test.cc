@@ -3,19 +3,19 @@
 #include <gtest/gtest.h>
 
 #include "estimators/ransac.h"
-#include "estimators/synthetic_scene_test_util.h"
+#include "geometry/essential_matrix.h"
+#include "synthetic_scene.h"
 
 namespace tessera {
 namespace {
 
-using testing::EssentialMatrixOf;
 using testing::MakeSyntheticTwoViewScene;
 using testing::ScaleInvariantDistance;
 using testing::SyntheticTwoViewOptions;
 
 Eigen::Matrix3d TrueFundamentalMatrix(const testing::SyntheticTwoViewScene& scene) {
   const Eigen::Matrix3d K_inv = scene.K.inverse();
-  return K_inv.transpose() * EssentialMatrixOf(scene.cam2_from_cam1) * K_inv;
+  return K_inv.transpose() * EssentialMatrixFromPose(scene.cam2_from_cam1) * K_inv;
 }
 
 TEST(FundamentalMatrixSevenPointEstimator, MinimalSampleContainsTheTruth) {

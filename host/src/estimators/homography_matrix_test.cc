@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "estimators/ransac.h"
-#include "estimators/synthetic_scene_test_util.h"
+#include "synthetic_scene.h"
 
 namespace tessera {
 namespace {

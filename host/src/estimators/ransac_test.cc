@@ -8,7 +8,7 @@
 #include <random>
 
 #include "estimators/essential_matrix.h"
-#include "estimators/synthetic_scene_test_util.h"
+#include "synthetic_scene.h"
 
 namespace tessera {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <random>
 
-#include "estimators/synthetic_scene_test_util.h"
+#include "synthetic_scene.h"
 #include "util/random.h"
 
 namespace tessera {

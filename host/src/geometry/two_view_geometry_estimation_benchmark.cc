@@ -8,8 +8,8 @@
 
 #include <benchmark/benchmark.h>
 
-#include "estimators/synthetic_scene_test_util.h"
 #include "geometry/two_view_geometry_estimation.h"
+#include "synthetic_scene.h"
 
 namespace tessera {
 namespace {

@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-#include "estimators/synthetic_scene_test_util.h"
+#include "synthetic_scene.h"
 #include "tessera/errors.h"
 
 namespace tessera {

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "sfm/incremental_mapper.h"
-#include "sfm/synthetic_scene_test_util.h"
+#include "synthetic_scene.h"
 #include "test_support.h"
 
 namespace tessera {

@@ -4,7 +4,7 @@
 
 #include "eval/evaluation.h"
 #include "geometry/essential_matrix.h"
-#include "sfm/synthetic_scene_test_util.h"
+#include "synthetic_scene.h"
 #include "tessera/errors.h"
 #include "test_support.h"
 

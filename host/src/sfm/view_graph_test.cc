@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "sfm/focal_length_estimation.h"
-#include "sfm/synthetic_scene_test_util.h"
+#include "synthetic_scene.h"
 
 namespace tessera {
 namespace {
