@@ -5,20 +5,12 @@
 #include "matcher_test_support.h"
 #include "test_support.h"
 
-namespace tessera {
+// In tessera::testing, beside the shared helpers of matcher_test_support.h.
+namespace tessera::testing {
 namespace {
 
-using testing::Evaluate;
-using testing::L2Rows;
-using testing::MakeHammingPair;
-using testing::MakeL2Pair;
-using testing::MatchesOf;
-using testing::Quality;
-using testing::Row;
-using testing::SyntheticPair;
-
 PluginInstance<Matcher> Load(const nlohmann::json& options = nlohmann::json::object()) {
-  return testing::LoadBundledPlugin<Matcher>("matcher", "brute_force", options, "pipeline.matcher");
+  return LoadBundledPlugin<Matcher>("matcher", "brute_force", options, "pipeline.matcher");
 }
 
 TEST(BruteForceMatcher, FindsTheTrueMatchesOfSiftLikeDescriptors) {
@@ -171,4 +163,4 @@ TEST(BruteForceMatcher, ValidatesOptions) {
 }
 
 }  // namespace
-}  // namespace tessera
+}  // namespace tessera::testing

@@ -7,20 +7,12 @@
 #include "matcher_test_support.h"
 #include "test_support.h"
 
-namespace tessera {
+// In tessera::testing, beside the shared helpers of matcher_test_support.h.
+namespace tessera::testing {
 namespace {
 
-using testing::Evaluate;
-using testing::L2Rows;
-using testing::MakeHammingPair;
-using testing::MakeL2Pair;
-using testing::MatchesOf;
-using testing::Quality;
-using testing::Row;
-using testing::SyntheticPair;
-
 PluginInstance<Matcher> Load(const nlohmann::json& options = nlohmann::json::object()) {
-  return testing::LoadBundledPlugin<Matcher>("matcher", "flann", options, "pipeline.matcher");
+  return LoadBundledPlugin<Matcher>("matcher", "flann", options, "pipeline.matcher");
 }
 
 // |A and B| / |A or B|: 1 when two matchers return the same matches.
@@ -56,7 +48,7 @@ TEST(FlannMatcher, FindsTheTrueMatchesOfBinaryDescriptors) {
 
 TEST(FlannMatcher, AgreesWithBruteForce) {
   const auto brute_force =
-      testing::LoadBundledPlugin<Matcher>("matcher", "brute_force", nlohmann::json::object());
+      LoadBundledPlugin<Matcher>("matcher", "brute_force", nlohmann::json::object());
   const auto flann = Load();
   const SyntheticPair l2 = MakeL2Pair(500, 200, 10, 3);
   EXPECT_GE(Agreement(flann->Match(l2.descriptors1, l2.descriptors2),
@@ -76,7 +68,7 @@ TEST(FlannMatcher, ExhaustiveSearchGivesBruteForceMatchesExactly) {
   const SyntheticPair pair = MakeL2Pair(400, 400, 30, 6);
   for (const bool cross_check : {true, false}) {
     const nlohmann::json options = {{"cross_check", cross_check}};
-    const auto brute_force = testing::LoadBundledPlugin<Matcher>("matcher", "brute_force", options);
+    const auto brute_force = LoadBundledPlugin<Matcher>("matcher", "brute_force", options);
     const FeatureMatches expected = brute_force->Match(pair.descriptors1, pair.descriptors2);
     ASSERT_GT(expected.size(), 100u);
     EXPECT_EQ(Load({{"cross_check", cross_check}, {"checks", 100000}})
@@ -273,4 +265,4 @@ TEST(FlannMatcher, ValidatesOptions) {
 }
 
 }  // namespace
-}  // namespace tessera
+}  // namespace tessera::testing
