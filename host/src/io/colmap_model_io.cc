@@ -1,4 +1,4 @@
-#include "scene/colmap_model_io.h"
+#include "tessera/io/colmap_model_io.h"
 
 #include <algorithm>
 #include <charconv>
@@ -12,7 +12,7 @@
 #include <type_traits>
 
 #include "tessera/errors.h"
-#include "util/file_io.h"
+#include "tessera/io/file_io.h"
 
 namespace tessera {
 namespace {
