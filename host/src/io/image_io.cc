@@ -127,9 +127,20 @@ std::string CheckPng(const Bytes& bytes, int* width, int* height) {
 constexpr int kDecodeFlags =
     cv::IMREAD_ANYDEPTH | cv::IMREAD_ANYCOLOR | cv::IMREAD_IGNORE_ORIENTATION;
 
-// Reads the headers of an image file held in memory. Returns why it is unusable,
-// or "" with `header` filled in. TIFF data is decoded (into `decoded` when given).
-std::string InspectImageDataImpl(const Bytes& bytes, ImageFileHeader* header, cv::Mat* decoded) {
+}  // namespace
+
+std::optional<std::vector<unsigned char>> ReadFileBytes(const fs::path& path) {
+  std::ifstream stream(path, std::ios::binary | std::ios::ate);
+  if (!stream) return std::nullopt;
+  const std::streamoff size = stream.tellg();
+  if (size < 0) return std::nullopt;
+  Bytes bytes(static_cast<size_t>(size));
+  stream.seekg(0);
+  if (size > 0 && !stream.read(reinterpret_cast<char*>(bytes.data()), size)) return std::nullopt;
+  return bytes;
+}
+
+std::string InspectImageData(const Bytes& bytes, ImageFileHeader* header, cv::Mat* decoded) {
   if (bytes.empty()) return "the file is empty";
   header->format = DetectFormat(bytes);
   int width = 0, height = 0;
@@ -170,6 +181,8 @@ std::string InspectImageDataImpl(const Bytes& bytes, ImageFileHeader* header, cv
   return "";
 }
 
+namespace {
+
 cv::Mat ToEightBit(const cv::Mat& image, const fs::path& path) {
   cv::Mat converted;
   switch (image.depth()) {
@@ -196,7 +209,7 @@ cv::Mat DecodeImage(const fs::path& path) {
   if (!bytes) throw InputError(path.string() + ": cannot read the image file");
   ImageFileHeader header;
   cv::Mat image;
-  const std::string problem = InspectImageDataImpl(*bytes, &header, &image);
+  const std::string problem = InspectImageData(*bytes, &header, &image);
   if (!problem.empty()) throw InputError(path.string() + ": cannot decode the image: " + problem);
   if (image.empty()) {
     try {
@@ -211,21 +224,6 @@ cv::Mat DecodeImage(const fs::path& path) {
 }
 
 }  // namespace
-
-std::optional<std::vector<unsigned char>> ReadFileBytes(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary | std::ios::ate);
-  if (!stream) return std::nullopt;
-  const std::streamoff size = stream.tellg();
-  if (size < 0) return std::nullopt;
-  Bytes bytes(static_cast<size_t>(size));
-  stream.seekg(0);
-  if (size > 0 && !stream.read(reinterpret_cast<char*>(bytes.data()), size)) return std::nullopt;
-  return bytes;
-}
-
-std::string InspectImageData(const Bytes& bytes, ImageFileHeader* header, cv::Mat* decoded) {
-  return InspectImageDataImpl(bytes, header, decoded);
-}
 
 cv::Mat ApplyExifOrientation(const cv::Mat& stored, int orientation) {
   cv::Mat displayed;
