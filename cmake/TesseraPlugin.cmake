@@ -26,6 +26,8 @@ function(tessera_add_plugin name)
 endfunction()
 
 # tessera_install_plugin(NAME): installs a bundled plugin next to the host's plugins.
+# Installed plugins find libtessera_io.so two folders up (lib/tessera/plugins -> lib).
 function(tessera_install_plugin name)
+  set_target_properties(${name} PROPERTIES INSTALL_RPATH "$ORIGIN/../..")
   install(TARGETS ${name} LIBRARY DESTINATION ${TESSERA_PLUGIN_SUBDIR})
 endfunction()

@@ -8,8 +8,8 @@
 #include <cstdio>
 #include <fstream>
 
+#include "tessera/io/file_io.h"
 #include "test_support.h"
-#include "util/file_io.h"
 #include "util/workspace_lock.h"
 
 namespace tessera {

@@ -18,8 +18,8 @@
 #include "plugin/bundle_adjuster_guard.h"
 #include "plugin/plugin_crash_log.h"
 #include "plugin/plugin_registry.h"
+#include "tessera/io/file_io.h"
 #include "test_support.h"
-#include "util/file_io.h"
 
 namespace tessera {
 namespace {

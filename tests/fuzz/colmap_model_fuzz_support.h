@@ -9,7 +9,7 @@
 #include <string>
 
 #include "fuzz_support.h"
-#include "scene/colmap_model_io.h"
+#include "tessera/io/colmap_model_io.h"
 
 namespace tessera::fuzz {
 

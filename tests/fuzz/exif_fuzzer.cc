@@ -6,7 +6,7 @@
 #include <cstdlib>
 
 #include "fuzz_support.h"
-#include "image/exif.h"
+#include "tessera/io/exif.h"
 
 namespace {
 

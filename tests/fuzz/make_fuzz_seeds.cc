@@ -16,9 +16,9 @@
 
 #include "database/database.h"
 #include "fuzz_support.h"
-#include "image/test_image_files.h"
-#include "scene/colmap_model_io.h"
-#include "util/file_io.h"
+#include "tessera/io/colmap_model_io.h"
+#include "tessera/io/file_io.h"
+#include "test_image_files.h"
 
 namespace tessera {
 namespace {

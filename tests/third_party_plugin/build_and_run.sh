@@ -1,8 +1,11 @@
 #!/bin/bash
-# Installs Tessera from BUILD_DIR into a temporary prefix, builds this folder's plugin
-# against the installed SDK alone, then lists and runs it through a manifest, and
-# compares it with the bundled ORB detector in a `tessera bench` run (everything else
-# the same): both rows register all 11 images of the small fountain sample.
+# Installs Tessera from BUILD_DIR into a temporary prefix, builds this folder's plugins
+# (the akaze detector and the bundler exporter) against the installed SDK alone, then
+# lists and runs the detector through a manifest, and compares it with the bundled ORB
+# detector in a `tessera bench` run (everything else the same): both rows register all
+# 11 images of the small fountain sample. The akaze row also exports with the bundler
+# exporter; its bundle.out must parse, hold the model's cameras and points, and
+# reproject its points onto their views in Bundler's conventions.
 # usage: build_and_run.sh BUILD_DIR SOURCE_DIR
 set -euo pipefail
 build_dir=$1
@@ -30,6 +33,7 @@ tessera="$work/prefix/bin/tessera"
 listing=$("$tessera" plugins --json --manifest "$work/manifest.json")
 echo "$listing" | grep -q '"name": "akaze"' || { echo "akaze not listed:"; echo "$listing"; exit 1; }
 echo "$listing" | grep -q '"name": "sift"' || { echo "bundled sift not found by the installed binary"; exit 1; }
+echo "$listing" | grep -q '"name": "bundler"' || { echo "bundler not listed:"; echo "$listing"; exit 1; }
 
 mkdir -p "$work/images"
 examples="$source_dir/../../examples/fountain-P11-small/images"
@@ -50,7 +54,8 @@ for detector in akaze orb; do
     "detector": {"plugin": "$detector", "options": {"max_num_features": 4000}},
     "pair_selector": {"plugin": "exhaustive"},
     "matcher": {"plugin": "brute_force"},
-    "bundle_adjuster": {"plugin": "ceres"}
+    "bundle_adjuster": {"plugin": "ceres"},
+    "exporters": [{"plugin": "colmap_binary"}$([ $detector = akaze ] && echo ', {"plugin": "bundler"}')]
   }
 }
 JSON
@@ -66,4 +71,58 @@ for r in rows:
     print("%s: %d of 11 registered, %d points, %.3f px" % (
         r["manifest"], r["num_registered"], r["num_points3D"], r["mean_reprojection_error_px"]))
 PY
-echo "third-party plugin built against the installed SDK, ran, and has its bench row"
+
+# The bundler export of the akaze row: Bundler v0.3 with the model's counts, images
+# listed and copied, points in front of their cameras (Bundler's look down -z) and
+# projecting onto their views (x right, y up, from the image centre).
+python3 - "$work/bench.json" <<'PY' || exit 1
+import json, math, os, sys
+row = json.load(open(sys.argv[1]))["rows"][1]
+folder = os.path.join(row["workspace"], "bundler")
+lines = open(os.path.join(folder, "bundle.out")).read().splitlines()
+assert lines[0] == "# Bundle file v0.3", lines[0]
+num_cameras, num_points = map(int, lines[1].split())
+assert num_cameras == row["num_registered"], (num_cameras, row["num_registered"])
+assert num_points == row["num_points3D"], (num_points, row["num_points3D"])
+assert len(lines) == 2 + 5 * num_cameras + 3 * num_points, len(lines)
+numbers = lambda i: [float(v) for v in lines[i].split()]
+cameras = []
+for c in range(num_cameras):
+    first = 2 + 5 * c
+    f, k1, k2 = numbers(first)
+    R = [numbers(first + 1 + r) for r in range(3)]
+    t = numbers(first + 4)
+    for a in range(3):
+        for b in range(3):
+            dot = sum(R[a][k] * R[b][k] for k in range(3))
+            assert abs(dot - (a == b)) < 1e-9, (c, R)
+    cameras.append((f, k1, k2, R, t))
+listed = open(os.path.join(folder, "list.txt")).read().splitlines()
+assert len(listed) == num_cameras, len(listed)
+for name in listed:
+    assert os.path.isfile(os.path.join(folder, name)), name
+errors = []
+for p in range(num_points):
+    first = 2 + 5 * num_cameras + 3 * p
+    X = numbers(first)
+    rgb = [int(v) for v in lines[first + 1].split()]
+    assert len(rgb) == 3 and all(0 <= v <= 255 for v in rgb), rgb
+    views = lines[first + 2].split()
+    n = int(views[0])
+    assert n >= 2 and len(views) == 1 + 4 * n, views
+    for v in range(n):
+        c, key = int(views[1 + 4 * v]), int(views[2 + 4 * v])
+        x, y = float(views[3 + 4 * v]), float(views[4 + 4 * v])
+        f, k1, k2, R, t = cameras[c]
+        P = [sum(R[r][k] * X[k] for k in range(3)) + t[r] for r in range(3)]
+        assert P[2] < 0, (p, c, P)
+        px, py = -P[0] / P[2], -P[1] / P[2]
+        r2 = px * px + py * py
+        d = 1 + k1 * r2 + k2 * r2 * r2
+        errors.append(math.hypot(f * d * px - x, f * d * py - y))
+mean = sum(errors) / len(errors)
+print("bundler: %d cameras, %d points, %d views, mean reprojection error %.3f px" %
+      (num_cameras, num_points, len(errors), mean))
+assert mean < 2.0, mean
+PY
+echo "third-party detector and exporter built against the installed SDK ran; the akaze row has its bench row and its Bundler export"

@@ -14,8 +14,10 @@
 
 #include "tessera/export.h"
 
-// Bumped whenever TesseraPluginInfo, a plugin interface or a type that crosses the
-// boundary changes; the host refuses a plugin built against another version.
+// Bumped whenever TesseraPluginInfo, a plugin interface, a type that crosses the
+// boundary or the API of Tessera::io (tessera/io/) changes; the host refuses a plugin
+// built against another version. libtessera_io's SONAME carries this number
+// (libtessera_io.so.2), so a plugin linked against another Tessera::io does not load.
 #define TESSERA_PLUGIN_ABI_VERSION 2
 
 extern "C" {

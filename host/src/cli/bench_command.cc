@@ -30,10 +30,10 @@
 #include "database/database.h"
 #include "eval/evaluation.h"
 #include "eval/ground_truth.h"
-#include "scene/colmap_model_io.h"
-#include "sfm/incremental_mapper.h"
 #include "tessera/errors.h"
-#include "util/file_io.h"
+#include "tessera/io/colmap_model_io.h"
+#include "tessera/io/file_io.h"
+#include "tessera/io/model_statistics.h"
 #include "util/timer.h"
 
 extern char** environ;
@@ -293,8 +293,9 @@ BenchRow RunColmap(const BenchOptions& options, const GroundTruth* ground_truth,
     row.num_registered = model.images.size();
     row.num_points = model.points3D.size();
     // The same figures, computed the same way, as Tessera's rows (mapping_summary.json).
-    row.mean_track_length = MeanTrackLength(model);
-    row.mean_reprojection_error = MeanReprojectionError(model);
+    const ModelStatistics statistics = ComputeModelStatistics(model);
+    row.mean_track_length = statistics.mean_track_length;
+    row.mean_reprojection_error = statistics.mean_reprojection_error;
     ScoreModel(model, ground_truth, &row);
   }
   return row;

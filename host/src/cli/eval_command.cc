@@ -9,8 +9,8 @@
 #include "cli/exit_codes.h"
 #include "eval/evaluation.h"
 #include "eval/ground_truth.h"
-#include "scene/colmap_model_io.h"
 #include "tessera/errors.h"
+#include "tessera/io/colmap_model_io.h"
 
 namespace tessera {
 

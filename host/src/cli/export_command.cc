@@ -9,9 +9,10 @@
 #include "cli/commands.h"
 #include "cli/exit_codes.h"
 #include "plugin/plugin_registry.h"
-#include "scene/colmap_model_io.h"
 #include "tessera/errors.h"
-#include "util/file_io.h"
+#include "tessera/io/colmap_model_io.h"
+#include "tessera/io/file_io.h"
+#include "tessera/io/model_statistics.h"
 #include "util/paths.h"
 #include "util/timer.h"
 
@@ -67,10 +68,7 @@ CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions&) {
                "model " + std::to_string(context.model_index),
                [&] { exporter->Export(reconstruction, context); });
 
-    size_t num_observations = 0;
-    for (const auto& [point3D_id, point3D] : reconstruction.points3D) {
-      num_observations += point3D.track.size();
-    }
+    const size_t num_observations = NumObservations(reconstruction);
     spdlog::info(
         "export: {} images, {} points, {} observations written with '{}' to {} in {:.2f} s",
         reconstruction.NumRegisteredImages(), reconstruction.points3D.size(), num_observations,

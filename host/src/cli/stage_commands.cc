@@ -15,13 +15,14 @@
 #include "feature/feature_extraction.h"
 #include "feature/feature_matching.h"
 #include "image/image_io.h"
-#include "image/point_colors.h"
 #include "plugin/bundle_adjuster_guard.h"
 #include "plugin/plugin_crash_log.h"
-#include "scene/colmap_model_io.h"
 #include "sfm/incremental_mapper.h"
 #include "sfm/mapper_input.h"
-#include "util/file_io.h"
+#include "tessera/io/colmap_model_io.h"
+#include "tessera/io/file_io.h"
+#include "tessera/io/model_statistics.h"
+#include "tessera/io/point_colors.h"
 #include "util/timer.h"
 #include "util/workspace_lock.h"
 
@@ -248,8 +249,9 @@ MappingSummary MapWorkspace(const PipelineContext& context, Database* database,
       }
     }
     summary.num_registered += model.images.size();
-    const double mean_track_length = MeanTrackLength(model);
-    const double mean_reprojection_error = MeanReprojectionError(model);
+    const ModelStatistics statistics = ComputeModelStatistics(model);
+    const double mean_track_length = statistics.mean_track_length;
+    const double mean_reprojection_error = statistics.mean_reprojection_error;
     nlohmann::json images = nlohmann::json::array();
     for (const auto& [image_id, image] : model.images) images.push_back(image.name);
     const ModelSelfCheck& check = result.self_checks.at(index);

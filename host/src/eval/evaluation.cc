@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <numeric>
 
+#include "tessera/io/model_statistics.h"
+
 namespace tessera {
 namespace {
 
@@ -33,34 +35,12 @@ double RotationAngleDeg(const Eigen::Matrix3d& R_a, const Eigen::Matrix3d& R_b) 
 }
 
 void AddModelStatistics(const Reconstruction& model, EvaluationResult* result) {
-  result->num_points3D = model.points3D.size();
-  double error_sum = 0;
-  size_t num_errors = 0;
-  for (const auto& [point3D_id, point3D] : model.points3D) {
-    result->num_observations += point3D.track.size();
-    for (const TrackElement& element : point3D.track) {
-      const auto image = model.images.find(element.image_id);
-      if (image == model.images.end() || !image->second.registered ||
-          element.point2D_idx >= image->second.points2D.size()) {
-        continue;
-      }
-      const auto camera = model.cameras.find(image->second.camera_id);
-      if (camera == model.cameras.end() || !camera->second.IsValid()) continue;
-      const Eigen::Vector3d point_in_cam = image->second.cam_from_world * point3D.xyz;
-      if (point_in_cam.z() <= std::numeric_limits<double>::epsilon()) {
-        ++result->num_observations_behind_camera;
-        continue;
-      }
-      const Eigen::Vector2d projected = camera->second.ImgFromCam(point_in_cam);
-      error_sum += (projected - image->second.points2D[element.point2D_idx].xy).norm();
-      ++num_errors;
-    }
-  }
-  result->mean_track_length =
-      model.points3D.empty()
-          ? 0.0
-          : result->num_observations / static_cast<double>(model.points3D.size());
-  if (num_errors > 0) result->mean_reprojection_error = error_sum / num_errors;
+  const ModelStatistics statistics = ComputeModelStatistics(model);
+  result->num_points3D = statistics.num_points3D;
+  result->num_observations = statistics.num_observations;
+  result->num_observations_behind_camera = statistics.num_observations_behind_camera;
+  result->mean_track_length = statistics.mean_track_length;
+  result->mean_reprojection_error = statistics.mean_reprojection_error;
 }
 
 std::string FormatNumber(double value, const char* format) {

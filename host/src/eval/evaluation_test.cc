@@ -8,8 +8,8 @@
 #include <random>
 
 #include "eval/ground_truth.h"
-#include "scene/colmap_model_io.h"
 #include "tessera/errors.h"
+#include "tessera/io/colmap_model_io.h"
 #include "test_support.h"
 
 namespace tessera {

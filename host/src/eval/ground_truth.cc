@@ -7,8 +7,8 @@
 #include <sstream>
 #include <vector>
 
-#include "scene/colmap_model_io.h"
 #include "tessera/errors.h"
+#include "tessera/io/colmap_model_io.h"
 
 namespace tessera {
 namespace {

@@ -9,9 +9,9 @@
 #include <opencv2/core.hpp>
 
 #include "image/camera_assignment.h"
-#include "image/exif.h"
 #include "image/image_io.h"
 #include "plugin/plugin_crash_log.h"
+#include "tessera/io/exif.h"
 #include "util/parallel.h"
 #include "util/timer.h"
 

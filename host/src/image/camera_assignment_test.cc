@@ -7,8 +7,8 @@
 
 #include "image/image_io.h"
 #include "image/sensor_database.h"
-#include "image/test_image_files.h"
 #include "tessera/errors.h"
+#include "test_image_files.h"
 #include "test_support.h"
 
 namespace tessera {

@@ -1,17 +1,18 @@
 #pragma once
 
-// Finding the input images, reading their sizes and EXIF without decoding them, and
-// decoding them the way detection and colouring see them (EXIF orientation applied).
+// Finding the input images and reading their sizes and EXIF without decoding them.
+// Decoding them the way detection and colouring see them is tessera/io/image_io.h
+// (included here: the scan accepts exactly what those functions decode).
 
 #include <cstdint>
 #include <filesystem>
-#include <opencv2/core.hpp>
 #include <string>
 #include <vector>
 
 #include "image/camera_assignment.h"  // the pipeline makes cameras right after the scan
 #include "image/image_entry.h"
 #include "manifest/manifest.h"
+#include "tessera/io/image_io.h"
 
 namespace tessera {
 
@@ -43,17 +44,5 @@ bool IsTesseraWorkspace(const std::filesystem::path& dir);
 // `dir` are left out, each with a line in skipped_folders. Every image gets its size
 // and content hash.
 ImageScan ScanImageFolder(const std::filesystem::path& dir, const ImageScanOptions& options = {});
-
-// Decodes to 8-bit grey with the EXIF orientation applied (16-bit data scaled by
-// 255/65535, floating point by 255). Throws InputError naming the file when it
-// cannot be decoded, including truncated JPEG or PNG data.
-cv::Mat ReadGrayImage(const std::filesystem::path& path);
-
-// Decodes to 8-bit BGR with the EXIF orientation applied; alpha is dropped.
-cv::Mat ReadColorImage(const std::filesystem::path& path);
-
-// Turns an image as stored into the image as displayed, for EXIF orientation 1..8
-// (other values: unchanged).
-cv::Mat ApplyExifOrientation(const cv::Mat& stored, int orientation);
 
 }  // namespace tessera

@@ -6,9 +6,9 @@
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
-#include "image/exif.h"
-#include "image/test_image_files.h"
 #include "tessera/errors.h"
+#include "tessera/io/exif.h"
+#include "test_image_files.h"
 #include "test_support.h"
 
 namespace tessera {

@@ -3,7 +3,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "util/file_io.h"
+#include "tessera/io/file_io.h"
 #include "util/strings.h"
 
 namespace tessera {

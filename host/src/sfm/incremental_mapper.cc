@@ -21,6 +21,7 @@
 #include "sfm/focal_length_estimation.h"
 #include "sfm/model_merger.h"
 #include "sfm/view_graph.h"
+#include "tessera/io/model_statistics.h"
 #include "util/random.h"
 
 namespace tessera {
@@ -1558,34 +1559,6 @@ MapperResult IncrementalMapper::Reconstruct(const MapperInput& input) const {
   result.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   return result;
-}
-
-double MeanReprojectionError(const Reconstruction& reconstruction) {
-  double sum = 0;
-  size_t count = 0;
-  for (const auto& [point3D_id, point3D] : reconstruction.points3D) {
-    for (const TrackElement& element : point3D.track) {
-      const Image& image = reconstruction.images.at(element.image_id);
-      const Camera& camera = reconstruction.cameras.at(image.camera_id);
-      sum += (camera.ImgFromCam(image.cam_from_world * point3D.xyz) -
-              image.points2D[element.point2D_idx].xy)
-                 .norm();
-      ++count;
-    }
-  }
-  return count > 0 ? sum / static_cast<double>(count) : 0;
-}
-
-size_t NumObservations(const Reconstruction& reconstruction) {
-  size_t count = 0;
-  for (const auto& [point3D_id, point3D] : reconstruction.points3D) count += point3D.track.size();
-  return count;
-}
-
-double MeanTrackLength(const Reconstruction& reconstruction) {
-  if (reconstruction.points3D.empty()) return 0;
-  return static_cast<double>(NumObservations(reconstruction)) /
-         static_cast<double>(reconstruction.points3D.size());
 }
 
 }  // namespace tessera

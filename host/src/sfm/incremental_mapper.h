@@ -100,10 +100,4 @@ class IncrementalMapper {
   uint64_t seed_;
 };
 
-// Mean reprojection error (px) over all observations of a model's points, and the mean
-// number of observations per point; 0 for an empty model.
-double MeanReprojectionError(const Reconstruction& reconstruction);
-double MeanTrackLength(const Reconstruction& reconstruction);
-size_t NumObservations(const Reconstruction& reconstruction);
-
 }  // namespace tessera

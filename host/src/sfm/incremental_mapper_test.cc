@@ -6,6 +6,7 @@
 #include "geometry/essential_matrix.h"
 #include "synthetic_scene.h"
 #include "tessera/errors.h"
+#include "tessera/io/model_statistics.h"
 #include "test_support.h"
 
 namespace tessera {
@@ -53,7 +54,7 @@ TEST(IncrementalMapper, RecoversASyntheticSceneWithNoise) {
   // error along the image plane; the cameras end up within a fraction of that.
   EXPECT_LT(evaluation.position_error_max, 0.01);
   EXPECT_LT(evaluation.rotation_error_max_deg, 0.05);
-  EXPECT_LT(MeanReprojectionError(model), 0.8);
+  EXPECT_LT(ComputeModelStatistics(model).mean_reprojection_error, 0.8);
   EXPECT_GT(model.points3D.size(), 0.9 * options.num_points);
   ExpectTracksAreTrue(scene, model);
 }
@@ -79,7 +80,7 @@ TEST(IncrementalMapper, FiltersTwoPercentOutlierMatches) {
   const EvaluationResult evaluation = EvaluateReconstruction(model, scene.GroundTruth());
   ASSERT_TRUE(evaluation.aligned) << evaluation.error;
   EXPECT_LT(evaluation.position_error_max, 0.01);
-  EXPECT_LT(MeanReprojectionError(model), 0.8);
+  EXPECT_LT(ComputeModelStatistics(model).mean_reprojection_error, 0.8);
   EXPECT_GT(result.num_refused_matches, 0u);
 }
 

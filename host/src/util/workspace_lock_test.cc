@@ -10,8 +10,8 @@
 #include <thread>
 
 #include "tessera/errors.h"
+#include "tessera/io/file_io.h"
 #include "test_support.h"
-#include "util/file_io.h"
 
 namespace tessera {
 namespace {

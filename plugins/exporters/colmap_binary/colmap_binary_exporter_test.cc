@@ -1,9 +1,9 @@
 #include <gtest/gtest.h>
 
 #include "common/synthetic_model_test_util.h"
-#include "scene/colmap_model_io.h"
+#include "tessera/io/colmap_model_io.h"
+#include "tessera/io/file_io.h"
 #include "test_support.h"
-#include "util/file_io.h"
 
 namespace tessera {
 namespace {

@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <string>
 
-#include "common/exporter_paths.h"
-#include "scene/colmap_model_io.h"
+#include "tessera/io/colmap_model_io.h"
+#include "tessera/io/exporter_paths.h"
 #include "tessera/sdk.h"
 
 namespace tessera {

@@ -3,6 +3,7 @@
 //   OUTPUT/<folder>/images/<name>                         undistorted images
 //   OUTPUT/<folder>/sparse/0/{cameras,images,points3D}.bin the model of those images
 
+#include <cctype>
 #include <map>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -10,12 +11,11 @@
 #include <string>
 #include <vector>
 
-#include "common/exporter_paths.h"
-#include "image/image_io.h"
-#include "scene/colmap_model_io.h"
+#include "tessera/io/colmap_model_io.h"
+#include "tessera/io/exporter_paths.h"
+#include "tessera/io/file_io.h"
+#include "tessera/io/image_io.h"
 #include "tessera/sdk.h"
-#include "util/file_io.h"
-#include "util/strings.h"
 
 namespace tessera {
 namespace {
@@ -60,11 +60,12 @@ UndistortionMaps MakeUndistortionMaps(const Camera& camera, const Camera& pinhol
 }
 
 std::string EncodeImage(const cv::Mat& image, const std::filesystem::path& path, int jpeg_quality) {
+  std::string extension = path.extension().string();  // OpenCV chooses the codec by it
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   std::vector<uchar> bytes;
   bool encoded = false;
   try {
-    encoded = cv::imencode(ToLower(path.extension().string()), image, bytes,
-                           {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
+    encoded = cv::imencode(extension, image, bytes, {cv::IMWRITE_JPEG_QUALITY, jpeg_quality});
   } catch (const cv::Exception&) {
     encoded = false;
   }

@@ -6,7 +6,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "common/synthetic_model_test_util.h"
-#include "scene/colmap_model_io.h"
+#include "tessera/io/colmap_model_io.h"
+#include "tessera/io/model_statistics.h"
 #include "test_support.h"
 
 namespace tessera {
@@ -30,22 +31,6 @@ cv::Mat RenderPattern(const Camera& camera,
     }
   }
   return image;
-}
-
-// Mean reprojection error of every observation through the model's own cameras.
-double MeanReprojectionError(const Reconstruction& model) {
-  double sum = 0;
-  size_t count = 0;
-  for (const auto& [point3D_id, point3D] : model.points3D) {
-    for (const TrackElement& element : point3D.track) {
-      const Image& image = model.images.at(element.image_id);
-      const Eigen::Vector2d projection =
-          model.cameras.at(image.camera_id).ImgFromCam(image.cam_from_world * point3D.xyz);
-      sum += (projection - image.points2D.at(element.point2D_idx).xy).norm();
-      ++count;
-    }
-  }
-  return count > 0 ? sum / count : 0;
 }
 
 TEST(GaussianSplattingExporter, UndistortsASimpleRadialCameraToPinhole) {
@@ -170,10 +155,10 @@ TEST(GaussianSplattingExporter, FountainImagesKeepTheirSizeAndPointsReproject) {
     EXPECT_EQ(written.cols, static_cast<int>(camera.width)) << image.name;
     EXPECT_EQ(written.rows, static_cast<int>(camera.height)) << image.name;
   }
-  const double error = MeanReprojectionError(undistorted);
+  const double error = ComputeModelStatistics(undistorted).mean_reprojection_error;
   EXPECT_LT(error, 1.0);
   // Undistortion moves the points with the images: the error stays COLMAP's.
-  EXPECT_NEAR(error, MeanReprojectionError(model), 1e-3);
+  EXPECT_NEAR(error, ComputeModelStatistics(model).mean_reprojection_error, 1e-3);
 }
 
 }  // namespace

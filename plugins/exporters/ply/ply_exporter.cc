@@ -11,10 +11,10 @@
 #include <string>
 #include <vector>
 
-#include "common/exporter_paths.h"
-#include "image/point_colors.h"
+#include "tessera/io/exporter_paths.h"
+#include "tessera/io/file_io.h"
+#include "tessera/io/point_colors.h"
 #include "tessera/sdk.h"
-#include "util/file_io.h"
 
 namespace tessera {
 namespace {

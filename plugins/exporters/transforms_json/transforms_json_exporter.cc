@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "common/exporter_paths.h"
+#include "tessera/io/exporter_paths.h"
+#include "tessera/io/file_io.h"
 #include "tessera/sdk.h"
-#include "util/file_io.h"
 
 namespace tessera {
 namespace {

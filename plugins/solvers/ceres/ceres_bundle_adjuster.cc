@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "cost_functions.h"
+#include "tessera/io/model_statistics.h"
 #include "tessera/sdk.h"
 
 namespace tessera {
@@ -80,28 +81,6 @@ struct Observation {
   image_t image_id;
   Eigen::Vector2d xy;
 };
-
-// Mean reprojection error in pixels of a point over every observation whose image is
-// registered, or -1 when there is none.
-double MeanReprojectionError(const Reconstruction& reconstruction, const Point3D& point3D) {
-  double sum = 0;
-  int count = 0;
-  for (const TrackElement& element : point3D.track) {
-    const auto image_it = reconstruction.images.find(element.image_id);
-    if (image_it == reconstruction.images.end() || !image_it->second.registered) continue;
-    const Image& image = image_it->second;
-    const auto camera_it = reconstruction.cameras.find(image.camera_id);
-    if (camera_it == reconstruction.cameras.end() || !camera_it->second.IsValid() ||
-        element.point2D_idx >= image.points2D.size()) {
-      continue;
-    }
-    const Eigen::Vector2d projected =
-        camera_it->second.ImgFromCam(image.cam_from_world * point3D.xyz);
-    sum += (projected - image.points2D[element.point2D_idx].xy).norm();
-    ++count;
-  }
-  return count > 0 ? sum / count : -1;
-}
 
 }  // namespace
 
@@ -336,7 +315,7 @@ class CeresBundleAdjuster : public BundleAdjuster {
     }
     for (const auto& [point3D_id, xyz] : points) {
       Point3D& point3D = rec.points3D.at(point3D_id);
-      point3D.error = MeanReprojectionError(rec, point3D);
+      point3D.error = PointReprojectionError(rec, point3D);
     }
     return summary;
   }

@@ -1,4 +1,4 @@
-#include "scene/colmap_model_io.h"
+#include "tessera/io/colmap_model_io.h"
 
 #include <algorithm>
 #include <charconv>
@@ -12,7 +12,7 @@
 #include <type_traits>
 
 #include "tessera/errors.h"
-#include "util/file_io.h"
+#include "tessera/io/file_io.h"
 
 namespace tessera {
 namespace {
@@ -481,8 +481,10 @@ std::ostringstream MakeTextStream() {
   return stream;
 }
 
-// Observations of registered images: COLMAP's header statistics count these.
-size_t NumObservations(const Reconstruction& reconstruction) {
+// Keypoints of registered images with a 3D point: what the headers of COLMAP's text
+// files count (the track view, NumObservations in model_statistics.h, gives the same
+// number for a consistent model).
+size_t NumRegisteredImageObservations(const Reconstruction& reconstruction) {
   size_t num_observations = 0;
   for (const auto& [image_id, image] : reconstruction.images) {
     if (!image.registered) continue;
@@ -564,7 +566,7 @@ std::string CamerasText(const Reconstruction& reconstruction, const std::vector<
 }
 
 std::string ImagesText(const Reconstruction& reconstruction, const std::vector<image_t>& ids) {
-  const size_t num_observations = NumObservations(reconstruction);
+  const size_t num_observations = NumRegisteredImageObservations(reconstruction);
   std::ostringstream text = MakeTextStream();
   text << "# Image list with two lines of data per image:\n"
        << "#   IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n"
@@ -594,7 +596,7 @@ std::string ImagesText(const Reconstruction& reconstruction, const std::vector<i
 }
 
 std::string Points3DText(const Reconstruction& reconstruction, const std::vector<point3D_t>& ids) {
-  const size_t num_observations = NumObservations(reconstruction);
+  const size_t num_observations = NumRegisteredImageObservations(reconstruction);
   std::ostringstream text = MakeTextStream();
   text << "# 3D point list with one line of data per point:\n"
        << "#   POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n"

@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "tessera/io/export.h"
 #include "tessera/reconstruction.h"
 
 namespace tessera {
@@ -13,7 +14,7 @@ namespace tessera {
 // images are read from `image_dir` by their names; one that cannot be read, or whose
 // size is not its camera's, is left out and named in the returned warnings (one line
 // each, starting with the file). Points seen by no usable image keep their colour.
-std::vector<std::string> ColorPointsFromImages(const std::filesystem::path& image_dir,
-                                               Reconstruction* reconstruction);
+TESSERA_IO_EXPORT std::vector<std::string> ColorPointsFromImages(
+    const std::filesystem::path& image_dir, Reconstruction* reconstruction);
 
 }  // namespace tessera

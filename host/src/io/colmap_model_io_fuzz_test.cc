@@ -13,10 +13,10 @@
 #include <utility>
 #include <vector>
 
-#include "scene/colmap_model_io.h"
 #include "tessera/errors.h"
+#include "tessera/io/colmap_model_io.h"
+#include "tessera/io/file_io.h"
 #include "test_support.h"
-#include "util/file_io.h"
 
 namespace {
 std::atomic<size_t> largest_allocation{0};

@@ -1,4 +1,4 @@
-#include "image/point_colors.h"
+#include "tessera/io/point_colors.h"
 
 #include <gtest/gtest.h>
 

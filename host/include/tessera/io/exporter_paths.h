@@ -1,6 +1,6 @@
 #pragma once
 
-// Where the bundled exporters write, relative to the run's output folder.
+// Where exporters write, relative to the run's output folder.
 
 #include <filesystem>
 #include <string>

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "tessera/ids.h"
+#include "tessera/io/export.h"
 #include "tessera/reconstruction.h"
 
 namespace tessera {
@@ -27,18 +28,19 @@ struct ColmapModelFileOrder {
 // the file and what is wrong on missing, truncated, malformed or inconsistent files
 // (an image of an unknown camera, a track element past an image's points). `order`,
 // when given, receives the order of the records in the files.
-Reconstruction ReadColmapModel(const std::filesystem::path& dir,
-                               ColmapModelFileOrder* order = nullptr);
+TESSERA_IO_EXPORT Reconstruction ReadColmapModel(const std::filesystem::path& dir,
+                                                 ColmapModelFileOrder* order = nullptr);
 
 // Whether `dir` holds the three files of a text or binary model.
-bool ExistsColmapModel(const std::filesystem::path& dir);
+TESSERA_IO_EXPORT bool ExistsColmapModel(const std::filesystem::path& dir);
 
 // Writes cameras/images/points3D.{txt|bin} into `dir` (created if missing) in COLMAP
 // 3.8's layouts; only registered images are written, as COLMAP does. Records are written
 // in the order of `order` where it lists them, the others by ascending id. Each file is
 // written under a temporary name in `dir` and renamed when complete, so a reader never
 // sees a half-written file. Throws InputError when a file cannot be written.
-void WriteColmapModel(const Reconstruction& reconstruction, const std::filesystem::path& dir,
-                      ColmapModelFormat format, const ColmapModelFileOrder* order = nullptr);
+TESSERA_IO_EXPORT void WriteColmapModel(const Reconstruction& reconstruction,
+                                        const std::filesystem::path& dir, ColmapModelFormat format,
+                                        const ColmapModelFileOrder* order = nullptr);
 
 }  // namespace tessera

@@ -1,4 +1,4 @@
-#include "image/exif.h"
+#include "tessera/io/exif.h"
 
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "image/test_image_files.h"
+#include "test_image_files.h"
 
 namespace tessera {
 namespace {

@@ -1,4 +1,4 @@
-#include "util/file_io.h"
+#include "tessera/io/file_io.h"
 
 #include <unistd.h>
 

@@ -1,4 +1,4 @@
-#include "scene/colmap_model_io.h"
+#include "tessera/io/colmap_model_io.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "image/exif.h"
+#include "tessera/io/exif.h"
 
 #include <libexif/exif-data.h>
 

@@ -1,12 +1,12 @@
-#include "image/point_colors.h"
+#include "tessera/io/point_colors.h"
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <map>
 #include <opencv2/core.hpp>
 
-#include "image/image_io.h"
 #include "tessera/errors.h"
+#include "tessera/io/image_io.h"
 
 namespace tessera {
 namespace {
