@@ -28,9 +28,10 @@ class CancellationToken {
 };
 
 // Called with the stage's name ("extract", "match", "map", "export"), the units done
-// and the units in all. Calls of one stage come one at a time (never concurrently),
-// with `done` increasing by one from 1 to `total`; a stage with nothing to do calls it
-// once with (0, 0).
+// and the units in all. Calls of one stage come one at a time (never concurrently) and
+// `done` never decreases: extract, match and export count 1, 2, ... up to `total` (a
+// cancelled stage stops short), map reports (0, 1) as the mapper starts and (1, 1) when
+// it ends; a stage with nothing to do calls it once with (0, 0).
 using ProgressCallback = std::function<void(const std::string& stage, size_t done, size_t total)>;
 
 struct StageControl {
