@@ -10,10 +10,10 @@
 
 #include "cli/commands.h"
 #include "cli/exit_codes.h"
-#include "cli/pipeline_context.h"
 #include "database/database.h"
 #include "feature/database_feature_reader.h"
-#include "feature/feature_extraction.h"
+#include "pipeline/extract_stage.h"
+#include "pipeline/pipeline_context.h"
 #include "plugin/plugin_call.h"
 #include "util/paths.h"
 #include "util/strings.h"

@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "manifest/manifest.h"
+#include "geometry/verification_settings.h"
 #include "tessera/camera.h"
 #include "tessera/features.h"
 #include "tessera/two_view_geometry.h"

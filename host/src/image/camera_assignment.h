@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "image/camera_settings.h"
 #include "image/image_entry.h"
-#include "manifest/manifest.h"
 #include "tessera/camera.h"
 
 namespace tessera {

@@ -8,6 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "geometry/verification_settings.h"
+#include "image/camera_settings.h"
+
 namespace tessera {
 
 // A plugin slot of the pipeline: which plugin, with which options.
@@ -15,33 +18,6 @@ struct PluginSlot {
   std::string plugin;
   nlohmann::json options = nlohmann::json::object();
   std::string json_path;  // where it sits in the manifest, e.g. "pipeline.detector"
-};
-
-// How cameras are made from images.
-struct CameraSettings {
-  // COLMAP camera model name for new cameras.
-  std::string model = "SIMPLE_RADIAL";
-  // One camera for all images of the same size (true) or one per image (false).
-  bool single_camera = true;
-  // Focal length, in pixels, when EXIF gives none: factor x the longer image side.
-  double default_focal_length_factor = 1.2;
-  // Known intrinsics (fx, fy, cx, cy in full-resolution pixels), overriding EXIF.
-  std::optional<Eigen::Vector4d> known_intrinsics;
-  // Where known_intrinsics came from ("camera.K" or a K.txt file), for messages.
-  std::string known_intrinsics_source;
-};
-
-// Geometric verification of putative matches.
-struct VerificationSettings {
-  double max_error_px = 4.0;       // RANSAC inlier threshold (epipolar / transfer error)
-  double confidence = 0.999;       // RANSAC stopping confidence
-  int min_num_trials = 100;        // RANSAC iterations at least
-  int max_num_trials = 10000;      // RANSAC iterations at most
-  double min_inlier_ratio = 0.25;  // lower bound used to cap the number of trials
-  int min_num_inliers = 15;        // fewer verified inliers: the pair is dropped
-  // A pair whose homography explains this fraction of the E/F inliers is flagged
-  // planar or panoramic (COLMAP's max_H_inlier_ratio).
-  double max_H_inlier_ratio = 0.8;
 };
 
 // The whole run configuration. Parsed and checked completely before any image is

@@ -1,7 +1,7 @@
 #pragma once
 
 // The colmap_text and colmap_binary exporters: one class, the format chosen by the
-// plugin, writing through the host's COLMAP model writer (scene/colmap_model_io.h).
+// plugin, writing through Tessera::io's COLMAP model writer (tessera/io/colmap_model_io.h).
 
 #include <filesystem>
 #include <string>

@@ -1,4 +1,4 @@
-#include "feature/feature_extraction.h"
+#include "pipeline/extract_stage.h"
 
 #include <spdlog/spdlog.h>
 
@@ -166,7 +166,8 @@ void WriteImageMetadata(const ImageScan& scan, const std::vector<Image>& images,
 
 ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const Manifest& manifest,
                                   const PluginInstance<Detector>& detector, Database* database,
-                                  const ImageScanOptions& scan_options) {
+                                  const ImageScanOptions& scan_options,
+                                  const StageControl& control) {
   const Timer timer;
   ExtractionSummary summary;
 
@@ -221,11 +222,19 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
                todo.size(), detector.name(), summary.num_reused);
 
   std::mutex database_mutex;
+  std::mutex progress_mutex;
+  size_t processed = 0;  // detected or skipped, under progress_mutex
+  const auto report = [&] {
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    control.Report("extract", ++processed, todo.size());
+  };
+  if (todo.empty()) control.Report("extract", 0, 0);
   std::atomic<size_t> done{0};
   std::atomic<size_t> num_features{0};
   std::atomic<size_t> num_failed{0};
   const Timer detect_timer;
   ParallelFor(todo.size(), manifest.EffectiveNumThreads(), [&](size_t k) {
+    if (control.Cancelled()) return;
     const ImageEntry& entry = scan.images[todo[k]];
     const Image& image = images[todo[k]];
     // Any failure before mapping skips the image, never the run: the reason is
@@ -268,6 +277,7 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
           {entry.name, std::nullopt, entry.file_size, entry.content_hash, failure});
       transaction.Commit();
       ++num_failed;
+      report();
       return;
     }
     {
@@ -281,10 +291,17 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
     const size_t n = ++done;
     spdlog::info("extract: [{}/{}] {}: {} features ({:.2f} images/s)", n, todo.size(), entry.name,
                  features.keypoints.size(), n / std::max(1e-9, detect_timer.ElapsedSeconds()));
+    report();
   });
   summary.num_failed += num_failed;
-  summary.num_detected = todo.size() - num_failed;
+  summary.num_detected = done;
   summary.num_features = num_features;
+  if (processed < todo.size()) {  // cancelled: the images not started are left for later
+    summary.status = StageStatus::kCancelled;
+    summary.seconds = timer.ElapsedSeconds();
+    spdlog::info("extract: cancelled after {} of {} images", processed, todo.size());
+    return summary;
+  }
   if (scan.images.size() - summary.num_failed < 2) {
     throw InputError(image_dir.string() + ": " +
                      std::to_string(scan.images.size() - summary.num_failed) +
@@ -293,6 +310,15 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
   }
   summary.seconds = timer.ElapsedSeconds();
   return summary;
+}
+
+void LogExtraction(const ExtractionSummary& s) {
+  spdlog::info(
+      "extract: {} images ({} skipped files), {} detected with {} features, {} reused, "
+      "{} skipped at decoding or detection, {} changed and {} removed since the last run, "
+      "{:.2f} s",
+      s.num_images, s.num_skipped_files, s.num_detected, s.num_features, s.num_reused, s.num_failed,
+      s.num_changed, s.num_removed, s.seconds);
 }
 
 }  // namespace tessera

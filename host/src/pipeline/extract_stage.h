@@ -7,21 +7,11 @@
 #include "database/database.h"
 #include "image/image_io.h"
 #include "manifest/manifest.h"
+#include "pipeline/run_summary.h"
+#include "pipeline/stage_control.h"
 #include "plugin/plugin_registry.h"
 
 namespace tessera {
-
-struct ExtractionSummary {
-  size_t num_images = 0;         // usable images in the folder
-  size_t num_skipped_files = 0;  // files that were not readable images
-  size_t num_detected = 0;       // images detected in this run
-  size_t num_reused = 0;         // images whose features were already in the database
-  size_t num_features = 0;       // keypoints found in this run
-  size_t num_failed = 0;         // images skipped at decoding or detection (now or earlier)
-  size_t num_changed = 0;        // images whose file changed since the workspace had them
-  size_t num_removed = 0;        // images the workspace had that are no longer in the folder
-  double seconds = 0;
-};
 
 // Ingests the images of `image_dir` into the database (cameras from EXIF or the
 // manifest, images in natural order) and detects features in every image that has
@@ -36,8 +26,17 @@ struct ExtractionSummary {
 // that cannot be decoded or detected is skipped with a warning naming it and the
 // reason, and recorded, so that later runs skip it too until its file changes.
 // Throws InputError when the folder has fewer than two usable images.
+//
+// `control`: progress ("extract", images decoded and detected or skipped, images to
+// detect) and cancellation, checked before each image. A cancelled run stops starting
+// images, lets those under way finish and returns status kCancelled: the workspace
+// holds every image ingested and the features of every image detected.
 ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const Manifest& manifest,
                                   const PluginInstance<Detector>& detector, Database* database,
-                                  const ImageScanOptions& scan_options = {});
+                                  const ImageScanOptions& scan_options = {},
+                                  const StageControl& control = {});
+
+// The stage's closing log line.
+void LogExtraction(const ExtractionSummary& summary);
 
 }  // namespace tessera

@@ -1,6 +1,6 @@
-#include "cli/pipeline_context.h"
+#include "pipeline/pipeline_context.h"
 
-#include "feature/feature_matching.h"
+#include "pipeline/match_stage.h"
 #include "util/paths.h"
 
 namespace tessera {

@@ -1,4 +1,4 @@
-#include "feature/feature_matching.h"
+#include "pipeline/match_stage.h"
 
 #include <spdlog/spdlog.h>
 
@@ -21,17 +21,6 @@
 namespace tessera {
 namespace {
 
-nlohmann::json VerificationProvenance(const VerificationSettings& s, uint64_t seed) {
-  return {{"max_error_px", s.max_error_px},
-          {"confidence", s.confidence},
-          {"min_num_trials", s.min_num_trials},
-          {"max_num_trials", s.max_num_trials},
-          {"min_inlier_ratio", s.min_inlier_ratio},
-          {"min_num_inliers", s.min_num_inliers},
-          {"max_H_inlier_ratio", s.max_H_inlier_ratio},
-          {"seed", seed}};
-}
-
 DescriptorMetric MetricFromName(const std::string& name) {
   return name == DescriptorMetricName(DescriptorMetric::kHamming) ? DescriptorMetric::kHamming
                                                                   : DescriptorMetric::kL2;
@@ -52,10 +41,11 @@ struct ImageFeatures {
 // selectors' order, which is local for sequential selectors and revisits the first
 // image of a row for exhaustive ones, so most reads hit. Thread-safe; an entry in use
 // outlives its eviction through its shared_ptr.
-class FeatureCache {
+class LruFeatureCache {
  public:
   // `dimension` > 0: every descriptor row read must have that width.
-  FeatureCache(const Database* database, DescriptorMetric metric, int dimension, size_t max_bytes)
+  LruFeatureCache(const Database* database, DescriptorMetric metric, int dimension,
+                  size_t max_bytes)
       : database_(database),
         metric_(metric),
         dimension_(dimension > 0 ? dimension : -1),
@@ -188,45 +178,38 @@ void CheckPairSelectors(const Manifest& manifest,
   }
 }
 
-MatchingSummary MatchFeatures(const Manifest& manifest,
-                              const std::vector<PluginInstance<PairSelector>>& pair_selectors,
-                              const PluginInstance<Matcher>& matcher, Database* database) {
-  const Timer timer;
-  MatchingSummary summary;
-  if (pair_selectors.size() != manifest.pair_selectors.size()) {
-    throw std::logic_error("MatchFeatures: " + std::to_string(pair_selectors.size()) +
-                           " pair selectors for " + std::to_string(manifest.pair_selectors.size()) +
-                           " manifest slots");
-  }
-
-  const auto features = database->ReadStageProvenance(Database::kFeaturesStage);
+WorkspaceDescriptors ReadWorkspaceDescriptors(const Database& database) {
+  const auto features = database.ReadStageProvenance(Database::kFeaturesStage);
   if (!features) {
-    throw InputError(database->path().string() +
+    throw InputError(database.path().string() +
                      ": no features in the workspace; run `tessera "
                      "extract` (or `tessera run`) first");
   }
-  const DescriptorMetric metric = MetricFromName(features->value("metric", "l2"));
+  WorkspaceDescriptors descriptors;
+  descriptors.features_provenance = *features;
+  descriptors.metric = MetricFromName(features->value("metric", "l2"));
   // Every descriptor read is checked to have the width of all others: features of two
   // detectors must never meet in a matcher.
-  const std::vector<int64_t> widths = database->DescriptorWidths();
+  const std::vector<int64_t> widths = database.DescriptorWidths();
   if (widths.size() > 1) {
     std::string list;
     for (const int64_t width : widths) list += (list.empty() ? "" : ", ") + std::to_string(width);
-    throw InputError(database->path().string() + ": the workspace holds descriptors of " +
+    throw InputError(database.path().string() + ": the workspace holds descriptors of " +
                      std::to_string(widths.size()) + " widths (" + list +
                      " bytes), features of different detectors; run `tessera extract` again");
   }
-  const int dimension = widths.empty() ? 0 : static_cast<int>(widths.front());
-  CheckPairSelectors(manifest, pair_selectors, metric, dimension);
+  descriptors.dimension = widths.empty() ? 0 : static_cast<int>(widths.front());
+  return descriptors;
+}
 
-  // Matches depend on the features and on how pairs were matched; geometries on the
-  // matches and the verification settings. Pair selection itself only decides which
-  // pairs exist, so changing it keeps every pair already matched.
-  const nlohmann::json matches_provenance = {{"features", *features},
+void InvalidateStaleResults(const Manifest& manifest, const PluginInstance<Matcher>& matcher,
+                            const WorkspaceDescriptors& descriptors, Database* database) {
+  const nlohmann::json matches_provenance = {{"features", descriptors.features_provenance},
                                              {"matcher", matcher.Provenance()}};
-  const nlohmann::json geometries_provenance = {
-      {"matches", matches_provenance},
-      {"verification", VerificationProvenance(manifest.verification, manifest.seed)}};
+  nlohmann::json verification = manifest.verification.ToJson();
+  verification["seed"] = manifest.seed;
+  const nlohmann::json geometries_provenance = {{"matches", matches_provenance},
+                                                {"verification", verification}};
   const auto stored_matches = database->ReadStageProvenance(Database::kMatchesStage);
   if (stored_matches && *stored_matches != matches_provenance) {
     spdlog::info("match: the matcher, its options or the features changed; discarding old matches");
@@ -239,13 +222,19 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
   }
   database->WriteStageProvenance(Database::kMatchesStage, matches_provenance);
   database->WriteStageProvenance(Database::kTwoViewGeometriesStage, geometries_provenance);
+}
 
+MatchPlan PlanMatching(const Manifest& manifest,
+                       const std::vector<PluginInstance<PairSelector>>& pair_selectors,
+                       const PluginInstance<Matcher>& matcher,
+                       const WorkspaceDescriptors& descriptors, Database* database) {
+  MatchPlan plan;
   // Images in capture order: pair selectors such as `sequential` rely on it.
-  std::vector<Image> images = database->ReadAllImages();
+  plan.images = database->ReadAllImages();
+  std::vector<Image>& images = plan.images;
   std::sort(images.begin(), images.end(),
             [](const Image& a, const Image& b) { return NaturalLess(a.name, b.name); });
-  std::map<camera_t, Camera> cameras;
-  for (const Camera& camera : database->ReadAllCameras()) cameras[camera.camera_id] = camera;
+  for (const Camera& camera : database->ReadAllCameras()) plan.cameras[camera.camera_id] = camera;
   // Workspaces made before metadata was stored have none: selectors see empty metadata.
   const std::map<image_t, ImageMetadata> metadata = database->ReadAllImageMetadata();
 
@@ -256,95 +245,162 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
     PairSelectionImage entry;
     entry.image_id = image.image_id;
     entry.name = image.name;
-    entry.camera = cameras.at(image.camera_id);
+    entry.camera = plan.cameras.at(image.camera_id);
     if (auto it = metadata.find(image.image_id); it != metadata.end()) entry.metadata = it->second;
     input.images.push_back(std::move(entry));
     image_ids.push_back(image.image_id);
   }
-  const DatabaseFeatureReader feature_reader(database, image_ids, metric, dimension);
+  const DatabaseFeatureReader feature_reader(database, image_ids, descriptors.metric,
+                                             descriptors.dimension);
   input.features = &feature_reader;
 
-  const std::vector<ImageIndexPair> pairs =
-      SelectPairs(manifest, pair_selectors, input, &summary.pairs_per_selector);
-  summary.num_pairs = pairs.size();
-  std::vector<ImageIndexPair> todo;
-  for (const auto& [i, j] : pairs) {
+  plan.pairs = SelectPairs(manifest, pair_selectors, input, &plan.pairs_per_selector);
+  for (const auto& [i, j] : plan.pairs) {
     const image_t id1 = images[i].image_id, id2 = images[j].image_id;
     if (database->ExistsMatches(id1, id2) && database->ExistsTwoViewGeometry(id1, id2)) {
-      ++summary.num_reused;
+      ++plan.num_reused;
     } else if (IsQuarantined(matcher.name(), PluginStage::kMatch,
                              PairSubject(images[i].name, images[j].name))) {
       spdlog::warn("match: skipping {} and {}: they crashed matcher '{}' twice", images[i].name,
                    images[j].name, matcher.name());
     } else {
-      todo.emplace_back(i, j);
+      plan.todo.emplace_back(i, j);
     }
   }
+  return plan;
+}
+
+class PairMatchVerifier::FeatureCache : public LruFeatureCache {
+  using LruFeatureCache::LruFeatureCache;
+};
+
+PairMatchVerifier::PairMatchVerifier(const Manifest& manifest,
+                                     const PluginInstance<Matcher>& matcher, const MatchPlan& plan,
+                                     const WorkspaceDescriptors& descriptors, Database* database)
+    : manifest_(manifest),
+      matcher_(matcher),
+      plan_(plan),
+      database_(database),
+      feature_cache_(std::make_unique<FeatureCache>(database, descriptors.metric,
+                                                    descriptors.dimension, kFeatureCacheBytes)) {}
+
+PairMatchVerifier::~PairMatchVerifier() = default;
+
+PairResult PairMatchVerifier::Run(const ImageIndexPair& pair) {
+  const auto [i, j] = pair;
+  const Image& image1 = plan_.images.at(i);
+  const Image& image2 = plan_.images.at(j);
+  const std::shared_ptr<const ImageFeatures> features1 = feature_cache_->Get(image1.image_id);
+  const std::shared_ptr<const ImageFeatures> features2 = feature_cache_->Get(image2.image_id);
+  PairResult result;
+  Timer step;
+  FeatureMatches matches;
+  if (database_->ExistsMatches(image1.image_id, image2.image_id)) {
+    std::lock_guard<std::mutex> lock(database_mutex_);
+    matches = database_->ReadMatches(image1.image_id, image2.image_id);
+  } else {
+    matches =
+        CallPlugin(matcher_.name(), PluginStage::kMatch, PairSubject(image1.name, image2.name),
+                   [&] { return matcher_->Match(features1->descriptors, features2->descriptors); });
+  }
+  result.match_seconds = step.ElapsedSeconds();
+  step.Restart();
+  const TwoViewGeometry geometry = EstimateTwoViewGeometry(
+      plan_.cameras.at(image1.camera_id), features1->keypoints, plan_.cameras.at(image2.camera_id),
+      features2->keypoints, matches, manifest_.verification,
+      DeriveSeed(manifest_.seed, ImagePairToPairId(image1.image_id, image2.image_id)));
+  result.verify_seconds = step.ElapsedSeconds();
+  {
+    std::lock_guard<std::mutex> lock(database_mutex_);
+    Database::Transaction transaction(database_);
+    if (!database_->ExistsMatches(image1.image_id, image2.image_id)) {
+      database_->WriteMatches(image1.image_id, image2.image_id, matches);
+    }
+    database_->WriteTwoViewGeometry(image1.image_id, image2.image_id, geometry);
+    transaction.Commit();
+  }
+  result.num_putative_matches = matches.size();
+  result.num_inlier_matches = geometry.inlier_matches.size();
+  return result;
+}
+
+MatchingSummary MatchFeatures(const Manifest& manifest,
+                              const std::vector<PluginInstance<PairSelector>>& pair_selectors,
+                              const PluginInstance<Matcher>& matcher, Database* database,
+                              const StageControl& control) {
+  const Timer timer;
+  MatchingSummary summary;
+  if (pair_selectors.size() != manifest.pair_selectors.size()) {
+    throw std::logic_error("MatchFeatures: " + std::to_string(pair_selectors.size()) +
+                           " pair selectors for " + std::to_string(manifest.pair_selectors.size()) +
+                           " manifest slots");
+  }
+  const WorkspaceDescriptors descriptors = ReadWorkspaceDescriptors(*database);
+  CheckPairSelectors(manifest, pair_selectors, descriptors.metric, descriptors.dimension);
+  InvalidateStaleResults(manifest, matcher, descriptors, database);
+  const MatchPlan plan = PlanMatching(manifest, pair_selectors, matcher, descriptors, database);
+  summary.pairs_per_selector = plan.pairs_per_selector;
+  summary.num_pairs = plan.pairs.size();
+  summary.num_reused = plan.num_reused;
+  const std::vector<ImageIndexPair>& todo = plan.todo;
+
   // "30 pairs from 'spatial'", or "24 pairs from 'spatial' + 10 from 'sequential' = 30".
   std::string chosen;
   for (const SelectorPairs& selector : summary.pairs_per_selector) {
     chosen += (chosen.empty() ? "" : " + ") + std::to_string(selector.num_pairs) +
               (chosen.empty() ? " pairs" : "") + " from '" + selector.plugin + "'";
   }
-  if (summary.pairs_per_selector.size() > 1) chosen += " = " + std::to_string(pairs.size());
+  if (summary.pairs_per_selector.size() > 1) chosen += " = " + std::to_string(plan.pairs.size());
   spdlog::info("match: {}, {} to match with '{}' ({} already done)", chosen, todo.size(),
                matcher.name(), summary.num_reused);
 
-  FeatureCache feature_cache(database, metric, dimension, kFeatureCacheBytes);
-  std::mutex database_mutex;
-  std::atomic<size_t> done{0}, putative{0}, inliers{0};
+  PairMatchVerifier verifier(manifest, matcher, plan, descriptors, database);
+  std::mutex progress_mutex;
+  size_t done = 0;  // under progress_mutex
+  std::atomic<size_t> putative{0}, inliers{0};
   std::atomic<int64_t> match_micros{0}, verify_micros{0};
   const Timer stage_timer;
   const size_t report_every = std::max<size_t>(1, todo.size() / 20);
+  if (todo.empty()) control.Report("match", 0, 0);
   ParallelFor(todo.size(), manifest.EffectiveNumThreads(), [&](size_t k) {
-    const auto [i, j] = todo[k];
-    const Image& image1 = images[i];
-    const Image& image2 = images[j];
-    const std::shared_ptr<const ImageFeatures> features1 = feature_cache.Get(image1.image_id);
-    const std::shared_ptr<const ImageFeatures> features2 = feature_cache.Get(image2.image_id);
-    Timer step;
-    FeatureMatches matches;
-    if (database->ExistsMatches(image1.image_id, image2.image_id)) {
-      std::lock_guard<std::mutex> lock(database_mutex);
-      matches = database->ReadMatches(image1.image_id, image2.image_id);
-    } else {
-      matches = CallPlugin(
-          matcher.name(), PluginStage::kMatch, PairSubject(image1.name, image2.name),
-          [&] { return matcher->Match(features1->descriptors, features2->descriptors); });
-    }
-    match_micros += static_cast<int64_t>(step.ElapsedSeconds() * 1e6);
-    step.Restart();
-    const TwoViewGeometry geometry = EstimateTwoViewGeometry(
-        cameras.at(image1.camera_id), features1->keypoints, cameras.at(image2.camera_id),
-        features2->keypoints, matches, manifest.verification,
-        DeriveSeed(manifest.seed, ImagePairToPairId(image1.image_id, image2.image_id)));
-    verify_micros += static_cast<int64_t>(step.ElapsedSeconds() * 1e6);
-    {
-      std::lock_guard<std::mutex> lock(database_mutex);
-      Database::Transaction transaction(database);
-      if (!database->ExistsMatches(image1.image_id, image2.image_id)) {
-        database->WriteMatches(image1.image_id, image2.image_id, matches);
-      }
-      database->WriteTwoViewGeometry(image1.image_id, image2.image_id, geometry);
-      transaction.Commit();
-    }
-    putative += matches.size();
-    inliers += geometry.inlier_matches.size();
+    if (control.Cancelled()) return;
+    const PairResult result = verifier.Run(todo[k]);
+    match_micros += static_cast<int64_t>(result.match_seconds * 1e6);
+    verify_micros += static_cast<int64_t>(result.verify_seconds * 1e6);
+    putative += result.num_putative_matches;
+    inliers += result.num_inlier_matches;
+    std::lock_guard<std::mutex> lock(progress_mutex);
     const size_t n = ++done;
     if (n % report_every == 0 || n == todo.size()) {
       spdlog::info("match: [{}/{}] pairs ({:.1f} pairs/s)", n, todo.size(),
                    n / std::max(1e-9, stage_timer.ElapsedSeconds()));
     }
+    control.Report("match", n, todo.size());
   });
 
-  summary.num_matched = todo.size();
+  summary.num_matched = done;
   summary.num_putative_matches = putative;
   summary.num_inlier_matches = inliers;
   summary.num_verified = database->NumVerifiedPairs();
   summary.match_seconds = match_micros / 1e6;
   summary.verify_seconds = verify_micros / 1e6;
   summary.seconds = timer.ElapsedSeconds();
+  if (done < todo.size()) {  // cancelled: the pairs not started are left for later
+    summary.status = StageStatus::kCancelled;
+    spdlog::info("match: cancelled after {} of {} pairs", done, todo.size());
+  }
   return summary;
+}
+
+void LogMatching(const MatchingSummary& s) {
+  const double mean_inliers =
+      s.num_matched > 0 ? static_cast<double>(s.num_inlier_matches) / s.num_matched : 0.0;
+  spdlog::info(
+      "match: {} pairs, {} matched now ({} reused), {} verified in the workspace; "
+      "{} putative and {} inlier matches now ({:.0f} inliers per pair); "
+      "matching {:.2f} s, verification {:.2f} s (thread time), {:.2f} s wall",
+      s.num_pairs, s.num_matched, s.num_reused, s.num_verified, s.num_putative_matches,
+      s.num_inlier_matches, mean_inliers, s.match_seconds, s.verify_seconds, s.seconds);
 }
 
 }  // namespace tessera

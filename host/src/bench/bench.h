@@ -1,0 +1,30 @@
+#pragma once
+
+// `tessera bench`: several manifests (and COLMAP) on the same images, compared.
+
+#include <string>
+#include <vector>
+
+namespace tessera {
+
+struct BenchOptions {
+  std::string images;
+  std::string ground_truth;  // empty: no accuracy columns
+  std::string output;        // folder of the workspaces, one per manifest
+  std::string json_file;     // each empty: not written
+  std::string csv_file;
+  std::string chart_file;
+  std::string camera_K;
+  bool with_colmap = false;
+  int threads = 0;
+  std::vector<std::string> manifests;
+};
+
+// Runs every manifest as its own `tessera run` child process (this executable), reads
+// back each run's run_summary.json and mapping_summary.json (RunSummary,
+// MappingSummary), prints the Markdown table and writes the files asked for. Returns
+// the exit code: 0 when every row ended with 0, else the first failing row's documented
+// code (2, 3 or 4), or 1. Throws InputError for bad options or a malformed manifest.
+int RunBench(const BenchOptions& options);
+
+}  // namespace tessera

@@ -1,0 +1,80 @@
+#include "pipeline/extract_stage.h"
+
+#include <gtest/gtest.h>
+
+#include "pipeline/stage_test_util.h"
+
+namespace tessera {
+namespace {
+
+size_t NumImagesWithFeatures(const Database& database) {
+  size_t count = 0;
+  for (const Image& image : database.ReadAllImages())
+    count += database.ExistsKeypoints(image.image_id);
+  return count;
+}
+
+TEST(ExtractStage, CancelledAfterTwoImagesKeepsThemAndARerunDoesTheRest) {
+  const testing::TemporaryDir dir;
+  testing::WriteSampleImages(dir.path() / "images", 4);
+  const testing::CheapPlugins plugins;
+  const Manifest manifest = testing::CheapManifest(1);
+  Database database(dir.path() / "database.db");
+
+  CancellationToken token;
+  StageControl control;
+  control.cancel = &token;
+  control.progress = [&](const std::string&, size_t done, size_t) {
+    if (done == 2) token.Cancel();
+  };
+  const ExtractionSummary first =
+      ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database, {}, control);
+  EXPECT_EQ(first.status, StageStatus::kCancelled);
+  EXPECT_EQ(first.num_detected, 2u);
+  EXPECT_EQ(database.NumImages(), 4u);  // every image is ingested before detection
+  EXPECT_EQ(NumImagesWithFeatures(database), 2u);
+  // The first two in capture order are the ones detected.
+  const std::vector<Image> images = database.ReadAllImages();
+  for (const Image& image : images) {
+    const bool early = image.name == "0000.jpg" || image.name == "0001.jpg";
+    EXPECT_EQ(database.ExistsKeypoints(image.image_id), early) << image.name;
+  }
+
+  const ExtractionSummary second =
+      ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database);
+  EXPECT_EQ(second.status, StageStatus::kCompleted);
+  EXPECT_EQ(second.num_reused, 2u);
+  EXPECT_EQ(second.num_detected, 2u);
+  EXPECT_EQ(NumImagesWithFeatures(database), 4u);
+}
+
+TEST(ExtractStage, ProgressIsMonotoneAndEndsAtTotal) {
+  const testing::TemporaryDir dir;
+  testing::WriteSampleImages(dir.path() / "images", 4);
+  const testing::CheapPlugins plugins;
+  const Manifest manifest = testing::CheapManifest(3);
+  Database database(dir.path() / "database.db");
+  std::vector<std::pair<size_t, size_t>> calls;
+  StageControl control;
+  control.progress = [&](const std::string& stage, size_t done, size_t total) {
+    EXPECT_EQ(stage, "extract");
+    calls.emplace_back(done, total);
+  };
+  const ExtractionSummary summary =
+      ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database, {}, control);
+  EXPECT_EQ(summary.status, StageStatus::kCompleted);
+  ASSERT_EQ(calls.size(), 4u);
+  for (size_t k = 0; k < calls.size(); ++k) {
+    EXPECT_EQ(calls[k].first, k + 1);
+    EXPECT_EQ(calls[k].second, 4u);
+  }
+
+  // Nothing left to do: one call, (0, 0).
+  calls.clear();
+  ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database, {}, control);
+  ASSERT_EQ(calls.size(), 1u);
+  EXPECT_EQ(calls[0], std::make_pair(size_t{0}, size_t{0}));
+}
+
+}  // namespace
+}  // namespace tessera

@@ -1,0 +1,45 @@
+#pragma once
+
+// The map stage: mapping the workspace's verified pairs, colouring the points, and
+// writing every model (exporters, else COLMAP binary) with mapping_summary.json.
+
+#include <cstddef>
+#include <filesystem>
+
+#include "database/database.h"
+#include "pipeline/mapping_summary.h"
+#include "pipeline/pipeline_context.h"
+#include "pipeline/run_summary.h"
+#include "pipeline/stage_control.h"
+#include "sfm/incremental_mapper.h"
+
+namespace tessera {
+
+// Removes sparse/<k> folders of an earlier run for k >= num_models, so that the folder
+// never mixes this run's models with stale ones. Other entries are left alone.
+void RemoveStaleModels(const std::filesystem::path& sparse_dir, size_t num_models);
+
+// The mapping summary of a mapper result: models (sparse_dir/<index>), why images were
+// left out, focal lengths estimated; the options as given; `seconds` left 0.
+MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& input,
+                                const std::filesystem::path& sparse_dir,
+                                const IncrementalMapperOptions& options, uint64_t seed);
+
+// Maps the workspace's verified matches and writes every model: through the manifest's
+// exporters, or as COLMAP binary in OUTPUT/sparse/<index>/ when it lists none; then
+// OUTPUT/mapping_summary.json. `image_dir_option` empty: the folder extract recorded.
+// No verified pair after matching: a summary with no model (the caller exits 3).
+// Throws InputError when matching has not run, and the first exporter's PluginError
+// once every exporter has run.
+//
+// `control`: progress ("map" 0/1 then 1/1; "export", models written of all) and
+// cancellation, checked before mapping and before each model is written. The mapper
+// itself runs to its end once started. Cancelled before writing: nothing of the old
+// output is touched; cancelled between models: the models written are whole, and
+// mapping_summary.json is not written. Status kCancelled either way.
+MapStageSummary MapWorkspace(const PipelineContext& context, Database* database,
+                             const std::filesystem::path& output_dir,
+                             const std::filesystem::path& image_dir_option,
+                             const StageControl& control = {});
+
+}  // namespace tessera

@@ -1,0 +1,61 @@
+#include "pipeline/map_stage.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "pipeline/extract_stage.h"
+#include "pipeline/match_stage.h"
+#include "pipeline/stage_test_util.h"
+
+namespace tessera {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(MapStage, RemoveStaleModelsRemovesNumberedFoldersFromNumModelsOn) {
+  const testing::TemporaryDir dir;
+  const fs::path sparse = dir.path() / "sparse";
+  for (const std::string name : {"0", "1", "5", "notes", "1234567"}) {
+    fs::create_directories(sparse / name);
+  }
+  std::ofstream(sparse / "2") << "a file";
+  RemoveStaleModels(sparse, 1);
+  EXPECT_TRUE(fs::exists(sparse / "0"));
+  EXPECT_FALSE(fs::exists(sparse / "1"));
+  EXPECT_FALSE(fs::exists(sparse / "5"));
+  EXPECT_TRUE(fs::exists(sparse / "notes"));
+  EXPECT_TRUE(fs::exists(sparse / "1234567"));  // more than 6 digits: not a model folder
+  EXPECT_TRUE(fs::exists(sparse / "2"));        // a file, not a folder
+}
+
+// Cancelled before mapping: the earlier run's output is untouched, nothing is written.
+TEST(MapStage, CancelledBeforeMappingTouchesNoOutput) {
+  const testing::TemporaryDir dir;
+  testing::WriteSampleImages(dir.path() / "images", 3);
+  const testing::CheapPlugins plugins;
+  const Manifest manifest = testing::CheapManifest(2);
+  Database database(dir.path() / "database.db");
+  ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database);
+  MatchFeatures(manifest, plugins.pair_selectors, plugins.matcher, &database);
+  fs::create_directories(dir.path() / "sparse" / "3");
+
+  PipelineContext context;  // no plugin: a cancelled stage must not need one
+  CancellationToken token;
+  token.Cancel();
+  StageControl control;
+  control.cancel = &token;
+  size_t num_progress_calls = 0;
+  control.progress = [&](const std::string&, size_t, size_t) { ++num_progress_calls; };
+  const MapStageSummary summary =
+      MapWorkspace(context, &database, dir.path(), dir.path() / "images", control);
+  EXPECT_EQ(summary.status, StageStatus::kCancelled);
+  EXPECT_EQ(summary.num_models, 0u);
+  EXPECT_EQ(summary.num_images, 3u);
+  EXPECT_EQ(num_progress_calls, 0u);
+  EXPECT_TRUE(fs::exists(dir.path() / "sparse" / "3"));
+  EXPECT_FALSE(fs::exists(dir.path() / "mapping_summary.json"));
+}
+
+}  // namespace
+}  // namespace tessera

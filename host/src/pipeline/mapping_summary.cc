@@ -1,0 +1,103 @@
+#include "pipeline/mapping_summary.h"
+
+#include "tessera/errors.h"
+#include "tessera/io/file_io.h"
+
+namespace tessera {
+
+nlohmann::json MappingSummary::ToJson() const {
+  nlohmann::json json = {{"models", nlohmann::json::array()},
+                         {"unregistered", nlohmann::json::array()}};
+  for (const Model& model : models) {
+    const ViewGraphCheck& check = model.view_graph_check;
+    const nlohmann::json self_check = {{"verified_pairs", check.verified_pairs},
+                                       {"agreeing_pairs", check.agreeing_pairs},
+                                       {"agreement", check.agreement},
+                                       {"possibly_folded", check.possibly_folded},
+                                       {"disagreeing_images", check.disagreeing_images}};
+    json["models"].push_back({{"index", model.index},
+                              {"folder", model.folder},
+                              {"num_images", model.num_images},
+                              {"num_points3D", model.num_points3D},
+                              {"mean_track_length", model.mean_track_length},
+                              {"mean_reprojection_error", model.mean_reprojection_error},
+                              {"view_graph_check", self_check},
+                              {"images", model.images}});
+  }
+  for (const Unregistered& image : unregistered) {
+    json["unregistered"].push_back({{"image", image.image}, {"reason", image.reason}});
+  }
+  json["focal_lengths_estimated"] = nlohmann::json::array();
+  for (const FocalLength& focal : focal_lengths_estimated) {
+    json["focal_lengths_estimated"].push_back({{"camera_id", focal.camera_id},
+                                               {"initial", focal.initial},
+                                               {"estimated", focal.estimated},
+                                               {"method", focal.method},
+                                               {"num_pairs", focal.num_pairs},
+                                               {"num_images", focal.num_images}});
+  }
+  json["view_graph_pairs_dropped"] = view_graph_pairs_dropped;
+  json["registrations_refused"] = registrations_refused;
+  json["merges"] = merges;
+  json["seconds"] = seconds;
+  json["mapper_options"] = mapper_options;
+  json["seed"] = seed;
+  return json;
+}
+
+MappingSummary MappingSummary::FromJson(const nlohmann::json& json) {
+  MappingSummary summary;
+  for (const nlohmann::json& entry : json.at("models")) {
+    Model model;
+    model.index = entry.at("index").get<size_t>();
+    model.folder = entry.at("folder").get<std::string>();
+    model.num_images = entry.at("num_images").get<size_t>();
+    model.num_points3D = entry.at("num_points3D").get<size_t>();
+    model.mean_track_length = entry.at("mean_track_length").get<double>();
+    model.mean_reprojection_error = entry.at("mean_reprojection_error").get<double>();
+    const nlohmann::json& check = entry.at("view_graph_check");
+    model.view_graph_check.verified_pairs = check.at("verified_pairs").get<size_t>();
+    model.view_graph_check.agreeing_pairs = check.at("agreeing_pairs").get<size_t>();
+    model.view_graph_check.agreement = check.at("agreement").get<double>();
+    model.view_graph_check.possibly_folded = check.at("possibly_folded").get<bool>();
+    model.view_graph_check.disagreeing_images =
+        check.at("disagreeing_images").get<std::vector<std::string>>();
+    model.images = entry.at("images").get<std::vector<std::string>>();
+    summary.models.push_back(std::move(model));
+  }
+  for (const nlohmann::json& entry : json.at("unregistered")) {
+    summary.unregistered.push_back(
+        {entry.at("image").get<std::string>(), entry.at("reason").get<std::string>()});
+  }
+  for (const nlohmann::json& entry : json.at("focal_lengths_estimated")) {
+    FocalLength focal;
+    focal.camera_id = entry.at("camera_id").get<camera_t>();
+    focal.initial = entry.at("initial").get<double>();
+    focal.estimated = entry.at("estimated").get<double>();
+    focal.method = entry.at("method").get<std::string>();
+    focal.num_pairs = entry.at("num_pairs").get<size_t>();
+    focal.num_images = entry.at("num_images").get<size_t>();
+    summary.focal_lengths_estimated.push_back(std::move(focal));
+  }
+  summary.view_graph_pairs_dropped = json.at("view_graph_pairs_dropped").get<size_t>();
+  summary.registrations_refused = json.at("registrations_refused").get<size_t>();
+  summary.merges = json.at("merges").get<std::vector<std::string>>();
+  summary.seconds = json.at("seconds").get<double>();
+  summary.mapper_options = json.at("mapper_options");
+  summary.seed = json.at("seed").get<uint64_t>();
+  return summary;
+}
+
+MappingSummary MappingSummary::Read(const std::filesystem::path& file) {
+  try {
+    return FromJson(nlohmann::json::parse(ReadFileContents(file)));
+  } catch (const nlohmann::json::exception& error) {
+    throw InputError(file.string() + ": not a mapping summary: " + error.what());
+  }
+}
+
+void MappingSummary::Write(const std::filesystem::path& file) const {
+  WriteFileAtomically(file, ToJson().dump(2) + "\n");
+}
+
+}  // namespace tessera

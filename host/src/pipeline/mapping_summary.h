@@ -1,0 +1,71 @@
+#pragma once
+
+// mapping_summary.json: what the map stage wrote, model by model, and why images were
+// left out. Written by `map` and `run`, read by `bench` and the GUI.
+
+#include <cstddef>
+#include <cstdint>
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "tessera/ids.h"
+
+namespace tessera {
+
+struct MappingSummary {
+  // How a model agrees with the view graph (sfm's ModelSelfCheck, images by name).
+  struct ViewGraphCheck {
+    size_t verified_pairs = 0;
+    size_t agreeing_pairs = 0;
+    double agreement = 1;
+    bool possibly_folded = false;
+    std::vector<std::string> disagreeing_images;
+  };
+  struct Model {
+    size_t index = 0;    // k of sparse/k
+    std::string folder;  // OUTPUT/sparse/k
+    size_t num_images = 0;
+    size_t num_points3D = 0;
+    double mean_track_length = 0;
+    double mean_reprojection_error = 0;  // px
+    ViewGraphCheck view_graph_check;
+    std::vector<std::string> images;  // registered, by name, in image id order
+  };
+  struct Unregistered {
+    std::string image;
+    std::string reason;
+  };
+  // A focal length estimated for a camera without a prior (sfm's FocalLengthReport).
+  struct FocalLength {
+    camera_t camera_id = 0;
+    double initial = 0;
+    double estimated = 0;
+    std::string method;
+    size_t num_pairs = 0;
+    size_t num_images = 0;
+  };
+
+  std::vector<Model> models;  // largest first
+  std::vector<Unregistered> unregistered;
+  std::vector<FocalLength> focal_lengths_estimated;
+  size_t view_graph_pairs_dropped = 0;
+  size_t registrations_refused = 0;
+  std::vector<std::string> merges;  // one line per merge, and per pair of models not merged
+  double seconds = 0;
+  nlohmann::json mapper_options = nlohmann::json::object();  // as IncrementalMapperOptions
+  uint64_t seed = 0;
+
+  // The file's JSON, keys as documented in the README.
+  nlohmann::json ToJson() const;
+  // Throws nlohmann::json::exception for a missing or mistyped field.
+  static MappingSummary FromJson(const nlohmann::json& json);
+
+  // Reads and parses FILE; throws InputError naming it when it cannot be read or parsed.
+  static MappingSummary Read(const std::filesystem::path& file);
+  // Writes FILE atomically (a temporary file renamed over it).
+  void Write(const std::filesystem::path& file) const;
+};
+
+}  // namespace tessera

@@ -1,0 +1,114 @@
+#pragma once
+
+// The match stage in three named steps, and MatchFeatures, which runs them in order:
+//   1. InvalidateStaleResults: discard stored matches and geometries that other
+//      features, another matcher or other verification settings made;
+//   2. PlanMatching: the pairs the selectors choose, and of those the ones to do;
+//   3. PairMatchVerifier::Run: match and verify one pair, committed on its own.
+
+#include <cstddef>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include "database/database.h"
+#include "manifest/manifest.h"
+#include "pipeline/run_summary.h"
+#include "pipeline/stage_control.h"
+#include "plugin/plugin_registry.h"
+
+namespace tessera {
+
+// Asks each selector (manifest.pair_selectors[i] made pair_selectors[i]) whether it
+// works with these descriptors (PairSelector::CheckDescriptors); `dimension` 0 when not
+// known yet. Throws InputError naming the manifest and the selector's JSON path.
+void CheckPairSelectors(const Manifest& manifest,
+                        const std::vector<PluginInstance<PairSelector>>& pair_selectors,
+                        DescriptorMetric metric, int dimension);
+
+// The workspace's descriptors: their metric and width (bytes per row; 0 when there
+// are none), and the provenance of the features. Throws InputError when the workspace
+// has no features or descriptors of several widths (features of two detectors).
+struct WorkspaceDescriptors {
+  DescriptorMetric metric = DescriptorMetric::kL2;
+  int dimension = 0;
+  nlohmann::json features_provenance;
+};
+WorkspaceDescriptors ReadWorkspaceDescriptors(const Database& database);
+
+// Step 1. Matches depend on the features and on how pairs were matched; geometries on
+// the matches, the verification settings (all of VerificationSettings::ToJson, so a
+// field added there is covered) and the seed. Stored results made otherwise are
+// discarded; the provenance of what this run makes is recorded. Pair selection itself
+// only decides which pairs exist, so changing it keeps every pair already matched.
+void InvalidateStaleResults(const Manifest& manifest, const PluginInstance<Matcher>& matcher,
+                            const WorkspaceDescriptors& descriptors, Database* database);
+
+// What step 2 chose: the workspace's images (in capture order), their cameras, every
+// chosen pair (indices into `images`) and those still to match and verify.
+struct MatchPlan {
+  std::vector<Image> images;
+  std::map<camera_t, Camera> cameras;
+  std::vector<ImageIndexPair> pairs;  // united over the selectors, each once as (min, max)
+  std::vector<ImageIndexPair> todo;   // pairs neither done already nor quarantined
+  std::vector<SelectorPairs> pairs_per_selector;
+  size_t num_reused = 0;  // pairs with matches and a geometry in the workspace
+};
+
+// Step 2. Selectors get every image in capture order with its camera and stored
+// metadata, and the workspace's features on demand; their pairs are united (each pair
+// once, in the order the selectors gave them, first selector first).
+MatchPlan PlanMatching(const Manifest& manifest,
+                       const std::vector<PluginInstance<PairSelector>>& pair_selectors,
+                       const PluginInstance<Matcher>& matcher,
+                       const WorkspaceDescriptors& descriptors, Database* database);
+
+// What step 3 did with one pair.
+struct PairResult {
+  size_t num_putative_matches = 0;
+  size_t num_inlier_matches = 0;
+  double match_seconds = 0;
+  double verify_seconds = 0;
+};
+
+// Step 3: matches and verifies pairs of a plan, one per Run call, each its own
+// transaction, so an interrupted run resumes where it stopped. Thread-safe. Features are
+// read through a bounded cache, so memory does not grow with the number of images.
+class PairMatchVerifier {
+ public:
+  // All four must outlive the verifier.
+  PairMatchVerifier(const Manifest& manifest, const PluginInstance<Matcher>& matcher,
+                    const MatchPlan& plan, const WorkspaceDescriptors& descriptors,
+                    Database* database);
+  ~PairMatchVerifier();
+
+  PairResult Run(const ImageIndexPair& pair);
+
+ private:
+  class FeatureCache;
+  const Manifest& manifest_;
+  const PluginInstance<Matcher>& matcher_;
+  const MatchPlan& plan_;
+  Database* database_;
+  std::unique_ptr<FeatureCache> feature_cache_;
+  std::mutex database_mutex_;
+};
+
+// The three steps in order, on manifest.EffectiveNumThreads() threads. The descriptor
+// metric and the features' provenance come from the database, so the detector need
+// not be loaded. Throws InputError when the database has no features.
+//
+// `control`: progress ("match", pairs done, pairs to do) and cancellation, checked
+// before each pair. A cancelled run stops starting pairs, lets those under way finish
+// and returns status kCancelled: the workspace holds every pair finished.
+MatchingSummary MatchFeatures(const Manifest& manifest,
+                              const std::vector<PluginInstance<PairSelector>>& pair_selectors,
+                              const PluginInstance<Matcher>& matcher, Database* database,
+                              const StageControl& control = {});
+
+// The stage's closing log line.
+void LogMatching(const MatchingSummary& summary);
+
+}  // namespace tessera

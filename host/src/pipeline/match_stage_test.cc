@@ -1,0 +1,119 @@
+#include "pipeline/match_stage.h"
+
+#include <gtest/gtest.h>
+
+#include "pipeline/extract_stage.h"
+#include "pipeline/stage_test_util.h"
+
+namespace tessera {
+namespace {
+
+// A workspace of 4 images (6 pairs) with features.
+class MatchStageTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    testing::WriteSampleImages(dir_.path() / "images", 4);
+    database_ = std::make_unique<Database>(dir_.path() / "database.db");
+    ExtractFeatures(dir_.path() / "images", testing::CheapManifest(2), plugins_.detector,
+                    database_.get());
+  }
+  MatchingSummary Match(const Manifest& manifest, const StageControl& control = {}) {
+    return MatchFeatures(manifest, plugins_.pair_selectors, plugins_.matcher, database_.get(),
+                         control);
+  }
+
+  testing::TemporaryDir dir_;
+  testing::CheapPlugins plugins_;
+  std::unique_ptr<Database> database_;
+};
+
+TEST_F(MatchStageTest, CancelledAfterThreePairsKeepsThemAndARerunDoesTheRest) {
+  CancellationToken token;
+  StageControl control;
+  control.cancel = &token;
+  control.progress = [&](const std::string&, size_t done, size_t) {
+    if (done == 3) token.Cancel();
+  };
+  const MatchingSummary first = Match(testing::CheapManifest(1), control);
+  EXPECT_EQ(first.status, StageStatus::kCancelled);
+  EXPECT_EQ(first.num_pairs, 6u);
+  EXPECT_EQ(first.num_matched, 3u);
+  EXPECT_EQ(database_->NumMatchedPairs(), 3u);
+  EXPECT_EQ(database_->ReadAllTwoViewGeometries().size(), 3u);
+
+  const MatchingSummary second = Match(testing::CheapManifest(1));
+  EXPECT_EQ(second.status, StageStatus::kCompleted);
+  EXPECT_EQ(second.num_reused, 3u);
+  EXPECT_EQ(second.num_matched, 3u);
+  EXPECT_EQ(database_->NumMatchedPairs(), 6u);
+  EXPECT_EQ(database_->ReadAllTwoViewGeometries().size(), 6u);
+}
+
+TEST_F(MatchStageTest, ProgressIsMonotoneAndEndsAtTotal) {
+  std::vector<std::pair<size_t, size_t>> calls;
+  StageControl control;
+  control.progress = [&](const std::string& stage, size_t done, size_t total) {
+    EXPECT_EQ(stage, "match");
+    calls.emplace_back(done, total);
+  };
+  EXPECT_EQ(Match(testing::CheapManifest(3), control).status, StageStatus::kCompleted);
+  ASSERT_EQ(calls.size(), 6u);
+  for (size_t k = 0; k < calls.size(); ++k) {
+    EXPECT_EQ(calls[k].first, k + 1);
+    EXPECT_EQ(calls[k].second, 6u);
+  }
+}
+
+TEST_F(MatchStageTest, TheThreeStepsOneByOne) {
+  const Manifest manifest = testing::CheapManifest(1);
+  const WorkspaceDescriptors descriptors = ReadWorkspaceDescriptors(*database_);
+  EXPECT_EQ(descriptors.metric, DescriptorMetric::kHamming);
+  EXPECT_EQ(descriptors.dimension, 32);  // ORB: 256 bits
+  InvalidateStaleResults(manifest, plugins_.matcher, descriptors, database_.get());
+  const MatchPlan plan = PlanMatching(manifest, plugins_.pair_selectors, plugins_.matcher,
+                                      descriptors, database_.get());
+  ASSERT_EQ(plan.images.size(), 4u);
+  EXPECT_EQ(plan.images.front().name, "0000.jpg");
+  EXPECT_EQ(plan.pairs.size(), 6u);
+  EXPECT_EQ(plan.todo.size(), 6u);
+  ASSERT_EQ(plan.pairs_per_selector.size(), 1u);
+  EXPECT_EQ(plan.pairs_per_selector[0].num_pairs, 6u);
+
+  // Neighbouring views of the fountain: many putative matches, a verified geometry.
+  PairMatchVerifier verifier(manifest, plugins_.matcher, plan, descriptors, database_.get());
+  const PairResult result = verifier.Run(plan.todo.front());
+  EXPECT_GT(result.num_putative_matches, 100u);
+  EXPECT_GE(result.num_inlier_matches, 15u);
+  EXPECT_LE(result.num_inlier_matches, result.num_putative_matches);
+  EXPECT_EQ(database_->NumMatchedPairs(), 1u);
+
+  const MatchPlan again = PlanMatching(manifest, plugins_.pair_selectors, plugins_.matcher,
+                                       descriptors, database_.get());
+  EXPECT_EQ(again.num_reused, 1u);
+  EXPECT_EQ(again.todo.size(), 5u);
+}
+
+// Staleness comes from VerificationSettings::ToJson: changing any field it has (set
+// through the manifest, by its key) recomputes every geometry; the same settings reuse.
+TEST_F(MatchStageTest, AnyChangedVerificationFieldRecomputesTheGeometries) {
+  EXPECT_EQ(Match(testing::CheapManifest(2)).num_matched, 6u);
+  EXPECT_EQ(Match(testing::CheapManifest(2)).num_reused, 6u);
+  const nlohmann::json defaults = VerificationSettings().ToJson();
+  ASSERT_EQ(defaults.size(), 7u);
+  for (const auto& [key, value] : defaults.items()) {
+    nlohmann::json changed = nlohmann::json::object();
+    changed[key] = value.is_number_integer() ? nlohmann::json(value.get<int>() + 1)
+                                             : nlohmann::json(value.get<double>() * 0.9);
+    const Manifest manifest = testing::CheapManifest(2, changed);
+    ASSERT_NE(manifest.verification.ToJson(), defaults) << key;
+    const MatchingSummary summary = Match(manifest);
+    EXPECT_EQ(summary.num_reused, 0u) << key;
+    EXPECT_EQ(summary.num_matched, 6u) << key;
+    // Back to the defaults: recomputed again, then reused.
+    EXPECT_EQ(Match(testing::CheapManifest(2)).num_reused, 0u) << key;
+  }
+  EXPECT_EQ(Match(testing::CheapManifest(2)).num_reused, 6u);
+}
+
+}  // namespace
+}  // namespace tessera

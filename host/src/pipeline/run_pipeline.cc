@@ -1,0 +1,90 @@
+#include "pipeline/run_pipeline.h"
+
+#include <spdlog/spdlog.h>
+
+#include "database/database.h"
+#include "pipeline/extract_stage.h"
+#include "pipeline/map_stage.h"
+#include "pipeline/match_stage.h"
+#include "pipeline/workspace.h"
+#include "tessera/io/file_io.h"
+#include "util/timer.h"
+
+namespace tessera {
+
+ExtractionSummary RunExtract(const PipelineContext& context, const RunOptions& options,
+                             const StageControl& control) {
+  context.Require("detector", "extract");
+  const auto lock = LockWorkspace(options.output_dir);
+  Database database(PrepareWorkspace(options.output_dir));
+  return ExtractFeatures(options.image_dir, context.manifest, context.detector, &database,
+                         WorkspaceScanOptions(options.output_dir, context.manifest), control);
+}
+
+MatchingSummary RunMatch(const PipelineContext& context, const RunOptions& options,
+                         const StageControl& control) {
+  context.Require("pair_selector", "match");
+  context.Require("matcher", "match");
+  const auto lock = LockWorkspace(options.output_dir);
+  Database database(PrepareWorkspace(options.output_dir));
+  return MatchFeatures(context.manifest, context.pair_selectors, context.matcher, &database,
+                       control);
+}
+
+MapStageSummary RunMap(const PipelineContext& context, const RunOptions& options,
+                       const StageControl& control) {
+  context.Require("bundle_adjuster", "map");
+  const std::filesystem::path database_file = PrepareWorkspace(options.output_dir);
+  const auto lock = LockWorkspace(options.output_dir);
+  if (!std::filesystem::exists(database_file)) {
+    throw InputError(database_file.string() +
+                     ": no workspace database; run extract and match first");
+  }
+  Database database(database_file);
+  CheckImagesUnchanged(options.image_dir, options.output_dir, context.manifest, database);
+  return MapWorkspace(context, &database, options.output_dir, options.image_dir, control);
+}
+
+RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
+                      const StageControl& control) {
+  const Timer timer;
+  context.Require("detector", "extract");
+  context.Require("pair_selector", "match");
+  context.Require("matcher", "match");
+  context.Require("bundle_adjuster", "map");
+  // A selector that cannot use the detector's descriptors fails before extraction.
+  context.CheckPairSelectorDescriptors(context.detector->Metric(), 0);
+  const std::filesystem::path database_file = PrepareWorkspace(options.output_dir);
+  const auto lock = LockWorkspace(options.output_dir);
+  Database database(database_file);
+  RunResult run;
+  RunSummary& summary = run.summary;
+  summary.extract =
+      ExtractFeatures(options.image_dir, context.manifest, context.detector, &database,
+                      WorkspaceScanOptions(options.output_dir, context.manifest), control);
+  if (summary.extract.status == StageStatus::kCancelled) {
+    run.status = StageStatus::kCancelled;
+    return run;
+  }
+  summary.match =
+      MatchFeatures(context.manifest, context.pair_selectors, context.matcher, &database, control);
+  LogExtraction(summary.extract);
+  LogMatching(summary.match);
+  if (summary.match.status == StageStatus::kCancelled) {
+    run.status = StageStatus::kCancelled;
+    return run;
+  }
+  summary.map = MapWorkspace(context, &database, options.output_dir, options.image_dir, control);
+  if (summary.map.status == StageStatus::kCancelled) {
+    run.status = StageStatus::kCancelled;
+    return run;
+  }
+  summary.total_seconds = timer.ElapsedSeconds();
+  spdlog::info("run: extract {:.2f} s, match {:.2f} s, map {:.2f} s, total {:.2f} s",
+               summary.extract.seconds, summary.match.seconds, summary.map.seconds,
+               summary.total_seconds);
+  WriteFileAtomically(options.output_dir / "run_summary.json", summary.ToJson().dump(2) + "\n");
+  return run;
+}
+
+}  // namespace tessera

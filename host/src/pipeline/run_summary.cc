@@ -1,0 +1,70 @@
+#include "pipeline/run_summary.h"
+
+namespace tessera {
+
+void to_json(nlohmann::json& json, const SelectorPairs& pairs) {
+  json = {{"plugin", pairs.plugin}, {"json_path", pairs.json_path}, {"num_pairs", pairs.num_pairs}};
+}
+
+void from_json(const nlohmann::json& json, SelectorPairs& pairs) {
+  pairs.plugin = json.at("plugin").get<std::string>();
+  pairs.json_path = json.at("json_path").get<std::string>();
+  pairs.num_pairs = json.at("num_pairs").get<size_t>();
+}
+
+nlohmann::json RunSummary::ToJson() const {
+  nlohmann::json selectors = nlohmann::json::array();
+  for (const SelectorPairs& selector : match.pairs_per_selector) selectors.push_back(selector);
+  return {{"extract",
+           {{"seconds", extract.seconds},
+            {"num_images", extract.num_images},
+            {"num_detected", extract.num_detected},
+            {"num_reused", extract.num_reused},
+            {"num_failed", extract.num_failed},
+            {"num_changed", extract.num_changed},
+            {"num_removed", extract.num_removed}}},
+          {"match",
+           {{"seconds", match.seconds},
+            {"num_pairs", match.num_pairs},
+            {"pairs_per_selector", selectors},
+            {"num_matched", match.num_matched},
+            {"num_reused", match.num_reused},
+            {"num_verified", match.num_verified}}},
+          {"map",
+           {{"seconds", map.seconds},
+            {"num_models", map.num_models},
+            {"num_registered", map.num_registered},
+            {"num_images", map.num_images}}},
+          {"total_seconds", total_seconds}};
+}
+
+RunSummary RunSummary::FromJson(const nlohmann::json& json) {
+  RunSummary summary;
+  const nlohmann::json& extract = json.at("extract");
+  summary.extract.seconds = extract.at("seconds").get<double>();
+  summary.extract.num_images = extract.at("num_images").get<size_t>();
+  summary.extract.num_detected = extract.at("num_detected").get<size_t>();
+  summary.extract.num_reused = extract.at("num_reused").get<size_t>();
+  summary.extract.num_failed = extract.at("num_failed").get<size_t>();
+  summary.extract.num_changed = extract.at("num_changed").get<size_t>();
+  summary.extract.num_removed = extract.at("num_removed").get<size_t>();
+  const nlohmann::json& match = json.at("match");
+  summary.match.seconds = match.at("seconds").get<double>();
+  summary.match.num_pairs = match.at("num_pairs").get<size_t>();
+  for (const nlohmann::json& selector :
+       match.value("pairs_per_selector", nlohmann::json::array())) {
+    summary.match.pairs_per_selector.push_back(selector.get<SelectorPairs>());
+  }
+  summary.match.num_matched = match.at("num_matched").get<size_t>();
+  summary.match.num_reused = match.at("num_reused").get<size_t>();
+  summary.match.num_verified = match.at("num_verified").get<size_t>();
+  const nlohmann::json& map = json.at("map");
+  summary.map.seconds = map.at("seconds").get<double>();
+  summary.map.num_models = map.at("num_models").get<size_t>();
+  summary.map.num_registered = map.at("num_registered").get<size_t>();
+  summary.map.num_images = map.at("num_images").get<size_t>();
+  summary.total_seconds = json.at("total_seconds").get<double>();
+  return summary;
+}
+
+}  // namespace tessera

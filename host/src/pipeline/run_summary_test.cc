@@ -1,0 +1,69 @@
+#include "pipeline/run_summary.h"
+
+#include <gtest/gtest.h>
+
+namespace tessera {
+namespace {
+
+RunSummary Example() {
+  RunSummary summary;
+  summary.extract = {StageStatus::kCompleted, 11, 1, 9, 2, 70000, 0, 3, 4, 1.5};
+  summary.match.num_pairs = 55;
+  summary.match.pairs_per_selector = {{"spatial", "pipeline.pair_selector[0]", 40},
+                                      {"sequential", "pipeline.pair_selector[1]", 20}};
+  summary.match.num_matched = 50;
+  summary.match.num_reused = 5;
+  summary.match.num_verified = 53;
+  summary.match.seconds = 2.25;
+  summary.map = {StageStatus::kCompleted, 2, 10, 11, 3.5};
+  summary.total_seconds = 7.75;
+  return summary;
+}
+
+TEST(RunSummary, JsonHasTheKeysBenchReads) {
+  const nlohmann::json json = Example().ToJson();
+  EXPECT_DOUBLE_EQ(json.at("extract").at("seconds").get<double>(), 1.5);
+  EXPECT_EQ(json.at("extract").at("num_images").get<size_t>(), 11u);
+  EXPECT_EQ(json.at("match").at("num_pairs").get<size_t>(), 55u);
+  EXPECT_EQ(json.at("match").at("pairs_per_selector").size(), 2u);
+  EXPECT_EQ(json.at("match").at("pairs_per_selector").at(1).at("plugin"), "sequential");
+  EXPECT_EQ(json.at("map").at("num_models").get<size_t>(), 2u);
+  EXPECT_DOUBLE_EQ(json.at("total_seconds").get<double>(), 7.75);
+  // What the file has is exactly this (status and in-memory figures stay out).
+  EXPECT_EQ(json.at("extract").size(), 7u);
+  EXPECT_EQ(json.at("match").size(), 6u);
+  EXPECT_EQ(json.at("map").size(), 4u);
+  EXPECT_EQ(json.size(), 4u);
+}
+
+TEST(RunSummary, RoundTrip) {
+  const RunSummary summary = Example();
+  const RunSummary back = RunSummary::FromJson(nlohmann::json::parse(summary.ToJson().dump(2)));
+  EXPECT_EQ(back.ToJson(), summary.ToJson());
+  EXPECT_EQ(back.extract.num_detected, 9u);
+  EXPECT_EQ(back.extract.num_removed, 4u);
+  ASSERT_EQ(back.match.pairs_per_selector.size(), 2u);
+  EXPECT_EQ(back.match.pairs_per_selector[0].json_path, "pipeline.pair_selector[0]");
+  EXPECT_EQ(back.match.pairs_per_selector[0].num_pairs, 40u);
+  EXPECT_EQ(back.map.num_registered, 10u);
+}
+
+TEST(RunSummary, OlderFilesWithoutPairsPerSelectorRead) {
+  nlohmann::json json = Example().ToJson();
+  json["match"].erase("pairs_per_selector");
+  const RunSummary back = RunSummary::FromJson(json);
+  EXPECT_TRUE(back.match.pairs_per_selector.empty());
+  EXPECT_EQ(back.match.num_pairs, 55u);
+}
+
+TEST(RunSummary, MissingOrMistypedFieldThrows) {
+  nlohmann::json json = Example().ToJson();
+  json["map"].erase("num_models");
+  EXPECT_THROW(RunSummary::FromJson(json), nlohmann::json::exception);
+  json = Example().ToJson();
+  json["total_seconds"] = "soon";
+  EXPECT_THROW(RunSummary::FromJson(json), nlohmann::json::exception);
+}
+
+}  // namespace
+}  // namespace tessera
