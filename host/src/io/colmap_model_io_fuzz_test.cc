@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "small_colmap_model.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
@@ -43,43 +44,12 @@ namespace fs = std::filesystem;
 // (up to 2^64 records) would ask for.
 constexpr size_t kMaxAllocationBytes = size_t{1} << 20;
 
-// Two cameras, three images with six keypoints each, four points seen twice or thrice.
-Reconstruction SmallModel() {
-  Reconstruction model;
-  model.cameras[1] = Camera::Create(1, CameraModelId::kPinhole, 400, 320, 240);
-  model.cameras[2] = Camera::Create(2, CameraModelId::kOpenCV, 500, 640, 480);
-  for (image_t image_id = 1; image_id <= 3; ++image_id) {
-    Image& image = model.images[image_id];
-    image.image_id = image_id;
-    image.camera_id = image_id == 3 ? 2 : 1;
-    image.name = "frame_" + std::to_string(image_id) + ".jpg";
-    image.registered = true;
-    image.cam_from_world.translation = Eigen::Vector3d(0.5 * image_id, 0, 0);
-    image.points2D.resize(6);
-    for (size_t i = 0; i < image.points2D.size(); ++i) {
-      image.points2D[i].xy = Eigen::Vector2d(10.25 * i + image_id, 20.5 * i);
-    }
-  }
-  for (point3D_t point3D_id = 1; point3D_id <= 4; ++point3D_id) {
-    Point3D& point3D = model.points3D[point3D_id];
-    point3D.xyz = Eigen::Vector3d(0.1 * point3D_id, -0.2, 4);
-    point3D.color = Eigen::Matrix<uint8_t, 3, 1>(200, 100, static_cast<uint8_t>(point3D_id));
-    point3D.error = 0.25;
-    for (image_t image_id = 1; image_id <= (point3D_id % 2 == 0 ? 3u : 2u); ++image_id) {
-      const auto idx = static_cast<point2D_t>(point3D_id);
-      point3D.track.push_back({image_id, idx});
-      model.images.at(image_id).points2D.at(idx).point3D_id = point3D_id;
-    }
-  }
-  return model;
-}
-
 // A model folder whose files the test rewrites one at a time.
 class CorruptModel {
  public:
   explicit CorruptModel(ColmapModelFormat format)
       : extension_(format == ColmapModelFormat::kBinary ? ".bin" : ".txt") {
-    WriteColmapModel(SmallModel(), dir_.path(), format);
+    WriteColmapModel(testing::SmallColmapModel(), dir_.path(), format);
   }
   fs::path File(const std::string& name) const { return dir_.path() / (name + extension_); }
 
