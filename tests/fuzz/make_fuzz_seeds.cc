@@ -104,9 +104,9 @@ void WriteImageSeeds(const fs::path& out, const fs::path& image_path) {
 
   using testing::TestExif;
   const TestExif exifs[] = {
-      {"Canon", "Canon EOS 5D Mark II", 24.0, 38, 6},
-      {"Apple", "iPhone 12", 4.2, 26, 1},
-      {"", "", 35.0, std::nullopt, 8},
+      {"Canon", "Canon EOS 5D Mark II", 24.0, 38, 6, {}},
+      {"Apple", "iPhone 12", 4.2, 26, 1, {}},
+      {"", "", 35.0, std::nullopt, 8, {}},
   };
   for (size_t i = 0; i < std::size(exifs); ++i) {
     const std::string name = "libexif_" + std::to_string(i);
