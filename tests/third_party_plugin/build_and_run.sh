@@ -58,11 +58,24 @@ cat "$work/run.log"
 grep -q "3 detected with" "$work/run.log" || { echo "akaze did not detect 3 images"; exit 1; }
 grep -Eq "3 pairs, 3 matched now" "$work/run.log" || { echo "pairs were not matched"; exit 1; }
 
+# Contradictory options of the out-of-tree plugins: exit code 2, one line naming the key.
+refuse() {  # refuse SLOT JSON EXPECTED
+  sed "s|\"$1\": {[^}]*}|\"$1\": $2|" "$work/manifest.json" > "$work/bad.json"
+  local rc=0
+  "$tessera" match --output "$work/out" --manifest "$work/bad.json" 2> "$work/bad.log" || rc=$?
+  [ "$rc" = 2 ] && grep -qF "$3" "$work/bad.log" || {
+    echo "expected exit code 2 and '$3', got $rc:"; cat "$work/bad.log"; exit 1; }
+}
+refuse pair_selector '{"plugin": "window_stride", "options": {"window": 3, "stride": 2}}' \
+  "pipeline.pair_selector.options.stride: = 2 must be 0 or greater than window = 3"
+refuse matcher '{"plugin": "symmetric_ratio", "options": {"cross_check": false}}' \
+  "pipeline.matcher.options.cross_check: = false contradicts symmetric = true"
+
 # One bench: a row of bundled plugins next to a row of the five out-of-tree ones.
 cat > "$work/bundled.json" <<JSON
 {
   "pipeline": {
-    "detector": {"plugin": "orb", "options": {"max_num_features": 4000}},
+    "detector": {"plugin": "orb", "options": {"max_num_features": 2000}},
     "pair_selector": {"plugin": "exhaustive"},
     "matcher": {"plugin": "brute_force"},
     "bundle_adjuster": {"plugin": "ceres"},
@@ -74,7 +87,7 @@ cat > "$work/third_party.json" <<JSON
 {
   "plugin_paths": ["build/plugins"],
   "pipeline": {
-    "detector": {"plugin": "akaze", "options": {"max_num_features": 4000}},
+    "detector": {"plugin": "akaze", "options": {"max_num_features": 2000}},
     "pair_selector": {"plugin": "window_stride", "options": {"window": 3, "stride": 5}},
     "matcher": {"plugin": "symmetric_ratio"},
     "bundle_adjuster": {"plugin": "cauchy"},
