@@ -2,6 +2,7 @@
 
 #include <Eigen/SVD>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "estimators/essential_matrix.h"
@@ -141,7 +142,13 @@ size_t ViewGraph::FilterByRotationCycles(double max_cycle_error_deg, size_t min_
     return edge.image_id1 == a ? edge.R_cam2_from_cam1 : edge.R_cam2_from_cam1.transpose();
   };
 
-  std::vector<size_t> num_cycles(edges_.size(), 0), num_bad(edges_.size(), 0);
+  // Every triangle: its three edges and whether it closes.
+  struct Triangle {
+    std::array<size_t, 3> edges;
+    bool closes = false;
+  };
+  std::vector<Triangle> triangles;
+  std::vector<std::vector<size_t>> triangles_of_edge(edges_.size());
   for (const auto& [pair, e_ab] : edge_of_pair) {
     const auto [a, b] = pair;
     const std::vector<image_t>& na = neighbours[a];
@@ -158,21 +165,39 @@ size_t ViewGraph::FilterByRotationCycles(double max_cycle_error_deg, size_t min_
         const image_t c = *ia;
         // a -> b -> c -> a is the identity for consistent rotations.
         const Eigen::Matrix3d cycle = rotation(c, a) * rotation(b, c) * rotation(a, b);
-        const bool bad = RotationAngleDeg(cycle) > max_cycle_error_deg;
-        for (const size_t e :
-             {e_ab, edge_of_pair.at(std::minmax(b, c)), edge_of_pair.at(std::minmax(a, c))}) {
-          ++num_cycles[e];
-          num_bad[e] += bad ? 1 : 0;
-        }
+        Triangle triangle{
+            {e_ab, edge_of_pair.at(std::minmax(b, c)), edge_of_pair.at(std::minmax(a, c))},
+            RotationAngleDeg(cycle) <= max_cycle_error_deg};
+        for (const size_t e : triangle.edges) triangles_of_edge[e].push_back(triangles.size());
+        triangles.push_back(triangle);
         ++ia;
         ++ib;
       }
     }
   }
+  // Weakest edges first, each judged by the triangles whose other edges remain: a
+  // strong pair at the end of a chain, whose triangles all run through wrong weak pairs
+  // of one image, keeps its place once those are gone (no triangle is left to judge it).
+  std::vector<size_t> order;
+  for (const auto& [pair, e] : edge_of_pair) order.push_back(e);
+  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return edges_[a].num_inliers < edges_[b].num_inliers;
+  });
   size_t num_removed = 0;
-  for (size_t e = 0; e < edges_.size(); ++e) {
-    if (num_cycles[e] < min_num_cycles) continue;
-    if (num_bad[e] == num_cycles[e]) {
+  for (const size_t e : order) {
+    if (triangles_of_edge[e].size() < min_num_cycles) continue;
+    size_t num_judging = 0;
+    bool any_closes = false;
+    for (const size_t t : triangles_of_edge[e]) {
+      const Triangle& triangle = triangles[t];
+      if (std::any_of(triangle.edges.begin(), triangle.edges.end(),
+                      [&](size_t other) { return edges_[other].removed; })) {
+        continue;
+      }
+      ++num_judging;
+      any_closes = any_closes || triangle.closes;
+    }
+    if (num_judging > 0 && !any_closes) {
       edges_[e].removed = true;
       ++num_removed;
     }

@@ -49,7 +49,9 @@ class ViewGraph {
   // triangles of the graph and closes none of them within `max_cycle_error_deg`. Not a
   // share of bad triangles: where most pairs are wrong (repeated texture matched across
   // an object) most triangles of a right pair hold a wrong one too, but wrong pairs
-  // rarely close a triangle. Returns how many it removed.
+  // rarely close a triangle. Edges are judged weakest (fewest inliers) first, each on
+  // its triangles whose other edges are not removed before it (an edge left with none
+  // stays). Returns how many it removed.
   size_t FilterByRotationCycles(double max_cycle_error_deg, size_t min_num_cycles);
 
   // Angle (degrees) between the edge's relative rotation and the one of two poses.

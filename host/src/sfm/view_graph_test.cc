@@ -64,6 +64,39 @@ TEST(ViewGraph, DropsThePairsThatFailTheirRotationCycles) {
   }
 }
 
+TEST(ViewGraph, KeepsAStrongPairWhoseTrianglesAllRunThroughWrongWeakPairs) {
+  // The last image's pairs to images 1-6 are weak and wrong (each rotation off by 30
+  // degrees about an axis of its own); its pair with image 7 is right and strong. Every
+  // triangle through that pair holds one of the wrong ones, so judged all at once it
+  // would be dropped with them and the image left with no pair at all.
+  SyntheticSceneOptions options;
+  options.num_images = 8;
+  SyntheticScene scene = MakeSyntheticScene(options);
+  const image_t last = 8;
+  std::set<std::pair<image_t, image_t>> corrupted;
+  for (MapperInput::Pair& pair : scene.input.pairs) {
+    if (pair.image_id2 != last || pair.image_id1 == last - 1) continue;
+    // Axes far apart, so that two wrong pairs never close a triangle by chance.
+    const Eigen::Vector3d axes[] = {{1, 0, 0}, {0, 1, 0},  {0, 0, 1},
+                                    {1, 1, 0}, {0, 1, -1}, {-1, 0, 1}};
+    const Eigen::Matrix3d twist =
+        Eigen::AngleAxisd(30 * M_PI / 180, axes[pair.image_id1 - 1].normalized())
+            .toRotationMatrix();
+    pair.geometry.cam2_from_cam1.rotation =
+        Eigen::Quaterniond(twist * pair.geometry.cam2_from_cam1.rotation.toRotationMatrix());
+    pair.geometry.E = EssentialMatrixFromPose(pair.geometry.cam2_from_cam1);
+    pair.geometry.inlier_matches.resize(pair.geometry.inlier_matches.size() / 4);
+    corrupted.insert({pair.image_id1, pair.image_id2});
+  }
+  ASSERT_EQ(corrupted.size(), 6u);
+  ViewGraph graph = ViewGraph::Build(scene.input, scene.input.cameras, AllPairs(scene), 0);
+  EXPECT_EQ(graph.FilterByRotationCycles(10, 3), corrupted.size());
+  for (const ViewGraphEdge& edge : graph.edges()) {
+    EXPECT_EQ(edge.removed, corrupted.count({edge.image_id1, edge.image_id2}) > 0)
+        << edge.image_id1 << "-" << edge.image_id2;
+  }
+}
+
 TEST(ViewGraph, ModelAgreementCountsThePairsAModelContradicts) {
   SyntheticSceneOptions options;
   options.num_images = 6;
