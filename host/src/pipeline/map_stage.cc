@@ -103,9 +103,13 @@ MapStageSummary MapWorkspace(const PipelineContext& context, Database* database,
   control.Report("map", 0, 1);
   const BundleAdjusterGuard bundle_adjuster(context.bundle_adjuster);
   const IncrementalMapper mapper(context.mapper_options, bundle_adjuster, context.manifest.seed);
-  MapperResult result = mapper.Reconstruct(input);
-  control.Report("map", 1, 1);
+  MapperObserver observer;
+  observer.should_stop = [&control] { return control.Cancelled(); };
+  observer.on_model_changed = control.model_changed;
+  MapperResult result = mapper.Reconstruct(input, observer);
+  // result.cancelled implies control.Cancelled(): the mapper stops only when asked.
   if (cancelled()) return summary;
+  control.Report("map", 1, 1);
 
   const std::filesystem::path image_dir = ImageFolder(image_dir_option, *database);
   if (image_dir.empty()) {

@@ -33,8 +33,9 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
 // once every exporter has run.
 //
 // `control`: progress ("map" 0/1 then 1/1; "export", models written of all) and
-// cancellation, checked before mapping and before each model is written. The mapper
-// itself runs to its end once started. Cancelled before writing: nothing of the old
+// cancellation, checked before mapping, by the mapper before each registration, and
+// before each model is written; `control.model_changed` sees the model grow. Cancelled
+// before writing: nothing of the old
 // output is touched; cancelled between models: the models written are whole, and
 // mapping_summary.json is not written. Status kCancelled either way.
 MapStageSummary MapWorkspace(const PipelineContext& context, Database* database,

@@ -8,6 +8,8 @@
 #include <functional>
 #include <string>
 
+#include "tessera/reconstruction.h"
+
 namespace tessera {
 
 // How a stage ended. A cancelled stage leaves the workspace consistent: every unit it
@@ -37,6 +39,9 @@ using ProgressCallback = std::function<void(const std::string& stage, size_t don
 struct StageControl {
   ProgressCallback progress;                  // may be empty
   const CancellationToken* cancel = nullptr;  // may be null: never cancelled
+  // The map stage's model as it grows, after each image registered (see
+  // MapperObserver::on_model_changed); may be empty. Called on the stage's thread.
+  std::function<void(size_t model_index, const Reconstruction& model)> model_changed;
 
   bool Cancelled() const { return cancel != nullptr && cancel->IsCancelled(); }
   void Report(const std::string& stage, size_t done, size_t total) const {

@@ -90,6 +90,18 @@ struct RunState {
   std::map<camera_t, Camera> cameras;
   ViewGraph view_graph;
   size_t num_registrations_refused = 0;
+  // The caller's observer (null: none, as in the calibration pass), the index of the
+  // model being grown, and whether the observer asked to stop.
+  const MapperObserver* observer = nullptr;
+  size_t model_index = 0;
+  bool cancelled = false;
+
+  // Asks the observer; once true, stays true.
+  bool ShouldStop() {
+    if (!cancelled && observer != nullptr && observer->should_stop)
+      cancelled = observer->should_stop();
+    return cancelled;
+  }
 };
 
 // One model, grown from an initial pair.
@@ -1086,6 +1098,7 @@ void ModelBuilder::GlobalRefinement() {
 void ModelBuilder::Grow(size_t max_images) {
   bool refined_since_failure = false;
   while (registered_.size() < max_images) {
+    if (run_.ShouldStop()) return;
     image_t next_image = kInvalidImageId;
     for (const image_t candidate : NextImages()) {
       if (RegisterImage(candidate)) {
@@ -1104,6 +1117,9 @@ void ModelBuilder::Grow(size_t max_images) {
     refined_since_failure = false;
     changed_since_global_ba_ = true;
     TriangulateImage(next_image);
+    if (run_.observer != nullptr && run_.observer->on_model_changed) {
+      run_.observer->on_model_changed(run_.model_index, rec_);
+    }
     if (LocalBundleAdjustment(next_image)) {
       // Small models: the local problem was the whole model.
       num_images_at_global_ba_ = registered_.size();
@@ -1140,6 +1156,7 @@ void ModelBuilder::Finish() {
   // it is refined in the final rounds only.
   refine_principal_point_ = options_.ba_refine_principal_point;
   for (int round = 0; round < options_.ba_global_max_refinements; ++round) {
+    if (run_.ShouldStop()) return;
     const size_t num_observations_before = NumObservations(rec_);
     GlobalRefinement();
     if (refine_principal_point_ && ResetImplausiblePrincipalPoints()) {
@@ -1402,9 +1419,12 @@ void EstimateFocalLengthsWithoutPrior(const RunState& run,
   // 2. Refined by bundle adjustment in a first model, mapped once for that alone: with
   // the structure of many views the focal length is well determined even where pairs
   // leave it open, and the view-graph checks of the real pass need it to be right.
-  RunState calibration{
-      run.input, run.options, run.bundle_adjuster, run.seed, {}, {}, {}, {}, {}, 0, 0, *cameras, {},
-      0};
+  RunState calibration{run.input, run.options, run.bundle_adjuster,
+                       run.seed,  {},          {},
+                       {},        {},          {},
+                       0,         0,           *cameras,
+                       {},        0,           nullptr,
+                       0,         false};
   const spdlog::level::level_enum level = spdlog::get_level();
   if (level > spdlog::level::debug) spdlog::set_level(spdlog::level::warn);
   PrepareRun(verified_pairs, &calibration);
@@ -1450,9 +1470,11 @@ void EstimateFocalLengthsWithoutPrior(const RunState& run,
 
 }  // namespace
 
-MapperResult IncrementalMapper::Reconstruct(const MapperInput& input) const {
+MapperResult IncrementalMapper::Reconstruct(const MapperInput& input,
+                                            const MapperObserver& observer) const {
   const auto start_time = std::chrono::steady_clock::now();
-  RunState run{input, options_, bundle_adjuster_, seed_, {}, {}, {}, {}, {}, 0, 0, {}, {}, 0};
+  RunState run{input, options_, bundle_adjuster_, seed_, {},   {}, {}, {}, {}, 0, 0, {},
+               {},    0,        &observer,        0,     false};
   run.cameras = input.cameras;
   MapperResult result;
 
@@ -1480,14 +1502,17 @@ MapperResult IncrementalMapper::Reconstruct(const MapperInput& input) const {
 
   for (int attempt = 0; static_cast<int>(result.models.size()) < options_.max_num_models;
        ++attempt) {
-    if (run.used_images.size() + 2 > input.images.size()) break;
+    if (run.used_images.size() + 2 > input.images.size() || run.ShouldStop()) break;
+    run.model_index = result.models.size();
     ModelBuilder builder(&run);
     if (!builder.Initialize()) break;
     builder.Grow();
     builder.Finish();
-    for (int round = 0; round < kMaxFinalGrowRounds && builder.GrowAgain(); ++round) {
+    for (int round = 0; round < kMaxFinalGrowRounds && !run.ShouldStop() && builder.GrowAgain();
+         ++round) {
       builder.Finish();
     }
+    if (run.cancelled) break;
     const size_t num_registered = builder.NumRegisteredImages();
     Reconstruction model = builder.TakeModel();
     if (num_registered < static_cast<size_t>(options_.min_model_size)) {
@@ -1501,6 +1526,14 @@ MapperResult IncrementalMapper::Reconstruct(const MapperInput& input) const {
     if (!options_.multiple_models) break;
   }
 
+  if (run.ShouldStop()) {
+    spdlog::info("map: stopped by the caller");
+    MapperResult stopped;
+    stopped.cancelled = true;
+    stopped.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+    return stopped;
+  }
   if (options_.merge_models) {
     MergeAlignedModels(options_, bundle_adjuster_, run.view_graph, run.tracks, seed_,
                        &result.models, &result.merges);

@@ -14,6 +14,7 @@
 // and every loop runs in id order, so the same input and seed give the same models.
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -84,6 +85,21 @@ struct MapperResult {
   int num_global_ba = 0;
   int num_local_ba = 0;
   double seconds = 0;
+  // Stopped by MapperObserver::should_stop: `models` and the reports are empty.
+  bool cancelled = false;
+};
+
+// What a caller (the map stage, a GUI) watches and controls while mapping runs. Both
+// may be empty; both are called on the mapping thread.
+struct MapperObserver {
+  // Polled before each registration and each final refinement round; true stops
+  // mapping soon after, and Reconstruct returns a result with `cancelled` set.
+  std::function<bool()> should_stop;
+  // After each image is registered and its tracks triangulated, with the model being
+  // grown (images not registered yet have `registered` false) and its index among the
+  // models started in this run (0, 1, ...; a model dropped as too small is reused).
+  // Not called for the calibration pass of focal-length estimation.
+  std::function<void(size_t model_index, const Reconstruction& model)> on_model_changed;
 };
 
 class IncrementalMapper {
@@ -92,7 +108,7 @@ class IncrementalMapper {
   IncrementalMapper(const IncrementalMapperOptions& options, const BundleAdjuster& bundle_adjuster,
                     uint64_t seed);
 
-  MapperResult Reconstruct(const MapperInput& input) const;
+  MapperResult Reconstruct(const MapperInput& input, const MapperObserver& observer = {}) const;
 
  private:
   IncrementalMapperOptions options_;

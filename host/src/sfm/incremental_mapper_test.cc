@@ -390,4 +390,32 @@ TEST(IncrementalMapperOptions, UnknownKeysAndBadValuesNameTheField) {
 }
 
 }  // namespace
+// The observer sees the model grow one registered image at a time, and stops mapping.
+TEST(IncrementalMapper, ObserverSeesTheModelGrowAndStopsIt) {
+  const SyntheticScene scene = MakeSyntheticScene(SyntheticSceneOptions{});
+  std::vector<size_t> num_registered;
+  MapperObserver observer;
+  observer.on_model_changed = [&](size_t model_index, const Reconstruction& model) {
+    EXPECT_EQ(model_index, 0u);
+    size_t n = 0;
+    for (const auto& [image_id, image] : model.images) n += image.registered ? 1 : 0;
+    num_registered.push_back(n);
+  };
+  const MapperResult full = IncrementalMapper({}, Adjuster(), 0).Reconstruct(scene.input, observer);
+  ASSERT_EQ(full.models.size(), 1u);
+  EXPECT_FALSE(full.cancelled);
+  const size_t num_images = scene.input.images.size();
+  ASSERT_EQ(num_registered.size(), num_images - 2) << "one call per image after the pair";
+  for (size_t k = 0; k < num_registered.size(); ++k) EXPECT_EQ(num_registered[k], k + 3);
+
+  // Stopped after the third image: no model, and nothing after the stop.
+  num_registered.clear();
+  observer.should_stop = [&] { return num_registered.size() >= 1; };
+  const MapperResult stopped =
+      IncrementalMapper({}, Adjuster(), 0).Reconstruct(scene.input, observer);
+  EXPECT_TRUE(stopped.cancelled);
+  EXPECT_TRUE(stopped.models.empty());
+  EXPECT_EQ(num_registered.size(), 1u);
+}
+
 }  // namespace tessera
