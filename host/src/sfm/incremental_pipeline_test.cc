@@ -1,4 +1,4 @@
-#include "sfm/incremental_mapper.h"
+#include "sfm/incremental_pipeline.h"
 
 #include <gtest/gtest.h>
 
@@ -24,7 +24,7 @@ const BundleAdjuster& Adjuster() {
 
 MapperResult Map(const SyntheticScene& scene, IncrementalMapperOptions options = {},
                  uint64_t seed = 0) {
-  return IncrementalMapper(options, Adjuster(), seed).Reconstruct(scene.input);
+  return IncrementalPipeline(options, Adjuster(), seed).Reconstruct(scene.input);
 }
 
 // Every observation of every point is a keypoint of one and the same true point.
@@ -40,7 +40,7 @@ void ExpectTracksAreTrue(const SyntheticScene& scene, const Reconstruction& mode
   EXPECT_EQ(num_wrong, 0u) << "points whose track mixes true points or clutter";
 }
 
-TEST(IncrementalMapper, RecoversASyntheticSceneWithNoise) {
+TEST(IncrementalPipeline, RecoversASyntheticSceneWithNoise) {
   SyntheticSceneOptions options;
   const SyntheticScene scene = MakeSyntheticScene(options);
   const MapperResult result = Map(scene);
@@ -59,7 +59,7 @@ TEST(IncrementalMapper, RecoversASyntheticSceneWithNoise) {
   ExpectTracksAreTrue(scene, model);
 }
 
-TEST(IncrementalMapper, FiltersTwoPercentOutlierMatches) {
+TEST(IncrementalPipeline, FiltersTwoPercentOutlierMatches) {
   SyntheticSceneOptions options;
   options.outlier_ratio = 0.02;
   options.seed = 2;
@@ -84,7 +84,7 @@ TEST(IncrementalMapper, FiltersTwoPercentOutlierMatches) {
   EXPECT_GT(result.num_refused_matches, 0u);
 }
 
-TEST(IncrementalMapper, RefinesAWrongFocalLengthPriorAndDistortion) {
+TEST(IncrementalPipeline, RefinesAWrongFocalLengthPriorAndDistortion) {
   SyntheticSceneOptions options;
   options.k1 = -0.05;
   options.prior_focal_factor = 1.1;
@@ -101,7 +101,7 @@ TEST(IncrementalMapper, RefinesAWrongFocalLengthPriorAndDistortion) {
   EXPECT_LT(evaluation.position_error_max, 0.02);
 }
 
-TEST(IncrementalMapper, RefinesAnOffCentrePrincipalPointWhenAsked) {
+TEST(IncrementalPipeline, RefinesAnOffCentrePrincipalPointWhenAsked) {
   SyntheticSceneOptions options;
   // 1.5% of the width, as Strecha's cameras. Horizontally only: the cameras stand on a
   // level arc, and a vertical offset is all but the same as tilting every one of them.
@@ -132,7 +132,7 @@ TEST(IncrementalMapper, RefinesAnOffCentrePrincipalPointWhenAsked) {
   EXPECT_LT(refined_error.position_error_mean, 0.5 * held_error.position_error_mean);
 }
 
-TEST(IncrementalMapper, AnImplausiblePrincipalPointIsPutBackAtTheCentre) {
+TEST(IncrementalPipeline, AnImplausiblePrincipalPointIsPutBackAtTheCentre) {
   // The true principal point is 15% of the width off centre: beyond the plausible 10%,
   // so the refined one is reset and held at the centre, as if it was never refined.
   SyntheticSceneOptions options;
@@ -148,7 +148,7 @@ TEST(IncrementalMapper, AnImplausiblePrincipalPointIsPutBackAtTheCentre) {
   EXPECT_EQ(camera.PrincipalPointY(), 0.5 * options.height);
 }
 
-TEST(IncrementalMapper, DisconnectedGroupsBecomeSeparateModelsLargestFirst) {
+TEST(IncrementalPipeline, DisconnectedGroupsBecomeSeparateModelsLargestFirst) {
   // Two scenes of 5 and 8 images with no match between them: ids 1-5 and 6-13.
   SyntheticSceneOptions small_options;
   small_options.num_images = 5;
@@ -201,7 +201,7 @@ void ExpectNoCameraOff(const SyntheticScene& scene, const Reconstruction& model,
   }
 }
 
-TEST(IncrementalMapper, EstimatesTheFocalLengthWhenThereIsNoPrior) {
+TEST(IncrementalPipeline, EstimatesTheFocalLengthWhenThereIsNoPrior) {
   SyntheticSceneOptions options;
   options.focal_prior = false;
   options.prior_focal_factor = 1.6;  // far off: 1.2 x 1600 px against 1000 px
@@ -231,7 +231,7 @@ SyntheticSceneOptions SymmetricObject() {
   return options;
 }
 
-TEST(IncrementalMapper, DoesNotFoldASymmetricObject) {
+TEST(IncrementalPipeline, DoesNotFoldASymmetricObject) {
   const SyntheticScene scene = MakeSyntheticScene(SymmetricObject());
   ASSERT_GT(scene.num_mirror_pairs, 50u);
   const MapperResult result = Map(scene);
@@ -242,7 +242,7 @@ TEST(IncrementalMapper, DoesNotFoldASymmetricObject) {
   EXPECT_FALSE(result.self_checks[0].possibly_folded);
 }
 
-TEST(IncrementalMapper, FlagsAFoldedModel) {
+TEST(IncrementalPipeline, FlagsAFoldedModel) {
   // Without the view graph, the symmetric object folds; the self-check says so.
   const SyntheticScene scene = MakeSyntheticScene(SymmetricObject());
   IncrementalMapperOptions unchecked;
@@ -294,7 +294,7 @@ void CorruptRotationsOfPairs(image_t image_id, bool scattered, SyntheticScene* s
   }
 }
 
-TEST(IncrementalMapper, KeepsAnImageWhosePairsDisagreeWithoutAnAlternative) {
+TEST(IncrementalPipeline, KeepsAnImageWhosePairsDisagreeWithoutAnAlternative) {
   // Where the scene barely constrains two-view rotations (a small object filmed with a
   // narrow field of view, a near-planar scene), many pairs give a wrong one, each wrong
   // in its own way: that is no fold, and the image's pose is kept. Pairs that agree on
@@ -321,7 +321,7 @@ TEST(IncrementalMapper, KeepsAnImageWhosePairsDisagreeWithoutAnAlternative) {
   ExpectNoCameraOff(coherent, refused.models[0], 5);
 }
 
-TEST(IncrementalMapper, MergesTwoModelsOfOneScene) {
+TEST(IncrementalPipeline, MergesTwoModelsOfOneScene) {
   // Images 1-7 and 8-14 of an arc; across the cut only the pairs (6, 8), (7, 8) and
   // (7, 9) match, on 40 points each: fewer than a registration needs (100 here), so the
   // images split into two models, which share the tracks of those matches.
@@ -352,7 +352,7 @@ TEST(IncrementalMapper, MergesTwoModelsOfOneScene) {
   EXPECT_LT(evaluation.position_error_max, 0.05);
 }
 
-TEST(IncrementalMapper, SameSeedSameModel) {
+TEST(IncrementalPipeline, SameSeedSameModel) {
   SyntheticSceneOptions options;
   options.outlier_ratio = 0.02;
   options.num_images = 8;
@@ -391,7 +391,7 @@ TEST(IncrementalMapperOptions, UnknownKeysAndBadValuesNameTheField) {
 
 }  // namespace
 // The observer sees the model grow one registered image at a time, and stops mapping.
-TEST(IncrementalMapper, ObserverSeesTheModelGrowAndStopsIt) {
+TEST(IncrementalPipeline, ObserverSeesTheModelGrowAndStopsIt) {
   const SyntheticScene scene = MakeSyntheticScene(SyntheticSceneOptions{});
   std::vector<size_t> num_registered;
   MapperObserver observer;
@@ -401,7 +401,8 @@ TEST(IncrementalMapper, ObserverSeesTheModelGrowAndStopsIt) {
     for (const auto& [image_id, image] : model.images) n += image.registered ? 1 : 0;
     num_registered.push_back(n);
   };
-  const MapperResult full = IncrementalMapper({}, Adjuster(), 0).Reconstruct(scene.input, observer);
+  const MapperResult full =
+      IncrementalPipeline({}, Adjuster(), 0).Reconstruct(scene.input, observer);
   ASSERT_EQ(full.models.size(), 1u);
   EXPECT_FALSE(full.cancelled);
   const size_t num_images = scene.input.images.size();
@@ -412,7 +413,7 @@ TEST(IncrementalMapper, ObserverSeesTheModelGrowAndStopsIt) {
   num_registered.clear();
   observer.should_stop = [&] { return num_registered.size() >= 1; };
   const MapperResult stopped =
-      IncrementalMapper({}, Adjuster(), 0).Reconstruct(scene.input, observer);
+      IncrementalPipeline({}, Adjuster(), 0).Reconstruct(scene.input, observer);
   EXPECT_TRUE(stopped.cancelled);
   EXPECT_TRUE(stopped.models.empty());
   EXPECT_EQ(num_registered.size(), 1u);
