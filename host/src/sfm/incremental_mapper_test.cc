@@ -165,6 +165,31 @@ TEST(IncrementalMapper, RegistersTheNextImagesAndRefusesOneThatSeesNoPoint) {
   EXPECT_EQ(setup.run.failure_reasons.at(12), "it sees only 0 3D points of the model");
 }
 
+// The RANSAC settings reach the estimators: RANSAC refuses a trial count of 0 from
+// either, naming the field.
+TEST(IncrementalMapper, RansacOptionsReachTheEstimators) {
+  const auto expect_refused = [](const std::function<void()>& step) {
+    try {
+      step();
+      ADD_FAILURE() << "RANSAC ran with max_num_trials 0";
+    } catch (const std::exception& error) {
+      EXPECT_NE(std::string(error.what()).find("max_num_trials = 0"), std::string::npos)
+          << error.what();
+    }
+  };
+  MapperSetup setup;
+  setup.run.ransac.init_max_num_trials = 0;
+  expect_refused([&] { IncrementalMapper(setup.options, &setup.run).Initialize(); });
+
+  setup.run.ransac = MapperRansacOptions();
+  setup.run.ransac.abs_pose_max_num_trials = 0;
+  IncrementalMapper mapper(setup.options, &setup.run);
+  ASSERT_EQ(mapper.Initialize(), IncrementalMapper::Status::kSuccess);
+  const std::vector<image_t> next = mapper.NextImages();
+  ASSERT_FALSE(next.empty());
+  expect_refused([&] { mapper.RegisterImage(next[0]); });
+}
+
 // Local BA: the new image and its local_ba_num_images - 1 best-connected neighbours are
 // free, the other images that see their points fixed; a result the adjuster calls
 // unusable leaves the poses as they were, a usable one is taken.

@@ -92,6 +92,11 @@ TEST(IncrementalTriangulator, LeavesOutAnObservationThatDisagrees) {
   EXPECT_EQ(point3D.track.size(), tracks.tracks[t].size() - 1);
   EXPECT_FALSE(ObservationManager::TrackHasImage(point3D, wrong.image_id));
   ExpectPointsAreTrue(scene, obs.model());
+  // Without pairs of observations to try, the disagreeing track gets no point.
+  obs.DeletePoint(obs.PointOfTrack(t));
+  IncrementalTriangulatorOptions no_pairs;
+  no_pairs.max_num_pairs = 0;
+  EXPECT_FALSE(IncrementalTriangulator(no_pairs, &obs).TriangulateTrack(t));
   // Rays closer than min_angle: no point.
   track_t other = t + 1;
   while (tracks.tracks[other].size() < 2) ++other;
