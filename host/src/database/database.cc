@@ -270,7 +270,8 @@ struct Database::Impl {
       exists_two_view_geometry, write_two_view_geometry, read_two_view_geometry,
       read_two_view_geometries, num_verified_pairs, read_stage, write_stage,
       write_calibration_source, write_image_metadata, read_image_metadata, descriptor_dimension,
-      read_image_files, write_image_file, delete_image_file, descriptor_widths;
+      read_image_files, write_image_file, delete_image_file, descriptor_widths,
+      read_num_keypoints_per_image, delete_stage;
 
   ~Impl() {
     // Statements first: a connection with live statements does not close.
@@ -309,7 +310,9 @@ struct Database::Impl {
                             &read_image_files,
                             &write_image_file,
                             &delete_image_file,
-                            &descriptor_widths}) {
+                            &descriptor_widths,
+                            &read_num_keypoints_per_image,
+                            &delete_stage}) {
       statement->reset();
     }
     if (in_transaction) sqlite3_exec(db, "ROLLBACK;", nullptr, nullptr, nullptr);
@@ -671,6 +674,7 @@ void Database::Impl::PrepareStatements() {
       Prepare("INSERT OR REPLACE INTO keypoints(image_id, rows, cols, data) VALUES(?, ?, ?, ?);");
   read_keypoints = Prepare("SELECT rows, cols, data FROM keypoints WHERE image_id = ?;");
   num_keypoints = Prepare("SELECT COALESCE(SUM(rows), 0) FROM keypoints;");
+  read_num_keypoints_per_image = Prepare("SELECT image_id, rows FROM keypoints ORDER BY image_id;");
   exists_descriptors = Prepare("SELECT 1 FROM descriptors WHERE image_id = ?;");
   write_descriptors =
       Prepare("INSERT OR REPLACE INTO descriptors(image_id, rows, cols, data) VALUES(?, ?, ?, ?);");
@@ -699,6 +703,7 @@ void Database::Impl::PrepareStatements() {
 
   read_stage = Prepare("SELECT provenance FROM tessera_stages WHERE stage = ?;");
   write_stage = Prepare("INSERT OR REPLACE INTO tessera_stages(stage, provenance) VALUES(?, ?);");
+  delete_stage = Prepare("DELETE FROM tessera_stages WHERE stage = ?;");
   write_calibration_source =
       Prepare("INSERT OR REPLACE INTO tessera_camera_priors(camera_id, source) VALUES(?, ?);");
   write_image_metadata =
@@ -953,6 +958,17 @@ size_t Database::NumKeypoints() const {
   return impl_->Count(*impl_->num_keypoints, "count the keypoints");
 }
 
+std::map<image_t, size_t> Database::ReadNumKeypointsPerImage() const {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  StatementUse use(*impl_->read_num_keypoints_per_image);
+  std::map<image_t, size_t> counts;
+  while (impl_->Step(use.get(), "count the keypoints of each image")) {
+    counts[static_cast<image_t>(sqlite3_column_int64(use.get(), 0))] =
+        static_cast<size_t>(sqlite3_column_int64(use.get(), 1));
+  }
+  return counts;
+}
+
 bool Database::ExistsDescriptors(image_t image_id) const {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   return impl_->Exists(*impl_->exists_descriptors, image_id,
@@ -1181,6 +1197,14 @@ void Database::WriteStageProvenance(const std::string& stage, const nlohmann::js
   StatementUse use(*impl_->write_stage);
   impl_->BindText(use.get(), 1, stage, operation);
   impl_->BindText(use.get(), 2, provenance.dump(), operation);
+  impl_->Step(use.get(), operation);
+}
+
+void Database::DeleteStageProvenance(const std::string& stage) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  const std::string operation = "delete the provenance of stage '" + stage + "'";
+  StatementUse use(*impl_->delete_stage);
+  impl_->BindText(use.get(), 1, stage, operation);
   impl_->Step(use.get(), operation);
 }
 

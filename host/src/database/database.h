@@ -96,6 +96,8 @@ class Database {
   void WriteKeypoints(image_t image_id, const FeatureKeypoints& keypoints);
   FeatureKeypoints ReadKeypoints(image_t image_id) const;
   size_t NumKeypoints() const;  // summed over all images
+  // Each image with a keypoints row and its number of keypoints, without reading them.
+  std::map<image_t, size_t> ReadNumKeypointsPerImage() const;
 
   // Descriptors: uint8 rows x cols. COLMAP's table has no place for the metric, so
   // the caller says which one the stage's detector produced.
@@ -141,6 +143,7 @@ class Database {
   // change invalidates only what depends on it. nullopt if the stage has no record.
   std::optional<nlohmann::json> ReadStageProvenance(const std::string& stage) const;
   void WriteStageProvenance(const std::string& stage, const nlohmann::json& provenance);
+  void DeleteStageProvenance(const std::string& stage);
 
   void WriteCalibrationSource(camera_t camera_id, CalibrationSource source);
 
