@@ -262,6 +262,7 @@ struct Database::Impl {
   // input like a file that is no database at all.
   bool opening = false;
   bool in_transaction = false;
+  bool read_only = false;  // Mode::kReadOnly
 
   std::unique_ptr<Statement> write_camera, update_camera, read_cameras, read_camera, write_image,
       read_image_with_name, read_images, num_cameras, num_images, exists_keypoints, write_keypoints,
@@ -564,12 +565,35 @@ struct Database::Impl {
 
   void Open();
   void CreateAndCheckSchema();
+  std::set<std::string> TableColumns(const std::string& table);
+  void CheckRequiredColumns();
   void PrepareStatements();
 };
 
+// An SQLite URI for `path` with `query`: '%', '?' and '#' percent-encoded.
+std::string DatabaseUri(const std::filesystem::path& path, const std::string& query) {
+  std::string uri = "file:";
+  for (const char c : std::filesystem::absolute(path).string()) {
+    if (c == '%') {
+      uri += "%25";
+    } else if (c == '?') {
+      uri += "%3f";
+    } else if (c == '#') {
+      uri += "%23";
+    } else {
+      uri += c;
+    }
+  }
+  return uri + "?" + query;
+}
+
 void Database::Impl::Open() {
-  const int rc =
-      sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  // Read only: SQLite's immutable mode takes no lock and writes nothing (no -shm, no
+  // -wal), so readers on network filesystems are safe while no one writes the file.
+  const std::string uri = read_only ? DatabaseUri(path, "immutable=1") : path.string();
+  const int flags = read_only ? SQLITE_OPEN_READONLY | SQLITE_OPEN_URI
+                              : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE;
+  const int rc = sqlite3_open_v2(uri.c_str(), &db, flags, nullptr);
   if (rc != SQLITE_OK) {
     const std::string message = db != nullptr ? sqlite3_errmsg(db) : sqlite3_errstr(rc);
     sqlite3_close_v2(db);
@@ -581,6 +605,7 @@ void Database::Impl::Open() {
   sqlite3_busy_timeout(db, 5000);
   // The first read of the file: a file that is not a database fails here.
   Exec("SELECT COUNT(*) FROM sqlite_master;", "read the schema");
+  if (read_only) return;
   // WAL, as COLMAP uses: readers do not block the writer, and a killed process leaves
   // the last committed state. NORMAL sync is durable against process crashes (only a
   // power loss may drop the last commits, never corrupt the file).
@@ -590,7 +615,33 @@ void Database::Impl::Open() {
   Exec("PRAGMA temp_store=MEMORY;", "set the temporary store");
 }
 
+std::set<std::string> Database::Impl::TableColumns(const std::string& table) {
+  std::set<std::string> columns;
+  const auto statement = Prepare("PRAGMA table_info(" + table + ");", false);
+  StatementUse use(*statement);
+  while (Step(use.get(), "read the columns of table " + table)) {
+    columns.insert(reinterpret_cast<const char*>(sqlite3_column_text(use.get(), 1)));
+  }
+  return columns;
+}
+
+void Database::Impl::CheckRequiredColumns() {
+  for (const auto& [table, required] : RequiredColumns()) {
+    const std::set<std::string> columns = TableColumns(table);
+    for (const std::string& column : required) {
+      if (columns.count(column) == 0) {
+        throw InputError("Database '" + path.string() + "' has an incompatible schema: table '" +
+                         table + "' has no column '" + column + "'.");
+      }
+    }
+  }
+}
+
 void Database::Impl::CreateAndCheckSchema() {
+  if (read_only) {
+    CheckRequiredColumns();
+    return;
+  }
   Exec("BEGIN IMMEDIATE;", "begin creating the tables");
   try {
     for (const char* sql :
@@ -599,18 +650,8 @@ void Database::Impl::CreateAndCheckSchema() {
       Exec(sql, "create the tables");
     }
 
-    const auto table_columns = [&](const std::string& table) {
-      std::set<std::string> columns;
-      const auto statement = Prepare("PRAGMA table_info(" + table + ");", false);
-      StatementUse use(*statement);
-      while (Step(use.get(), "read the columns of table " + table)) {
-        columns.insert(reinterpret_cast<const char*>(sqlite3_column_text(use.get(), 1)));
-      }
-      return columns;
-    };
-
     // Databases of COLMAP before 3.7 lack the geometry columns; COLMAP adds them.
-    const std::set<std::string> geometry_columns = table_columns("two_view_geometries");
+    const std::set<std::string> geometry_columns = TableColumns("two_view_geometries");
     for (const char* column : kTwoViewGeometryAddedColumns) {
       if (geometry_columns.count(column) == 0) {
         Exec(("ALTER TABLE two_view_geometries ADD COLUMN " + std::string(column) + " BLOB;")
@@ -619,15 +660,7 @@ void Database::Impl::CreateAndCheckSchema() {
       }
     }
 
-    for (const auto& [table, required] : RequiredColumns()) {
-      const std::set<std::string> columns = table_columns(table);
-      for (const std::string& column : required) {
-        if (columns.count(column) == 0) {
-          throw InputError("Database '" + path.string() + "' has an incompatible schema: table '" +
-                           table + "' has no column '" + column + "'.");
-        }
-      }
-    }
+    CheckRequiredColumns();
 
     const auto user_version = Prepare("PRAGMA user_version;", false);
     bool fresh = false;
@@ -721,8 +754,12 @@ void Database::Impl::PrepareStatements() {
       Prepare("SELECT DISTINCT cols FROM descriptors WHERE rows > 0 ORDER BY cols;");
 }
 
-Database::Database(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
+Database::Database(const std::filesystem::path& path, Mode mode) : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
+  impl_->read_only = mode == Mode::kReadOnly;
+  if (impl_->read_only && !std::filesystem::exists(path)) {
+    throw InputError("Cannot open database file '" + path.string() + "': it does not exist.");
+  }
   impl_->opening = true;
   impl_->Open();
   impl_->CreateAndCheckSchema();

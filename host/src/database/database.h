@@ -45,7 +45,14 @@ class Database {
   // Opens or creates the database at `path` and creates missing tables. Throws
   // InputError naming the file if it cannot be opened or is not a SQLite database /
   // has an incompatible schema.
-  explicit Database(const std::filesystem::path& path);
+  //
+  // Mode::kReadOnly opens an existing file for reading only, without taking a lock or
+  // writing anything (SQLite's immutable mode, no -wal or -shm file), so that readers on
+  // several hosts of a network filesystem are safe while no one writes the file (the
+  // matching shards of `tessera slurm` read database.db so). The schema is checked, not
+  // created; a write fails.
+  enum class Mode { kReadWrite, kReadOnly };
+  explicit Database(const std::filesystem::path& path, Mode mode = Mode::kReadWrite);
   ~Database();
   Database(const Database&) = delete;
   Database& operator=(const Database&) = delete;

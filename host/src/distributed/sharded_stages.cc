@@ -125,8 +125,17 @@ MatchingSummary RunMatchShard(const PipelineContext& context, const RunOptions& 
                      "(tessera merge --output " +
                      options.output_dir.string() + ")");
   }
-  // Read only: features, images and the pairs already done.
-  Database source(source_file);
+  // Read only, without a lock (shards on many hosts read it at once): features, images
+  // and the pairs already done. Immutable reads do not see a write-ahead log, which only a
+  // killed writer leaves behind.
+  std::error_code error;
+  const std::filesystem::path wal = source_file.string() + "-wal";
+  if (std::filesystem::exists(wal, error) && std::filesystem::file_size(wal, error) > 0) {
+    throw InputError(wal.string() + ": " + source_file.string() +
+                     " has changes a killed writer did not fold in; run `tessera merge --output " +
+                     options.output_dir.string() + "` again, then the matching shards");
+  }
+  Database source(source_file, Database::Mode::kReadOnly);
   const WorkspaceDescriptors descriptors = ReadWorkspaceDescriptors(source);
   CheckPairSelectors(context.manifest, context.pair_selectors, descriptors.metric,
                      descriptors.dimension);
