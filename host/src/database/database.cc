@@ -570,6 +570,8 @@ struct Database::Impl {
   void PrepareStatements();
 };
 
+namespace {
+
 // An SQLite URI for `path` with `query`: '%', '?' and '#' percent-encoded.
 std::string DatabaseUri(const std::filesystem::path& path, const std::string& query) {
   std::string uri = "file:";
@@ -586,6 +588,8 @@ std::string DatabaseUri(const std::filesystem::path& path, const std::string& qu
   }
   return uri + "?" + query;
 }
+
+}  // namespace
 
 void Database::Impl::Open() {
   // Read only: SQLite's immutable mode takes no lock and writes nothing (no -shm, no
