@@ -10,6 +10,8 @@
 #  - measured: N = 2 shards run side by side (2 workers on this machine), merges
 #    included, against the single run's wall-clock time.
 # Every time is wall-clock seconds of one process. On a shared machine they are inflated.
+# All of fox with one thread per process takes about an hour here; IMAGES may be a
+# subset (the figures in distributed/README.md are for its first 20 images).
 # usage: slurm_shards.sh TESSERA [IMAGES] [MANIFEST]
 set -euo pipefail
 tessera=$1
