@@ -30,5 +30,7 @@ CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions& glob
 CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterBenchCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterVocabCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterMergeCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera
