@@ -1,0 +1,655 @@
+#include "gui/gui_app.h"
+
+#define GLFW_INCLUDE_NONE
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "cli/exit_codes.h"
+#include "gui/gl.h"
+#include "gui/model_loader.h"
+#include "gui/renderer.h"
+#include "manifest/manifest.h"
+#include "tessera/errors.h"
+#include "tessera/io/colmap_model_io.h"
+#include "tessera/io/model_statistics.h"
+
+namespace tessera::gui {
+namespace fs = std::filesystem;
+namespace {
+
+std::string& GlfwError() {
+  static std::string error;
+  return error;
+}
+
+void OnGlfwError(int /*code*/, const char* description) { GlfwError() = description; }
+
+GuiApp* AppOf(GLFWwindow* window) { return static_cast<GuiApp*>(glfwGetWindowUserPointer(window)); }
+
+template <size_t N>
+void CopyPath(const fs::path& path, std::array<char, N>* buffer) {
+  const std::string text = path.string();
+  std::strncpy(buffer->data(), text.c_str(), N - 1);
+  (*buffer)[N - 1] = '\0';
+}
+
+std::string FormatSeconds(double seconds) {
+  if (seconds < 0) return "?";
+  if (seconds < 60) return std::to_string(static_cast<int>(std::lround(seconds))) + " s";
+  const long minutes = std::lround(seconds) / 60;
+  return std::to_string(minutes) + " min " + std::to_string(std::lround(seconds) % 60) + " s";
+}
+
+void ErrorText(const std::string& text) {
+  if (text.empty()) return;
+  ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.35f, 0.3f, 1.0f));
+  ImGui::TextWrapped("%s", text.c_str());
+  ImGui::PopStyleColor();
+}
+
+constexpr float kPanelWidth = 420;
+
+// Whether the folder (or a sub-folder) has a file with an image extension; stops at the
+// first one, so that a large folder costs nothing on the UI thread.
+bool HasImageFile(const fs::path& dir) {
+  std::error_code error;
+  for (fs::recursive_directory_iterator
+           it(dir, fs::directory_options::skip_permission_denied, error),
+       end;
+       !error && it != end; it.increment(error)) {
+    std::string extension = it->path().extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);
+    for (const char* known : {".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".webp"}) {
+      if (extension == known) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+// Marks the window as changed on any input; ImGui's own callbacks chain to these.
+void MarkChanged(GLFWwindow* window);
+
+GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
+  const char* display = std::getenv("DISPLAY");
+  const char* wayland = std::getenv("WAYLAND_DISPLAY");
+  if ((display == nullptr || *display == '\0') && (wayland == nullptr || *wayland == '\0')) {
+    throw InputError(
+        "tessera gui: no display (DISPLAY is not set); every other verb works without one");
+  }
+  glfwSetErrorCallback(OnGlfwError);
+  if (glfwInit() == GLFW_FALSE) {
+    throw InputError("tessera gui: cannot open the display '" +
+                     std::string(display != nullptr ? display : wayland) + "': " + GlfwError());
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  glfwWindowHint(GLFW_DOUBLEBUFFER, GLFW_TRUE);
+  window_ = glfwCreateWindow(options.width, options.height, "Tessera", nullptr, nullptr);
+  if (window_ == nullptr) {
+    const std::string error = GlfwError();
+    glfwTerminate();
+    throw InputError("tessera gui: no OpenGL 3.3 core context on this display: " + error);
+  }
+  glfwMakeContextCurrent(window_);
+  glfwSwapInterval(0);
+  glfwSetWindowUserPointer(window_, this);
+  // Installed before ImGui's, which call them after their own.
+  glfwSetCursorPosCallback(window_, [](GLFWwindow* w, double, double) { MarkChanged(w); });
+  glfwSetMouseButtonCallback(window_, [](GLFWwindow* w, int, int, int) { MarkChanged(w); });
+  glfwSetScrollCallback(window_, [](GLFWwindow* w, double, double) { MarkChanged(w); });
+  glfwSetKeyCallback(window_, [](GLFWwindow* w, int, int, int, int) { MarkChanged(w); });
+  glfwSetCharCallback(window_, [](GLFWwindow* w, unsigned int) { MarkChanged(w); });
+  glfwSetWindowFocusCallback(window_, [](GLFWwindow* w, int) { MarkChanged(w); });
+  glfwSetWindowSizeCallback(window_, [](GLFWwindow* w, int, int) { MarkChanged(w); });
+  glfwSetWindowRefreshCallback(window_, [](GLFWwindow* w) { MarkChanged(w); });
+
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(window_, true);
+  ImGui_ImplOpenGL3_Init("#version 330 core");
+  renderer_ = std::make_unique<Renderer>();
+
+  auto wake = [this]() {
+    changed_.store(true);
+    glfwPostEmptyEvent();
+  };
+  log_sink_ = std::make_shared<LogSink>();
+  log_sink_->SetOnLine(wake);
+  spdlog::default_logger()->sinks().push_back(log_sink_);
+  controller_ = std::make_unique<RunController>(wake);
+
+  CopyPath(options.images, &images_);
+  CopyPath(options.output, &output_);
+  CopyPath(options.manifest, &manifest_);
+  CopyPath(options.model, &model_path_);
+  if (!options.model.empty()) OpenModel(options.model);
+}
+
+void MarkChanged(GLFWwindow* window) {
+  if (GuiApp* app = AppOf(window)) app->MarkChangedFromInput();
+}
+
+GuiApp::~GuiApp() {
+  controller_.reset();  // cancels and joins the worker: no more log lines or wake-ups
+  auto& sinks = spdlog::default_logger()->sinks();
+  sinks.erase(std::remove(sinks.begin(), sinks.end(), log_sink_), sinks.end());
+  if (image_texture_ != 0) glDeleteTextures(1, &image_texture_);
+  renderer_.reset();
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  glfwDestroyWindow(window_);
+  glfwTerminate();
+}
+
+bool GuiApp::ShouldClose() const { return glfwWindowShouldClose(window_) != 0; }
+
+bool GuiApp::Step(double max_wait_s) {
+  if (frames_pending_ == 0) {
+    // While a run goes on, the progress bars' times move: a frame every 0.25 s at least.
+    glfwWaitEventsTimeout(controller_->Running() ? std::min(max_wait_s, 0.25) : max_wait_s);
+  } else {
+    glfwPollEvents();
+  }
+  if (changed_.exchange(false)) frames_pending_ = std::max(frames_pending_, 2);
+  if (frames_pending_ == 0 && controller_->Running()) frames_pending_ = 1;
+  if (frames_pending_ == 0) return false;
+  Frame();
+  --frames_pending_;
+  return true;
+}
+
+void GuiApp::MarkChangedFromInput() { changed_.store(true); }
+
+size_t GuiApp::NumScenePoints() const { return scene_ == nullptr ? 0 : scene_->NumPoints(); }
+size_t GuiApp::NumSceneCameras() const { return scene_ == nullptr ? 0 : scene_->cameras.size(); }
+
+std::optional<WidgetRect> GuiApp::Widget(const std::string& name) const {
+  const auto found = widgets_.find(name);
+  if (found == widgets_.end()) return std::nullopt;
+  return found->second;
+}
+
+void GuiApp::Record(const std::string& name) {
+  const ImVec2 min = ImGui::GetItemRectMin();
+  const ImVec2 max = ImGui::GetItemRectMax();
+  widgets_[name] = {min.x, min.y, max.x, max.y};
+}
+
+WidgetRect GuiApp::ViewRect() const {
+  int width = 0, height = 0;
+  glfwGetWindowSize(window_, &width, &height);
+  const float left = options_.view_only ? 0 : std::min(kPanelWidth, 0.45f * width);
+  return {left, 0, static_cast<float>(width), static_cast<float>(height)};
+}
+
+void GuiApp::ShowScene(std::shared_ptr<const Scene> scene, bool frame) {
+  scene_ = std::move(scene);
+  renderer_->SetScene(scene_);
+  if (frame && scene_ != nullptr) {
+    camera_.Frame(scene_->center, scene_->radius, scene_->forward, scene_->up,
+                  scene_->camera_centers);
+  }
+  changed_.store(true);
+}
+
+bool GuiApp::OpenModel(const fs::path& path) {
+  model_error_.clear();
+  try {
+    model_folders_ = FindModelFolders(path);
+  } catch (const InputError& error) {
+    model_error_ = error.what();
+    spdlog::error("{}", model_error_);
+    return false;
+  }
+  CopyPath(path, &model_path_);
+  LoadModelFolder(0);
+  return model_error_.empty();
+}
+
+void GuiApp::LoadModelFolder(size_t index) {
+  model_error_.clear();
+  if (index >= model_folders_.size()) return;
+  try {
+    auto model = std::make_shared<const Reconstruction>(ReadColmapModel(model_folders_[index]));
+    model_index_ = static_cast<int>(index);
+    selected_image_ = kInvalidImageId;
+    selected_point_ = kInvalidPoint3DId;
+    user_moved_camera_ = false;
+    ShowScene(MakeScene(std::move(model)), /*frame=*/true);
+    spdlog::info("gui: opened {} ({} images, {} points)", model_folders_[index].string(),
+                 scene_->cameras.size(), scene_->NumPoints());
+  } catch (const InputError& error) {
+    model_error_ = error.what();
+    spdlog::error("{}", model_error_);
+  }
+}
+
+bool GuiApp::Run() {
+  setup_error_.clear();
+  images_error_.clear();
+  manifest_error_.clear();
+  const fs::path images(images_.data());
+  const fs::path output(output_.data());
+  const fs::path manifest(manifest_.data());
+  std::error_code error;
+  if (images.empty()) {
+    images_error_ = "choose the folder of images";
+  } else if (!fs::is_directory(images, error)) {
+    images_error_ = images.string() + ": no such folder";
+  } else if (!HasImageFile(images)) {
+    images_error_ = images.string() + ": no images in this folder (JPEG, PNG, TIFF, BMP, WebP)";
+  }
+  if (output.empty()) setup_error_ = "choose an output folder (the workspace)";
+  if (!manifest.empty()) {
+    try {
+      Manifest::Load(manifest);
+    } catch (const InputError& exception) {
+      manifest_error_ = exception.what();
+    }
+  }
+  if (!images_error_.empty() || !manifest_error_.empty() || !setup_error_.empty()) {
+    for (const std::string* message : {&images_error_, &manifest_error_}) {
+      if (!message->empty() && setup_error_.empty()) setup_error_ = *message;
+    }
+    spdlog::error("{}", setup_error_);
+    return false;
+  }
+  selected_image_ = kInvalidImageId;
+  selected_point_ = kInvalidPoint3DId;
+  user_moved_camera_ = false;
+  model_folders_.clear();
+  if (!controller_->Start({images, output, manifest})) {
+    setup_error_ = "a run is going on";
+    return false;
+  }
+  return true;
+}
+
+void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
+  if (auto scene = controller_->TakeScene(&scene_version_)) {
+    ShowScene(std::move(scene), !user_moved_camera_);
+  }
+  const RunStatus status = controller_->Status();
+  if (status.state != last_state_) {
+    last_state_ = status.state;
+    if (status.state == RunState::kCompleted) {
+      // The written model has the points' colours; show it (and any others).
+      try {
+        model_folders_ = FindModelFolders(status.output_dir);
+        const bool moved = user_moved_camera_;
+        LoadModelFolder(0);
+        user_moved_camera_ = moved;
+      } catch (const InputError&) {
+        // No exporter wrote a COLMAP model: keep the mapper's last model.
+      }
+    }
+    if (status.state == RunState::kFailed) setup_error_ = status.error;
+  }
+
+  ImGui_ImplOpenGL3_NewFrame();
+  ImGui_ImplGlfw_NewFrame();
+  ImGuiIO& io = ImGui::GetIO();
+  if (input != nullptr) {
+    io.MousePos = ImVec2(input->x, input->y);
+    io.MouseDown[0] = input->left_down;
+    for (int button = 1; button < 5; ++button) io.MouseDown[button] = false;
+    if (!input->text.empty()) io.AddInputCharactersUTF8(input->text.c_str());
+  }
+  ImGui::NewFrame();
+  if (!options_.view_only) {
+    DrawSetupPanel(status);
+    DrawSelection();
+  }
+  HandleViewInput();
+  ImGui::Render();
+
+  int fb_width = 0, fb_height = 0, width = 0, height = 0;
+  glfwGetFramebufferSize(window_, &fb_width, &fb_height);
+  glfwGetWindowSize(window_, &width, &height);
+  glViewport(0, 0, fb_width, fb_height);
+  glClearColor(0.06f, 0.06f, 0.07f, 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  const WidgetRect view = ViewRect();
+  const float scale = width > 0 ? static_cast<float>(fb_width) / static_cast<float>(width) : 1;
+  const std::array<int, 4> viewport = {static_cast<int>(view.min_x * scale), 0,
+                                       static_cast<int>((view.max_x - view.min_x) * scale),
+                                       fb_height};
+  const float aspect =
+      static_cast<float>(viewport[2]) / static_cast<float>(std::max(viewport[3], 1));
+  renderer_->Draw(viewport, camera_.ProjectionMatrix(aspect) * camera_.ViewMatrix(), point_size_,
+                  frustum_size_, selected_image_);
+  ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+  if (capture != nullptr) *capture = ReadFramebuffer(fb_width, fb_height);
+  glfwSwapBuffers(window_);
+  ++frames_drawn_;
+}
+
+void GuiApp::SaveScreenshot(const fs::path& file) {
+  RgbImage image;
+  Frame(nullptr, &image);
+  WritePng(image, file);
+}
+
+void GuiApp::DrawSetupPanel(const RunStatus& status) {
+  int width = 0, height = 0;
+  glfwGetWindowSize(window_, &width, &height);
+  const WidgetRect view = ViewRect();
+  ImGui::SetNextWindowPos(ImVec2(0, 0), ImGuiCond_Always);
+  ImGui::SetNextWindowSize(ImVec2(view.min_x, static_cast<float>(height)), ImGuiCond_Always);
+  ImGui::Begin("Tessera", nullptr,
+               ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+  const bool running = controller_->Running();
+
+  ImGui::TextUnformatted("Reconstruct");
+  ImGui::InputTextWithHint("Images", "folder of photographs", images_.data(), images_.size());
+  Record("images");
+  ErrorText(images_error_);
+  ImGui::InputTextWithHint("Output", "workspace folder", output_.data(), output_.size());
+  Record("output");
+  ImGui::InputTextWithHint("Manifest", "default manifest", manifest_.data(), manifest_.size());
+  Record("manifest");
+  ErrorText(manifest_error_);
+
+  ImGui::BeginDisabled(running);
+  if (ImGui::Button("Run")) Run();
+  ImGui::EndDisabled();
+  Record("run");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!running);
+  if (ImGui::Button("Cancel")) controller_->Cancel();
+  ImGui::EndDisabled();
+  Record("cancel");
+  ImGui::SameLine();
+  ImGui::Text("%s", RunStateName(status.state));
+  if (status.state == RunState::kFailed || !setup_error_.empty()) {
+    ErrorText(setup_error_.empty() ? status.error : setup_error_);
+  }
+  for (const StageProgress& stage : status.stages) {
+    const float fraction =
+        stage.total == 0 ? 1.0f : static_cast<float>(stage.done) / static_cast<float>(stage.total);
+    std::string overlay = std::to_string(stage.done) + "/" + std::to_string(stage.total);
+    if (stage.rate_per_s > 0) {
+      char rate[64];
+      std::snprintf(rate, sizeof(rate), "  %.2f/s", stage.rate_per_s);
+      overlay += rate;
+      if (stage.done < stage.total) overlay += ", " + FormatSeconds(stage.remaining_s) + " left";
+    }
+    ImGui::ProgressBar(fraction, ImVec2(-80, 0), overlay.c_str());
+    ImGui::SameLine();
+    ImGui::TextUnformatted(stage.stage.c_str());
+  }
+
+  ImGui::Separator();
+  ImGui::TextUnformatted("Open a model (COLMAP folder, workspace or database.db)");
+  ImGui::InputTextWithHint("##model", "model folder", model_path_.data(), model_path_.size());
+  Record("model");
+  ImGui::SameLine();
+  if (ImGui::Button("Open")) OpenModel(fs::path(model_path_.data()));
+  Record("open");
+  ErrorText(model_error_);
+  if (model_folders_.size() > 1) {
+    const std::string current = "model " + std::to_string(model_index_);
+    if (ImGui::BeginCombo("Model", current.c_str())) {
+      for (size_t i = 0; i < model_folders_.size(); ++i) {
+        const std::string label =
+            "model " + std::to_string(i) + "  (" + model_folders_[i].filename().string() + ")";
+        if (ImGui::Selectable(label.c_str(), static_cast<int>(i) == model_index_)) {
+          LoadModelFolder(i);
+        }
+      }
+      ImGui::EndCombo();
+    }
+  }
+  ImGui::Text("%zu points, %zu cameras", NumScenePoints(), NumSceneCameras());
+  ImGui::SliderFloat("Point size", &point_size_, 1, 10, "%.0f px");
+  ImGui::SliderFloat("Camera size", &frustum_size_, 0.01f, 0.5f, "%.2f");
+  if (ImGui::Button("Recentre") && scene_ != nullptr) {
+    camera_.Frame(scene_->center, scene_->radius, scene_->forward, scene_->up,
+                  scene_->camera_centers);
+  }
+  ImGui::SameLine();
+  ImGui::TextDisabled("drag: orbit, shift+drag/right: pan, wheel: zoom, click: details");
+
+  ImGui::Separator();
+  ImGui::TextUnformatted("Log");
+  ImGui::BeginChild("log", ImVec2(0, 0), true, ImGuiWindowFlags_HorizontalScrollbar);
+  const std::vector<LogLine> lines = log_sink_->Lines();
+  ImGuiListClipper clipper;
+  clipper.Begin(static_cast<int>(lines.size()));
+  while (clipper.Step()) {
+    for (int i = clipper.DisplayStart; i < clipper.DisplayEnd; ++i) {
+      const LogLine& line = lines[static_cast<size_t>(i)];
+      const ImVec4 color = line.level >= spdlog::level::err    ? ImVec4(1.0f, 0.4f, 0.35f, 1)
+                           : line.level == spdlog::level::warn ? ImVec4(1.0f, 0.8f, 0.3f, 1)
+                                                               : ImVec4(0.85f, 0.85f, 0.85f, 1);
+      ImGui::TextColored(color, "%s", line.text.c_str());
+    }
+  }
+  if (log_lines_seen_ != lines.size()) {
+    log_lines_seen_ = lines.size();
+    ImGui::SetScrollHereY(1.0f);
+  }
+  ImGui::EndChild();
+  ImGui::End();
+}
+
+void GuiApp::DrawSelection() {
+  if (scene_ == nullptr) return;
+  const Reconstruction& model = *scene_->model;
+  const WidgetRect view = ViewRect();
+  if (selected_image_ != kInvalidImageId && model.images.count(selected_image_) > 0) {
+    const Image& image = model.images.at(selected_image_);
+    ImGui::SetNextWindowPos(ImVec2(view.max_x - 10, 10), ImGuiCond_Appearing, ImVec2(1, 0));
+    bool open = true;
+    ImGui::Begin("Camera", &open, ImGuiWindowFlags_AlwaysAutoResize);
+    size_t observations = 0, usable = 0;
+    double error_sum = 0;
+    for (size_t i = 0; i < image.points2D.size(); ++i) {
+      const point3D_t point_id = image.points2D[i].point3D_id;
+      const auto point = model.points3D.find(point_id);
+      if (point == model.points3D.end()) continue;
+      ++observations;
+      const ObservationError error = ComputeObservationError(
+          model, point->second, {image.image_id, static_cast<point2D_t>(i)});
+      if (error.usable) {
+        ++usable;
+        error_sum += error.error_px;
+      }
+    }
+    ImGui::Text("%s  (image %u, camera %u)", image.name.c_str(), image.image_id, image.camera_id);
+    ImGui::Text("%zu observations, mean reprojection error %.3f px", observations,
+                usable > 0 ? error_sum / static_cast<double>(usable) : 0.0);
+    // The photograph with its observations, when the image folder has it.
+    if (texture_image_ != selected_image_) {
+      texture_image_ = selected_image_;
+      texture_width_ = 0;
+      const cv::Mat bgr =
+          cv::imread((fs::path(images_.data()) / image.name).string(), cv::IMREAD_COLOR);
+      if (!bgr.empty()) {
+        const double shrink = std::min(1.0, 480.0 / bgr.cols);
+        cv::Mat rgb;
+        cv::resize(bgr, rgb, cv::Size(), shrink, shrink, cv::INTER_AREA);
+        cv::cvtColor(rgb, rgb, cv::COLOR_BGR2RGB);
+        if (image_texture_ == 0) glGenTextures(1, &image_texture_);
+        glBindTexture(GL_TEXTURE_2D, image_texture_);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, rgb.cols, rgb.rows, 0, GL_RGB, GL_UNSIGNED_BYTE,
+                     rgb.data);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        texture_width_ = rgb.cols;
+        texture_height_ = rgb.rows;
+        texture_scale_ = static_cast<float>(rgb.cols) / static_cast<float>(bgr.cols);
+      }
+    }
+    if (texture_width_ > 0) {
+      const ImVec2 origin = ImGui::GetCursorScreenPos();
+      ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(image_texture_)),
+                   ImVec2(static_cast<float>(texture_width_), static_cast<float>(texture_height_)));
+      ImDrawList* draw = ImGui::GetWindowDrawList();
+      for (const Point2D& point : image.points2D) {
+        if (!point.HasPoint3D() || model.points3D.count(point.point3D_id) == 0) continue;
+        draw->AddCircle(ImVec2(origin.x + static_cast<float>(point.xy.x()) * texture_scale_,
+                               origin.y + static_cast<float>(point.xy.y()) * texture_scale_),
+                        2.5f, IM_COL32(60, 255, 90, 255));
+      }
+    } else {
+      ImGui::TextDisabled("(the photograph is not in the image folder)");
+    }
+    ImGui::End();
+    if (!open) selected_image_ = kInvalidImageId;
+  }
+  if (selected_point_ != kInvalidPoint3DId && model.points3D.count(selected_point_) > 0) {
+    const Point3D& point = model.points3D.at(selected_point_);
+    ImGui::SetNextWindowPos(ImVec2(view.max_x - 10, view.max_y - 10), ImGuiCond_Appearing,
+                            ImVec2(1, 1));
+    bool open = true;
+    ImGui::Begin("Point", &open, ImGuiWindowFlags_AlwaysAutoResize);
+    ImGui::Text("point %llu at (%.3f, %.3f, %.3f), error %.3f px",
+                static_cast<unsigned long long>(selected_point_), point.xyz.x(), point.xyz.y(),
+                point.xyz.z(), point.error);
+    ImGui::Text("track of %zu observations:", point.track.size());
+    for (const TrackElement& element : point.track) {
+      const auto image = model.images.find(element.image_id);
+      if (image == model.images.end() || element.point2D_idx >= image->second.points2D.size()) {
+        continue;
+      }
+      const Eigen::Vector2d& xy = image->second.points2D[element.point2D_idx].xy;
+      ImGui::BulletText("%s  (%.1f, %.1f)", image->second.name.c_str(), xy.x(), xy.y());
+    }
+    ImGui::End();
+    if (!open) selected_point_ = kInvalidPoint3DId;
+  }
+}
+
+void GuiApp::HandleViewInput() {
+  ImGuiIO& io = ImGui::GetIO();
+  const WidgetRect view = ViewRect();
+  const bool in_view = !io.WantCaptureMouse && io.MousePos.x >= view.min_x &&
+                       io.MousePos.x < view.max_x && io.MousePos.y >= view.min_y &&
+                       io.MousePos.y < view.max_y;
+  if (in_view && ImGui::IsMouseClicked(ImGuiMouseButton_Left)) {
+    dragging_ = true;
+    drag_distance_ = 0;
+  }
+  if (dragging_ && ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
+    const ImVec2 delta = io.MouseDelta;
+    drag_distance_ += std::abs(delta.x) + std::abs(delta.y);
+    if (delta.x != 0 || delta.y != 0) {
+      if (io.KeyShift || io.KeyCtrl) {
+        camera_.Pan(delta.x, delta.y, view.max_y - view.min_y);
+      } else {
+        camera_.Orbit(delta.x, delta.y);
+      }
+      user_moved_camera_ = true;
+    }
+  }
+  if (dragging_ && ImGui::IsMouseReleased(ImGuiMouseButton_Left)) {
+    dragging_ = false;
+    if (drag_distance_ < 3) Pick(io.MousePos.x, io.MousePos.y);
+  }
+  if (in_view && ImGui::IsMouseDown(ImGuiMouseButton_Right)) {
+    camera_.Pan(io.MouseDelta.x, io.MouseDelta.y, view.max_y - view.min_y);
+    user_moved_camera_ = true;
+  }
+  if (in_view && io.MouseWheel != 0) {
+    camera_.Zoom(io.MouseWheel);
+    user_moved_camera_ = true;
+  }
+}
+
+void GuiApp::Pick(float x, float y) {
+  if (scene_ == nullptr) return;
+  const WidgetRect view = ViewRect();
+  const float width = view.max_x - view.min_x;
+  const float height = view.max_y - view.min_y;
+  const Eigen::Matrix4f world_to_clip =
+      camera_.ProjectionMatrix(width / std::max(height, 1.0f)) * camera_.ViewMatrix();
+  // Window pixels of a world point; false behind the view.
+  auto project = [&](const Eigen::Vector3f& world, Eigen::Vector2f* pixel, float* depth) {
+    const Eigen::Vector4f clip = world_to_clip * world.homogeneous();
+    if (clip.w() <= 0) return false;
+    *pixel = Eigen::Vector2f(view.min_x + (clip.x() / clip.w() + 1) / 2 * width,
+                             view.min_y + (1 - clip.y() / clip.w()) / 2 * height);
+    *depth = clip.w();
+    return true;
+  };
+  const Eigen::Vector2f click(x, y);
+  Eigen::Vector2f pixel;
+  float depth = 0;
+  float best = 10;  // pixels
+  image_t best_image = kInvalidImageId;
+  for (const SceneCamera& camera : scene_->cameras) {
+    if (!project(camera.center_in_world, &pixel, &depth)) continue;
+    const float distance = (pixel - click).norm();
+    if (distance < best) {
+      best = distance;
+      best_image = camera.image_id;
+    }
+  }
+  if (best_image != kInvalidImageId) {
+    selected_image_ = best_image;
+    return;
+  }
+  best = 6;
+  float best_depth = 0;
+  point3D_t best_point = kInvalidPoint3DId;
+  for (size_t i = 0; i < scene_->point_ids.size(); ++i) {
+    const Eigen::Vector3f world(scene_->positions[3 * i], scene_->positions[3 * i + 1],
+                                scene_->positions[3 * i + 2]);
+    if (!project(world, &pixel, &depth)) continue;
+    const float distance = (pixel - click).norm();
+    if (distance < best || (distance == best && depth < best_depth)) {
+      best = distance;
+      best_depth = depth;
+      best_point = scene_->point_ids[i];
+    }
+  }
+  selected_point_ = best_point;
+}
+
+int RunGui(const GuiCommandOptions& options) {
+  if (!options.screenshot.empty() && options.gui.model.empty() && options.gui.images.empty()) {
+    throw InputError("gui: --screenshot needs --model or --images");
+  }
+  GuiApp app(options.gui);
+  if (!options.gui.model.empty() && !app.ModelError().empty()) throw InputError(app.ModelError());
+  if (options.screenshot.empty()) {
+    if (!options.gui.images.empty() && !options.gui.output.empty()) app.Run();
+    while (!app.ShouldClose()) app.Step(1.0);
+    return kExitSuccess;
+  }
+  if (!options.gui.images.empty()) {
+    if (!app.Run()) throw InputError(app.SetupError());
+    while (app.controller().Running()) app.Step(0.1);
+    app.controller().Join();
+    const RunStatus status = app.controller().Status();
+    if (status.state == RunState::kFailed) return status.exit_code;
+  }
+  // ImGui lays its windows out from the second frame on.
+  for (int i = 1; i < std::max(options.frames, 2); ++i) app.Frame();
+  app.SaveScreenshot(options.screenshot);
+  spdlog::info("gui: wrote {}", options.screenshot.string());
+  return kExitSuccess;
+}
+
+}  // namespace tessera::gui

@@ -1,0 +1,324 @@
+// The GUI in a private X server (Xvfb, llvmpipe): driven by simulated mouse clicks and
+// typing (ImGui 1.86 has no test engine), its screenshots checked by pixel counts and
+// against a committed reference image.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cstdio>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <regex>
+
+#include "gui/gui_app.h"
+#include "gui/renderer.h"
+#include "gui/xvfb.h"
+#include "pipeline/stage_test_util.h"
+#include "tessera/errors.h"
+#include "test_support.h"
+
+namespace tessera::gui {
+namespace {
+namespace fs = std::filesystem;
+
+class GuiWindowTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string why;
+    if (!xvfb_.Start(&why)) GTEST_SKIP() << "skipped: " << why;
+  }
+
+  // A move, a press and a release at the centre of the widget, one frame each.
+  static void Click(GuiApp* app, const WidgetRect& rect) {
+    for (bool down : {false, true, false}) {
+      SyntheticInput input;
+      input.x = rect.CenterX();
+      input.y = rect.CenterY();
+      input.left_down = down;
+      app->Frame(&input);
+    }
+  }
+  static void Click(GuiApp* app, const std::string& widget) {
+    const std::optional<WidgetRect> rect = app->Widget(widget);
+    ASSERT_TRUE(rect.has_value()) << widget;
+    Click(app, *rect);
+  }
+  static void Type(GuiApp* app, const std::string& text) {
+    SyntheticInput input;
+    input.x = -1;
+    input.y = -1;
+    input.text = text;
+    app->Frame(&input);
+  }
+  // Draws frames (as the event loop would) until `done` or the time runs out.
+  template <typename Done>
+  static bool WaitFor(GuiApp* app, Done done, double seconds) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end) {
+      if (done()) return true;
+      app->Step(0.02);
+    }
+    return done();
+  }
+  static bool LogHas(const GuiApp& app, const std::regex& pattern) {
+    for (const LogLine& line : app.LogLines()) {
+      if (std::regex_search(line.text, pattern)) return true;
+    }
+    return false;
+  }
+
+  // 8 images of the sample at 400 px, and a cheap manifest (ORB, every pair, brute force,
+  // Ceres, a COLMAP binary model).
+  void MakeSample() {
+    tessera::testing::WriteSampleImages(dir_.path() / "images", 8);
+    manifest_ = dir_.path() / "manifest.json";
+    std::ofstream(manifest_) << R"({
+      "pipeline": {
+        "detector": {"plugin": "orb", "options": {"max_num_features": 2000}},
+        "pair_selector": {"plugin": "exhaustive"},
+        "matcher": {"plugin": "brute_force"},
+        "bundle_adjuster": {"plugin": "ceres"},
+        "exporters": [{"plugin": "colmap_binary"}]
+      },
+      "threads": 2
+    })";
+  }
+
+  testing::Xvfb xvfb_;
+  tessera::testing::TemporaryDir dir_;
+  fs::path manifest_;
+};
+
+struct PixelCounts {
+  size_t non_background = 0;
+  size_t frustum = 0;
+};
+
+PixelCounts CountViewPixels(const RgbImage& image, const WidgetRect& view) {
+  PixelCounts counts;
+  for (int y = static_cast<int>(view.min_y); y < static_cast<int>(view.max_y); ++y) {
+    for (int x = static_cast<int>(view.min_x); x < static_cast<int>(view.max_x); ++x) {
+      const uint8_t* p = &image.pixels[(static_cast<size_t>(y) * image.width + x) * 3];
+      if (p[0] != kBackgroundColor[0] || p[1] != kBackgroundColor[1] ||
+          p[2] != kBackgroundColor[2]) {
+        ++counts.non_background;
+      }
+      if (p[0] == kFrustumColor[0] && p[1] == kFrustumColor[1] && p[2] == kFrustumColor[2]) {
+        ++counts.frustum;
+      }
+    }
+  }
+  return counts;
+}
+
+TEST(GuiNoDisplay, RefusesWithOneLine) {
+  const char* display = std::getenv("DISPLAY");
+  const std::string saved = display != nullptr ? display : "";
+  unsetenv("DISPLAY");
+  unsetenv("WAYLAND_DISPLAY");
+  try {
+    GuiApp app(GuiOptions{});
+    FAIL() << "a window opened without a display";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "tessera gui: no display (DISPLAY is not set); every other verb works without one");
+  }
+  if (!saved.empty()) setenv("DISPLAY", saved.c_str(), 1);
+}
+
+TEST_F(GuiWindowTest, ClickThroughRunOnTheSampleShowsTheReconstruction) {
+  MakeSample();
+  GuiOptions options;
+  options.output = dir_.path() / "out";
+  options.manifest = manifest_;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  // Set the folder: click the field and type its path; then press Run.
+  Click(&app, "images");
+  Type(&app, (dir_.path() / "images").string());
+  Click(&app, "run");
+  ASSERT_TRUE(app.controller().Running() || app.controller().Status().state != RunState::kIdle)
+      << app.SetupError();
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return !app.controller().Running(); }, 120));
+  const RunStatus status = app.controller().Status();
+  ASSERT_EQ(status.state, RunState::kCompleted) << status.error;
+  app.Frame();
+  RgbImage image;
+  app.Frame(nullptr, &image);
+  EXPECT_GE(app.NumSceneCameras(), 6u);  // of 8 images
+  // The log pane has the CLI's lines.
+  EXPECT_TRUE(LogHas(app, std::regex(R"(^\[info\] extract: 8 images, 8 to detect with 'orb')")));
+  const PixelCounts counts = CountViewPixels(image, app.ViewRect());
+  std::printf("3D view: %zu points, %zu cameras, %zu non-background and %zu frustum pixels\n",
+              app.NumScenePoints(), app.NumSceneCameras(), counts.non_background, counts.frustum);
+  // Each point covers 2x2 pixels; the framing keeps 90 % of the points in view, and at
+  // 860x800 pixels of view no more than three in four overlap: a quarter of 4 pixels
+  // per point is the bound. A frustum has 8 edges of at least 10 pixels each.
+  EXPECT_GT(counts.non_background, app.NumScenePoints());
+  EXPECT_GT(app.NumScenePoints(), 1000u);
+  EXPECT_GT(counts.frustum, 80 * app.NumSceneCameras());
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) WritePng(image, keep);
+}
+
+TEST_F(GuiWindowTest, CancelDuringMatchingThenRunReusesFeaturesAndPairs) {
+  MakeSample();
+  GuiOptions options;
+  options.images = dir_.path() / "images";
+  options.output = dir_.path() / "out";
+  options.manifest = manifest_;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  Click(&app, "run");
+  ASSERT_TRUE(WaitFor(
+      &app,
+      [&] {
+        const RunStatus status = app.controller().Status();
+        return !status.stages.empty() && status.stages.back().stage == "match" &&
+               status.stages.back().done >= 1;
+      },
+      60));
+  const auto cancelled_at = std::chrono::steady_clock::now();
+  Click(&app, "cancel");
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return !app.controller().Running(); }, 10));
+  const double cancel_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - cancelled_at).count();
+  EXPECT_LT(cancel_s, 2.0);
+  RunStatus status = app.controller().Status();
+  ASSERT_EQ(status.state, RunState::kCancelled);
+  ASSERT_FALSE(status.stages.empty());
+  EXPECT_EQ(status.stages.back().stage, "match");
+  EXPECT_LT(status.stages.back().done, status.stages.back().total);
+  EXPECT_TRUE(LogHas(app, std::regex("run cancelled")));
+
+  Click(&app, "run");
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return !app.controller().Running(); }, 120));
+  status = app.controller().Status();
+  ASSERT_EQ(status.state, RunState::kCompleted) << status.error;
+  EXPECT_TRUE(
+      LogHas(app, std::regex(R"(extract: 8 images, 0 to detect with 'orb' \(8 already done\))")));
+  // Some pairs were finished before the cancel, and are not matched again.
+  EXPECT_TRUE(LogHas(
+      app, std::regex(R"(match: .* to match with 'brute_force' \([1-9][0-9]* already done\))")));
+}
+
+TEST_F(GuiWindowTest, ReferenceImageOfColmapsFountainModel) {
+  const fs::path model =
+      tessera::testing::SharedDir() / "anchors" / "colmap-3.8" / "fountain-P11" / "sparse" / "0";
+  if (!fs::exists(model / "points3D.bin")) GTEST_SKIP() << "skipped: " << model << " is missing";
+  GuiOptions options;
+  options.model = model;
+  options.width = 320;
+  options.height = 240;
+  options.view_only = true;
+  GuiApp app(options);
+  ASSERT_EQ(app.ModelError(), "");
+  app.Frame();
+  RgbImage image;
+  app.Frame(nullptr, &image);
+  ASSERT_EQ(image.width, 320);
+  ASSERT_EQ(image.height, 240);
+  const fs::path reference_file = tessera::testing::SourceDir() / "host" / "src" / "gui" /
+                                  "testdata" / "fountain_colmap_320x240.png";
+  if (std::getenv("TESSERA_UPDATE_GUI_REFERENCE") != nullptr) WritePng(image, reference_file);
+  const cv::Mat reference = cv::imread(reference_file.string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(reference.empty()) << reference_file;
+  ASSERT_EQ(reference.cols, 320);
+  ASSERT_EQ(reference.rows, 240);
+  // Tolerance: a pixel differs when a channel differs by more than 24 of 255; at most
+  // 1 % of the pixels may differ (point rasterisation at the edges of pixels may move by
+  // one pixel between Mesa versions).
+  size_t differing = 0;
+  size_t drawn = 0;
+  for (int y = 0; y < 240; ++y) {
+    for (int x = 0; x < 320; ++x) {
+      const cv::Vec3b bgr = reference.at<cv::Vec3b>(y, x);
+      const uint8_t* rgb = &image.pixels[(static_cast<size_t>(y) * 320 + x) * 3];
+      bool differs = false;
+      for (int c = 0; c < 3; ++c) differs |= std::abs(int(bgr[2 - c]) - int(rgb[c])) > 24;
+      differing += differs ? 1 : 0;
+      drawn += (rgb[0] != kBackgroundColor[0] || rgb[1] != kBackgroundColor[1]) ? 1 : 0;
+    }
+  }
+  EXPECT_LE(differing, 320u * 240 / 100);
+  EXPECT_GT(drawn, 320u * 240 / 20);  // the model covers more than 5 % of the view
+}
+
+TEST_F(GuiWindowTest, BadInputIsShownInThePanel) {
+  const fs::path empty = dir_.path() / "empty";
+  fs::create_directories(empty);
+  GuiOptions options;
+  options.images = empty;
+  options.output = dir_.path() / "out";
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  // A folder with no images.
+  Click(&app, "run");
+  EXPECT_EQ(app.SetupError(),
+            empty.string() + ": no images in this folder (JPEG, PNG, TIFF, BMP, WebP)");
+  EXPECT_FALSE(app.controller().Running());
+  // A model folder that is not a model.
+  EXPECT_FALSE(app.OpenModel(empty));
+  EXPECT_NE(app.ModelError().find(": not a model:"), std::string::npos) << app.ModelError();
+  app.Frame();
+}
+
+TEST_F(GuiWindowTest, BadManifestAndPluginThatFailsToLoad) {
+  tessera::testing::WriteSampleImages(dir_.path() / "images", 2);
+  const fs::path bad_manifest = dir_.path() / "bad.json";
+  std::ofstream(bad_manifest) << R"({"pipeline": {"detector": {"plugin": "orb", "options": []}}})";
+  GuiOptions options;
+  options.images = dir_.path() / "images";
+  options.output = dir_.path() / "out";
+  options.manifest = bad_manifest;
+  {
+    GuiApp app(options);
+    app.Frame();
+    EXPECT_FALSE(app.Run());
+    EXPECT_NE(app.SetupError().find("pipeline.detector.options"), std::string::npos)
+        << app.SetupError();
+    app.Frame();
+  }
+  // A plugin whose factory throws: the run fails with its name, the window stays.
+  const fs::path throwing_manifest = dir_.path() / "throws.json";
+  std::ofstream(throwing_manifest)
+      << R"({"plugin_paths": [")" +
+             (tessera::testing::BinaryDir() / "test_plugins" / "factory_throws").string() +
+             R"("], "pipeline": {"pair_selector": {"plugin": "throws"}}})";
+  options.manifest = throwing_manifest;
+  GuiApp app(options);
+  app.Frame();
+  ASSERT_TRUE(app.Run()) << app.SetupError();
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return !app.controller().Running(); }, 30));
+  const RunStatus status = app.controller().Status();
+  EXPECT_EQ(status.state, RunState::kFailed);
+  EXPECT_EQ(status.exit_code, 2);
+  EXPECT_NE(status.error.find("cannot reach the license server"), std::string::npos)
+      << status.error;
+  app.Frame();
+  EXPECT_EQ(app.SetupError(), status.error);
+}
+
+TEST_F(GuiWindowTest, NoRedrawWhenNothingChanged) {
+  GuiOptions options;
+  options.width = 400;
+  options.height = 300;
+  options.view_only = true;
+  GuiApp app(options);
+  for (int i = 0; i < 10; ++i) app.Step(0.05);  // settle: the first frames and events
+  const size_t frames = app.frames_drawn();
+  for (int i = 0; i < 3; ++i) EXPECT_FALSE(app.Step(0.1));
+  EXPECT_EQ(app.frames_drawn(), frames);
+  app.SetViewOrbit(10, 0);
+  app.MarkChangedFromInput();
+  EXPECT_TRUE(app.Step(0.1));
+}
+
+}  // namespace
+}  // namespace tessera::gui
