@@ -314,6 +314,7 @@ void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
     if (!input->text.empty()) io.AddInputCharactersUTF8(input->text.c_str());
   }
   ImGui::NewFrame();
+  widgets_.clear();
   if (!options_.view_only) {
     DrawSetupPanel(status);
     DrawSelection();
@@ -477,12 +478,19 @@ void GuiApp::DrawSelection() {
     ImGui::Text("%s  (image %u, camera %u)", image.name.c_str(), image.image_id, image.camera_id);
     ImGui::Text("%zu observations, mean reprojection error %.3f px", observations,
                 usable > 0 ? error_sum / static_cast<double>(usable) : 0.0);
+    Record("camera details");
+    const ImVec2 position = ImGui::GetWindowPos();
+    const ImVec2 size = ImGui::GetWindowSize();
+    widgets_["camera window"] = {position.x, position.y, position.x + size.x, position.y + size.y};
     // The photograph with its observations, when the image folder has it.
     if (texture_image_ != selected_image_) {
       texture_image_ = selected_image_;
       texture_width_ = 0;
-      const cv::Mat bgr =
-          cv::imread((fs::path(images_.data()) / image.name).string(), cv::IMREAD_COLOR);
+      const fs::path file = fs::path(images_.data()) / image.name;
+      std::error_code error;
+      const cv::Mat bgr = fs::is_regular_file(file, error)
+                              ? cv::imread(file.string(), cv::IMREAD_COLOR)
+                              : cv::Mat();
       if (!bgr.empty()) {
         const double shrink = std::min(1.0, 480.0 / bgr.cols);
         cv::Mat rgb;
@@ -528,6 +536,7 @@ void GuiApp::DrawSelection() {
                 static_cast<unsigned long long>(selected_point_), point.xyz.x(), point.xyz.y(),
                 point.xyz.z(), point.error);
     ImGui::Text("track of %zu observations:", point.track.size());
+    Record("point details");
     for (const TrackElement& element : point.track) {
       const auto image = model.images.find(element.image_id);
       if (image == model.images.end() || element.point2D_idx >= image->second.points2D.size()) {
@@ -577,30 +586,28 @@ void GuiApp::HandleViewInput() {
   }
 }
 
-void GuiApp::Pick(float x, float y) {
-  if (scene_ == nullptr) return;
+std::optional<std::array<float, 2>> GuiApp::ProjectToWindow(const Eigen::Vector3f& world) const {
   const WidgetRect view = ViewRect();
   const float width = view.max_x - view.min_x;
   const float height = view.max_y - view.min_y;
-  const Eigen::Matrix4f world_to_clip =
-      camera_.ProjectionMatrix(width / std::max(height, 1.0f)) * camera_.ViewMatrix();
-  // Window pixels of a world point; false behind the view.
-  auto project = [&](const Eigen::Vector3f& world, Eigen::Vector2f* pixel, float* depth) {
-    const Eigen::Vector4f clip = world_to_clip * world.homogeneous();
-    if (clip.w() <= 0) return false;
-    *pixel = Eigen::Vector2f(view.min_x + (clip.x() / clip.w() + 1) / 2 * width,
-                             view.min_y + (1 - clip.y() / clip.w()) / 2 * height);
-    *depth = clip.w();
-    return true;
+  const Eigen::Vector4f clip = camera_.ProjectionMatrix(width / std::max(height, 1.0f)) *
+                               camera_.ViewMatrix() * world.homogeneous();
+  if (clip.w() <= 0) return std::nullopt;
+  return std::array<float, 2>{view.min_x + (clip.x() / clip.w() + 1) / 2 * width,
+                              view.min_y + (1 - clip.y() / clip.w()) / 2 * height};
+}
+
+void GuiApp::Pick(float x, float y) {
+  if (scene_ == nullptr) return;
+  // The nearest camera centre within 10 pixels, else the nearest point within 6.
+  auto distance_to_click = [&](const Eigen::Vector3f& world) {
+    const auto pixel = ProjectToWindow(world);
+    return pixel ? std::hypot((*pixel)[0] - x, (*pixel)[1] - y) : 1e9f;
   };
-  const Eigen::Vector2f click(x, y);
-  Eigen::Vector2f pixel;
-  float depth = 0;
-  float best = 10;  // pixels
+  float best = 10;
   image_t best_image = kInvalidImageId;
   for (const SceneCamera& camera : scene_->cameras) {
-    if (!project(camera.center_in_world, &pixel, &depth)) continue;
-    const float distance = (pixel - click).norm();
+    const float distance = distance_to_click(camera.center_in_world);
     if (distance < best) {
       best = distance;
       best_image = camera.image_id;
@@ -611,16 +618,12 @@ void GuiApp::Pick(float x, float y) {
     return;
   }
   best = 6;
-  float best_depth = 0;
   point3D_t best_point = kInvalidPoint3DId;
   for (size_t i = 0; i < scene_->point_ids.size(); ++i) {
-    const Eigen::Vector3f world(scene_->positions[3 * i], scene_->positions[3 * i + 1],
-                                scene_->positions[3 * i + 2]);
-    if (!project(world, &pixel, &depth)) continue;
-    const float distance = (pixel - click).norm();
-    if (distance < best || (distance == best && depth < best_depth)) {
+    const float distance = distance_to_click(Eigen::Vector3f(
+        scene_->positions[3 * i], scene_->positions[3 * i + 1], scene_->positions[3 * i + 2]));
+    if (distance < best) {
       best = distance;
-      best_depth = depth;
       best_point = scene_->point_ids[i];
     }
   }
@@ -632,7 +635,8 @@ int RunGui(const GuiCommandOptions& options) {
     throw InputError("gui: --screenshot needs --model or --images");
   }
   GuiApp app(options.gui);
-  if (!options.gui.model.empty() && !app.ModelError().empty()) throw InputError(app.ModelError());
+  // OpenModel has logged the one-line message.
+  if (!options.gui.model.empty() && !app.ModelError().empty()) return kExitBadInput;
   if (options.screenshot.empty()) {
     if (!options.gui.images.empty() && !options.gui.output.empty()) app.Run();
     while (!app.ShouldClose()) app.Step(1.0);

@@ -87,6 +87,9 @@ class GuiApp {
   size_t NumScenePoints() const;
   size_t NumSceneCameras() const;
   void SetViewOrbit(float dx_px, float dy_px) { camera_.Orbit(dx_px, dy_px); }
+  // Where a world point shows in the 3D view, in window pixels; nothing when behind it.
+  std::optional<std::array<float, 2>> ProjectToWindow(const Eigen::Vector3f& world) const;
+  const Scene* scene() const { return scene_.get(); }
   image_t selected_image() const { return selected_image_; }
   point3D_t selected_point() const { return selected_point_; }
   // For the window system's callbacks.

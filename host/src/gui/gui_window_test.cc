@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
@@ -246,6 +247,56 @@ TEST_F(GuiWindowTest, ReferenceImageOfColmapsFountainModel) {
   }
   EXPECT_LE(differing, 320u * 240 / 100);
   EXPECT_GT(drawn, 320u * 240 / 20);  // the model covers more than 5 % of the view
+}
+
+TEST_F(GuiWindowTest, ClickingACameraOrAPointShowsItsDetails) {
+  const fs::path model =
+      tessera::testing::SharedDir() / "anchors" / "colmap-3.8" / "fountain-P11" / "sparse" / "0";
+  if (!fs::exists(model / "points3D.bin")) GTEST_SKIP() << "skipped: " << model << " is missing";
+  GuiOptions options;
+  options.model = model;
+  // The photographs, for the camera's window, when the data set is there.
+  options.images = tessera::testing::SharedDir() / "datasets" / "fountain-P11" / "images";
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  ASSERT_NE(app.scene(), nullptr);
+  const SceneCamera& camera = app.scene()->cameras.at(3);
+  const auto center = app.ProjectToWindow(camera.center_in_world);
+  ASSERT_TRUE(center.has_value());
+  Click(&app, WidgetRect{(*center)[0], (*center)[1], (*center)[0], (*center)[1]});
+  EXPECT_EQ(app.selected_image(), camera.image_id);
+  app.Frame();  // the window appears, sized to its contents from the next frame on
+  app.Frame();
+  ASSERT_TRUE(app.Widget("camera details").has_value());
+  // A point (the first in view and not under the camera's window): the one nearest the
+  // click within 6 pixels is picked.
+  const Scene& scene = *app.scene();
+  const WidgetRect covered = app.Widget("camera window").value();
+  const WidgetRect view = app.ViewRect();
+  std::optional<std::array<float, 2>> pixel;
+  for (size_t i = 0; i < scene.NumPoints() && !pixel; ++i) {
+    pixel = app.ProjectToWindow(Eigen::Vector3f(scene.positions[3 * i], scene.positions[3 * i + 1],
+                                                scene.positions[3 * i + 2]));
+    if (!pixel) continue;
+    const float x = (*pixel)[0], y = (*pixel)[1];
+    const bool in_view = x > view.min_x + 8 && x < view.max_x - 8 && y > 8 && y < view.max_y - 8;
+    const bool under_window = x > covered.min_x - 8 && x < covered.max_x + 8 &&
+                              y > covered.min_y - 8 && y < covered.max_y + 8;
+    if (!in_view || under_window) pixel.reset();
+  }
+  ASSERT_TRUE(pixel.has_value());
+  Click(&app, WidgetRect{(*pixel)[0], (*pixel)[1], (*pixel)[0], (*pixel)[1]});
+  ASSERT_NE(app.selected_point(), kInvalidPoint3DId)
+      << (*pixel)[0] << "," << (*pixel)[1] << " window " << covered.min_x << "," << covered.min_y
+      << "-" << covered.max_x << "," << covered.max_y << " image " << app.selected_image();
+  const Point3D& picked = scene.model->points3D.at(app.selected_point());
+  const auto picked_pixel = app.ProjectToWindow(picked.xyz.cast<float>());
+  EXPECT_LT(std::hypot((*picked_pixel)[0] - (*pixel)[0], (*picked_pixel)[1] - (*pixel)[1]), 6);
+  RgbImage image;
+  app.Frame(nullptr, &image);
+  EXPECT_TRUE(app.Widget("point details").has_value());
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) WritePng(image, keep);
 }
 
 TEST_F(GuiWindowTest, BadInputIsShownInThePanel) {
