@@ -135,6 +135,7 @@ GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
   spdlog::default_logger()->sinks().push_back(log_sink_);
   controller_ = std::make_unique<RunController>(wake);
 
+  follow_run_ = options.follow_run;
   CopyPath(options.images, &images_);
   CopyPath(options.output, &output_);
   CopyPath(options.manifest, &manifest_);
@@ -285,12 +286,12 @@ bool GuiApp::Run() {
 
 void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
   if (auto scene = controller_->TakeScene(&scene_version_)) {
-    ShowScene(std::move(scene), !user_moved_camera_);
+    if (follow_run_) ShowScene(std::move(scene), !user_moved_camera_);
   }
   const RunStatus status = controller_->Status();
   if (status.state != last_state_) {
     last_state_ = status.state;
-    if (status.state == RunState::kCompleted) {
+    if (status.state == RunState::kCompleted && follow_run_) {
       // The written model has the points' colours; show it (and any others).
       try {
         model_folders_ = FindModelFolders(status.output_dir);
@@ -380,6 +381,8 @@ void GuiApp::DrawSetupPanel(const RunStatus& status) {
   Record("cancel");
   ImGui::SameLine();
   ImGui::Text("%s", RunStateName(status.state));
+  ImGui::SameLine();
+  ImGui::Checkbox("show the model growing", &follow_run_);
   if (status.state == RunState::kFailed || !setup_error_.empty()) {
     ErrorText(setup_error_.empty() ? status.error : setup_error_);
   }

@@ -34,6 +34,7 @@ struct GuiOptions {
   int width = 1280;  // window size in screen pixels
   int height = 800;
   bool view_only = false;  // no panels: the 3D view fills the window
+  bool follow_run = true;  // show the model of a run as it grows (a check box)
 };
 
 // Mouse and keyboard input given by a test instead of the window system, applied after
@@ -90,6 +91,8 @@ class GuiApp {
   // Where a world point shows in the 3D view, in window pixels; nothing when behind it.
   std::optional<std::array<float, 2>> ProjectToWindow(const Eigen::Vector3f& world) const;
   const Scene* scene() const { return scene_.get(); }
+  // Shows `scene` (framed) as if opened.
+  void SetScene(std::shared_ptr<const Scene> scene) { ShowScene(std::move(scene), true); }
   image_t selected_image() const { return selected_image_; }
   point3D_t selected_point() const { return selected_point_; }
   // For the window system's callbacks.
@@ -125,6 +128,7 @@ class GuiApp {
   bool user_moved_camera_ = false;
   std::vector<std::filesystem::path> model_folders_;
   int model_index_ = 0;
+  bool follow_run_ = true;
   OrbitCamera camera_;
   float point_size_ = 2;
   float frustum_size_ = 0.15f;
