@@ -152,6 +152,9 @@ GuiApp::~GuiApp() {
   auto& sinks = spdlog::default_logger()->sinks();
   sinks.erase(std::remove(sinks.begin(), sinks.end(), log_sink_), sinks.end());
   if (image_texture_ != 0) glDeleteTextures(1, &image_texture_);
+  for (Texture& texture : pair_textures_) {
+    if (texture.id != 0) glDeleteTextures(1, &texture.id);
+  }
   renderer_.reset();
   ImGui_ImplOpenGL3_Shutdown();
   ImGui_ImplGlfw_Shutdown();
@@ -319,6 +322,7 @@ void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
   if (!options_.view_only) {
     DrawSetupPanel(status);
     DrawSelection();
+    DrawMatchMatrix();
   }
   HandleViewInput();
   ImGui::Render();
@@ -431,6 +435,15 @@ void GuiApp::DrawSetupPanel(const RunStatus& status) {
   }
   ImGui::SameLine();
   ImGui::TextDisabled("drag: orbit, shift+drag/right: pan, wheel: zoom, click: details");
+
+  if (ImGui::Button("Match matrix")) {
+    const fs::path workspace(output_.data()[0] != '\0' ? output_.data() : model_path_.data());
+    OpenMatchMatrix(workspace);
+  }
+  Record("match matrix");
+  ImGui::SameLine();
+  ImGui::TextDisabled("of the output folder (else the model's workspace)");
+  ErrorText(match_error_);
 
   ImGui::Separator();
   ImGui::TextUnformatted("Log");
@@ -631,6 +644,133 @@ void GuiApp::Pick(float x, float y) {
     }
   }
   selected_point_ = best_point;
+}
+
+bool GuiApp::LoadTexture(const fs::path& file, int max_width, Texture* texture) {
+  std::error_code error;
+  const cv::Mat bgr =
+      fs::is_regular_file(file, error) ? cv::imread(file.string(), cv::IMREAD_COLOR) : cv::Mat();
+  if (bgr.empty()) {
+    texture->width = 0;
+    return false;
+  }
+  const double shrink = std::min(1.0, static_cast<double>(max_width) / bgr.cols);
+  cv::Mat rgb;
+  cv::resize(bgr, rgb, cv::Size(), shrink, shrink, cv::INTER_AREA);
+  cv::cvtColor(rgb, rgb, cv::COLOR_BGR2RGB);
+  if (texture->id == 0) glGenTextures(1, &texture->id);
+  glBindTexture(GL_TEXTURE_2D, texture->id);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+  glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+  glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+  glTexImage2D(GL_TEXTURE_2D, 0, GL_RGB, rgb.cols, rgb.rows, 0, GL_RGB, GL_UNSIGNED_BYTE, rgb.data);
+  glBindTexture(GL_TEXTURE_2D, 0);
+  texture->width = rgb.cols;
+  texture->height = rgb.rows;
+  texture->scale = static_cast<float>(rgb.cols) / static_cast<float>(bgr.cols);
+  return true;
+}
+
+bool GuiApp::OpenMatchMatrix(const fs::path& path) {
+  match_error_.clear();
+  pair_row_ = pair_column_ = -1;
+  pair_inliers_ = {};
+  try {
+    match_matrix_ = ReadMatchMatrix(path);
+    show_match_matrix_ = true;
+    return true;
+  } catch (const InputError& error) {
+    match_error_ = error.what();
+    spdlog::error("{}", match_error_);
+    match_matrix_.reset();
+    return false;
+  }
+}
+
+void GuiApp::DrawMatchMatrix() {
+  if (!show_match_matrix_ || !match_matrix_) return;
+  const MatchMatrix& matrix = *match_matrix_;
+  const WidgetRect view = ViewRect();
+  ImGui::SetNextWindowPos(ImVec2(view.min_x + 10, 10), ImGuiCond_Appearing);
+  ImGui::Begin("Match matrix", &show_match_matrix_, ImGuiWindowFlags_AlwaysAutoResize);
+  const size_t n = matrix.size();
+  ImGui::Text("%zu images; colour: verified inliers (most: %d). Click a cell.", n,
+              matrix.max_inliers);
+  const float cell = std::clamp(360.0f / static_cast<float>(std::max<size_t>(n, 1)), 2.0f, 24.0f);
+  const ImVec2 origin = ImGui::GetCursorScreenPos();
+  const float side = cell * static_cast<float>(n);
+  ImGui::InvisibleButton("cells", ImVec2(std::max(side, 1.0f), std::max(side, 1.0f)));
+  Record("match cells");
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  for (size_t row = 0; row < n; ++row) {
+    for (size_t column = 0; column < n; ++column) {
+      const int inliers = matrix.Inliers(row, column);
+      const float t = matrix.max_inliers > 0 ? static_cast<float>(inliers) / matrix.max_inliers : 0;
+      // Dark blue (none) to yellow (most).
+      const ImU32 color =
+          inliers == 0 ? IM_COL32(30, 30, 45, 255)
+                       : IM_COL32(static_cast<int>(40 + 215 * t), static_cast<int>(60 + 170 * t),
+                                  static_cast<int>(150 - 120 * t), 255);
+      const ImVec2 min(origin.x + cell * static_cast<float>(column),
+                       origin.y + cell * static_cast<float>(row));
+      draw->AddRectFilled(
+          min, ImVec2(min.x + cell - (cell > 4 ? 1 : 0), min.y + cell - (cell > 4 ? 1 : 0)), color);
+    }
+  }
+  if (pair_row_ >= 0) {
+    const ImVec2 min(origin.x + cell * static_cast<float>(pair_column_),
+                     origin.y + cell * static_cast<float>(pair_row_));
+    draw->AddRect(min, ImVec2(min.x + cell, min.y + cell), IM_COL32(255, 255, 255, 255));
+  }
+  if (ImGui::IsItemHovered() && n > 0) {
+    const ImVec2 mouse = ImGui::GetIO().MousePos;
+    const int row =
+        std::clamp(static_cast<int>((mouse.y - origin.y) / cell), 0, static_cast<int>(n) - 1);
+    const int column =
+        std::clamp(static_cast<int>((mouse.x - origin.x) / cell), 0, static_cast<int>(n) - 1);
+    ImGui::SetTooltip("%s - %s: %d inliers", matrix.names[static_cast<size_t>(row)].c_str(),
+                      matrix.names[static_cast<size_t>(column)].c_str(),
+                      matrix.Inliers(static_cast<size_t>(row), static_cast<size_t>(column)));
+    if (ImGui::IsItemClicked(ImGuiMouseButton_Left) && row != column) {
+      pair_row_ = row;
+      pair_column_ = column;
+      try {
+        pair_inliers_ = ReadPairInliers(matrix.database, matrix.image_ids[static_cast<size_t>(row)],
+                                        matrix.image_ids[static_cast<size_t>(column)]);
+      } catch (const InputError& error) {
+        match_error_ = error.what();
+        pair_inliers_ = {};
+      }
+      const fs::path images(images_.data());
+      LoadTexture(images / pair_inliers_.name1, 360, &pair_textures_[0]);
+      LoadTexture(images / pair_inliers_.name2, 360, &pair_textures_[1]);
+    }
+  }
+  if (pair_row_ >= 0) {
+    ImGui::Text("%s - %s: %zu inlier matches", pair_inliers_.name1.c_str(),
+                pair_inliers_.name2.c_str(), pair_inliers_.xy1.size());
+    if (pair_textures_[0].width > 0 && pair_textures_[1].width > 0) {
+      const ImVec2 left = ImGui::GetCursorScreenPos();
+      for (const Texture& texture : pair_textures_) {
+        ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(texture.id)),
+                     ImVec2(static_cast<float>(texture.width), static_cast<float>(texture.height)));
+        ImGui::SameLine();
+      }
+      ImGui::NewLine();
+      const float right_x =
+          left.x + static_cast<float>(pair_textures_[0].width) + ImGui::GetStyle().ItemSpacing.x;
+      for (size_t i = 0; i < pair_inliers_.xy1.size(); ++i) {
+        const ImVec2 a(left.x + pair_inliers_.xy1[i].x() * pair_textures_[0].scale,
+                       left.y + pair_inliers_.xy1[i].y() * pair_textures_[0].scale);
+        const ImVec2 b(right_x + pair_inliers_.xy2[i].x() * pair_textures_[1].scale,
+                       left.y + pair_inliers_.xy2[i].y() * pair_textures_[1].scale);
+        draw->AddLine(a, b, IM_COL32(60, 255, 90, 160));
+      }
+    } else {
+      ImGui::TextDisabled("(the photographs are not in the image folder)");
+    }
+  }
+  ImGui::End();
 }
 
 int RunGui(const GuiCommandOptions& options) {

@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "gui/log_sink.h"
+#include "gui/match_matrix.h"
 #include "gui/orbit_camera.h"
 #include "gui/run_controller.h"
 #include "gui/screenshot.h"
@@ -81,6 +82,13 @@ class GuiApp {
   bool OpenModel(const std::filesystem::path& path);
   const std::string& ModelError() const { return model_error_; }
   const std::string& SetupError() const { return setup_error_; }
+  // Opens the match matrix of the workspace `path` (its database.db); false with the
+  // message in MatchError when it cannot.
+  bool OpenMatchMatrix(const std::filesystem::path& path);
+  const std::string& MatchError() const { return match_error_; }
+  // The pair (row, column) clicked in the match matrix and its inlier matches.
+  std::pair<int, int> SelectedPair() const { return {pair_row_, pair_column_}; }
+  const PairInliers& SelectedPairInliers() const { return pair_inliers_; }
   std::optional<WidgetRect> Widget(const std::string& name) const;
   // The 3D view's rectangle in window pixels.
   WidgetRect ViewRect() const;
@@ -104,6 +112,7 @@ class GuiApp {
   void DrawSetupPanel(const RunStatus& status);
   void DrawModelPanel();
   void DrawSelection();
+  void DrawMatchMatrix();
   void HandleViewInput();
   void Pick(float x, float y);
   void Record(const std::string& name);
@@ -139,6 +148,21 @@ class GuiApp {
   int texture_width_ = 0, texture_height_ = 0;
   float texture_scale_ = 1;
   size_t log_lines_seen_ = 0;
+
+  // The match matrix window and its selected pair (row, column).
+  struct Texture {
+    unsigned int id = 0;
+    int width = 0, height = 0;
+    float scale = 1;  // texture pixels per image pixel
+  };
+  // Loads `file` shrunk to at most max_width pixels; false when it cannot be read.
+  static bool LoadTexture(const std::filesystem::path& file, int max_width, Texture* texture);
+  bool show_match_matrix_ = false;
+  std::optional<MatchMatrix> match_matrix_;
+  std::string match_error_;
+  int pair_row_ = -1, pair_column_ = -1;
+  PairInliers pair_inliers_;
+  Texture pair_textures_[2];
 
   // Mouse in the 3D view.
   bool dragging_ = false;

@@ -205,6 +205,24 @@ TEST_F(GuiWindowTest, CancelDuringMatchingThenRunReusesFeaturesAndPairs) {
   // Some pairs were finished before the cancel, and are not matched again.
   EXPECT_TRUE(LogHas(
       app, std::regex(R"(match: .* to match with 'brute_force' \([1-9][0-9]* already done\))")));
+
+  // The match matrix of the workspace: click the cell of images 1 and 2 (row 0, column 1).
+  Click(&app, "match matrix");
+  ASSERT_EQ(app.MatchError(), "");
+  app.Frame();
+  app.Frame();
+  const WidgetRect cells = app.Widget("match cells").value();
+  const float cell = (cells.max_x - cells.min_x) / 8;
+  Click(&app, WidgetRect{cells.min_x + 1.5f * cell, cells.min_y + 0.5f * cell,
+                         cells.min_x + 1.5f * cell, cells.min_y + 0.5f * cell});
+  EXPECT_EQ(app.SelectedPair(), std::make_pair(0, 1));
+  EXPECT_EQ(app.SelectedPairInliers().name1, "0000.jpg");
+  EXPECT_EQ(app.SelectedPairInliers().name2, "0001.jpg");
+  EXPECT_GT(app.SelectedPairInliers().xy1.size(), 15u);  // a verified pair
+  RgbImage image;
+  app.Frame();
+  app.Frame(nullptr, &image);
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) WritePng(image, keep);
 }
 
 TEST_F(GuiWindowTest, ReferenceImageOfColmapsFountainModel) {
