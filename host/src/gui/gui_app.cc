@@ -20,9 +20,13 @@
 #include "gui/model_loader.h"
 #include "gui/renderer.h"
 #include "manifest/manifest.h"
+#include "pipeline/pipeline_context.h"
+#include "plugin/plugin_call.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
+#include "tessera/io/file_io.h"
 #include "tessera/io/model_statistics.h"
+#include "util/paths.h"
 
 namespace tessera::gui {
 namespace fs = std::filesystem;
@@ -374,6 +378,8 @@ void GuiApp::DrawSetupPanel(const RunStatus& status) {
   Record("manifest");
   ErrorText(manifest_error_);
 
+  DrawManifestEditor();
+
   ImGui::BeginDisabled(running);
   if (ImGui::Button("Run")) Run();
   ImGui::EndDisabled();
@@ -669,6 +675,119 @@ bool GuiApp::LoadTexture(const fs::path& file, int max_width, Texture* texture) 
   texture->height = rgb.rows;
   texture->scale = static_cast<float>(rgb.cols) / static_cast<float>(bgr.cols);
   return true;
+}
+
+void GuiApp::SetEditorText(const std::string& text) {
+  const size_t size = std::min(text.size(), editor_text_.size() - 1);
+  std::copy(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(size), editor_text_.begin());
+  editor_text_[size] = '\0';
+}
+
+bool GuiApp::LoadManifestIntoEditor() {
+  editor_error_.clear();
+  const fs::path file = manifest_[0] != '\0' ? fs::path(manifest_.data()) : DefaultManifestFile();
+  try {
+    const std::string text = ReadFileContents(file);
+    if (text.size() >= editor_text_.size()) {
+      throw InputError(file.string() + ": too long for the editor (64 KiB)");
+    }
+    SetEditorText(text);
+    editor_status_ = "loaded " + file.string();
+    return true;
+  } catch (const InputError& error) {
+    editor_error_ = error.what();
+    return false;
+  }
+}
+
+bool GuiApp::CheckEditedManifest() {
+  editor_error_.clear();
+  editor_status_.clear();
+  const fs::path base_dir = manifest_[0] != '\0' ? fs::path(manifest_.data()).parent_path()
+                                                 : DefaultManifestFile().parent_path();
+  try {
+    const nlohmann::json json = nlohmann::json::parse(std::string(editor_text_.data()));
+    PipelineContext::Create(Manifest::FromJson(json, base_dir, "the manifest editor"));
+    editor_status_ = "valid: every plugin was created with its options";
+    return true;
+  } catch (const nlohmann::json::parse_error& error) {
+    editor_error_ = std::string("the manifest editor: invalid JSON: ") + error.what();
+  } catch (const PluginError& error) {
+    editor_error_ = error.what();
+  } catch (const InputError& error) {
+    editor_error_ = error.what();
+  }
+  return false;
+}
+
+bool GuiApp::SaveEditedManifest(const fs::path& file) {
+  if (file.empty()) {
+    editor_error_ = "choose a file to save the manifest to";
+    return false;
+  }
+  if (!CheckEditedManifest()) return false;
+  try {
+    WriteFileAtomically(file, editor_text_.data());
+  } catch (const InputError& error) {
+    editor_error_ = error.what();
+    return false;
+  }
+  CopyPath(file, &manifest_);
+  editor_status_ = "saved " + file.string() + "; Run uses it";
+  return true;
+}
+
+bool GuiApp::SetEditorPlugin(const std::string& slot, const std::string& plugin) {
+  editor_error_.clear();
+  try {
+    nlohmann::json json = nlohmann::json::parse(std::string(editor_text_.data()));
+    json["pipeline"][slot] = {{"plugin", plugin}};
+    SetEditorText(json.dump(2));
+    return true;
+  } catch (const nlohmann::json::exception& error) {
+    editor_error_ = std::string("the manifest editor: ") + error.what();
+    return false;
+  }
+}
+
+void GuiApp::DrawManifestEditor() {
+  if (!ImGui::CollapsingHeader("Pipeline: plugins and options (manifest editor)")) return;
+  Record("manifest editor");
+  if (editor_text_[0] == '\0') LoadManifestIntoEditor();
+  if (plugins_by_kind_.empty()) {
+    try {
+      const PluginRegistry registry = PluginRegistry::Discover(PluginSearchPath({}));
+      for (const char* kind : {"detector", "pair_selector", "matcher", "bundle_adjuster"}) {
+        plugins_by_kind_[kind] = registry.NamesOfKind(kind);
+      }
+    } catch (const std::exception& error) {
+      editor_error_ = error.what();
+      plugins_by_kind_["detector"] = {};
+    }
+  }
+  // One plugin per slot, from the plugins found on the plugin path.
+  for (const auto& [kind, names] : plugins_by_kind_) {
+    const std::string label = kind + "##slot";
+    if (ImGui::BeginCombo(label.c_str(), "choose...")) {
+      for (const std::string& name : names) {
+        if (ImGui::Selectable(name.c_str())) SetEditorPlugin(kind, name);
+      }
+      ImGui::EndCombo();
+    }
+  }
+  ImGui::InputTextMultiline("##manifest json", editor_text_.data(), editor_text_.size(),
+                            ImVec2(-1, ImGui::GetTextLineHeight() * 12));
+  if (ImGui::Button("Check")) CheckEditedManifest();
+  ImGui::SameLine();
+  if (ImGui::Button("Reload")) LoadManifestIntoEditor();
+  ImGui::SameLine();
+  if (ImGui::Button("Save as")) SaveEditedManifest(fs::path(save_path_.data()));
+  ImGui::SameLine();
+  ImGui::SetNextItemWidth(-1);
+  ImGui::InputTextWithHint("##save path", "manifest file to write", save_path_.data(),
+                           save_path_.size());
+  ErrorText(editor_error_);
+  if (!editor_status_.empty()) ImGui::TextDisabled("%s", editor_status_.c_str());
 }
 
 bool GuiApp::OpenMatchMatrix(const fs::path& path) {

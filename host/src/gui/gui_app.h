@@ -82,6 +82,19 @@ class GuiApp {
   bool OpenModel(const std::filesystem::path& path);
   const std::string& ModelError() const { return model_error_; }
   const std::string& SetupError() const { return setup_error_; }
+  // The manifest editor: loads the manifest field's file (empty: the default manifest)
+  // into the editor; checks the editor's JSON as `tessera run` does (parsed, every plugin
+  // created with its options); saves it to `file` (after checking) and makes it the
+  // run's manifest. False with the message in EditorError.
+  bool LoadManifestIntoEditor();
+  bool CheckEditedManifest();
+  bool SaveEditedManifest(const std::filesystem::path& file);
+  void SetEditorText(const std::string& text);
+  std::string EditorText() const { return editor_text_.data(); }
+  const std::string& EditorError() const { return editor_error_; }
+  // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "bundle_adjuster")
+  // in the editor's JSON, with no options.
+  bool SetEditorPlugin(const std::string& slot, const std::string& plugin);
   // Opens the match matrix of the workspace `path` (its database.db); false with the
   // message in MatchError when it cannot.
   bool OpenMatchMatrix(const std::filesystem::path& path);
@@ -113,6 +126,7 @@ class GuiApp {
   void DrawModelPanel();
   void DrawSelection();
   void DrawMatchMatrix();
+  void DrawManifestEditor();
   void HandleViewInput();
   void Pick(float x, float y);
   void Record(const std::string& name);
@@ -148,6 +162,12 @@ class GuiApp {
   int texture_width_ = 0, texture_height_ = 0;
   float texture_scale_ = 1;
   size_t log_lines_seen_ = 0;
+
+  // The manifest editor.
+  std::vector<char> editor_text_ = std::vector<char>(1 << 16, '\0');
+  std::array<char, 1024> save_path_{};
+  std::string editor_error_, editor_status_;
+  std::map<std::string, std::vector<std::string>> plugins_by_kind_;  // found on first use
 
   // The match matrix window and its selected pair (row, column).
   struct Texture {

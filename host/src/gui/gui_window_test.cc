@@ -14,6 +14,7 @@
 #include "gui/gui_app.h"
 #include "gui/renderer.h"
 #include "gui/xvfb.h"
+#include "manifest/manifest.h"
 #include "pipeline/stage_test_util.h"
 #include "tessera/errors.h"
 #include "test_support.h"
@@ -372,6 +373,31 @@ TEST_F(GuiWindowTest, BadManifestAndPluginThatFailsToLoad) {
       << status.error;
   app.Frame();
   EXPECT_EQ(app.SetupError(), status.error);
+}
+
+TEST_F(GuiWindowTest, ManifestEditorChecksAsTheCliAndSaves) {
+  GuiOptions options;
+  GuiApp app(options);
+  app.Frame();
+  ASSERT_TRUE(app.LoadManifestIntoEditor()) << app.EditorError();
+  EXPECT_NE(app.EditorText().find("\"sift\""), std::string::npos);  // the default manifest
+  // A bad option value: the plugin's own validation names the JSON path.
+  app.SetEditorText(
+      R"({"pipeline": {"detector": {"plugin": "orb", "options": {"max_num_features": "many"}}}})");
+  EXPECT_FALSE(app.CheckEditedManifest());
+  EXPECT_NE(app.EditorError().find("pipeline.detector"), std::string::npos) << app.EditorError();
+  app.SetEditorText("{\"pipeline\": ");
+  EXPECT_FALSE(app.CheckEditedManifest());
+  EXPECT_NE(app.EditorError().find("invalid JSON"), std::string::npos) << app.EditorError();
+  // A plugin chosen for a slot, then saved: the run's manifest is the saved file.
+  app.SetEditorText(R"({"pipeline": {"pair_selector": {"plugin": "exhaustive"}}})");
+  ASSERT_TRUE(app.SetEditorPlugin("detector", "orb"));
+  const fs::path saved = dir_.path() / "saved.json";
+  ASSERT_TRUE(app.SaveEditedManifest(saved)) << app.EditorError();
+  const Manifest manifest = Manifest::Load(saved);
+  ASSERT_TRUE(manifest.detector.has_value());
+  EXPECT_EQ(manifest.detector->plugin, "orb");
+  app.Frame();
 }
 
 TEST_F(GuiWindowTest, NoRedrawWhenNothingChanged) {
