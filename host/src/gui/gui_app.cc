@@ -369,14 +369,20 @@ void GuiApp::DrawSetupPanel(const RunStatus& status) {
   const bool running = controller_->Running();
 
   ImGui::TextUnformatted("Reconstruct");
+  ImGui::PushItemWidth(-110);
   ImGui::InputTextWithHint("Images", "folder of photographs", images_.data(), images_.size());
   Record("images");
+  ImGui::SameLine();
+  FolderBrowser("images", &images_);
   ErrorText(images_error_);
   ImGui::InputTextWithHint("Output", "workspace folder", output_.data(), output_.size());
   Record("output");
+  ImGui::SameLine();
+  FolderBrowser("output", &output_);
   ImGui::InputTextWithHint("Manifest", "default manifest", manifest_.data(), manifest_.size());
   Record("manifest");
   ErrorText(manifest_error_);
+  ImGui::PopItemWidth();
 
   DrawManifestEditor();
 
@@ -788,6 +794,47 @@ void GuiApp::DrawManifestEditor() {
                            save_path_.size());
   ErrorText(editor_error_);
   if (!editor_status_.empty()) ImGui::TextDisabled("%s", editor_status_.c_str());
+}
+
+void GuiApp::FolderBrowser(const std::string& name, std::array<char, 1024>* path) {
+  const std::string popup = "browse " + name;
+  if (ImGui::Button(("...##" + name).c_str())) {
+    std::error_code error;
+    browse_dir_ =
+        (*path)[0] != '\0' ? fs::absolute(fs::path(path->data()), error) : fs::current_path(error);
+    if (!fs::is_directory(browse_dir_, error)) browse_dir_ = browse_dir_.parent_path();
+    ImGui::OpenPopup(popup.c_str());
+  }
+  Record(popup);
+  if (!ImGui::BeginPopup(popup.c_str())) return;
+  ImGui::TextUnformatted(browse_dir_.string().c_str());
+  if (ImGui::Button("Choose this folder")) {
+    CopyPath(browse_dir_, path);
+    ImGui::CloseCurrentPopup();
+  }
+  Record("choose folder");
+  ImGui::Separator();
+  if (ImGui::Selectable("..", false, ImGuiSelectableFlags_DontClosePopups)) {
+    browse_dir_ = browse_dir_.parent_path();
+  }
+  std::vector<std::string> folders;
+  std::error_code error;
+  for (fs::directory_iterator it(browse_dir_, fs::directory_options::skip_permission_denied, error),
+       end;
+       !error && it != end && folders.size() < 1000; it.increment(error)) {
+    std::error_code type_error;
+    if (it->is_directory(type_error)) folders.push_back(it->path().filename().string());
+  }
+  std::sort(folders.begin(), folders.end());
+  fs::path next;
+  for (const std::string& folder : folders) {
+    if (ImGui::Selectable((folder + "/").c_str(), false, ImGuiSelectableFlags_DontClosePopups)) {
+      next = browse_dir_ / folder;
+    }
+    Record("folder " + folder);
+  }
+  if (!next.empty()) browse_dir_ = next;
+  ImGui::EndPopup();
 }
 
 bool GuiApp::OpenMatchMatrix(const fs::path& path) {

@@ -92,6 +92,8 @@ class GuiApp {
   void SetEditorText(const std::string& text);
   std::string EditorText() const { return editor_text_.data(); }
   const std::string& EditorError() const { return editor_error_; }
+  std::string ImagesField() const { return images_.data(); }
+  std::string OutputField() const { return output_.data(); }
   // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "bundle_adjuster")
   // in the editor's JSON, with no options.
   bool SetEditorPlugin(const std::string& slot, const std::string& plugin);
@@ -127,6 +129,8 @@ class GuiApp {
   void DrawSelection();
   void DrawMatchMatrix();
   void DrawManifestEditor();
+  // A "..." button that opens a folder browser; the chosen folder goes into `path`.
+  void FolderBrowser(const std::string& name, std::array<char, 1024>* path);
   void HandleViewInput();
   void Pick(float x, float y);
   void Record(const std::string& name);
@@ -163,6 +167,7 @@ class GuiApp {
   float texture_scale_ = 1;
   size_t log_lines_seen_ = 0;
 
+  std::filesystem::path browse_dir_;  // the folder browser's current folder
   // The manifest editor.
   std::vector<char> editor_text_ = std::vector<char>(1 << 16, '\0');
   std::array<char, 1024> save_path_{};

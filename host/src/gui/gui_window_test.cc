@@ -400,6 +400,22 @@ TEST_F(GuiWindowTest, ManifestEditorChecksAsTheCliAndSaves) {
   app.Frame();
 }
 
+TEST_F(GuiWindowTest, FolderBrowserChoosesTheImageFolder) {
+  fs::create_directories(dir_.path() / "photos");
+  fs::create_directories(dir_.path() / "other");
+  GuiOptions options;
+  options.images = dir_.path();
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  Click(&app, "browse images");
+  app.Frame();
+  Click(&app, "folder photos");
+  app.Frame();
+  Click(&app, "choose folder");
+  EXPECT_EQ(app.ImagesField(), (dir_.path() / "photos").string());
+}
+
 TEST_F(GuiWindowTest, NoRedrawWhenNothingChanged) {
   GuiOptions options;
   options.width = 400;
