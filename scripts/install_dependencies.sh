@@ -12,6 +12,7 @@ packages=(
   libfaiss-dev
   libxxhash-dev
   clang libclang-rt-dev
+  xvfb xauth libgl1-mesa-dri
 )
 # The reference system, for the interoperability tests and benchmarks, and Open3D, an
 # independent PLY reader for the ply exporter's test; optional.

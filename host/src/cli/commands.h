@@ -32,5 +32,6 @@ CommandRegistration RegisterBenchCommand(CLI::App& app, const GlobalOptions& glo
 CommandRegistration RegisterVocabCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterMergeCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera
