@@ -8,6 +8,7 @@
 
 #include "cli/commands.h"
 #include "cli/exit_codes.h"
+#include "cli/interrupt.h"
 #include "distributed/shard_plan.h"
 #include "distributed/sharded_stages.h"
 #include "pipeline/extract_stage.h"
@@ -59,7 +60,15 @@ PipelineContext LoadContext(const StageOptions& options) {
   return context;
 }
 
+// Ctrl-C (SIGINT) or SIGTERM cancels the stages: what they finished is kept.
+StageControl InterruptibleControl() {
+  StageControl control;
+  control.cancel = &InterruptToken();
+  return control;
+}
+
 int MappingExitCode(const MapStageSummary& summary, const std::filesystem::path& database) {
+  if (summary.status == StageStatus::kCancelled) return ReportInterrupted("map");
   if (summary.num_models > 0) return kExitSuccess;
   spdlog::error(
       "{}: no model could be built: no pair of images initialised a model "
@@ -76,7 +85,8 @@ CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
   AddCommonOptions(sub, options.get(), /*needs_images=*/false);
   return {sub, [options]() {
             const PipelineContext context = LoadContext(*options);
-            const MapStageSummary summary = RunMap(context, {options->images, options->output});
+            const MapStageSummary summary =
+                RunMap(context, {options->images, options->output}, InterruptibleControl());
             return MappingExitCode(summary, std::filesystem::path(options->output) / "database.db");
           }};
 }
@@ -90,12 +100,18 @@ CommandRegistration RegisterExtractCommand(CLI::App& app, const GlobalOptions&) 
             if (!options->shard.empty()) {
               const Shard shard = ParseShard(options->shard);
               const PipelineContext context = LoadContext(*options);
-              LogExtraction(RunExtractShard(context, {options->images, options->output}, shard));
-              return static_cast<int>(kExitSuccess);
+              const ExtractionSummary summary = RunExtractShard(
+                  context, {options->images, options->output}, shard, InterruptibleControl());
+              LogExtraction(summary);
+              return summary.status == StageStatus::kCancelled ? ReportInterrupted("extract")
+                                                               : kExitSuccess;
             }
             const PipelineContext context = LoadContext(*options);
-            LogExtraction(RunExtract(context, {options->images, options->output}));
-            return static_cast<int>(kExitSuccess);
+            const ExtractionSummary summary =
+                RunExtract(context, {options->images, options->output}, InterruptibleControl());
+            LogExtraction(summary);
+            return summary.status == StageStatus::kCancelled ? ReportInterrupted("extract")
+                                                             : kExitSuccess;
           }};
 }
 
@@ -108,12 +124,18 @@ CommandRegistration RegisterMatchCommand(CLI::App& app, const GlobalOptions&) {
             if (!options->shard.empty()) {
               const Shard shard = ParseShard(options->shard);
               const PipelineContext context = LoadContext(*options);
-              LogMatching(RunMatchShard(context, {options->images, options->output}, shard));
-              return static_cast<int>(kExitSuccess);
+              const MatchingSummary summary = RunMatchShard(
+                  context, {options->images, options->output}, shard, InterruptibleControl());
+              LogMatching(summary);
+              return summary.status == StageStatus::kCancelled ? ReportInterrupted("match")
+                                                               : kExitSuccess;
             }
             const PipelineContext context = LoadContext(*options);
-            LogMatching(RunMatch(context, {options->images, options->output}));
-            return static_cast<int>(kExitSuccess);
+            const MatchingSummary summary =
+                RunMatch(context, {options->images, options->output}, InterruptibleControl());
+            LogMatching(summary);
+            return summary.status == StageStatus::kCancelled ? ReportInterrupted("match")
+                                                             : kExitSuccess;
           }};
 }
 
@@ -123,7 +145,9 @@ CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions&) {
   AddCommonOptions(sub, options.get(), /*needs_images=*/true);
   return {sub, [options]() {
             const PipelineContext context = LoadContext(*options);
-            const RunResult run = RunPipeline(context, {options->images, options->output});
+            const RunResult run =
+                RunPipeline(context, {options->images, options->output}, InterruptibleControl());
+            if (run.status == StageStatus::kCancelled) return ReportInterrupted("run");
             return MappingExitCode(run.summary.map,
                                    std::filesystem::path(options->output) / "database.db");
           }};
