@@ -12,6 +12,7 @@
 #include "pipeline/match_stage.h"
 #include "pipeline/pipeline_context.h"
 #include "pipeline/run_pipeline.h"
+#include "util/paths.h"
 
 namespace tessera {
 namespace {
@@ -21,25 +22,45 @@ struct StageOptions {
   std::string output;
   std::string manifest;
   std::string camera_K;
+  std::string masks;
+  std::vector<std::string> videos;
   int threads = 0;
 };
 
 void AddCommonOptions(CLI::App* sub, StageOptions* options, bool needs_images) {
   auto* images = sub->add_option("--images", options->images, "Folder of input images");
-  if (needs_images) images->required();
+  if (needs_images) {
+    // --video instead of --images: keyframes of the videos become the images.
+    auto* videos = sub->add_option("--video", options->videos,
+                                   "A video to take sharp keyframes from (repeatable)");
+    images->excludes(videos);
+    sub->callback([images, videos] {
+      if (images->count() == 0 && videos->count() == 0) {
+        throw CLI::RequiredError("--images or --video");
+      }
+    });
+  }
   sub->add_option("--output", options->output, "Workspace folder (database.db, models)")
       ->required();
   sub->add_option("--manifest", options->manifest, "Pipeline manifest (default: default.json)");
   sub->add_option("--camera-K", options->camera_K,
                   "Known intrinsics: a text file with the 3x3 matrix K (overrides EXIF)");
+  if (needs_images) {
+    sub->add_option("--masks", options->masks,
+                    "Folder of image masks, IMAGE.png per image (black: no features)");
+  }
   sub->add_option("--threads", options->threads,
                   "Worker threads (default: manifest, else all cores)")
       ->check(CLI::NonNegativeNumber);
 }
 
 PipelineContext LoadContext(const StageOptions& options) {
-  const std::filesystem::path file =
+  std::filesystem::path file =
       options.manifest.empty() ? std::filesystem::path() : std::filesystem::path(options.manifest);
+  // Video: ordered frames that may come back to where they started.
+  if (file.empty() && !options.videos.empty()) {
+    file = DefaultManifestFile().parent_path() / "ordered_loop.json";
+  }
   PipelineContext context = PipelineContext::Create(file);
   if (options.threads > 0) context.manifest.num_threads = options.threads;
   if (!options.camera_K.empty()) {
@@ -47,6 +68,7 @@ PipelineContext LoadContext(const StageOptions& options) {
     context.manifest.camera.known_intrinsics = Eigen::Vector4d(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
     context.manifest.camera.known_intrinsics_source = options.camera_K;
   }
+  if (!options.masks.empty()) context.manifest.camera.mask_path = options.masks;
   return context;
 }
 
@@ -78,7 +100,9 @@ CommandRegistration RegisterExtractCommand(CLI::App& app, const GlobalOptions&) 
   AddCommonOptions(sub, options.get(), /*needs_images=*/true);
   return {sub, [options]() {
             const PipelineContext context = LoadContext(*options);
-            LogExtraction(RunExtract(context, {options->images, options->output}));
+            LogExtraction(RunExtract(context, {options->images,
+                                               options->output,
+                                               {options->videos.begin(), options->videos.end()}}));
             return static_cast<int>(kExitSuccess);
           }};
 }
@@ -98,12 +122,15 @@ CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions&) {
   auto options = std::make_shared<StageOptions>();
   CLI::App* sub = app.add_subcommand("run", "Run every stage: images in, model out");
   AddCommonOptions(sub, options.get(), /*needs_images=*/true);
-  return {sub, [options]() {
-            const PipelineContext context = LoadContext(*options);
-            const RunResult run = RunPipeline(context, {options->images, options->output});
-            return MappingExitCode(run.summary.map,
-                                   std::filesystem::path(options->output) / "database.db");
-          }};
+  return {
+      sub, [options]() {
+        const PipelineContext context = LoadContext(*options);
+        const RunResult run = RunPipeline(
+            context,
+            {options->images, options->output, {options->videos.begin(), options->videos.end()}});
+        return MappingExitCode(run.summary.map,
+                               std::filesystem::path(options->output) / "database.db");
+      }};
 }
 
 }  // namespace tessera

@@ -1,0 +1,40 @@
+// The mapper on OPENCV_FISHEYE cameras (a wide-angle synthetic scene; the prior camera
+// knows the focal length but not the distortion), with the error bounds of the pinhole
+// test in incremental_mapper_test.cc.
+
+#include <gtest/gtest.h>
+
+#include "eval/evaluation.h"
+#include "sfm/incremental_mapper.h"
+#include "synthetic_scene.h"
+#include "tessera/io/model_statistics.h"
+#include "test_support.h"
+
+namespace tessera {
+namespace {
+
+TEST(FisheyeMapping, RecoversAWideAngleFisheyeSceneAndItsDistortion) {
+  testing::SyntheticSceneOptions options;
+  options.fisheye = true;
+  options.focal_length = 600;  // 1600 px wide: rays up to 53 degrees off the axis
+  const testing::SyntheticScene scene = testing::MakeSyntheticScene(options);
+  ASSERT_EQ(scene.input.cameras.at(1).model_id, CameraModelId::kOpenCVFisheye);
+  const auto adjuster =
+      testing::LoadBundledPlugin<BundleAdjuster>("bundle_adjuster", "ceres", {{"num_threads", 1}});
+  const MapperResult result = IncrementalMapper({}, *adjuster, 0).Reconstruct(scene.input);
+  ASSERT_EQ(result.models.size(), 1u);
+  const Reconstruction& model = result.models[0];
+  EXPECT_EQ(model.images.size(), scene.input.images.size());
+  const EvaluationResult evaluation = EvaluateReconstruction(model, scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  EXPECT_LT(evaluation.position_error_max, 0.01);
+  EXPECT_LT(evaluation.rotation_error_max_deg, 0.05);
+  EXPECT_LT(ComputeModelStatistics(model).mean_reprojection_error, 0.8);
+  const Camera& camera = model.cameras.at(1);
+  EXPECT_EQ(camera.model_id, CameraModelId::kOpenCVFisheye);
+  EXPECT_NEAR(camera.FocalLengthX(), options.focal_length, 0.005 * options.focal_length);
+  EXPECT_NEAR(camera.params[4], options.fisheye_k[0], 0.005);  // k1, from a prior of 0
+}
+
+}  // namespace
+}  // namespace tessera
