@@ -98,8 +98,9 @@ TEST(GaussianSplattingExporter, UndistortsAnOpenCVFisheyeCameraToPinholeWithItsM
   mask(cv::Rect(0, 0, 80, 120)).setTo(0);  // the left half
   for (const auto& [image_id, image] : model.images) {
     ASSERT_TRUE(cv::imwrite((images.path() / image.name).string(), original));
-    if (image_id != 2)
+    if (image_id != 2) {
       ASSERT_TRUE(cv::imwrite((masks.path() / (image.name + ".png")).string(), mask));
+    }
   }
   auto exporter = testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting",
                                                        {{"mask_path", masks.path().string()}});
