@@ -26,7 +26,7 @@ ImageMasks FindImageMasks(const std::filesystem::path& mask_dir,
                           const std::vector<std::string>& image_names) {
   std::error_code error;
   if (!std::filesystem::is_directory(mask_dir, error)) {
-    throw InputError(mask_dir.string() + ": the mask folder is not a folder");
+    throw InputError(mask_dir.string() + ": no such mask folder");
   }
   ImageMasks masks;
   masks.folder = mask_dir;

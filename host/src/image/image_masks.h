@@ -30,7 +30,7 @@ struct ImageMasks {
 // names them). Empty when neither exists.
 std::filesystem::path FindMaskFile(const std::filesystem::path& mask_dir, const std::string& name);
 
-// Finds the mask of each image. Throws InputError naming the folder if it is not one.
+// Finds the mask of each image. Throws InputError naming the folder when it does not exist.
 ImageMasks FindImageMasks(const std::filesystem::path& mask_dir,
                           const std::vector<std::string>& image_names);
 
