@@ -1,7 +1,7 @@
 #!/bin/bash
-# Video input end to end: a video made here from the ordered fox frames at 360 px wide
-# (H.264 MP4, OpenCV's VideoWriter), with a blurred copy after every third frame and the
-# camera held still for 8 frames twice (tessera_test_video). `tessera run --video` with
+# Video input end to end: a video made here from the 50 ordered fox frames at 360 px
+# wide (H.264 MP4, OpenCV's VideoWriter), with a blurred copy after every third frame and
+# the camera held still for 8 frames twice (tessera_test_video). `tessera run --video` with
 # the default manifest for video (ordered_loop.json) must keep no blurred frame, leave no
 # gap of more than two segments' motion (plus one frame's) along the path, from its start
 # to its end, and register every kept frame in one model. Bad input: a missing and an empty video are exit 2 naming the file.

@@ -1,7 +1,8 @@
 // Writes a test video from an ordered folder of images (tests of video input): each
 // image resized to WIDTH pixels wide, every third one followed by a blurred copy
 // (Gaussian blur, sigma 3 px at 480 px), and the camera held still (the same image
-// repeated STILL times) after images 10 and 30. FOURCC avc1 is H.264 in MP4.
+// repeated STILL times) after the images a quarter and three quarters of the way. FOURCC
+// avc1 is H.264 in MP4.
 // Prints one line per video frame: "INDEX SOURCE KIND" with KIND sharp, blurred or still
 // (0-based frame index, 0-based source image index).
 // usage: tessera_test_video IMAGE_DIR OUT.mp4 WIDTH [FOURCC avc1] [FPS 10] [STILL 8]
@@ -61,7 +62,7 @@ int main(int argc, char** argv) {
       writer << blurred;
       std::printf("%d %zu blurred\n", index++, i);
     }
-    if (i == 10 || i == 30) {
+    if (i == files.size() / 4 || i == files.size() * 3 / 4) {
       for (int k = 0; k < still; ++k) {
         writer << frame;
         std::printf("%d %zu still\n", index++, i);
