@@ -1,11 +1,19 @@
 #!/bin/bash
 # How pair selection scales: pairs, pair-selection time and matching time (match +
-# verify, wall) against the number of images n, for the retrieval selector and for
-# exhaustive pairs, with the fitted exponent b of y = a n^b (least squares on log-log).
+# verify) against the number of images n, for the retrieval and spatial selectors and
+# for exhaustive pairs, with the fitted exponent b of y = a n^b (least squares on
+# log-log). Times are CPU seconds of the `tessera match` process (user + system, all
+# threads, benchmarks/cpu_split.py), so that other work on the machine hardly changes
+# them: selection runs from the start of the process to the log line that reports the
+# chosen pairs (start-up included: loading the plugins and reading the image list, the
+# whole of exhaustive's figure), matching from that line to the end.
 # Images: every photo of ../shared/datasets (180) at MAX_SIZE px, plus a central 70% crop
 # and a 60% rescale of each (tessera_image_variants): 540 real, distinct images, listed
-# in a fixed shuffled order; the first n of them make the set of size n. Exhaustive runs
-# only up to EXHAUSTIVE_MAX images (default 100); past that its matching time is
+# in a fixed shuffled order; the first n of them make the set of size n. For `spatial`
+# the images are geotagged (tessera_test_geotag) on a synthetic survey grid, 20 images a
+# row 15 m apart, in that order: positions unrelated to the content, so most of its
+# pairs fail verification, but its pairs and costs grow as a flight's would. Exhaustive
+# runs only up to EXHAUSTIVE_MAX images (default 100); past that its matching time is
 # extrapolated from its fit. Features are detected once per size and shared.
 # usage: benchmarks/pairs_vs_n.sh [SIZES...]   (default: 10 25 50 100 200 400)
 #   env: MAX_SIZE (640), EXHAUSTIVE_MAX (100), THREADS (2), NUM_FEATURES (2000), POOL
@@ -13,6 +21,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 tessera="$root/build/bin/tessera"
 variants="$root/build/bin/tessera_image_variants"
+geotag="$root/build/bin/tessera_test_geotag"
 datasets="$root/../shared/datasets"
 sizes=("$@")
 [ ${#sizes[@]} -gt 0 ] || sizes=(10 25 50 100 200 400)
@@ -33,11 +42,18 @@ fi
 # A fixed shuffle: by a hash of the name.
 ls "$pool" | while read -r f; do echo "$(echo "$f" | sha1sum | cut -c1-12) $f"; done |
   sort | cut -d' ' -f2 > "$work/order.txt"
+if [ ! -f "$pool/.geotagged" ]; then
+  awk '{ i = NR - 1; printf "%s %d %d 0\n", $1, 15 * (i % 20), 15 * int(i / 20) }' \
+    "$work/order.txt" > "$work/positions.txt"
+  "$geotag" "$pool" "$work/positions.txt" 47.0 8.0 400 > /dev/null
+  touch "$pool/.geotagged"
+fi
 echo "pool: $(wc -l < "$work/order.txt") images at most $max_size px"
 
 manifest() {  # selector -> manifest file
   local selector='{"plugin": "exhaustive"}'
   [ "$1" = retrieval ] && selector='{"plugin": "retrieval", "options": {"num_neighbors": 20}}'
+  [ "$1" = spatial ] && selector='{"plugin": "spatial", "options": {"num_neighbors": 20, "max_distance": 50}}'
   cat > "$work/$1.json" <<JSON
 {"pipeline": {"detector": {"plugin": "sift", "options": {"max_num_features": $num_features}},
               "pair_selector": $selector, "matcher": {"plugin": "flann"}}}
@@ -45,7 +61,7 @@ JSON
   echo "$work/$1.json"
 }
 
-echo "| selector | images | pairs | selection s | matching s |"
+echo "| selector | images | pairs | selection CPU s | matching CPU s |"
 echo "| --- | --- | --- | --- | --- |"
 : > "$work/rows.txt"
 for n in "${sizes[@]}"; do
@@ -53,24 +69,15 @@ for n in "${sizes[@]}"; do
   head -n "$n" "$work/order.txt" | while read -r f; do ln -s "$pool/$f" "$work/images_$n/$f"; done
   "$tessera" -q extract --images "$work/images_$n" --output "$work/features_$n" \
     --threads "$threads" --manifest "$(manifest exhaustive)"
-  for selector in retrieval exhaustive; do
+  for selector in retrieval spatial exhaustive; do
     [ "$selector" = exhaustive ] && [ "$n" -gt "$exhaustive_max" ] && continue
     rm -rf "$work/run"
     cp -r "$work/features_$n" "$work/run"
-    # Each log line stamped as it arrives: selection runs from the start of the process
-    # to the line that reports the chosen pairs (so it includes start-up: loading the
-    # plugins and reading the image list, the whole of exhaustive's figure); matching
-    # (match + verify + writing) from that line to the end.
-    start=$(now)
-    "$tessera" match --output "$work/run" --threads "$threads" \
-      --manifest "$(manifest "$selector")" 2>&1 > /dev/null |
-      while IFS= read -r line; do echo "$(now) $line"; done > "$work/match.log"
-    end=$(now)
-    chosen=$(grep -m1 "pairs from '" "$work/match.log" | cut -d' ' -f1)
-    [ -n "$chosen" ] || { cat "$work/match.log"; exit 1; }
+    read -r selection matching < <("$root/benchmarks/cpu_split.py" "pairs from '" \
+      "$work/match.log" "$tessera" match --output "$work/run" --threads "$threads" \
+      --manifest "$(manifest "$selector")")
+    [ -n "${matching:-}" ] || { tail -5 "$work/match.log"; exit 1; }
     pairs=$(sqlite3 "$work/run/database.db" "SELECT COUNT(*) FROM matches")
-    selection=$(echo "$chosen - $start" | bc -l)
-    matching=$(echo "$end - $chosen" | bc -l)
     printf "| %s | %d | %d | %.3f | %.1f |\n" "$selector" "$n" "$pairs" "$selection" "$matching"
     echo "$selector $n $pairs $selection $matching" >> "$work/rows.txt"
   done
@@ -86,7 +93,7 @@ fit() {  # selector column [N]
 echo
 echo "| selector | exponent of pairs | exponent of selection time | exponent of matching time |"
 echo "| --- | --- | --- | --- |"
-for selector in retrieval exhaustive; do
+for selector in retrieval spatial exhaustive; do
   echo "| $selector | $(fit "$selector" 3) | $(fit "$selector" 4) | $(fit "$selector" 5) |"
 done
 for n in "${sizes[@]}"; do

@@ -12,10 +12,14 @@ packages=(
   libfaiss-dev
   libxxhash-dev
   clang libclang-rt-dev
+  xvfb xauth libgl1-mesa-dri
 )
 # The reference system, for the interoperability tests and benchmarks, and Open3D, an
 # independent PLY reader for the ply exporter's test; optional.
 optional_packages=(colmap python3-open3d)
+# A one-node Slurm cluster for the Slurm end-to-end test (tests/end_to_end/slurm_test.sh);
+# optional: the test skips without it.
+optional_packages+=(slurmctld slurmd slurm-client munge)
 
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi

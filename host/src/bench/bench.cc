@@ -33,7 +33,7 @@
 #include "eval/ground_truth.h"
 #include "pipeline/mapping_summary.h"
 #include "pipeline/run_summary.h"
-#include "sfm/incremental_mapper.h"
+#include "sfm/incremental_pipeline.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"

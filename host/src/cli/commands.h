@@ -30,5 +30,8 @@ CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions& glob
 CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterBenchCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterVocabCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterMergeCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera

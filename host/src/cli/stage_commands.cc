@@ -8,6 +8,8 @@
 
 #include "cli/commands.h"
 #include "cli/exit_codes.h"
+#include "distributed/shard_plan.h"
+#include "distributed/sharded_stages.h"
 #include "pipeline/extract_stage.h"
 #include "pipeline/match_stage.h"
 #include "pipeline/pipeline_context.h"
@@ -25,7 +27,14 @@ struct StageOptions {
   std::string masks;
   std::vector<std::string> videos;
   int threads = 0;
+  std::string shard;  // extract and match: "K/N", one shard (distributed/)
 };
+
+void AddShardOption(CLI::App* sub, StageOptions* options) {
+  sub->add_option("--shard", options->shard,
+                  "K/N: only shard K of N, into OUTPUT/shards/ (`tessera merge` folds the "
+                  "shards into database.db)");
+}
 
 void AddCommonOptions(CLI::App* sub, StageOptions* options, bool needs_images) {
   auto* images = sub->add_option("--images", options->images, "Folder of input images");
@@ -98,7 +107,14 @@ CommandRegistration RegisterExtractCommand(CLI::App& app, const GlobalOptions&) 
   auto options = std::make_shared<StageOptions>();
   CLI::App* sub = app.add_subcommand("extract", "Ingest images and detect features");
   AddCommonOptions(sub, options.get(), /*needs_images=*/true);
+  AddShardOption(sub, options.get());
   return {sub, [options]() {
+            if (!options->shard.empty()) {
+              const Shard shard = ParseShard(options->shard);
+              const PipelineContext context = LoadContext(*options);
+              LogExtraction(RunExtractShard(context, {options->images, options->output}, shard));
+              return static_cast<int>(kExitSuccess);
+            }
             const PipelineContext context = LoadContext(*options);
             LogExtraction(RunExtract(context, {options->images,
                                                options->output,
@@ -111,7 +127,14 @@ CommandRegistration RegisterMatchCommand(CLI::App& app, const GlobalOptions&) {
   auto options = std::make_shared<StageOptions>();
   CLI::App* sub = app.add_subcommand("match", "Match and verify image pairs of a workspace");
   AddCommonOptions(sub, options.get(), /*needs_images=*/false);
+  AddShardOption(sub, options.get());
   return {sub, [options]() {
+            if (!options->shard.empty()) {
+              const Shard shard = ParseShard(options->shard);
+              const PipelineContext context = LoadContext(*options);
+              LogMatching(RunMatchShard(context, {options->images, options->output}, shard));
+              return static_cast<int>(kExitSuccess);
+            }
             const PipelineContext context = LoadContext(*options);
             LogMatching(RunMatch(context, {options->images, options->output}));
             return static_cast<int>(kExitSuccess);

@@ -262,6 +262,7 @@ struct Database::Impl {
   // input like a file that is no database at all.
   bool opening = false;
   bool in_transaction = false;
+  bool read_only = false;  // Mode::kReadOnly
 
   std::unique_ptr<Statement> write_camera, update_camera, read_cameras, read_camera, write_image,
       read_image_with_name, read_images, num_cameras, num_images, exists_keypoints, write_keypoints,
@@ -270,7 +271,8 @@ struct Database::Impl {
       exists_two_view_geometry, write_two_view_geometry, read_two_view_geometry,
       read_two_view_geometries, num_verified_pairs, read_stage, write_stage,
       write_calibration_source, write_image_metadata, read_image_metadata, descriptor_dimension,
-      read_image_files, write_image_file, delete_image_file, descriptor_widths;
+      read_image_files, write_image_file, delete_image_file, descriptor_widths,
+      read_num_keypoints_per_image, delete_stage;
 
   ~Impl() {
     // Statements first: a connection with live statements does not close.
@@ -309,7 +311,9 @@ struct Database::Impl {
                             &read_image_files,
                             &write_image_file,
                             &delete_image_file,
-                            &descriptor_widths}) {
+                            &descriptor_widths,
+                            &read_num_keypoints_per_image,
+                            &delete_stage}) {
       statement->reset();
     }
     if (in_transaction) sqlite3_exec(db, "ROLLBACK;", nullptr, nullptr, nullptr);
@@ -561,12 +565,39 @@ struct Database::Impl {
 
   void Open();
   void CreateAndCheckSchema();
+  std::set<std::string> TableColumns(const std::string& table);
+  void CheckRequiredColumns();
   void PrepareStatements();
 };
 
+namespace {
+
+// An SQLite URI for `path` with `query`: '%', '?' and '#' percent-encoded.
+std::string DatabaseUri(const std::filesystem::path& path, const std::string& query) {
+  std::string uri = "file:";
+  for (const char c : std::filesystem::absolute(path).string()) {
+    if (c == '%') {
+      uri += "%25";
+    } else if (c == '?') {
+      uri += "%3f";
+    } else if (c == '#') {
+      uri += "%23";
+    } else {
+      uri += c;
+    }
+  }
+  return uri + "?" + query;
+}
+
+}  // namespace
+
 void Database::Impl::Open() {
-  const int rc =
-      sqlite3_open_v2(path.c_str(), &db, SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE, nullptr);
+  // Read only: SQLite's immutable mode takes no lock and writes nothing (no -shm, no
+  // -wal), so readers on network filesystems are safe while no one writes the file.
+  const std::string uri = read_only ? DatabaseUri(path, "immutable=1") : path.string();
+  const int flags = read_only ? SQLITE_OPEN_READONLY | SQLITE_OPEN_URI
+                              : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE;
+  const int rc = sqlite3_open_v2(uri.c_str(), &db, flags, nullptr);
   if (rc != SQLITE_OK) {
     const std::string message = db != nullptr ? sqlite3_errmsg(db) : sqlite3_errstr(rc);
     sqlite3_close_v2(db);
@@ -578,6 +609,7 @@ void Database::Impl::Open() {
   sqlite3_busy_timeout(db, 5000);
   // The first read of the file: a file that is not a database fails here.
   Exec("SELECT COUNT(*) FROM sqlite_master;", "read the schema");
+  if (read_only) return;
   // WAL, as COLMAP uses: readers do not block the writer, and a killed process leaves
   // the last committed state. NORMAL sync is durable against process crashes (only a
   // power loss may drop the last commits, never corrupt the file).
@@ -587,7 +619,33 @@ void Database::Impl::Open() {
   Exec("PRAGMA temp_store=MEMORY;", "set the temporary store");
 }
 
+std::set<std::string> Database::Impl::TableColumns(const std::string& table) {
+  std::set<std::string> columns;
+  const auto statement = Prepare("PRAGMA table_info(" + table + ");", false);
+  StatementUse use(*statement);
+  while (Step(use.get(), "read the columns of table " + table)) {
+    columns.insert(reinterpret_cast<const char*>(sqlite3_column_text(use.get(), 1)));
+  }
+  return columns;
+}
+
+void Database::Impl::CheckRequiredColumns() {
+  for (const auto& [table, required] : RequiredColumns()) {
+    const std::set<std::string> columns = TableColumns(table);
+    for (const std::string& column : required) {
+      if (columns.count(column) == 0) {
+        throw InputError("Database '" + path.string() + "' has an incompatible schema: table '" +
+                         table + "' has no column '" + column + "'.");
+      }
+    }
+  }
+}
+
 void Database::Impl::CreateAndCheckSchema() {
+  if (read_only) {
+    CheckRequiredColumns();
+    return;
+  }
   Exec("BEGIN IMMEDIATE;", "begin creating the tables");
   try {
     for (const char* sql :
@@ -596,18 +654,8 @@ void Database::Impl::CreateAndCheckSchema() {
       Exec(sql, "create the tables");
     }
 
-    const auto table_columns = [&](const std::string& table) {
-      std::set<std::string> columns;
-      const auto statement = Prepare("PRAGMA table_info(" + table + ");", false);
-      StatementUse use(*statement);
-      while (Step(use.get(), "read the columns of table " + table)) {
-        columns.insert(reinterpret_cast<const char*>(sqlite3_column_text(use.get(), 1)));
-      }
-      return columns;
-    };
-
     // Databases of COLMAP before 3.7 lack the geometry columns; COLMAP adds them.
-    const std::set<std::string> geometry_columns = table_columns("two_view_geometries");
+    const std::set<std::string> geometry_columns = TableColumns("two_view_geometries");
     for (const char* column : kTwoViewGeometryAddedColumns) {
       if (geometry_columns.count(column) == 0) {
         Exec(("ALTER TABLE two_view_geometries ADD COLUMN " + std::string(column) + " BLOB;")
@@ -616,15 +664,7 @@ void Database::Impl::CreateAndCheckSchema() {
       }
     }
 
-    for (const auto& [table, required] : RequiredColumns()) {
-      const std::set<std::string> columns = table_columns(table);
-      for (const std::string& column : required) {
-        if (columns.count(column) == 0) {
-          throw InputError("Database '" + path.string() + "' has an incompatible schema: table '" +
-                           table + "' has no column '" + column + "'.");
-        }
-      }
-    }
+    CheckRequiredColumns();
 
     const auto user_version = Prepare("PRAGMA user_version;", false);
     bool fresh = false;
@@ -671,6 +711,7 @@ void Database::Impl::PrepareStatements() {
       Prepare("INSERT OR REPLACE INTO keypoints(image_id, rows, cols, data) VALUES(?, ?, ?, ?);");
   read_keypoints = Prepare("SELECT rows, cols, data FROM keypoints WHERE image_id = ?;");
   num_keypoints = Prepare("SELECT COALESCE(SUM(rows), 0) FROM keypoints;");
+  read_num_keypoints_per_image = Prepare("SELECT image_id, rows FROM keypoints ORDER BY image_id;");
   exists_descriptors = Prepare("SELECT 1 FROM descriptors WHERE image_id = ?;");
   write_descriptors =
       Prepare("INSERT OR REPLACE INTO descriptors(image_id, rows, cols, data) VALUES(?, ?, ?, ?);");
@@ -699,6 +740,7 @@ void Database::Impl::PrepareStatements() {
 
   read_stage = Prepare("SELECT provenance FROM tessera_stages WHERE stage = ?;");
   write_stage = Prepare("INSERT OR REPLACE INTO tessera_stages(stage, provenance) VALUES(?, ?);");
+  delete_stage = Prepare("DELETE FROM tessera_stages WHERE stage = ?;");
   write_calibration_source =
       Prepare("INSERT OR REPLACE INTO tessera_camera_priors(camera_id, source) VALUES(?, ?);");
   write_image_metadata =
@@ -716,8 +758,12 @@ void Database::Impl::PrepareStatements() {
       Prepare("SELECT DISTINCT cols FROM descriptors WHERE rows > 0 ORDER BY cols;");
 }
 
-Database::Database(const std::filesystem::path& path) : impl_(std::make_unique<Impl>()) {
+Database::Database(const std::filesystem::path& path, Mode mode) : impl_(std::make_unique<Impl>()) {
   impl_->path = path;
+  impl_->read_only = mode == Mode::kReadOnly;
+  if (impl_->read_only && !std::filesystem::exists(path)) {
+    throw InputError("Cannot open database file '" + path.string() + "': it does not exist.");
+  }
   impl_->opening = true;
   impl_->Open();
   impl_->CreateAndCheckSchema();
@@ -953,6 +999,17 @@ size_t Database::NumKeypoints() const {
   return impl_->Count(*impl_->num_keypoints, "count the keypoints");
 }
 
+std::map<image_t, size_t> Database::ReadNumKeypointsPerImage() const {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  StatementUse use(*impl_->read_num_keypoints_per_image);
+  std::map<image_t, size_t> counts;
+  while (impl_->Step(use.get(), "count the keypoints of each image")) {
+    counts[static_cast<image_t>(sqlite3_column_int64(use.get(), 0))] =
+        static_cast<size_t>(sqlite3_column_int64(use.get(), 1));
+  }
+  return counts;
+}
+
 bool Database::ExistsDescriptors(image_t image_id) const {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   return impl_->Exists(*impl_->exists_descriptors, image_id,
@@ -1181,6 +1238,14 @@ void Database::WriteStageProvenance(const std::string& stage, const nlohmann::js
   StatementUse use(*impl_->write_stage);
   impl_->BindText(use.get(), 1, stage, operation);
   impl_->BindText(use.get(), 2, provenance.dump(), operation);
+  impl_->Step(use.get(), operation);
+}
+
+void Database::DeleteStageProvenance(const std::string& stage) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  const std::string operation = "delete the provenance of stage '" + stage + "'";
+  StatementUse use(*impl_->delete_stage);
+  impl_->BindText(use.get(), 1, stage, operation);
   impl_->Step(use.get(), operation);
 }
 

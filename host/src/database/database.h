@@ -45,7 +45,14 @@ class Database {
   // Opens or creates the database at `path` and creates missing tables. Throws
   // InputError naming the file if it cannot be opened or is not a SQLite database /
   // has an incompatible schema.
-  explicit Database(const std::filesystem::path& path);
+  //
+  // Mode::kReadOnly opens an existing file for reading only, without taking a lock or
+  // writing anything (SQLite's immutable mode, no -wal or -shm file), so that readers on
+  // several hosts of a network filesystem are safe while no one writes the file (the
+  // matching shards of `tessera slurm` read database.db so). The schema is checked, not
+  // created; a write fails.
+  enum class Mode { kReadWrite, kReadOnly };
+  explicit Database(const std::filesystem::path& path, Mode mode = Mode::kReadWrite);
   ~Database();
   Database(const Database&) = delete;
   Database& operator=(const Database&) = delete;
@@ -96,6 +103,8 @@ class Database {
   void WriteKeypoints(image_t image_id, const FeatureKeypoints& keypoints);
   FeatureKeypoints ReadKeypoints(image_t image_id) const;
   size_t NumKeypoints() const;  // summed over all images
+  // Each image with a keypoints row and its number of keypoints, without reading them.
+  std::map<image_t, size_t> ReadNumKeypointsPerImage() const;
 
   // Descriptors: uint8 rows x cols. COLMAP's table has no place for the metric, so
   // the caller says which one the stage's detector produced.
@@ -141,6 +150,7 @@ class Database {
   // change invalidates only what depends on it. nullopt if the stage has no record.
   std::optional<nlohmann::json> ReadStageProvenance(const std::string& stage) const;
   void WriteStageProvenance(const std::string& stage, const nlohmann::json& provenance);
+  void DeleteStageProvenance(const std::string& stage);
 
   void WriteCalibrationSource(camera_t camera_id, CalibrationSource source);
 

@@ -1150,5 +1150,42 @@ TEST_F(DatabaseTest, AFullDiskIsAnInputErrorAndKeepsTheCommittedState) {
   EXPECT_FALSE(database.ExistsDescriptors(1));
 }
 
+TEST(DatabaseReadOnly, ReadsWithoutWritingAndRefusesWrites) {
+  testing::TemporaryDir dir;
+  const fs::path path = dir.path() / "what?#%.db";  // characters a URI must encode
+  std::mt19937 rng(3);
+  {
+    Database database(path);
+    database.WriteCamera(Camera::Create(kInvalidCameraId, CameraModelId::kPinhole, 500, 640, 480));
+    Image image;
+    image.name = "a.jpg";
+    image.camera_id = 1;
+    database.WriteImage(image);
+    database.WriteKeypoints(1, RandomKeypoints(7, &rng));
+    database.WriteStageProvenance("x", {{"a", 1}});
+    database.WriteStageProvenance("y", {{"b", 2}});
+    database.DeleteStageProvenance("y");
+  }
+  ASSERT_FALSE(fs::exists(path.string() + "-wal"));
+  const auto modified = fs::last_write_time(path);
+  {
+    const Database reader(path, Database::Mode::kReadOnly);
+    const Database other(path, Database::Mode::kReadOnly);
+    EXPECT_EQ(reader.ReadAllImages().size(), 1u);
+    EXPECT_EQ(reader.ReadNumKeypointsPerImage(), (std::map<image_t, size_t>{{1, 7}}));
+    EXPECT_EQ(other.ReadKeypoints(1).size(), 7u);
+    EXPECT_EQ(reader.ReadStageProvenance("x"), nlohmann::json({{"a", 1}}));
+    EXPECT_FALSE(reader.ReadStageProvenance("y"));
+    Database writer(path, Database::Mode::kReadOnly);
+    EXPECT_THROW(writer.WriteKeypoints(1, RandomKeypoints(2, &rng)), std::exception);
+    EXPECT_FALSE(fs::exists(path.string() + "-wal"));
+    EXPECT_FALSE(fs::exists(path.string() + "-shm"));
+  }
+  EXPECT_EQ(fs::last_write_time(path), modified);
+  EXPECT_EQ(Database(path).ReadKeypoints(1).size(), 7u);
+  EXPECT_THROW(Database(dir.path() / "missing.db", Database::Mode::kReadOnly), InputError);
+  EXPECT_FALSE(fs::exists(dir.path() / "missing.db"));
+}
+
 }  // namespace
 }  // namespace tessera

@@ -7,6 +7,7 @@
 
 #include "image/image_io.h"
 #include "image/sensor_database.h"
+#include "manifest/manifest.h"
 #include "tessera/errors.h"
 #include "test_image_files.h"
 #include "test_support.h"

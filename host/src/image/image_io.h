@@ -11,7 +11,7 @@
 
 #include "image/camera_assignment.h"  // the pipeline makes cameras right after the scan
 #include "image/image_entry.h"
-#include "manifest/manifest.h"
+#include "image/image_limits.h"
 #include "tessera/io/image_io.h"
 
 namespace tessera {
@@ -25,7 +25,7 @@ struct ImageScan {
 struct ImageScanOptions {
   // Folders never scanned (the run's own output folder): output never feeds input.
   std::vector<std::filesystem::path> excluded_folders;
-  int64_t max_image_pixels = Manifest().max_image_pixels;  // refused before decoding
+  int64_t max_image_pixels = kDefaultMaxImagePixels;  // refused before decoding
   // The mask folder (camera.mask_path), never scanned for images; empty: none.
   std::filesystem::path mask_folder;
 };

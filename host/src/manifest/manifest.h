@@ -10,6 +10,7 @@
 
 #include "geometry/verification_settings.h"
 #include "image/camera_settings.h"
+#include "image/image_limits.h"
 
 namespace tessera {
 
@@ -29,7 +30,7 @@ struct Manifest {
   int num_threads = 0;  // 0: all cores
   // Images whose header claims more pixels are skipped before decoding, so that a
   // lying header cannot ask for gigabytes. Enough for 100-megapixel photos.
-  int64_t max_image_pixels = 250'000'000;
+  int64_t max_image_pixels = kDefaultMaxImagePixels;
 
   std::optional<PluginSlot> detector;
   // One or more: `pipeline.pair_selector` is a slot or an array of slots, whose pairs

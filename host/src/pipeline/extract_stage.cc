@@ -168,8 +168,8 @@ void WriteImageMetadata(const ImageScan& scan, const std::vector<Image>& images,
 
 ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const Manifest& manifest,
                                   const PluginInstance<Detector>& detector, Database* database,
-                                  const ImageScanOptions& scan_options,
-                                  const StageControl& control) {
+                                  const ImageScanOptions& scan_options, const StageControl& control,
+                                  const std::function<bool(size_t)>& select) {
   const Timer timer;
   ExtractionSummary summary;
 
@@ -229,6 +229,7 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
   WriteImageMetadata(scan, images, database);
   std::vector<size_t> todo;
   for (size_t i = 0; i < images.size(); ++i) {
+    if (select && !select(i)) continue;  // another shard's image
     if (images[i].image_id == kInvalidImageId) {
       spdlog::warn("Skipped '{}' (as in an earlier run, the file is unchanged): {}",
                    scan.images[i].name, skipped_before.at(scan.images[i].name));

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -31,10 +32,15 @@ namespace tessera {
 // detect) and cancellation, checked before each image. A cancelled run stops starting
 // images, lets those under way finish and returns status kCancelled: the workspace
 // holds every image ingested and the features of every image detected.
+//
+// `select` (a shard of the images, distributed/): when set, only the images whose index
+// in the scan (natural name order) it accepts are detected; the others are ingested
+// and left without features.
 ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const Manifest& manifest,
                                   const PluginInstance<Detector>& detector, Database* database,
                                   const ImageScanOptions& scan_options = {},
-                                  const StageControl& control = {});
+                                  const StageControl& control = {},
+                                  const std::function<bool(size_t)>& select = {});
 
 // The stage's closing log line.
 void LogExtraction(const ExtractionSummary& summary);

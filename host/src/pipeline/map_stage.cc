@@ -102,7 +102,7 @@ MapStageSummary MapWorkspace(const PipelineContext& context, Database* database,
   if (cancelled()) return summary;
   control.Report("map", 0, 1);
   const BundleAdjusterGuard bundle_adjuster(context.bundle_adjuster);
-  const IncrementalMapper mapper(context.mapper_options, bundle_adjuster, context.manifest.seed);
+  const IncrementalPipeline mapper(context.mapper_options, bundle_adjuster, context.manifest.seed);
   MapperObserver observer;
   observer.should_stop = [&control] { return control.Cancelled(); };
   observer.on_model_changed = control.model_changed;

@@ -11,7 +11,7 @@
 #include "pipeline/pipeline_context.h"
 #include "pipeline/run_summary.h"
 #include "pipeline/stage_control.h"
-#include "sfm/incremental_mapper.h"
+#include "sfm/incremental_pipeline.h"
 
 namespace tessera {
 

@@ -202,14 +202,23 @@ WorkspaceDescriptors ReadWorkspaceDescriptors(const Database& database) {
   return descriptors;
 }
 
-void InvalidateStaleResults(const Manifest& manifest, const PluginInstance<Matcher>& matcher,
-                            const WorkspaceDescriptors& descriptors, Database* database) {
-  const nlohmann::json matches_provenance = {{"features", descriptors.features_provenance},
-                                             {"matcher", matcher.Provenance()}};
+MatchProvenance MakeMatchProvenance(const Manifest& manifest,
+                                    const PluginInstance<Matcher>& matcher,
+                                    const WorkspaceDescriptors& descriptors) {
+  MatchProvenance provenance;
+  provenance.matches = {{"features", descriptors.features_provenance},
+                        {"matcher", matcher.Provenance()}};
   nlohmann::json verification = manifest.verification.ToJson();
   verification["seed"] = manifest.seed;
-  const nlohmann::json geometries_provenance = {{"matches", matches_provenance},
-                                                {"verification", verification}};
+  provenance.geometries = {{"matches", provenance.matches}, {"verification", verification}};
+  return provenance;
+}
+
+void InvalidateStaleResults(const Manifest& manifest, const PluginInstance<Matcher>& matcher,
+                            const WorkspaceDescriptors& descriptors, Database* database) {
+  const MatchProvenance provenance = MakeMatchProvenance(manifest, matcher, descriptors);
+  const nlohmann::json& matches_provenance = provenance.matches;
+  const nlohmann::json& geometries_provenance = provenance.geometries;
   const auto stored_matches = database->ReadStageProvenance(Database::kMatchesStage);
   if (stored_matches && *stored_matches != matches_provenance) {
     spdlog::info("match: the matcher, its options or the features changed; discarding old matches");
@@ -276,11 +285,12 @@ class PairMatchVerifier::FeatureCache : public LruFeatureCache {
 
 PairMatchVerifier::PairMatchVerifier(const Manifest& manifest,
                                      const PluginInstance<Matcher>& matcher, const MatchPlan& plan,
-                                     const WorkspaceDescriptors& descriptors, Database* database)
+                                     const WorkspaceDescriptors& descriptors, Database* database,
+                                     Database* results)
     : manifest_(manifest),
       matcher_(matcher),
       plan_(plan),
-      database_(database),
+      database_(results != nullptr ? results : database),
       feature_cache_(std::make_unique<FeatureCache>(database, descriptors.metric,
                                                     descriptors.dimension, kFeatureCacheBytes)) {}
 

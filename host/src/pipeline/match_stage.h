@@ -38,6 +38,17 @@ struct WorkspaceDescriptors {
 };
 WorkspaceDescriptors ReadWorkspaceDescriptors(const Database& database);
 
+// What a run records as the provenance of the matches and of the two-view geometries:
+// matches depend on the features and on how pairs were matched; geometries on the
+// matches, the verification settings and the seed.
+struct MatchProvenance {
+  nlohmann::json matches;
+  nlohmann::json geometries;
+};
+MatchProvenance MakeMatchProvenance(const Manifest& manifest,
+                                    const PluginInstance<Matcher>& matcher,
+                                    const WorkspaceDescriptors& descriptors);
+
 // Step 1. Matches depend on the features and on how pairs were matched; geometries on
 // the matches, the verification settings (all of VerificationSettings::ToJson, so a
 // field added there is covered) and the seed. Stored results made otherwise are
@@ -78,10 +89,12 @@ struct PairResult {
 // read through a bounded cache, so memory does not grow with the number of images.
 class PairMatchVerifier {
  public:
-  // All four must outlive the verifier.
+  // All four must outlive the verifier. `results` (a shard database, distributed/):
+  // where matches and geometries are looked up and written, features still being read
+  // from `database`; nullptr: `database`.
   PairMatchVerifier(const Manifest& manifest, const PluginInstance<Matcher>& matcher,
                     const MatchPlan& plan, const WorkspaceDescriptors& descriptors,
-                    Database* database);
+                    Database* database, Database* results = nullptr);
   ~PairMatchVerifier();
 
   PairResult Run(const ImageIndexPair& pair);
@@ -91,7 +104,7 @@ class PairMatchVerifier {
   const Manifest& manifest_;
   const PluginInstance<Matcher>& matcher_;
   const MatchPlan& plan_;
-  Database* database_;
+  Database* database_;  // where results go
   std::unique_ptr<FeatureCache> feature_cache_;
   std::mutex database_mutex_;
 };

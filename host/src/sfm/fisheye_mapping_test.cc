@@ -1,13 +1,13 @@
 // The mapper on OPENCV_FISHEYE cameras (a wide-angle synthetic scene; the prior camera
 // knows the focal length but not the distortion), with the error bounds of the pinhole
-// test in incremental_mapper_test.cc.
+// test in incremental_pipeline_test.cc.
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "eval/evaluation.h"
-#include "sfm/incremental_mapper.h"
+#include "sfm/incremental_pipeline.h"
 #include "synthetic_scene.h"
 #include "tessera/io/model_statistics.h"
 #include "test_support.h"
@@ -24,7 +24,7 @@ TEST(FisheyeMapping, RecoversAWideAngleFisheyeSceneAndItsDistortion) {
   ASSERT_EQ(scene.input.cameras.at(1).model_id, CameraModelId::kOpenCVFisheye);
   const auto adjuster =
       testing::LoadBundledPlugin<BundleAdjuster>("bundle_adjuster", "ceres", {{"num_threads", 1}});
-  const MapperResult result = IncrementalMapper({}, *adjuster, 0).Reconstruct(scene.input);
+  const MapperResult result = IncrementalPipeline({}, *adjuster, 0).Reconstruct(scene.input);
   ASSERT_EQ(result.models.size(), 1u);
   const Reconstruction& model = result.models[0];
   EXPECT_EQ(model.images.size(), scene.input.images.size());

@@ -10,7 +10,7 @@
 #include <map>
 #include <vector>
 
-#include "sfm/incremental_mapper.h"
+#include "sfm/mapper_input.h"
 
 namespace tessera {
 

@@ -1,119 +1,220 @@
 #pragma once
 
-// The incremental mapper: from verified matches to one or more models of cameras,
-// poses and 3D points, after COLMAP's IncrementalMapper (Schonberger and Frahm, CVPR
-// 2016) with union-find feature tracks (one track, one 3D point).
+// The steps of growing one model, after COLMAP's IncrementalMapper (Schonberger and
+// Frahm, CVPR 2016) with union-find feature tracks (one track, one 3D point):
 //
-//   tracks -> initial pair (relative pose, triangulation, global BA)
-//          -> repeat: next best view, P3P/EPnP LO-RANSAC registration, triangulation
-//             of its tracks, local BA, filtering; global BA as the model grows
-//          -> final rounds of track completion and merging, retriangulation, global BA
-//          -> further models from the images left, while any pair of them initialises
+//   Initialize          initial pair: relative pose, triangulation, global BA
+//   NextImages          unregistered images by next-best-view score
+//   RegisterImage       P3P/EPnP LO-RANSAC, checked against the view graph
+//   TriangulateImage    its tracks (IncrementalTriangulator)
+//   LocalBundleAdjustment, GlobalBundleAdjustment, GlobalRefinement, FilterPoints
+//   Finish              final rounds of refinement
+//   TakeModel
 //
-// Every random choice is seeded from the run's seed and the image or pair it serves,
-// and every loop runs in id order, so the same input and seed give the same models.
+// The loop that calls them, and the handling of several models, is
+// IncrementalPipeline's. Every random choice is seeded from the run's seed and the
+// image or pair it serves, and every loop runs in id order, so the same input and seed
+// give the same model.
 
+#include <cstddef>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <map>
+#include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sfm/feature_tracks.h"
 #include "sfm/incremental_mapper_options.h"
+#include "sfm/incremental_triangulator.h"
+#include "sfm/mapper_input.h"
+#include "sfm/observation_manager.h"
+#include "sfm/view_graph.h"
 #include "tessera/bundle_adjuster.h"
 #include "tessera/reconstruction.h"
-#include "tessera/two_view_geometry.h"
 
 namespace tessera {
 
-// What the mapper starts from: every camera, every image with its keypoints in
-// points2D (poses unknown), and the verified geometry of each image pair.
-struct MapperInput {
+// The estimators' RANSAC settings, which the manifest does not set. Their thresholds
+// are IncrementalMapperOptions' (init_max_error, abs_pose_max_error, tri_max_error).
+struct MapperRansacOptions {
+  // Relative pose of a candidate initial pair: five-point LO-RANSAC on its matches.
+  double init_confidence = 0.9999;
+  double init_min_inlier_ratio = 0.25;
+  int init_max_num_trials = 10000;
+  // Registration: P3P/EPnP LO-RANSAC on the 2D-3D correspondences; the minimum inlier
+  // ratio is abs_pose_min_inlier_ratio, but at least abs_pose_min_inlier_ratio_floor.
+  double abs_pose_confidence = 0.9999;
+  double abs_pose_min_inlier_ratio_floor = 0.01;
+  int abs_pose_max_num_trials = 10000;
+  // Triangulation: pairs of observations tried when a track's observations disagree.
+  size_t tri_max_num_pairs = 200;
+  // Each estimator's seed is derived from the run's seed, a stream per estimator and
+  // the pair or image (and trial) it serves.
+  uint64_t init_seed_stream = 1;
+  uint64_t abs_pose_seed_stream = 2;
+};
+
+// What the models of one run share: the verified pairs the view graph kept and their
+// tracks, which images a model took, why images failed, and counters.
+struct MapperRunState {
+  MapperRunState(const MapperInput& input, const BundleAdjuster& bundle_adjuster, uint64_t seed)
+      : input(input), bundle_adjuster(bundle_adjuster), seed(seed), cameras(input.cameras) {}
+
+  // Before the first model: the view graph of `cameras` over `pairs` (verified ones,
+  // of input), filtered by rotation cycles when options.filter_view_graph, and the
+  // tracks of the pairs it keeps; returns how many pairs the filter dropped.
+  size_t Prepare(const IncrementalMapperOptions& options,
+                 const std::vector<const MapperInput::Pair*>& pairs);
+
+  const MapperInput& input;
+  const BundleAdjuster& bundle_adjuster;  // must outlive the state
+  uint64_t seed = 0;
+  MapperRansacOptions ransac;
+  // The cameras every model starts from: the input's, with estimated focal lengths.
   std::map<camera_t, Camera> cameras;
-  std::map<image_t, Image> images;
-  struct Pair {
-    image_t image_id1 = kInvalidImageId;
-    image_t image_id2 = kInvalidImageId;
-    TwoViewGeometry geometry;  // inlier_matches index image_id1's then image_id2's keypoints
-  };
-  std::vector<Pair> pairs;
-};
-
-// What the mapper found out about a camera's focal length before mapping.
-struct FocalLengthReport {
-  camera_t camera_id = kInvalidCameraId;
-  double initial = 0;    // px, the default the camera came with
-  double estimated = 0;  // px, what mapping started from
-  // How: "view graph" (from the pairs' fundamental matrices) and "first model" (refined
-  // by bundle adjustment in a first mapping pass).
-  std::string method;
-  size_t num_pairs = 0;   // pairs that took part in the view-graph estimate
-  size_t num_images = 0;  // images of the first model
-};
-
-// How a model agrees with the view graph: its verified pairs whose relative rotation is
-// the model's within reg_max_rotation_error, their share of the pairs' inliers, and the
-// images most of whose pairs' inliers disagree.
-struct ModelSelfCheck {
-  size_t num_pairs = 0;
-  size_t num_agreeing = 0;
-  // Share of the pairs' inliers in agreeing pairs (see ModelAgreement::inlier_share).
-  double agreement = 1;
-  std::vector<image_t> disagreeing_images;
-  // agreement < min_model_agreement: the model may be folded by symmetric structure.
-  bool possibly_folded = false;
-};
-
-struct MapperResult {
-  // Largest first (most registered images, then most points).
-  std::vector<Reconstruction> models;
-  // One per model, in the same order.
-  std::vector<ModelSelfCheck> self_checks;
-  // Focal lengths estimated for cameras without a prior.
-  std::vector<FocalLengthReport> focal_lengths;
-  // Pairs dropped by view-graph filtering, of those verified.
-  size_t num_pairs_dropped = 0;
-  // Registrations refused because they disagreed with the view graph.
-  size_t num_registrations_refused = 0;
-  // One line per merge of two models, and per pair of models tried and not merged.
-  std::vector<std::string> merges;
-  // Why each image that is in no model was left out.
-  std::map<image_t, std::string> unregistered_reasons;
-  size_t num_tracks = 0;
-  size_t num_refused_matches = 0;
+  ViewGraph view_graph;
+  std::vector<const MapperInput::Pair*> verified_pairs;
+  FeatureTracks tracks;
+  // Images that belong to an accepted model.
+  std::set<image_t> used_images;
+  // Initial pairs that were tried and failed, or that started a model.
+  std::set<std::pair<image_t, image_t>> tried_initial_pairs;
+  // The latest reason an image could not be registered.
+  std::map<image_t, std::string> failure_reasons;
   int num_global_ba = 0;
   int num_local_ba = 0;
-  double seconds = 0;
-  // Stopped by MapperObserver::should_stop: `models` and the reports are empty.
-  bool cancelled = false;
-};
-
-// What a caller (the map stage, a GUI) watches and controls while mapping runs. Both
-// may be empty; both are called on the mapping thread.
-struct MapperObserver {
-  // Polled before each registration and each final refinement round; true stops
-  // mapping soon after, and Reconstruct returns a result with `cancelled` set.
-  std::function<bool()> should_stop;
-  // After each image is registered and its tracks triangulated, with the model being
-  // grown (images not registered yet have `registered` false) and its index among the
-  // models started in this run (0, 1, ...; a model dropped as too small is reused).
-  // Not called for the calibration pass of focal-length estimation.
-  std::function<void(size_t model_index, const Reconstruction& model)> on_model_changed;
+  size_t num_registrations_refused = 0;
 };
 
 class IncrementalMapper {
  public:
-  // `bundle_adjuster` must outlive the mapper.
-  IncrementalMapper(const IncrementalMapperOptions& options, const BundleAdjuster& bundle_adjuster,
-                    uint64_t seed);
+  enum class Status {
+    kSuccess,
+    // Initialize: no pair of images outside accepted models gives a start with enough
+    // well-triangulated points.
+    kNoInitialPair,
+    // RegisterImage: the image sees fewer points of the model than
+    // abs_pose_min_num_inliers.
+    kTooFewPoints,
+    // RegisterImage: PnP found too few consistent 2D-3D correspondences.
+    kNoPose,
+    // RegisterImage: the pose disagrees with the image's verified pairs (see
+    // IncrementalMapperOptions::check_registration).
+    kRefusedByViewGraph,
+    // A bundle adjustment's result was not usable; the model kept its state before it.
+    kBundleAdjustmentFailed,
+    // Finish: the caller asked to stop.
+    kCancelled,
+  };
 
-  MapperResult Reconstruct(const MapperInput& input, const MapperObserver& observer = {}) const;
+  // `run` must outlive the mapper (`options` is copied); the model starts with run->cameras and
+  // every input image, none registered.
+  IncrementalMapper(const IncrementalMapperOptions& options, MapperRunState* run);
+
+  // Chooses the initial pair (most triangulated points, discounted below the goal
+  // median angle init_min_tri_angle, then at half and a quarter of it), registers it,
+  // triangulates its matches and adjusts it.
+  Status Initialize();
+  // Unregistered images that see enough of the model's points, best first: coverage
+  // of the image by keypoints with a point, times the connection strength (the inliers
+  // of its strongest pair with a registered image over those of its strongest pair).
+  // Also records why an image sees too few points.
+  std::vector<image_t> NextImages();
+  Status RegisterImage(image_t image_id);
+  // Returns the points created plus the observations added.
+  size_t TriangulateImage(image_t image_id);
+  // The image and its local_ba_num_images - 1 most connected neighbours, with the other
+  // images that see their points held fixed; then completion and filtering of those
+  // points.
+  Status LocalBundleAdjustment(image_t image_id);
+  // Whether the model grew by ba_global_images_ratio or ba_global_points_ratio since
+  // the last global bundle adjustment (false when the last local one was the whole
+  // model).
+  bool GlobalRefinementDue() const;
+  // Whether an image registered since the last global bundle adjustment.
+  bool ChangedSinceGlobalBundleAdjustment() const { return changed_since_global_ba_; }
+  Status GlobalBundleAdjustment();
+  // Track completion and merging, retriangulation, then a global bundle adjustment;
+  // every unregistered image gets new registration trials.
+  Status GlobalRefinement();
+  // Removes the observations of the points reprojecting further than
+  // filter_max_reproj_error and the points whose rays meet at less than
+  // filter_min_tri_angle; returns the observations removed.
+  size_t FilterPoints(const std::set<point3D_t>& point3D_ids);
+  // Up to ba_global_max_refinements rounds of global refinement, until the
+  // observations change by less than 0.1%, with the principal point refined when asked
+  // (put back at the centre where implausible). `should_stop` is polled before each.
+  Status Finish(const std::function<bool()>& should_stop = {});
+  // Every unregistered image is tried again, none waits for more neighbours, and an
+  // image the view graph refused is retried with the neighbours that agree on it.
+  void BeginFinalRounds();
+
+  size_t NumRegisteredImages() const { return obs_.registered_images().size(); }
+  // The model being grown: every image, unregistered ones with `registered` false.
+  const Reconstruction& model() const { return obs_.model(); }
+  const ObservationManager& observations() const { return obs_; }
+  // The registered images, their cameras and the points; the mapper is left empty.
+  Reconstruction TakeModel() { return obs_.TakeModel(); }
 
  private:
-  IncrementalMapperOptions options_;
-  const BundleAdjuster& bundle_adjuster_;
-  uint64_t seed_;
+  struct InitialPair {
+    const MapperInput::Pair* pair = nullptr;
+    Rigid3d cam2_from_cam1;
+    struct Point {
+      track_t track_id;
+      point2D_t idx1, idx2;
+      Eigen::Vector3d xyz;  // in camera 1
+    };
+    std::vector<Point> points;
+    double median_angle = 0;  // radians
+    double score = 0;
+  };
+  bool EvaluateInitialPair(const MapperInput::Pair& pair, InitialPair* result) const;
+  double ConnectionStrength(image_t image_id) const;
+  // Registered images that the image has an unremoved pair with, and all of them.
+  std::pair<size_t, size_t> NumRegisteredNeighbours(image_t image_id) const;
+  bool AgreesWithViewGraph(image_t image_id, const Eigen::Matrix3d& R_cam_from_world,
+                           std::string* why) const;
+  // After a refused registration: the heaviest group (by inliers) of registered
+  // neighbours whose pairs imply one rotation of the image becomes its trusted
+  // neighbours; its pairs to the others are dropped from the view graph.
+  void TrustStrongestAgreeingPairs(image_t image_id);
+  struct RotationVote {
+    size_t edge = 0;
+    image_t neighbour = kInvalidImageId;
+    Eigen::Matrix3d R_cam_from_world;  // implied for the image
+    double weight = 0;                 // the pair's inliers
+  };
+  std::vector<RotationVote> RotationVotes(image_t image_id) const;
+  double HeaviestVoteGroup(const std::vector<RotationVote>& votes,
+                           const std::function<bool(const RotationVote&)>& eligible,
+                           size_t* best) const;
+  bool ResetImplausiblePrincipalPoints();
+  BundleAdjustmentConfig MakeBundleAdjustmentConfig() const;
+  Status Fail(image_t image_id, Status status, const std::string& why);
+
+  const IncrementalMapperOptions options_;
+  MapperRunState& run_;
+  ObservationManager obs_;
+  IncrementalTriangulator triangulator_;
+  std::map<image_t, int> num_registration_trials_;
+  std::map<image_t, std::set<image_t>> trusted_neighbours_;
+  // Images refused by the view-graph check, with how many registered neighbours they
+  // had then: they wait until they have more.
+  std::map<image_t, size_t> refused_with_neighbours_;
+  bool final_rounds_ = false;
+  size_t num_images_at_global_ba_ = 0;
+  size_t num_points_at_global_ba_ = 0;
+  bool changed_since_global_ba_ = false;
+  bool local_ba_was_global_ = false;
+  // Whether BA moves the principal point now: only in the final global rounds.
+  bool refine_principal_point_ = false;
 };
+
+// "success", "no initial pair", ...: for the log.
+const char* StatusName(IncrementalMapper::Status status);
 
 }  // namespace tessera

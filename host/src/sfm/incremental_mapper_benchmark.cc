@@ -20,7 +20,7 @@
 #include <map>
 #include <vector>
 
-#include "sfm/incremental_mapper.h"
+#include "sfm/incremental_pipeline.h"
 #include "synthetic_scene.h"
 #include "test_support.h"
 
@@ -49,7 +49,7 @@ void BM_IncrementalMapperPath(benchmark::State& state) {
   int num_global_ba = 0, num_local_ba = 0;
   for (auto _ : state) {
     const MapperResult result =
-        IncrementalMapper(IncrementalMapperOptions{}, Adjuster(), 0).Reconstruct(scene.input);
+        IncrementalPipeline(IncrementalMapperOptions{}, Adjuster(), 0).Reconstruct(scene.input);
     num_models = result.models.size();
     num_registered = num_models > 0 ? result.models[0].images.size() : 0;
     num_points = num_models > 0 ? result.models[0].points3D.size() : 0;

@@ -12,7 +12,7 @@
 #include <map>
 #include <vector>
 
-#include "sfm/incremental_mapper.h"
+#include "sfm/mapper_input.h"
 #include "tessera/reconstruction.h"
 
 namespace tessera {

@@ -1,0 +1,56 @@
+// `tessera gui`: the desktop GUI (gui/), or its headless screenshot mode. Without a
+// display it exits 2 with one line; a build without GLFW/ImGui/OpenGL says so.
+
+#include "cli/commands.h"
+#include "cli/exit_codes.h"
+#include "tessera/errors.h"
+
+#ifdef TESSERA_HAS_GUI
+#include "gui/gui_app.h"
+#endif
+
+namespace tessera {
+
+CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions&) {
+  struct GuiArguments {
+    std::string images, output, manifest, model, screenshot;
+    int frames = 3, width = 1280, height = 800;
+    bool view_only = false;
+  };
+  auto options = std::make_shared<GuiArguments>();
+  CLI::App* sub = app.add_subcommand("gui", "Desktop GUI: set up, run and watch the model grow");
+  sub->add_option("--images", options->images, "Folder of input images");
+  sub->add_option("--output", options->output, "Workspace folder");
+  sub->add_option("--manifest", options->manifest, "Pipeline manifest (default: default.json)");
+  sub->add_option("--model", options->model,
+                  "Model to open: a COLMAP model folder, a workspace or its database.db");
+  sub->add_option("--screenshot", options->screenshot,
+                  "Write a PNG of the window (after the run, given --images and --output; or "
+                  "of --model) and exit");
+  sub->add_option("--frames", options->frames, "Frames drawn before the screenshot (at least 2)")
+      ->check(CLI::PositiveNumber);
+  sub->add_option("--width", options->width, "Window width")->check(CLI::Range(200, 8192));
+  sub->add_option("--height", options->height, "Window height")->check(CLI::Range(200, 8192));
+  sub->add_flag("--view-only", options->view_only, "Only the 3D view, without the panels");
+  return {sub, [options]() -> int {
+#ifdef TESSERA_HAS_GUI
+            gui::GuiCommandOptions command;
+            command.gui.images = options->images;
+            command.gui.output = options->output;
+            command.gui.manifest = options->manifest;
+            command.gui.model = options->model;
+            command.gui.width = options->width;
+            command.gui.height = options->height;
+            command.gui.view_only = options->view_only;
+            command.screenshot = options->screenshot;
+            command.frames = options->frames;
+            return gui::RunGui(command);
+#else
+            throw InputError(
+                "tessera gui: this tessera was built without the GUI (GLFW, Dear ImGui or "
+                "OpenGL was not found)");
+#endif
+          }};
+}
+
+}  // namespace tessera

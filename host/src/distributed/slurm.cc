@@ -1,0 +1,149 @@
+#include "distributed/slurm.h"
+
+#include <sys/stat.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <sstream>
+
+#include "tessera/errors.h"
+#include "tessera/io/file_io.h"
+
+namespace tessera {
+namespace {
+
+std::string Header(const SlurmOptions& options, const std::string& name, bool array) {
+  const std::filesystem::path logs = options.output_dir / "slurm" / "logs";
+  std::string text = "#!/bin/bash\n";
+  text += "#SBATCH --job-name=tessera-" + name + "\n";
+  text += "#SBATCH --output=" + (logs / (name + (array ? "-%a" : "") + "-%j.log")).string() + "\n";
+  if (options.threads > 0)
+    text += "#SBATCH --cpus-per-task=" + std::to_string(options.threads) + "\n";
+  if (!options.partition.empty()) text += "#SBATCH --partition=" + options.partition + "\n";
+  if (!options.time.empty()) text += "#SBATCH --time=" + options.time + "\n";
+  // A job whose dependency failed is cancelled instead of waiting for ever.
+  text += "#SBATCH --kill-on-invalid-dep=yes\n";
+  for (const std::string& arg : options.sbatch_args) text += "#SBATCH " + arg + "\n";
+  text += "set -euo pipefail\n";
+  return text;
+}
+
+std::string CommonArgs(const SlurmOptions& options) {
+  std::string args = " --output " + ShellQuote(options.output_dir.string());
+  if (!options.manifest.empty()) args += " --manifest " + ShellQuote(options.manifest.string());
+  if (options.threads > 0) args += " --threads " + std::to_string(options.threads);
+  return args;
+}
+
+}  // namespace
+
+std::string ShellQuote(const std::string& word) {
+  std::string quoted = "'";
+  for (const char c : word) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
+std::string ArraySpec(const std::vector<int>& indices) {
+  bool contiguous = !indices.empty();
+  for (size_t i = 1; i < indices.size(); ++i) contiguous &= indices[i] == indices[i - 1] + 1;
+  if (contiguous && indices.size() > 1) {
+    return std::to_string(indices.front()) + "-" + std::to_string(indices.back());
+  }
+  std::string spec;
+  for (const int index : indices) spec += (spec.empty() ? "" : ",") + std::to_string(index);
+  return spec;
+}
+
+std::vector<SlurmScript> MakeSlurmScripts(const SlurmOptions& options, const SlurmPlan& plan) {
+  const std::string tessera = ShellQuote(options.tessera.string());
+  const std::string images = ShellQuote(options.image_dir.string());
+  const std::string n = std::to_string(options.workers);
+  const std::string common = CommonArgs(options);
+  const std::string camera_K =
+      options.camera_K.empty() ? "" : " --camera-K " + ShellQuote(options.camera_K.string());
+  const std::string shard = " --shard \"$SLURM_ARRAY_TASK_ID/" + n + "\"";
+  std::vector<SlurmScript> scripts;
+  const auto add = [&](const std::string& name, bool array, const std::vector<int>& indices,
+                       const std::string& command) {
+    std::string text = Header(options, name, array);
+    if (array)
+      text.insert(text.find("#SBATCH --output"), "#SBATCH --array=" + ArraySpec(indices) + "\n");
+    text += "exec " + tessera + " " + command + "\n";
+    scripts.push_back({name, options.output_dir / "slurm" / (name + ".sh"), text});
+  };
+  if (!plan.extract_shards.empty()) {
+    add("extract", true, plan.extract_shards,
+        "extract --images " + images + common + camera_K + shard);
+  }
+  add("merge_extract", false, {},
+      "merge --output " + ShellQuote(options.output_dir.string()) + " --stage extract --shards " +
+          n);
+  if (!plan.match_shards.empty()) {
+    add("match", true, plan.match_shards, "match" + common + shard);
+  }
+  add("merge_match", false, {},
+      "merge --output " + ShellQuote(options.output_dir.string()) + " --stage match --shards " + n);
+  add("map", false, {}, "map --images " + images + common);
+  return scripts;
+}
+
+void WriteSlurmScripts(const std::vector<SlurmScript>& scripts) {
+  for (const SlurmScript& script : scripts) {
+    std::error_code error;
+    std::filesystem::create_directories(script.path.parent_path() / "logs", error);
+    if (error) {
+      throw InputError((script.path.parent_path() / "logs").string() +
+                       ": cannot create the folder: " + error.message());
+    }
+    WriteFileAtomically(script.path, script.text);
+    std::filesystem::permissions(script.path,
+                                 std::filesystem::perms::owner_exec |
+                                     std::filesystem::perms::group_exec |
+                                     std::filesystem::perms::others_exec,
+                                 std::filesystem::perm_options::add, error);
+  }
+}
+
+std::filesystem::path FindInPath(const std::string& program) {
+  const char* path = std::getenv("PATH");
+  if (path == nullptr) return {};
+  std::stringstream folders(path);
+  std::string folder;
+  while (std::getline(folders, folder, ':')) {
+    if (folder.empty()) continue;
+    const std::filesystem::path candidate = std::filesystem::path(folder) / program;
+    struct stat info {};
+    if (stat(candidate.c_str(), &info) == 0 && S_ISREG(info.st_mode) && (info.st_mode & S_IXUSR)) {
+      return candidate;
+    }
+  }
+  return {};
+}
+
+std::vector<std::string> SubmitSlurmScripts(const std::filesystem::path& sbatch,
+                                            const std::vector<SlurmScript>& scripts) {
+  std::vector<std::string> ids;
+  for (const SlurmScript& script : scripts) {
+    std::string command = ShellQuote(sbatch.string()) + " --parsable";
+    if (!ids.empty()) command += " --dependency=afterok:" + ids.back();
+    command += " " + ShellQuote(script.path.string()) + " 2>&1";
+    std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
+    if (!pipe) throw std::runtime_error("cannot run " + sbatch.string());
+    std::string output;
+    std::array<char, 512> buffer{};
+    while (fgets(buffer.data(), buffer.size(), pipe.get()) != nullptr) output += buffer.data();
+    const int status = pclose(pipe.release());
+    while (!output.empty() && (output.back() == '\n' || output.back() == '\r')) output.pop_back();
+    if (status != 0 || output.empty()) {
+      throw InputError(sbatch.string() + " refused " + script.path.string() + ": " + output);
+    }
+    // --parsable prints "id" or "id;cluster".
+    ids.push_back(output.substr(0, output.find(';')));
+  }
+  return ids;
+}
+
+}  // namespace tessera

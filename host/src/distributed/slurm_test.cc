@@ -1,0 +1,152 @@
+#include "distributed/slurm.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include "pipeline/stage_test_util.h"
+
+namespace tessera {
+namespace {
+
+SlurmOptions Options() {
+  SlurmOptions options;
+  options.tessera = "/opt/tessera/bin/tessera";
+  options.image_dir = "/shared/photos";
+  options.output_dir = "/shared/out";
+  options.manifest = "/shared/m.json";
+  options.workers = 4;
+  options.threads = 8;
+  options.partition = "cpu";
+  options.time = "02:00:00";
+  options.sbatch_args = {"--account=sfm"};
+  return options;
+}
+
+const SlurmScript& Named(const std::vector<SlurmScript>& scripts, const std::string& name) {
+  for (const SlurmScript& script : scripts) {
+    if (script.name == name) return script;
+  }
+  throw std::runtime_error("no script " + name);
+}
+
+bool Has(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+TEST(Slurm, ArraySpecs) {
+  EXPECT_EQ(ArraySpec({0, 1, 2, 3}), "0-3");
+  EXPECT_EQ(ArraySpec({2}), "2");
+  EXPECT_EQ(ArraySpec({0, 2, 5}), "0,2,5");
+}
+
+TEST(Slurm, ShellQuoting) {
+  EXPECT_EQ(ShellQuote("/a b/c"), "'/a b/c'");
+  EXPECT_EQ(ShellQuote("it's"), "'it'\\''s'");
+}
+
+TEST(Slurm, FiveScriptsInOrderWithArraysAndOptions) {
+  const std::vector<SlurmScript> scripts =
+      MakeSlurmScripts(Options(), {{0, 1, 2, 3}, {0, 1, 2, 3}});
+  ASSERT_EQ(scripts.size(), 5u);
+  const std::vector<std::string> names = {"extract", "merge_extract", "match", "merge_match",
+                                          "map"};
+  for (size_t i = 0; i < names.size(); ++i) {
+    EXPECT_EQ(scripts[i].name, names[i]);
+    EXPECT_EQ(scripts[i].path, std::filesystem::path("/shared/out/slurm") / (names[i] + ".sh"));
+    const std::string& text = scripts[i].text;
+    EXPECT_EQ(text.rfind("#!/bin/bash\n", 0), 0u);
+    EXPECT_TRUE(Has(text, "#SBATCH --partition=cpu\n")) << text;
+    EXPECT_TRUE(Has(text, "#SBATCH --time=02:00:00\n")) << text;
+    EXPECT_TRUE(Has(text, "#SBATCH --account=sfm\n")) << text;
+    EXPECT_TRUE(Has(text, "#SBATCH --cpus-per-task=8\n")) << text;
+    EXPECT_TRUE(Has(text, "#SBATCH --kill-on-invalid-dep=yes\n")) << text;
+    EXPECT_TRUE(Has(text, "exec '/opt/tessera/bin/tessera' ")) << text;
+  }
+  const std::string& extract = Named(scripts, "extract").text;
+  EXPECT_TRUE(Has(extract, "#SBATCH --array=0-3\n")) << extract;
+  EXPECT_TRUE(Has(extract,
+                  "extract --images '/shared/photos' --output '/shared/out' --manifest "
+                  "'/shared/m.json' --threads 8 --shard \"$SLURM_ARRAY_TASK_ID/4\""))
+      << extract;
+  EXPECT_TRUE(Has(extract, "#SBATCH --output=/shared/out/slurm/logs/extract-%a-%j.log")) << extract;
+  EXPECT_TRUE(Has(Named(scripts, "merge_extract").text,
+                  "merge --output '/shared/out' --stage extract --shards 4"));
+  EXPECT_TRUE(Has(Named(scripts, "match").text, "match --output '/shared/out'"));
+  EXPECT_TRUE(Has(Named(scripts, "merge_match").text, "--stage match --shards 4"));
+  EXPECT_TRUE(Has(Named(scripts, "map").text, "map --images '/shared/photos' --output"));
+  EXPECT_FALSE(Has(Named(scripts, "map").text, "--array"));
+}
+
+TEST(Slurm, ARerunHasOnlyTheUnfinishedShards) {
+  const std::vector<SlurmScript> scripts = MakeSlurmScripts(Options(), {{}, {1, 3}});
+  ASSERT_EQ(scripts.size(), 4u);
+  EXPECT_EQ(scripts[0].name, "merge_extract");
+  EXPECT_TRUE(Has(Named(scripts, "match").text, "#SBATCH --array=1,3\n"));
+}
+
+TEST(Slurm, ScriptsAreWrittenExecutable) {
+  testing::TemporaryDir dir;
+  SlurmOptions options = Options();
+  options.output_dir = dir.path() / "out";
+  WriteSlurmScripts(MakeSlurmScripts(options, {{0}, {0}}));
+  const std::filesystem::path extract = dir.path() / "out" / "slurm" / "extract.sh";
+  ASSERT_TRUE(std::filesystem::exists(extract));
+  EXPECT_NE(std::filesystem::status(extract).permissions() & std::filesystem::perms::owner_exec,
+            std::filesystem::perms::none);
+  EXPECT_TRUE(std::filesystem::is_directory(dir.path() / "out" / "slurm" / "logs"));
+}
+
+TEST(Slurm, FindsProgramsInPath) {
+  EXPECT_FALSE(FindInPath("sh").empty());
+  EXPECT_TRUE(FindInPath("no-such-program-tessera").empty());
+}
+
+// The verbs' arguments, as a user gives them.
+class DistributedArguments : public ::testing::Test {
+ protected:
+  testing::CommandResult Tessera(const std::string& arguments, const std::string& env = "") {
+    return testing::RunCommand(TESSERA_TEST_EXECUTABLE, arguments, env);
+  }
+  testing::TemporaryDir dir_;
+};
+
+TEST_F(DistributedArguments, AShardOutsideTheRangeIsExit2) {
+  testing::WriteSampleImages(dir_.path() / "images", 2);
+  const std::string images = (dir_.path() / "images").string();
+  const std::string out = (dir_.path() / "out").string();
+  for (const char* shard : {"3/3", "0/0", "-1/2", "x"}) {
+    const auto result = Tessera(std::string("extract --images ") + images + " --output " + out +
+                                " --shard " + shard);
+    EXPECT_EQ(result.exit_code, 2) << shard << ": " << result.output;
+    EXPECT_TRUE(Has(result.output, "--shard")) << result.output;
+    const auto match = Tessera("match --output " + out + " --shard " + shard);
+    EXPECT_EQ(match.exit_code, 2) << match.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir_.path() / "out" / "shards"));
+  const auto workers = Tessera("slurm --images " + images + " --output " + out + " --workers 0");
+  EXPECT_EQ(workers.exit_code, 2) << workers.output;
+}
+
+TEST_F(DistributedArguments, SbatchMissingIsExit2SuggestingDryRun) {
+  testing::WriteSampleImages(dir_.path() / "images", 2);
+  std::ofstream(dir_.path() / "m.json")
+      << R"({"pipeline": {"detector": {"plugin": "orb"}, "pair_selector": {"plugin": "exhaustive"},
+                          "matcher": {"plugin": "brute_force"}}})";
+  const std::string arguments = "slurm --images " + (dir_.path() / "images").string() +
+                                " --output " + (dir_.path() / "out").string() +
+                                " --workers 2 --manifest " + (dir_.path() / "m.json").string();
+  const auto result = Tessera(arguments, "PATH=/nonexistent");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_TRUE(Has(result.output, "sbatch")) << result.output;
+  EXPECT_TRUE(Has(result.output, "--dry-run")) << result.output;
+  const auto dry = Tessera(arguments + " --dry-run", "PATH=/nonexistent");
+  EXPECT_EQ(dry.exit_code, 0) << dry.output;
+  std::ifstream extract(dir_.path() / "out" / "slurm" / "extract.sh");
+  const std::string text((std::istreambuf_iterator<char>(extract)), {});
+  EXPECT_TRUE(Has(text, "#SBATCH --array=0-1")) << text;
+  EXPECT_FALSE(std::filesystem::exists(dir_.path() / "out" / "database.db"));
+}
+
+}  // namespace
+}  // namespace tessera

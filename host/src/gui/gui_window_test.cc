@@ -1,0 +1,436 @@
+// The GUI in a private X server (Xvfb, llvmpipe): driven by simulated mouse clicks and
+// typing (ImGui 1.86 has no test engine), its screenshots checked by pixel counts and
+// against a committed reference image.
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <opencv2/imgcodecs.hpp>
+#include <regex>
+
+#include "gui/gui_app.h"
+#include "gui/renderer.h"
+#include "gui/xvfb.h"
+#include "manifest/manifest.h"
+#include "pipeline/stage_test_util.h"
+#include "tessera/errors.h"
+#include "test_support.h"
+
+namespace tessera::gui {
+namespace {
+namespace fs = std::filesystem;
+
+class GuiWindowTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string why;
+    if (!xvfb_.Start(&why)) GTEST_SKIP() << "skipped: " << why;
+  }
+
+  // A move, a press and a release at the centre of the widget, one frame each.
+  static void Click(GuiApp* app, const WidgetRect& rect) {
+    for (bool down : {false, true, false}) {
+      SyntheticInput input;
+      input.x = rect.CenterX();
+      input.y = rect.CenterY();
+      input.left_down = down;
+      app->Frame(&input);
+    }
+  }
+  static void Click(GuiApp* app, const std::string& widget) {
+    const std::optional<WidgetRect> rect = app->Widget(widget);
+    ASSERT_TRUE(rect.has_value()) << widget;
+    Click(app, *rect);
+  }
+  static void Type(GuiApp* app, const std::string& text) {
+    SyntheticInput input;
+    input.x = -1;
+    input.y = -1;
+    input.text = text;
+    app->Frame(&input);
+  }
+  // Draws frames (as the event loop would) until `done` or the time runs out.
+  template <typename Done>
+  static bool WaitFor(GuiApp* app, Done done, double seconds) {
+    const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    while (std::chrono::steady_clock::now() < end) {
+      if (done()) return true;
+      app->Step(0.02);
+    }
+    return done();
+  }
+  static bool LogHas(const GuiApp& app, const std::regex& pattern) {
+    for (const LogLine& line : app.LogLines()) {
+      if (std::regex_search(line.text, pattern)) return true;
+    }
+    return false;
+  }
+
+  // 8 images of the sample at 400 px, and a cheap manifest (ORB, every pair, brute force,
+  // Ceres, a COLMAP binary model).
+  void MakeSample() {
+    tessera::testing::WriteSampleImages(dir_.path() / "images", 8);
+    manifest_ = dir_.path() / "manifest.json";
+    std::ofstream(manifest_) << R"({
+      "pipeline": {
+        "detector": {"plugin": "orb", "options": {"max_num_features": 2000}},
+        "pair_selector": {"plugin": "exhaustive"},
+        "matcher": {"plugin": "brute_force"},
+        "bundle_adjuster": {"plugin": "ceres"},
+        "exporters": [{"plugin": "colmap_binary"}]
+      },
+      "threads": 2
+    })";
+  }
+
+  testing::Xvfb xvfb_;
+  tessera::testing::TemporaryDir dir_;
+  fs::path manifest_;
+};
+
+struct PixelCounts {
+  size_t non_background = 0;
+  size_t frustum = 0;
+};
+
+PixelCounts CountViewPixels(const RgbImage& image, const WidgetRect& view) {
+  PixelCounts counts;
+  for (int y = static_cast<int>(view.min_y); y < static_cast<int>(view.max_y); ++y) {
+    for (int x = static_cast<int>(view.min_x); x < static_cast<int>(view.max_x); ++x) {
+      const uint8_t* p = &image.pixels[(static_cast<size_t>(y) * image.width + x) * 3];
+      if (p[0] != kBackgroundColor[0] || p[1] != kBackgroundColor[1] ||
+          p[2] != kBackgroundColor[2]) {
+        ++counts.non_background;
+      }
+      if (p[0] == kFrustumColor[0] && p[1] == kFrustumColor[1] && p[2] == kFrustumColor[2]) {
+        ++counts.frustum;
+      }
+    }
+  }
+  return counts;
+}
+
+TEST(GuiNoDisplay, RefusesWithOneLine) {
+  const char* display = std::getenv("DISPLAY");
+  const std::string saved = display != nullptr ? display : "";
+  unsetenv("DISPLAY");
+  unsetenv("WAYLAND_DISPLAY");
+  try {
+    GuiApp app(GuiOptions{});
+    FAIL() << "a window opened without a display";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "tessera gui: no display (DISPLAY is not set); every other verb works without one");
+  }
+  if (!saved.empty()) setenv("DISPLAY", saved.c_str(), 1);
+}
+
+TEST_F(GuiWindowTest, ClickThroughRunOnTheSampleShowsTheReconstruction) {
+  MakeSample();
+  GuiOptions options;
+  options.output = dir_.path() / "out";
+  options.manifest = manifest_;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  // Set the folder: click the field and type its path; then press Run.
+  Click(&app, "images");
+  Type(&app, (dir_.path() / "images").string());
+  Click(&app, "run");
+  ASSERT_TRUE(app.controller().Running() || app.controller().Status().state != RunState::kIdle)
+      << app.SetupError();
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return !app.controller().Running(); }, 120));
+  const RunStatus status = app.controller().Status();
+  ASSERT_EQ(status.state, RunState::kCompleted) << status.error;
+  app.Frame();
+  RgbImage image;
+  app.Frame(nullptr, &image);
+  EXPECT_GE(app.NumSceneCameras(), 6u);  // of 8 images
+  // The log pane has the CLI's lines.
+  EXPECT_TRUE(LogHas(app, std::regex(R"(^\[info\] extract: 8 images, 8 to detect with 'orb')")));
+  const PixelCounts counts = CountViewPixels(image, app.ViewRect());
+  std::printf("3D view: %zu points, %zu cameras, %zu non-background and %zu frustum pixels\n",
+              app.NumScenePoints(), app.NumSceneCameras(), counts.non_background, counts.frustum);
+  // Each point covers 2x2 pixels; the framing keeps 90 % of the points in view, and at
+  // 860x800 pixels of view no more than three in four overlap: a quarter of 4 pixels
+  // per point is the bound. A frustum has 8 edges of at least 10 pixels each.
+  EXPECT_GT(counts.non_background, app.NumScenePoints());
+  EXPECT_GT(app.NumScenePoints(), 1000u);
+  EXPECT_GT(counts.frustum, 80 * app.NumSceneCameras());
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) WritePng(image, keep);
+}
+
+TEST_F(GuiWindowTest, CancelDuringMatchingThenRunReusesFeaturesAndPairs) {
+  MakeSample();
+  GuiOptions options;
+  options.images = dir_.path() / "images";
+  options.output = dir_.path() / "out";
+  options.manifest = manifest_;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  Click(&app, "run");
+  ASSERT_TRUE(WaitFor(
+      &app,
+      [&] {
+        const RunStatus status = app.controller().Status();
+        return !status.stages.empty() && status.stages.back().stage == "match" &&
+               status.stages.back().done >= 1;
+      },
+      60));
+  const auto cancelled_at = std::chrono::steady_clock::now();
+  Click(&app, "cancel");
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return !app.controller().Running(); }, 10));
+  const double cancel_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - cancelled_at).count();
+  std::printf("Cancel to the worker's end: %.3f s\n", cancel_s);
+  EXPECT_LT(cancel_s, 2.0);
+  RunStatus status = app.controller().Status();
+  ASSERT_EQ(status.state, RunState::kCancelled);
+  ASSERT_FALSE(status.stages.empty());
+  EXPECT_EQ(status.stages.back().stage, "match");
+  EXPECT_LT(status.stages.back().done, status.stages.back().total);
+  EXPECT_TRUE(LogHas(app, std::regex("run cancelled")));
+
+  Click(&app, "run");
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return !app.controller().Running(); }, 120));
+  status = app.controller().Status();
+  ASSERT_EQ(status.state, RunState::kCompleted) << status.error;
+  EXPECT_TRUE(
+      LogHas(app, std::regex(R"(extract: 8 images, 0 to detect with 'orb' \(8 already done\))")));
+  // Some pairs were finished before the cancel, and are not matched again.
+  EXPECT_TRUE(LogHas(
+      app, std::regex(R"(match: .* to match with 'brute_force' \([1-9][0-9]* already done\))")));
+
+  // The match matrix of the workspace: click the cell of images 1 and 2 (row 0, column 1).
+  Click(&app, "match matrix");
+  ASSERT_EQ(app.MatchError(), "");
+  app.Frame();
+  app.Frame();
+  const WidgetRect cells = app.Widget("match cells").value();
+  const float cell = (cells.max_x - cells.min_x) / 8;
+  Click(&app, WidgetRect{cells.min_x + 1.5f * cell, cells.min_y + 0.5f * cell,
+                         cells.min_x + 1.5f * cell, cells.min_y + 0.5f * cell});
+  EXPECT_EQ(app.SelectedPair(), std::make_pair(0, 1));
+  EXPECT_EQ(app.SelectedPairInliers().name1, "0000.jpg");
+  EXPECT_EQ(app.SelectedPairInliers().name2, "0001.jpg");
+  EXPECT_GT(app.SelectedPairInliers().xy1.size(), 15u);  // a verified pair
+  RgbImage image;
+  app.Frame();
+  app.Frame(nullptr, &image);
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) WritePng(image, keep);
+}
+
+TEST_F(GuiWindowTest, ReferenceImageOfColmapsFountainModel) {
+  const fs::path model =
+      tessera::testing::SharedDir() / "anchors" / "colmap-3.8" / "fountain-P11" / "sparse" / "0";
+  if (!fs::exists(model / "points3D.bin")) GTEST_SKIP() << "skipped: " << model << " is missing";
+  GuiOptions options;
+  options.model = model;
+  options.width = 320;
+  options.height = 240;
+  options.view_only = true;
+  GuiApp app(options);
+  ASSERT_EQ(app.ModelError(), "");
+  app.Frame();
+  RgbImage image;
+  app.Frame(nullptr, &image);
+  ASSERT_EQ(image.width, 320);
+  ASSERT_EQ(image.height, 240);
+  const fs::path reference_file = tessera::testing::SourceDir() / "host" / "src" / "gui" /
+                                  "testdata" / "fountain_colmap_320x240.png";
+  if (std::getenv("TESSERA_UPDATE_GUI_REFERENCE") != nullptr) WritePng(image, reference_file);
+  const cv::Mat reference = cv::imread(reference_file.string(), cv::IMREAD_COLOR);
+  ASSERT_FALSE(reference.empty()) << reference_file;
+  ASSERT_EQ(reference.cols, 320);
+  ASSERT_EQ(reference.rows, 240);
+  // Tolerance: a pixel differs when a channel differs by more than 24 of 255; at most
+  // 1 % of the pixels may differ (point rasterisation at the edges of pixels may move by
+  // one pixel between Mesa versions).
+  size_t differing = 0;
+  size_t drawn = 0;
+  for (int y = 0; y < 240; ++y) {
+    for (int x = 0; x < 320; ++x) {
+      const cv::Vec3b bgr = reference.at<cv::Vec3b>(y, x);
+      const uint8_t* rgb = &image.pixels[(static_cast<size_t>(y) * 320 + x) * 3];
+      bool differs = false;
+      for (int c = 0; c < 3; ++c) differs |= std::abs(int(bgr[2 - c]) - int(rgb[c])) > 24;
+      differing += differs ? 1 : 0;
+      drawn += (rgb[0] != kBackgroundColor[0] || rgb[1] != kBackgroundColor[1]) ? 1 : 0;
+    }
+  }
+  EXPECT_LE(differing, 320u * 240 / 100);
+  EXPECT_GT(drawn, 320u * 240 / 20);  // the model covers more than 5 % of the view
+}
+
+TEST_F(GuiWindowTest, ClickingACameraOrAPointShowsItsDetails) {
+  const fs::path model =
+      tessera::testing::SharedDir() / "anchors" / "colmap-3.8" / "fountain-P11" / "sparse" / "0";
+  if (!fs::exists(model / "points3D.bin")) GTEST_SKIP() << "skipped: " << model << " is missing";
+  GuiOptions options;
+  options.model = model;
+  // The photographs, for the camera's window, when the data set is there.
+  options.images = tessera::testing::SharedDir() / "datasets" / "fountain-P11" / "images";
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  ASSERT_NE(app.scene(), nullptr);
+  const SceneCamera& camera = app.scene()->cameras.at(3);
+  const auto center = app.ProjectToWindow(camera.center_in_world);
+  ASSERT_TRUE(center.has_value());
+  Click(&app, WidgetRect{(*center)[0], (*center)[1], (*center)[0], (*center)[1]});
+  EXPECT_EQ(app.selected_image(), camera.image_id);
+  app.Frame();  // the window appears, sized to its contents from the next frame on
+  app.Frame();
+  ASSERT_TRUE(app.Widget("camera details").has_value());
+  // A point (the first in view and not under the camera's window): the one nearest the
+  // click within 6 pixels is picked.
+  const Scene& scene = *app.scene();
+  const WidgetRect covered = app.Widget("camera window").value();
+  const WidgetRect view = app.ViewRect();
+  std::optional<std::array<float, 2>> pixel;
+  for (size_t i = 0; i < scene.NumPoints() && !pixel; ++i) {
+    pixel = app.ProjectToWindow(Eigen::Vector3f(scene.positions[3 * i], scene.positions[3 * i + 1],
+                                                scene.positions[3 * i + 2]));
+    if (!pixel) continue;
+    const float x = (*pixel)[0], y = (*pixel)[1];
+    const bool in_view = x > view.min_x + 8 && x < view.max_x - 8 && y > 8 && y < view.max_y - 8;
+    const bool under_window = x > covered.min_x - 8 && x < covered.max_x + 8 &&
+                              y > covered.min_y - 8 && y < covered.max_y + 8;
+    if (!in_view || under_window) pixel.reset();
+  }
+  ASSERT_TRUE(pixel.has_value());
+  Click(&app, WidgetRect{(*pixel)[0], (*pixel)[1], (*pixel)[0], (*pixel)[1]});
+  ASSERT_NE(app.selected_point(), kInvalidPoint3DId)
+      << (*pixel)[0] << "," << (*pixel)[1] << " window " << covered.min_x << "," << covered.min_y
+      << "-" << covered.max_x << "," << covered.max_y << " image " << app.selected_image();
+  const Point3D& picked = scene.model->points3D.at(app.selected_point());
+  const auto picked_pixel = app.ProjectToWindow(picked.xyz.cast<float>());
+  EXPECT_LT(std::hypot((*picked_pixel)[0] - (*pixel)[0], (*picked_pixel)[1] - (*pixel)[1]), 6);
+  RgbImage image;
+  app.Frame(nullptr, &image);
+  EXPECT_TRUE(app.Widget("point details").has_value());
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) WritePng(image, keep);
+}
+
+TEST_F(GuiWindowTest, BadInputIsShownInThePanel) {
+  const fs::path empty = dir_.path() / "empty";
+  fs::create_directories(empty);
+  GuiOptions options;
+  options.images = empty;
+  options.output = dir_.path() / "out";
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  // A folder with no images.
+  Click(&app, "run");
+  EXPECT_EQ(app.SetupError(),
+            empty.string() + ": no images in this folder (JPEG, PNG, TIFF, BMP, WebP)");
+  EXPECT_FALSE(app.controller().Running());
+  // A model folder that is not a model.
+  EXPECT_FALSE(app.OpenModel(empty));
+  EXPECT_NE(app.ModelError().find(": not a model:"), std::string::npos) << app.ModelError();
+  app.Frame();
+}
+
+TEST_F(GuiWindowTest, BadManifestAndPluginThatFailsToLoad) {
+  tessera::testing::WriteSampleImages(dir_.path() / "images", 2);
+  const fs::path bad_manifest = dir_.path() / "bad.json";
+  std::ofstream(bad_manifest) << R"({"pipeline": {"detector": {"plugin": "orb", "options": []}}})";
+  GuiOptions options;
+  options.images = dir_.path() / "images";
+  options.output = dir_.path() / "out";
+  options.manifest = bad_manifest;
+  {
+    GuiApp app(options);
+    app.Frame();
+    EXPECT_FALSE(app.Run());
+    EXPECT_NE(app.SetupError().find("pipeline.detector.options"), std::string::npos)
+        << app.SetupError();
+    app.Frame();
+  }
+  // A plugin whose factory throws: the run fails with its name, the window stays.
+  const fs::path throwing_manifest = dir_.path() / "throws.json";
+  std::ofstream(throwing_manifest)
+      << R"({"plugin_paths": [")" +
+             (tessera::testing::BinaryDir() / "test_plugins" / "factory_throws").string() +
+             R"("], "pipeline": {"pair_selector": {"plugin": "throws"}}})";
+  options.manifest = throwing_manifest;
+  GuiApp app(options);
+  app.Frame();
+  ASSERT_TRUE(app.Run()) << app.SetupError();
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return !app.controller().Running(); }, 30));
+  const RunStatus status = app.controller().Status();
+  EXPECT_EQ(status.state, RunState::kFailed);
+  EXPECT_EQ(status.exit_code, 2);
+  EXPECT_NE(status.error.find("cannot reach the license server"), std::string::npos)
+      << status.error;
+  app.Frame();
+  EXPECT_EQ(app.SetupError(), status.error);
+}
+
+TEST_F(GuiWindowTest, ManifestEditorChecksAsTheCliAndSaves) {
+  GuiOptions options;
+  GuiApp app(options);
+  app.Frame();
+  ASSERT_TRUE(app.LoadManifestIntoEditor()) << app.EditorError();
+  EXPECT_NE(app.EditorText().find("\"sift\""), std::string::npos);  // the default manifest
+  // A bad option value: the plugin's own validation names the JSON path.
+  app.SetEditorText(
+      R"({"pipeline": {"detector": {"plugin": "orb", "options": {"max_num_features": "many"}}}})");
+  EXPECT_FALSE(app.CheckEditedManifest());
+  EXPECT_NE(app.EditorError().find("pipeline.detector"), std::string::npos) << app.EditorError();
+  app.SetEditorText("{\"pipeline\": ");
+  EXPECT_FALSE(app.CheckEditedManifest());
+  EXPECT_NE(app.EditorError().find("invalid JSON"), std::string::npos) << app.EditorError();
+  // A plugin chosen for a slot, then saved: the run's manifest is the saved file.
+  app.SetEditorText(R"({"pipeline": {"pair_selector": {"plugin": "exhaustive"}}})");
+  ASSERT_TRUE(app.SetEditorPlugin("detector", "orb"));
+  const fs::path saved = dir_.path() / "saved.json";
+  ASSERT_TRUE(app.SaveEditedManifest(saved)) << app.EditorError();
+  const Manifest manifest = Manifest::Load(saved);
+  ASSERT_TRUE(manifest.detector.has_value());
+  EXPECT_EQ(manifest.detector->plugin, "orb");
+  app.Frame();
+}
+
+TEST_F(GuiWindowTest, FolderBrowserChoosesTheImageFolder) {
+  fs::create_directories(dir_.path() / "photos");
+  fs::create_directories(dir_.path() / "other");
+  GuiOptions options;
+  options.images = dir_.path();
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  Click(&app, "browse images");
+  app.Frame();
+  Click(&app, "folder photos");
+  app.Frame();
+  Click(&app, "choose folder");
+  EXPECT_EQ(app.ImagesField(), (dir_.path() / "photos").string());
+}
+
+TEST_F(GuiWindowTest, NoRedrawWhenNothingChanged) {
+  GuiOptions options;
+  options.width = 400;
+  options.height = 300;
+  options.view_only = true;
+  GuiApp app(options);
+  for (int i = 0; i < 10; ++i) app.Step(0.05);  // settle: the first frames and events
+  const size_t frames = app.frames_drawn();
+  for (int i = 0; i < 3; ++i) EXPECT_FALSE(app.Step(0.1));
+  EXPECT_EQ(app.frames_drawn(), frames);
+  app.SetViewOrbit(10, 0);
+  app.MarkChangedFromInput();
+  EXPECT_TRUE(app.Step(0.1));
+}
+
+}  // namespace
+}  // namespace tessera::gui

@@ -1,0 +1,42 @@
+#include "gui/model_loader.h"
+
+#include <algorithm>
+#include <string>
+
+#include "tessera/errors.h"
+#include "tessera/io/colmap_model_io.h"
+
+namespace tessera::gui {
+namespace fs = std::filesystem;
+
+std::vector<fs::path> FindModelFolders(const fs::path& path) {
+  std::error_code error;
+  if (!fs::exists(path, error)) throw InputError(path.string() + ": no such file or folder");
+  if (fs::is_directory(path, error) && ExistsColmapModel(path)) return {path};
+  const fs::path workspace = fs::is_directory(path, error) ? path : path.parent_path();
+  if (!fs::is_directory(path, error) && path.filename() != "database.db") {
+    throw InputError(path.string() + ": not a model folder or a workspace database.db");
+  }
+  std::vector<std::pair<int, fs::path>> models;
+  const fs::path sparse = workspace / "sparse";
+  if (fs::is_directory(sparse, error)) {
+    for (const auto& entry : fs::directory_iterator(sparse, error)) {
+      const std::string name = entry.path().filename().string();
+      if (name.empty() || !std::all_of(name.begin(), name.end(), ::isdigit) || name.size() > 6) {
+        continue;
+      }
+      if (ExistsColmapModel(entry.path())) models.emplace_back(std::stoi(name), entry.path());
+    }
+  }
+  if (models.empty()) {
+    throw InputError(path.string() +
+                     ": not a model: no cameras, images and points3D (.bin or .txt) in it, and "
+                     "no sparse/N model folders beside a workspace database");
+  }
+  std::sort(models.begin(), models.end());
+  std::vector<fs::path> folders;
+  for (const auto& [index, folder] : models) folders.push_back(folder);
+  return folders;
+}
+
+}  // namespace tessera::gui

@@ -1,0 +1,171 @@
+#include "gui/run_controller.h"
+
+#include <spdlog/spdlog.h>
+
+#include "cli/exit_codes.h"
+#include "pipeline/pipeline_context.h"
+#include "pipeline/run_pipeline.h"
+#include "plugin/plugin_call.h"
+#include "tessera/errors.h"
+
+namespace tessera::gui {
+
+const char* RunStateName(RunState state) {
+  switch (state) {
+    case RunState::kIdle:
+      return "idle";
+    case RunState::kRunning:
+      return "running";
+    case RunState::kCompleted:
+      return "completed";
+    case RunState::kCancelled:
+      return "cancelled";
+    case RunState::kFailed:
+      return "failed";
+  }
+  return "unknown";
+}
+
+RunController::RunController(std::function<void()> on_change) : on_change_(std::move(on_change)) {}
+
+RunController::~RunController() {
+  Cancel();
+  Join();
+}
+
+bool RunController::Start(const RunRequest& request) {
+  if (running_.exchange(true)) return false;
+  if (worker_.joinable()) worker_.join();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    status_ = RunStatus();
+    status_.state = RunState::kRunning;
+    status_.output_dir = request.output_dir;
+    stage_starts_.clear();
+    cancel_ = std::make_unique<CancellationToken>();
+  }
+  worker_ = std::thread(&RunController::Work, this, request);
+  return true;
+}
+
+void RunController::Cancel() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (cancel_ != nullptr) cancel_->Cancel();
+}
+
+bool RunController::Running() const { return running_.load(); }
+
+void RunController::Join() {
+  if (worker_.joinable()) worker_.join();
+}
+
+RunStatus RunController::Status() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  RunStatus status = status_;
+  const auto now = std::chrono::steady_clock::now();
+  if (status.state == RunState::kRunning) {
+    // Elapsed time moves on between reports.
+    for (size_t i = 0; i < status.stages.size(); ++i) {
+      StageProgress& stage = status.stages[i];
+      if (stage.total > 0 && stage.done >= stage.total) continue;
+      stage.elapsed_s = std::chrono::duration<double>(now - stage_starts_[i]).count();
+    }
+  }
+  return status;
+}
+
+std::shared_ptr<const Scene> RunController::TakeScene(uint64_t* version) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (scene_version_ == *version) return nullptr;
+  *version = scene_version_;
+  return scene_;
+}
+
+void RunController::Notify() {
+  if (on_change_) on_change_();
+}
+
+void RunController::Work(RunRequest request) {
+  StageControl control;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    control.cancel = cancel_.get();
+  }
+  control.progress = [this](const std::string& stage, size_t done, size_t total) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      const auto now = std::chrono::steady_clock::now();
+      if (status_.stages.empty() || status_.stages.back().stage != stage) {
+        status_.stages.push_back({stage, done, total});
+        stage_starts_.push_back(now);
+      }
+      StageProgress& progress = status_.stages.back();
+      const double elapsed = std::chrono::duration<double>(now - stage_starts_.back()).count();
+      progress.done = done;
+      progress.total = total;
+      progress.elapsed_s = elapsed;
+      if (done > 0 && elapsed > 0) {
+        progress.rate_per_s = static_cast<double>(done) / elapsed;
+        progress.remaining_s =
+            static_cast<double>(total - std::min(done, total)) / progress.rate_per_s;
+      }
+    }
+    Notify();
+  };
+  control.model_changed = [this](size_t /*model_index*/, const Reconstruction& model) {
+    // Copied and flattened here, on the worker; the UI thread only swaps the pointer.
+    std::shared_ptr<const Scene> scene = MakeScene(std::make_shared<const Reconstruction>(model));
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      scene_ = std::move(scene);
+      ++scene_version_;
+    }
+    Notify();
+  };
+
+  RunState state = RunState::kFailed;
+  std::string error;
+  size_t num_models = 0;
+  int exit_code = kExitInternalError;
+  try {
+    const PipelineContext context = PipelineContext::Create(request.manifest_file);
+    const RunResult result = RunPipeline(context, {request.image_dir, request.output_dir}, control);
+    num_models = result.summary.map.num_models;
+    if (result.status == StageStatus::kCancelled) {
+      state = RunState::kCancelled;
+      exit_code = kExitSuccess;
+      spdlog::info("run cancelled: the finished work is kept in {}; Run again resumes it",
+                   request.output_dir.string());
+    } else if (num_models == 0) {
+      error = (request.output_dir / "database.db").string() +
+              ": no model could be built: no pair of images initialised a model";
+      spdlog::error("{}", error);
+      exit_code = kExitNoModel;
+    } else {
+      state = RunState::kCompleted;
+      exit_code = kExitSuccess;
+    }
+  } catch (const PluginError& exception) {
+    error = exception.what();
+    exit_code = exception.input_error() ? kExitBadInput : kExitInternalError;
+    spdlog::error("{}", error);
+  } catch (const InputError& exception) {
+    error = exception.what();
+    exit_code = kExitBadInput;
+    spdlog::error("{}", error);
+  } catch (const std::exception& exception) {
+    error = std::string("internal error: ") + exception.what();
+    spdlog::error("{}", error);
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    status_.state = state;
+    status_.error = error;
+    status_.num_models = num_models;
+    status_.exit_code = exit_code;
+  }
+  running_.store(false);
+  Notify();
+}
+
+}  // namespace tessera::gui

@@ -1,0 +1,85 @@
+#pragma once
+
+// Runs the pipeline (RunPipeline, as `tessera run`) on a worker thread for the GUI:
+// progress of each stage with its rate and remaining time, Cancel, the growing model
+// (StageControl::model_changed) and the error of a run that failed. The UI thread only
+// copies small state under a mutex the worker holds briefly; it never waits on a stage.
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "gui/scene.h"
+#include "pipeline/stage_control.h"
+
+namespace tessera::gui {
+
+struct RunRequest {
+  std::filesystem::path image_dir;
+  std::filesystem::path output_dir;
+  std::filesystem::path manifest_file;  // empty: the default manifest
+};
+
+struct StageProgress {
+  std::string stage;
+  size_t done = 0;
+  size_t total = 0;
+  double elapsed_s = 0;  // since the stage's first report
+  // Units per second and seconds left, from the units done since the stage started;
+  // negative when not known yet.
+  double rate_per_s = -1;
+  double remaining_s = -1;
+};
+
+enum class RunState { kIdle, kRunning, kCompleted, kCancelled, kFailed };
+const char* RunStateName(RunState state);
+
+struct RunStatus {
+  RunState state = RunState::kIdle;
+  std::vector<StageProgress> stages;  // in the order they started
+  std::string error;                  // kFailed: the one-line message
+  size_t num_models = 0;              // kCompleted: models written
+  // As `tessera run` would exit: 0, 1 (internal), 2 (bad input), 3 (no model).
+  int exit_code = 0;
+  std::filesystem::path output_dir;
+};
+
+class RunController {
+ public:
+  // on_change is called from the worker thread whenever the status or scene changed.
+  explicit RunController(std::function<void()> on_change = {});
+  ~RunController();  // cancels a run and joins the worker
+
+  // Starts a run; false (and nothing started) while one is running.
+  bool Start(const RunRequest& request);
+  void Cancel();
+  bool Running() const;
+  // Waits for the worker to end (tests and the screenshot mode).
+  void Join();
+
+  RunStatus Status() const;
+  // The latest model the mapper reported, when newer than *version (then updated).
+  std::shared_ptr<const Scene> TakeScene(uint64_t* version) const;
+
+ private:
+  void Work(RunRequest request);
+  void Notify();
+
+  std::function<void()> on_change_;
+  mutable std::mutex mutex_;
+  RunStatus status_;
+  std::vector<std::chrono::steady_clock::time_point> stage_starts_;
+  std::shared_ptr<const Scene> scene_;
+  uint64_t scene_version_ = 0;
+  std::unique_ptr<CancellationToken> cancel_;
+  std::atomic<bool> running_{false};
+  std::thread worker_;
+};
+
+}  // namespace tessera::gui

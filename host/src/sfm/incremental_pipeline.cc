@@ -1,0 +1,452 @@
+#include "sfm/incremental_pipeline.h"
+
+#include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <utility>
+
+#include "sfm/focal_length_estimation.h"
+#include "sfm/model_merger.h"
+#include "sfm/view_graph.h"
+#include "util/random.h"
+
+namespace tessera {
+namespace {
+
+// Seed streams, so that no two random choices of a run share a seed (see
+// MapperRansacOptions for the mapper's own).
+constexpr uint64_t kMergeStream = 3;
+// The first model that calibrates cameras without a focal prior: it needs this many
+// images at least, and grows to this many at most (its bundle adjustment determines
+// the focal length well long before, at a fraction of a whole model's cost).
+constexpr size_t kMinCalibrationImages = 5;
+constexpr size_t kMaxCalibrationImages = 20;
+// Rounds of growing again after the final refinement, while images still register.
+constexpr int kMaxFinalGrowRounds = 2;
+
+// Configurations whose matches are correspondences of one 3D point.
+bool IsVerified(const TwoViewGeometry& geometry) {
+  return geometry.config == TwoViewGeometry::CALIBRATED ||
+         geometry.config == TwoViewGeometry::UNCALIBRATED ||
+         geometry.config == TwoViewGeometry::PLANAR ||
+         geometry.config == TwoViewGeometry::PANORAMIC ||
+         geometry.config == TwoViewGeometry::PLANAR_OR_PANORAMIC;
+}
+
+// The caller's observer (null: none, as in the calibration pass), the index of the
+// model being grown, and whether the observer asked to stop.
+struct RunControl {
+  const MapperObserver* observer = nullptr;
+  size_t model_index = 0;
+  bool cancelled = false;
+
+  // Asks the observer; once true, stays true.
+  bool ShouldStop() {
+    if (!cancelled && observer != nullptr && observer->should_stop)
+      cancelled = observer->should_stop();
+    return cancelled;
+  }
+};
+
+// Registers images while any registers, or until the model has `max_images`.
+void Grow(IncrementalMapper* mapper, RunControl* control,
+          size_t max_images = std::numeric_limits<size_t>::max()) {
+  bool refined_since_failure = false;
+  while (mapper->NumRegisteredImages() < max_images) {
+    if (control->ShouldStop()) return;
+    image_t next_image = kInvalidImageId;
+    for (const image_t candidate : mapper->NextImages()) {
+      if (mapper->RegisterImage(candidate) == IncrementalMapper::Status::kSuccess) {
+        next_image = candidate;
+        break;
+      }
+    }
+    if (next_image == kInvalidImageId) {
+      // A global refinement may add the points a failed image needed; once, and only
+      // when the model changed since the last one.
+      if (refined_since_failure || !mapper->ChangedSinceGlobalBundleAdjustment()) break;
+      mapper->GlobalRefinement();
+      refined_since_failure = true;
+      continue;
+    }
+    refined_since_failure = false;
+    mapper->TriangulateImage(next_image);
+    if (control->observer != nullptr && control->observer->on_model_changed) {
+      control->observer->on_model_changed(control->model_index, mapper->model());
+    }
+    mapper->LocalBundleAdjustment(next_image);
+    if (mapper->GlobalRefinementDue()) mapper->GlobalRefinement();
+  }
+}
+
+// Tries every unregistered image again, as after a global bundle adjustment; true if
+// one registered (the model then grew as far as it could).
+bool GrowAgain(IncrementalMapper* mapper, RunControl* control) {
+  const size_t num_before = mapper->NumRegisteredImages();
+  mapper->BeginFinalRounds();
+  Grow(mapper, control);
+  return mapper->NumRegisteredImages() > num_before;
+}
+
+// Bundle adjustment of a whole model and the removal of observations it leaves too far
+// from their points, as after a merge.
+void AdjustWholeModel(const IncrementalMapperOptions& options,
+                      const BundleAdjuster& bundle_adjuster, Reconstruction* model) {
+  BundleAdjustmentConfig config;
+  config.refine_focal_length = options.ba_refine_focal_length;
+  config.refine_principal_point = options.ba_refine_principal_point;
+  config.refine_extra_params = options.ba_refine_extra_params;
+  config.fix_gauge = true;
+  config.max_num_iterations = options.ba_global_max_num_iterations;
+  config.function_tolerance = options.ba_global_function_tolerance;
+  for (const auto& [image_id, image] : model->images) config.images.insert(image_id);
+  const BundleAdjustmentSummary summary = bundle_adjuster.Adjust(config, model);
+  if (!summary.usable) {
+    spdlog::warn("map: bundle adjustment of a merged model failed: {}", summary.BriefReport());
+  }
+  for (auto it = model->points3D.begin(); it != model->points3D.end();) {
+    Point3D& point3D = it->second;
+    Track kept;
+    double sum = 0;
+    for (const TrackElement& element : point3D.track) {
+      Image& image = model->images.at(element.image_id);
+      const Eigen::Vector3d point_in_cam = image.cam_from_world * point3D.xyz;
+      const double error = point_in_cam.z() > 0
+                               ? (model->cameras.at(image.camera_id).ImgFromCam(point_in_cam) -
+                                  image.points2D[element.point2D_idx].xy)
+                                     .norm()
+                               : std::numeric_limits<double>::infinity();
+      if (error <= options.filter_max_reproj_error) {
+        kept.push_back(element);
+        sum += error;
+      } else {
+        image.points2D[element.point2D_idx].point3D_id = kInvalidPoint3DId;
+      }
+    }
+    if (kept.size() < 2) {
+      for (const TrackElement& element : kept) {
+        model->images.at(element.image_id).points2D[element.point2D_idx].point3D_id =
+            kInvalidPoint3DId;
+      }
+      it = model->points3D.erase(it);
+      continue;
+    }
+    point3D.error = sum / static_cast<double>(kept.size());
+    point3D.track = std::move(kept);
+    ++it;
+  }
+}
+
+ModelSelfCheck SelfCheck(const ViewGraph& view_graph, const Reconstruction& model,
+                         const IncrementalMapperOptions& options) {
+  const ModelAgreement agreement =
+      ComputeModelAgreement(view_graph, model, options.reg_max_rotation_error);
+  ModelSelfCheck check;
+  check.num_pairs = agreement.num_pairs;
+  check.num_agreeing = agreement.num_agreeing;
+  check.agreement = agreement.inlier_share;
+  for (const auto& image : agreement.disagreeing_images) {
+    check.disagreeing_images.push_back(image.image_id);
+  }
+  check.possibly_folded = agreement.inlier_share < options.min_model_agreement;
+  return check;
+}
+
+// Sorts models largest first (most images, then most points).
+void SortModels(std::vector<Reconstruction>* models) {
+  std::stable_sort(models->begin(), models->end(), [](const auto& a, const auto& b) {
+    if (a.images.size() != b.images.size()) return a.images.size() > b.images.size();
+    return a.points3D.size() > b.points3D.size();
+  });
+}
+
+// Merges every pair of models that aligns, largest first, until none does; a merge that
+// makes the model disagree more with the view graph than its parts is undone.
+void MergeAlignedModels(const IncrementalMapperOptions& options,
+                        const BundleAdjuster& bundle_adjuster, const ViewGraph& view_graph,
+                        const FeatureTracks& tracks, uint64_t seed,
+                        std::vector<Reconstruction>* models, std::vector<std::string>* log) {
+  ModelMergeOptions merge_options;
+  merge_options.min_num_shared_points = static_cast<size_t>(options.merge_min_shared_points);
+  merge_options.max_reproj_error = options.merge_max_reproj_error;
+  std::set<std::pair<std::set<image_t>, std::set<image_t>>> tried;
+  bool merged_any = true;
+  while (merged_any && models->size() > 1) {
+    merged_any = false;
+    SortModels(models);
+    for (size_t a = 0; a < models->size() && !merged_any; ++a) {
+      for (size_t b = a + 1; b < models->size() && !merged_any; ++b) {
+        std::set<image_t> images_a, images_b;
+        for (const auto& [image_id, image] : (*models)[a].images) images_a.insert(image_id);
+        for (const auto& [image_id, image] : (*models)[b].images) images_b.insert(image_id);
+        if (!tried.insert({images_a, images_b}).second) continue;
+        Reconstruction merged = (*models)[a];
+        const ModelMergeReport report = tessera::MergeModels(
+            tracks, merge_options,
+            DeriveSeed(seed, kMergeStream * 0x100000000ull + *images_b.begin()), (*models)[b],
+            &merged);
+        const std::string names =
+            fmt::format("models of {} and {} images", images_a.size(), images_b.size());
+        if (!report.merged) {
+          spdlog::info("map: {} not merged: {}", names, report.reason);
+          log->push_back(names + " not merged: " + report.reason);
+          continue;
+        }
+        AdjustWholeModel(options, bundle_adjuster, &merged);
+        const double agreement_a = SelfCheck(view_graph, (*models)[a], options).agreement;
+        const double agreement_b = SelfCheck(view_graph, (*models)[b], options).agreement;
+        const double agreement = SelfCheck(view_graph, merged, options).agreement;
+        constexpr double kMaxAgreementLoss = 0.05;
+        if (agreement < std::min(agreement_a, agreement_b) - kMaxAgreementLoss) {
+          const std::string why = fmt::format(
+              "{} align on {} of {} shared points, but the merged model agrees with pairs "
+              "holding {:.0f}% of its inliers (the parts: {:.0f}% and {:.0f}%); merge undone",
+              names, report.num_inliers, report.num_shared_points, 100 * agreement,
+              100 * agreement_a, 100 * agreement_b);
+          spdlog::info("map: {}", why);
+          log->push_back(why);
+          continue;
+        }
+        const std::string why = fmt::format(
+            "{} merged: one similarity aligns {} of their {} shared points within {:g} px; "
+            "it agrees with pairs holding {:.0f}% of its inliers",
+            names, report.num_inliers, report.num_shared_points, options.merge_max_reproj_error,
+            100 * agreement);
+        spdlog::info("map: {}", why);
+        log->push_back(why);
+        (*models)[a] = std::move(merged);
+        models->erase(models->begin() + static_cast<std::ptrdiff_t>(b));
+        merged_any = true;
+      }
+    }
+  }
+  SortModels(models);
+}
+
+// Focal lengths of the cameras without a prior, in `cameras`: from the view graph where
+// it determines them, then refined in a first model.
+void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
+                                      const MapperRunState& run,
+                                      const std::vector<const MapperInput::Pair*>& verified_pairs,
+                                      std::map<camera_t, Camera>* cameras,
+                                      std::vector<FocalLengthReport>* reports) {
+  std::map<camera_t, FocalLengthReport> by_camera;
+  for (const auto& [camera_id, camera] : *cameras) {
+    if (camera.has_prior_focal_length) continue;
+    FocalLengthReport& report = by_camera[camera_id];
+    report.camera_id = camera_id;
+    report.initial = report.estimated = camera.MeanFocalLength();
+  }
+  if (by_camera.empty()) return;
+
+  // 1. From the fundamental matrices, where they determine it.
+  for (const auto& [camera_id, estimate] :
+       EstimateFocalLengths(run.input, verified_pairs, FocalLengthEstimationOptions())) {
+    if (estimate.at_search_bound) {
+      spdlog::info(
+          "map: camera {}: the image pairs do not determine its focal length (their best fit "
+          "lies at the end of the range searched, as when every camera aims at one point)",
+          camera_id);
+      continue;
+    }
+    cameras->at(camera_id).SetFocalLength(estimate.focal_length);
+    FocalLengthReport& report = by_camera.at(camera_id);
+    report.estimated = estimate.focal_length;
+    report.method = "view graph";
+    report.num_pairs = estimate.num_pairs;
+  }
+
+  // 2. Refined by bundle adjustment in a first model, mapped once for that alone: with
+  // the structure of many views the focal length is well determined even where pairs
+  // leave it open, and the view-graph checks of the real pass need it to be right.
+  MapperRunState calibration(run.input, run.bundle_adjuster, run.seed);
+  calibration.ransac = run.ransac;
+  calibration.cameras = *cameras;
+  const spdlog::level::level_enum level = spdlog::get_level();
+  if (level > spdlog::level::debug) spdlog::set_level(spdlog::level::warn);
+  calibration.Prepare(options, verified_pairs);
+  IncrementalMapper mapper(options, &calibration);
+  Reconstruction model;
+  if (mapper.Initialize() == IncrementalMapper::Status::kSuccess) {
+    // Global bundle adjustments as it grew refined the focal length; the final rounds
+    // of refinement would cost as much again for little more.
+    RunControl no_observer;
+    Grow(&mapper, &no_observer, kMaxCalibrationImages);
+    model = mapper.TakeModel();
+  }
+  spdlog::set_level(level);
+
+  for (auto& [camera_id, report] : by_camera) {
+    const auto it = model.cameras.find(camera_id);
+    if (model.images.size() < kMinCalibrationImages || it == model.cameras.end()) {
+      spdlog::info(
+          "map: camera {}: no first model of {} images or more to refine its focal length "
+          "from; mapping starts from {:.1f} px",
+          camera_id, kMinCalibrationImages, report.estimated);
+      continue;
+    }
+    const Camera& camera = cameras->at(camera_id);
+    const double side = static_cast<double>(std::max(camera.width, camera.height));
+    const double focal = it->second.MeanFocalLength();
+    if (!(focal > 0.25 * side && focal < 5 * side)) continue;
+    cameras->at(camera_id).SetFocalLength(focal);
+    report.estimated = focal;
+    report.method = report.method.empty() ? "first model" : report.method + ", first model";
+    report.num_images = model.images.size();
+  }
+  for (const auto& [camera_id, report] : by_camera) {
+    if (report.method.empty()) continue;
+    spdlog::info(
+        "map: camera {} has no focal-length prior: mapping starts from {:.1f} px (from the {}{}) "
+        "instead of the default {:.1f} px",
+        camera_id, report.estimated, report.method,
+        report.num_images > 0 ? fmt::format(" of {} images", report.num_images) : "",
+        report.initial);
+    reports->push_back(report);
+  }
+}
+
+}  // namespace
+
+IncrementalPipeline::IncrementalPipeline(const IncrementalMapperOptions& options,
+                                         const BundleAdjuster& bundle_adjuster, uint64_t seed,
+                                         const MapperRansacOptions& ransac_options)
+    : options_(options),
+      bundle_adjuster_(bundle_adjuster),
+      seed_(seed),
+      ransac_options_(ransac_options) {}
+
+MapperResult IncrementalPipeline::Reconstruct(const MapperInput& input,
+                                              const MapperObserver& observer) const {
+  const auto start_time = std::chrono::steady_clock::now();
+  MapperRunState run(input, bundle_adjuster_, seed_);
+  run.ransac = ransac_options_;
+  RunControl control;
+  control.observer = &observer;
+  const auto should_stop = [&control] { return control.ShouldStop(); };
+  MapperResult result;
+
+  std::vector<const MapperInput::Pair*> verified_pairs;
+  for (const MapperInput::Pair& pair : input.pairs) {
+    if (!IsVerified(pair.geometry) ||
+        pair.geometry.inlier_matches.size() < static_cast<size_t>(options_.min_num_matches) ||
+        input.images.count(pair.image_id1) == 0 || input.images.count(pair.image_id2) == 0) {
+      continue;
+    }
+    verified_pairs.push_back(&pair);
+  }
+
+  if (options_.estimate_focal_length) {
+    EstimateFocalLengthsWithoutPrior(options_, run, verified_pairs, &run.cameras,
+                                     &result.focal_lengths);
+  }
+  result.num_pairs_dropped = run.Prepare(options_, verified_pairs);
+  result.num_tracks = run.tracks.tracks.size();
+  result.num_refused_matches = run.tracks.num_refused_matches;
+  spdlog::info(
+      "map: {} images, {} verified pairs, {} tracks ({} matches refused: they joined "
+      "two features of one image)",
+      input.images.size(), run.verified_pairs.size(), result.num_tracks,
+      result.num_refused_matches);
+
+  for (int attempt = 0; static_cast<int>(result.models.size()) < options_.max_num_models;
+       ++attempt) {
+    if (run.used_images.size() + 2 > input.images.size() || control.ShouldStop()) break;
+    control.model_index = result.models.size();
+    IncrementalMapper mapper(options_, &run);
+    if (mapper.Initialize() != IncrementalMapper::Status::kSuccess) break;
+    Grow(&mapper, &control);
+    mapper.Finish(should_stop);
+    for (int round = 0;
+         round < kMaxFinalGrowRounds && !control.ShouldStop() && GrowAgain(&mapper, &control);
+         ++round) {
+      mapper.Finish(should_stop);
+    }
+    if (control.cancelled) break;
+    const size_t num_registered = mapper.NumRegisteredImages();
+    Reconstruction model = mapper.TakeModel();
+    if (num_registered < static_cast<size_t>(options_.min_model_size)) {
+      spdlog::info("map: dropped a model of {} images (fewer than min_model_size {})",
+                   num_registered, options_.min_model_size);
+      continue;
+    }
+    for (const auto& [image_id, image] : model.images) run.used_images.insert(image_id);
+    spdlog::info("map: model of {} images and {} points", num_registered, model.points3D.size());
+    result.models.push_back(std::move(model));
+    if (!options_.multiple_models) break;
+  }
+
+  if (control.ShouldStop()) {
+    spdlog::info("map: stopped by the caller");
+    MapperResult stopped;
+    stopped.cancelled = true;
+    stopped.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+    return stopped;
+  }
+  if (options_.merge_models) {
+    MergeAlignedModels(options_, bundle_adjuster_, run.view_graph, run.tracks, seed_,
+                       &result.models, &result.merges);
+  } else {
+    SortModels(&result.models);
+  }
+  for (size_t m = 0; m < result.models.size(); ++m) {
+    ModelSelfCheck check = SelfCheck(run.view_graph, result.models[m], options_);
+    if (check.possibly_folded) {
+      std::string names;
+      for (size_t i = 0; i < check.disagreeing_images.size() && i < 10; ++i) {
+        names += (i > 0 ? ", " : "") + input.images.at(check.disagreeing_images[i]).name;
+      }
+      if (check.disagreeing_images.size() > 10) names += ", ...";
+      spdlog::warn(
+          "map: model {} may be folded by symmetric or repeated structure: its poses agree "
+          "within {:g} deg with {} of its {} verified pairs, which hold only {:.0f}% of their "
+          "inliers (min_model_agreement {:.0f}%); images whose pairs mostly disagree: {}",
+          m, options_.reg_max_rotation_error, check.num_agreeing, check.num_pairs,
+          100 * check.agreement, 100 * options_.min_model_agreement,
+          names.empty() ? "none" : names);
+    } else {
+      spdlog::info(
+          "map: model {}: its poses agree with {} of its {} verified pairs, {:.1f}% of their "
+          "inliers",
+          m, check.num_agreeing, check.num_pairs, 100 * check.agreement);
+    }
+    result.self_checks.push_back(std::move(check));
+  }
+  result.num_registrations_refused = run.num_registrations_refused;
+
+  std::set<image_t> in_verified_pair;
+  for (const MapperInput::Pair* pair : run.verified_pairs) {
+    in_verified_pair.insert(pair->image_id1);
+    in_verified_pair.insert(pair->image_id2);
+  }
+  std::set<image_t> in_model;
+  for (const Reconstruction& model : result.models) {
+    for (const auto& [image_id, image] : model.images) in_model.insert(image_id);
+  }
+  for (const auto& [image_id, image] : input.images) {
+    if (in_model.count(image_id) > 0) continue;
+    std::string reason;
+    if (in_verified_pair.count(image_id) == 0) {
+      reason = "no verified pair with at least " + std::to_string(options_.min_num_matches) +
+               " inlier matches";
+    } else if (run.failure_reasons.count(image_id) > 0) {
+      reason = run.failure_reasons.at(image_id);
+    } else {
+      reason = "it shares no 3D point with any model and no initial pair with another image";
+    }
+    result.unregistered_reasons[image_id] = reason;
+  }
+  result.num_global_ba = run.num_global_ba;
+  result.num_local_ba = run.num_local_ba;
+  result.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  return result;
+}
+
+}  // namespace tessera

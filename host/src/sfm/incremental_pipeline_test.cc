@@ -1,0 +1,422 @@
+#include "sfm/incremental_pipeline.h"
+
+#include <gtest/gtest.h>
+
+#include "eval/evaluation.h"
+#include "geometry/essential_matrix.h"
+#include "synthetic_scene.h"
+#include "tessera/errors.h"
+#include "tessera/io/model_statistics.h"
+#include "test_support.h"
+
+namespace tessera {
+namespace {
+
+using testing::MakeSyntheticScene;
+using testing::SyntheticScene;
+using testing::SyntheticSceneOptions;
+
+const BundleAdjuster& Adjuster() {
+  static const auto adjuster =
+      testing::LoadBundledPlugin<BundleAdjuster>("bundle_adjuster", "ceres", {{"num_threads", 1}});
+  return *adjuster;
+}
+
+MapperResult Map(const SyntheticScene& scene, IncrementalMapperOptions options = {},
+                 uint64_t seed = 0) {
+  return IncrementalPipeline(options, Adjuster(), seed).Reconstruct(scene.input);
+}
+
+// Every observation of every point is a keypoint of one and the same true point.
+void ExpectTracksAreTrue(const SyntheticScene& scene, const Reconstruction& model) {
+  size_t num_wrong = 0;
+  for (const auto& [point3D_id, point3D] : model.points3D) {
+    std::set<int> true_points;
+    for (const TrackElement& element : point3D.track) {
+      true_points.insert(scene.true_point_of_keypoint.at(element.image_id)[element.point2D_idx]);
+    }
+    if (true_points.size() != 1 || *true_points.begin() < 0) ++num_wrong;
+  }
+  EXPECT_EQ(num_wrong, 0u) << "points whose track mixes true points or clutter";
+}
+
+TEST(IncrementalPipeline, RecoversASyntheticSceneWithNoise) {
+  SyntheticSceneOptions options;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const MapperResult result = Map(scene);
+  ASSERT_EQ(result.models.size(), 1u);
+  const Reconstruction& model = result.models[0];
+  EXPECT_EQ(model.images.size(), scene.input.images.size());
+  EXPECT_TRUE(result.unregistered_reasons.empty());
+  const EvaluationResult evaluation = EvaluateReconstruction(model, scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  // 0.5 px noise at 1000 px focal length and 10 units distance: 5e-3 units per pixel of
+  // error along the image plane; the cameras end up within a fraction of that.
+  EXPECT_LT(evaluation.position_error_max, 0.01);
+  EXPECT_LT(evaluation.rotation_error_max_deg, 0.05);
+  EXPECT_LT(ComputeModelStatistics(model).mean_reprojection_error, 0.8);
+  EXPECT_GT(model.points3D.size(), 0.9 * options.num_points);
+  ExpectTracksAreTrue(scene, model);
+}
+
+TEST(IncrementalPipeline, FiltersTwoPercentOutlierMatches) {
+  SyntheticSceneOptions options;
+  options.outlier_ratio = 0.02;
+  options.seed = 2;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  ASSERT_GT(scene.num_outlier_matches, 100u);
+  // Thresholds at 4 sigma of the 0.5 px keypoint noise. With the default 4 px (8 sigma)
+  // an outlier match that happens to lie within a few pixels of its epipolar line and is
+  // seen by no third image is indistinguishable from a true two-view point, and whether
+  // one survives depends on when bundle adjustment stops.
+  IncrementalMapperOptions mapper_options;
+  mapper_options.tri_max_error = 4 * options.noise_px;
+  mapper_options.filter_max_reproj_error = 4 * options.noise_px;
+  const MapperResult result = Map(scene, mapper_options);
+  ASSERT_EQ(result.models.size(), 1u);
+  const Reconstruction& model = result.models[0];
+  EXPECT_EQ(model.images.size(), scene.input.images.size());
+  ExpectTracksAreTrue(scene, model);
+  const EvaluationResult evaluation = EvaluateReconstruction(model, scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  EXPECT_LT(evaluation.position_error_max, 0.01);
+  EXPECT_LT(ComputeModelStatistics(model).mean_reprojection_error, 0.8);
+  EXPECT_GT(result.num_refused_matches, 0u);
+}
+
+TEST(IncrementalPipeline, RefinesAWrongFocalLengthPriorAndDistortion) {
+  SyntheticSceneOptions options;
+  options.k1 = -0.05;
+  options.prior_focal_factor = 1.1;
+  options.seed = 3;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const MapperResult result = Map(scene);
+  ASSERT_EQ(result.models.size(), 1u);
+  const Reconstruction& model = result.models[0];
+  EXPECT_EQ(model.images.size(), scene.input.images.size());
+  const Camera& camera = model.cameras.at(1);
+  EXPECT_NEAR(camera.FocalLengthX(), options.focal_length, 0.005 * options.focal_length);
+  EXPECT_NEAR(camera.params[3], options.k1, 0.005);
+  const EvaluationResult evaluation = EvaluateReconstruction(model, scene.GroundTruth());
+  EXPECT_LT(evaluation.position_error_max, 0.02);
+}
+
+TEST(IncrementalPipeline, RefinesAnOffCentrePrincipalPointWhenAsked) {
+  SyntheticSceneOptions options;
+  // 1.5% of the width, as Strecha's cameras. Horizontally only: the cameras stand on a
+  // level arc, and a vertical offset is all but the same as tilting every one of them.
+  options.principal_point_offset_x = 24;
+  options.seed = 8;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const double centre_x = 0.5 * options.width, centre_y = 0.5 * options.height;
+
+  // Held at the centre (the default), the principal point stays there.
+  const MapperResult held = Map(scene);
+  ASSERT_EQ(held.models.size(), 1u);
+  EXPECT_EQ(held.models[0].cameras.at(1).PrincipalPointX(), centre_x);
+  EXPECT_EQ(held.models[0].cameras.at(1).PrincipalPointY(), centre_y);
+
+  IncrementalMapperOptions mapper_options;
+  mapper_options.ba_refine_principal_point = true;
+  const MapperResult refined = Map(scene, mapper_options);
+  ASSERT_EQ(refined.models.size(), 1u);
+  const Camera& camera = refined.models[0].cameras.at(1);
+  EXPECT_NEAR(camera.PrincipalPointX(), centre_x + options.principal_point_offset_x, 2.0);
+  EXPECT_NEAR(camera.PrincipalPointY(), centre_y, 2.0);
+
+  // And the cameras are where they truly are, better than with the point held.
+  const EvaluationResult held_error = EvaluateReconstruction(held.models[0], scene.GroundTruth());
+  const EvaluationResult refined_error =
+      EvaluateReconstruction(refined.models[0], scene.GroundTruth());
+  ASSERT_TRUE(held_error.aligned && refined_error.aligned);
+  EXPECT_LT(refined_error.position_error_mean, 0.5 * held_error.position_error_mean);
+}
+
+TEST(IncrementalPipeline, AnImplausiblePrincipalPointIsPutBackAtTheCentre) {
+  // The true principal point is 15% of the width off centre: beyond the plausible 10%,
+  // so the refined one is reset and held at the centre, as if it was never refined.
+  SyntheticSceneOptions options;
+  options.principal_point_offset_x = 0.15 * options.width;
+  options.seed = 9;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  IncrementalMapperOptions mapper_options;
+  mapper_options.ba_refine_principal_point = true;
+  const MapperResult result = Map(scene, mapper_options);
+  ASSERT_FALSE(result.models.empty());
+  const Camera& camera = result.models[0].cameras.at(1);
+  EXPECT_EQ(camera.PrincipalPointX(), 0.5 * options.width);
+  EXPECT_EQ(camera.PrincipalPointY(), 0.5 * options.height);
+}
+
+TEST(IncrementalPipeline, DisconnectedGroupsBecomeSeparateModelsLargestFirst) {
+  // Two scenes of 5 and 8 images with no match between them: ids 1-5 and 6-13.
+  SyntheticSceneOptions small_options;
+  small_options.num_images = 5;
+  small_options.seed = 4;
+  SyntheticSceneOptions large_options;
+  large_options.num_images = 8;
+  large_options.seed = 5;
+  SyntheticScene scene = MakeSyntheticScene(small_options);
+  const SyntheticScene large = MakeSyntheticScene(large_options);
+  const image_t offset = 5;
+  for (const auto& [image_id, image] : large.input.images) {
+    Image shifted = image;
+    shifted.image_id = image_id + offset;
+    shifted.name = "large_" + image.name;
+    scene.input.images[shifted.image_id] = shifted;
+  }
+  for (MapperInput::Pair pair : large.input.pairs) {
+    pair.image_id1 += offset;
+    pair.image_id2 += offset;
+    scene.input.pairs.push_back(pair);
+  }
+  // And one image that matches nothing.
+  Image lonely = scene.input.images.at(1);
+  lonely.image_id = 100;
+  lonely.name = "lonely.png";
+  scene.input.images[100] = lonely;
+
+  const MapperResult result = Map(scene);
+  ASSERT_EQ(result.models.size(), 2u);
+  EXPECT_EQ(result.models[0].images.size(), 8u);
+  EXPECT_EQ(result.models[1].images.size(), 5u);
+  EXPECT_EQ(result.models[0].images.begin()->first, 6u);
+  ASSERT_EQ(result.unregistered_reasons.size(), 1u);
+  EXPECT_EQ(result.unregistered_reasons.at(100),
+            "no verified pair with at least 15 inlier matches");
+
+  IncrementalMapperOptions single;
+  single.multiple_models = false;
+  EXPECT_EQ(Map(scene, single).models.size(), 1u);
+}
+
+// No image of `model` is more than `max_deg` off its true orientation, once aligned.
+void ExpectNoCameraOff(const SyntheticScene& scene, const Reconstruction& model, double max_deg) {
+  const EvaluationResult evaluation = EvaluateReconstruction(model, scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  for (const ImageEvaluation& row : evaluation.images) {
+    if (row.registered) {
+      EXPECT_LT(row.rotation_error_deg, max_deg) << row.name;
+    }
+  }
+}
+
+TEST(IncrementalPipeline, EstimatesTheFocalLengthWhenThereIsNoPrior) {
+  SyntheticSceneOptions options;
+  options.focal_prior = false;
+  options.prior_focal_factor = 1.6;  // far off: 1.2 x 1600 px against 1000 px
+  options.seed = 11;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const MapperResult result = Map(scene);
+  ASSERT_EQ(result.focal_lengths.size(), 1u);
+  EXPECT_NEAR(result.focal_lengths[0].estimated, options.focal_length, 0.02 * options.focal_length);
+  ASSERT_EQ(result.models.size(), 1u);
+  EXPECT_EQ(result.models[0].images.size(), scene.input.images.size());
+  EXPECT_NEAR(result.models[0].cameras.at(1).FocalLengthX(), options.focal_length,
+              0.005 * options.focal_length);
+  ExpectNoCameraOff(scene, result.models[0], 0.1);
+}
+
+// An object seen from all around whose back half repeats its front half turned by half a
+// turn: pairs of images from nearly opposite sides match on the repeated half, and a
+// model that puts one side's cameras onto the other explains those matches exactly.
+SyntheticSceneOptions SymmetricObject() {
+  SyntheticSceneOptions options;
+  options.num_images = 36;
+  options.arc_deg = 350;
+  options.num_points = 3000;
+  options.max_view_angle_deg = 60;
+  options.symmetric_fraction = 0.3;
+  options.seed = 12;
+  return options;
+}
+
+TEST(IncrementalPipeline, DoesNotFoldASymmetricObject) {
+  const SyntheticScene scene = MakeSyntheticScene(SymmetricObject());
+  ASSERT_GT(scene.num_mirror_pairs, 50u);
+  const MapperResult result = Map(scene);
+  ASSERT_EQ(result.models.size(), 1u);
+  EXPECT_EQ(result.models[0].images.size(), scene.input.images.size());
+  ExpectNoCameraOff(scene, result.models[0], 5);
+  ASSERT_EQ(result.self_checks.size(), 1u);
+  EXPECT_FALSE(result.self_checks[0].possibly_folded);
+}
+
+TEST(IncrementalPipeline, FlagsAFoldedModel) {
+  // Without the view graph, the symmetric object folds; the self-check says so.
+  const SyntheticScene scene = MakeSyntheticScene(SymmetricObject());
+  IncrementalMapperOptions unchecked;
+  unchecked.filter_view_graph = false;
+  unchecked.check_registration = false;
+  const MapperResult result = Map(scene, unchecked);
+  ASSERT_FALSE(result.models.empty());
+  const EvaluationResult evaluation = EvaluateReconstruction(result.models[0], scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned);
+  EXPECT_GT(evaluation.num_wrongly_registered, 0u);
+  EXPECT_GT(evaluation.rotation_error_max_deg, 90);
+  EXPECT_TRUE(result.self_checks[0].possibly_folded);
+  EXPECT_FALSE(result.self_checks[0].disagreeing_images.empty());
+}
+
+// Gives the pairs of `image_id` with every image more than one position away on the arc
+// a wrong relative rotation (their E): the true one turned by 40 degrees about an axis
+// that differs per pair (`scattered`), or the one a pose of the image turned by 40
+// degrees about the vertical would give (one wrong rotation that they all agree on).
+void CorruptRotationsOfPairs(image_t image_id, bool scattered, SyntheticScene* scene) {
+  const std::vector<Eigen::Vector3d> axes = {{1, 0, 0},  {0, 1, 0}, {0, 0, 1},  {1, 1, 0},
+                                             {1, -1, 0}, {0, 1, 1}, {0, 1, -1}, {1, 0, 1},
+                                             {1, 0, -1}, {1, 1, 1}, {-1, 1, 1}};
+  const Eigen::Matrix3d turn =
+      Eigen::AngleAxisd(40 * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  size_t k = 0;
+  for (MapperInput::Pair& pair : scene->input.pairs) {
+    if (pair.image_id1 != image_id && pair.image_id2 != image_id) continue;
+    const image_t other = pair.image_id1 == image_id ? pair.image_id2 : pair.image_id1;
+    if (std::abs(static_cast<int>(other) - static_cast<int>(image_id)) <= 1) continue;
+    const Eigen::Matrix3d R1 =
+        scene->true_cam_from_world.at(pair.image_id1).rotation.toRotationMatrix();
+    const Eigen::Matrix3d R2 =
+        scene->true_cam_from_world.at(pair.image_id2).rotation.toRotationMatrix();
+    Eigen::Matrix3d R_cam2_from_cam1;
+    if (scattered) {
+      const Eigen::Matrix3d wrong =
+          Eigen::AngleAxisd(40 * M_PI / 180, axes[k++ % axes.size()].normalized())
+              .toRotationMatrix();
+      R_cam2_from_cam1 = wrong * R2 * R1.transpose();
+    } else if (pair.image_id1 == image_id) {
+      R_cam2_from_cam1 = R2 * (turn * R1).transpose();
+    } else {
+      R_cam2_from_cam1 = turn * R2 * R1.transpose();
+    }
+    Rigid3d cam2_from_cam1 = pair.geometry.cam2_from_cam1;
+    cam2_from_cam1.rotation = Eigen::Quaterniond(R_cam2_from_cam1);
+    pair.geometry.E = EssentialMatrixFromPose(cam2_from_cam1);
+  }
+}
+
+TEST(IncrementalPipeline, KeepsAnImageWhosePairsDisagreeWithoutAnAlternative) {
+  // Where the scene barely constrains two-view rotations (a small object filmed with a
+  // narrow field of view, a near-planar scene), many pairs give a wrong one, each wrong
+  // in its own way: that is no fold, and the image's pose is kept. Pairs that agree on
+  // one other rotation are the sign of a fold, and the pose is refused.
+  SyntheticSceneOptions options;
+  options.seed = 14;
+  const image_t image_id = 6;
+  IncrementalMapperOptions mapper_options;
+  mapper_options.filter_view_graph = false;  // the registration check alone
+
+  SyntheticScene scattered = MakeSyntheticScene(options);
+  CorruptRotationsOfPairs(image_id, /*scattered=*/true, &scattered);
+  const MapperResult kept = Map(scattered, mapper_options);
+  ASSERT_EQ(kept.models.size(), 1u);
+  EXPECT_EQ(kept.models[0].images.size(), scattered.input.images.size());
+  EXPECT_EQ(kept.num_registrations_refused, 0u);
+  ExpectNoCameraOff(scattered, kept.models[0], 0.5);
+
+  SyntheticScene coherent = MakeSyntheticScene(options);
+  CorruptRotationsOfPairs(image_id, /*scattered=*/false, &coherent);
+  const MapperResult refused = Map(coherent, mapper_options);
+  EXPECT_GT(refused.num_registrations_refused, 0u);
+  ASSERT_FALSE(refused.models.empty());
+  ExpectNoCameraOff(coherent, refused.models[0], 5);
+}
+
+TEST(IncrementalPipeline, MergesTwoModelsOfOneScene) {
+  // Images 1-7 and 8-14 of an arc; across the cut only the pairs (6, 8), (7, 8) and
+  // (7, 9) match, on 40 points each: fewer than a registration needs (100 here), so the
+  // images split into two models, which share the tracks of those matches.
+  SyntheticSceneOptions options;
+  options.num_images = 14;
+  options.max_pair_gap = 2;
+  options.seed = 13;
+  SyntheticScene scene = MakeSyntheticScene(options);
+  for (MapperInput::Pair& pair : scene.input.pairs) {
+    if (pair.image_id1 <= 7 && pair.image_id2 >= 8) pair.geometry.inlier_matches.resize(40);
+  }
+  IncrementalMapperOptions mapper_options;
+  mapper_options.abs_pose_min_num_inliers = 100;
+  IncrementalMapperOptions unmerged = mapper_options;
+  unmerged.merge_models = false;
+  const MapperResult split = Map(scene, unmerged);
+  ASSERT_EQ(split.models.size(), 2u);
+  EXPECT_EQ(split.models[0].images.size() + split.models[1].images.size(),
+            scene.input.images.size());
+
+  const MapperResult result = Map(scene, mapper_options);
+  ASSERT_EQ(result.models.size(), 1u);
+  EXPECT_EQ(result.models[0].images.size(), scene.input.images.size());
+  ASSERT_EQ(result.merges.size(), 1u);
+  EXPECT_NE(result.merges[0].find("merged"), std::string::npos) << result.merges[0];
+  ExpectNoCameraOff(scene, result.models[0], 0.5);
+  const EvaluationResult evaluation = EvaluateReconstruction(result.models[0], scene.GroundTruth());
+  EXPECT_LT(evaluation.position_error_max, 0.05);
+}
+
+TEST(IncrementalPipeline, SameSeedSameModel) {
+  SyntheticSceneOptions options;
+  options.outlier_ratio = 0.02;
+  options.num_images = 8;
+  options.seed = 6;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const MapperResult a = Map(scene, {}, 7);
+  const MapperResult b = Map(scene, {}, 7);
+  ASSERT_EQ(a.models.size(), 1u);
+  ASSERT_EQ(b.models.size(), 1u);
+  const Reconstruction& model_a = a.models[0];
+  const Reconstruction& model_b = b.models[0];
+  ASSERT_EQ(model_a.points3D.size(), model_b.points3D.size());
+  for (const auto& [image_id, image] : model_a.images) {
+    const Image& other = model_b.images.at(image_id);
+    EXPECT_EQ(image.cam_from_world.translation, other.cam_from_world.translation);
+    EXPECT_EQ(image.cam_from_world.rotation.coeffs(), other.cam_from_world.rotation.coeffs());
+  }
+  for (const auto& [point3D_id, point3D] : model_a.points3D) {
+    EXPECT_EQ(point3D.xyz, model_b.points3D.at(point3D_id).xyz);
+  }
+}
+
+TEST(IncrementalMapperOptions, UnknownKeysAndBadValuesNameTheField) {
+  EXPECT_EQ(IncrementalMapperOptions::FromJson(nlohmann::json::object()).init_min_tri_angle, 16.0);
+  try {
+    IncrementalMapperOptions::FromJson({{"init_min_tri_angel", 8}});
+    FAIL();
+  } catch (const OptionError& error) {
+    EXPECT_NE(std::string(error.what()).find("mapper.init_min_tri_angel"), std::string::npos);
+    EXPECT_NE(std::string(error.what()).find("did you mean 'init_min_tri_angle'"),
+              std::string::npos);
+  }
+  EXPECT_THROW(IncrementalMapperOptions::FromJson({{"abs_pose_min_num_inliers", 2}}), OptionError);
+  EXPECT_THROW(IncrementalMapperOptions::FromJson({{"multiple_models", 1}}), OptionError);
+}
+
+}  // namespace
+// The observer sees the model grow one registered image at a time, and stops mapping.
+TEST(IncrementalPipeline, ObserverSeesTheModelGrowAndStopsIt) {
+  const SyntheticScene scene = MakeSyntheticScene(SyntheticSceneOptions{});
+  std::vector<size_t> num_registered;
+  MapperObserver observer;
+  observer.on_model_changed = [&](size_t model_index, const Reconstruction& model) {
+    EXPECT_EQ(model_index, 0u);
+    size_t n = 0;
+    for (const auto& [image_id, image] : model.images) n += image.registered ? 1 : 0;
+    num_registered.push_back(n);
+  };
+  const MapperResult full =
+      IncrementalPipeline({}, Adjuster(), 0).Reconstruct(scene.input, observer);
+  ASSERT_EQ(full.models.size(), 1u);
+  EXPECT_FALSE(full.cancelled);
+  const size_t num_images = scene.input.images.size();
+  ASSERT_EQ(num_registered.size(), num_images - 2) << "one call per image after the pair";
+  for (size_t k = 0; k < num_registered.size(); ++k) EXPECT_EQ(num_registered[k], k + 3);
+
+  // Stopped after the third image: no model, and nothing after the stop.
+  num_registered.clear();
+  observer.should_stop = [&] { return num_registered.size() >= 1; };
+  const MapperResult stopped =
+      IncrementalPipeline({}, Adjuster(), 0).Reconstruct(scene.input, observer);
+  EXPECT_TRUE(stopped.cancelled);
+  EXPECT_TRUE(stopped.models.empty());
+  EXPECT_EQ(num_registered.size(), 1u);
+}
+
+}  // namespace tessera
