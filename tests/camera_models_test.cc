@@ -16,7 +16,9 @@ TEST(CameraModels, IdsNamesAndParameterCountsMatchColmap) {
                                                                    {1, "PINHOLE", 4},
                                                                    {2, "SIMPLE_RADIAL", 4},
                                                                    {3, "RADIAL", 5},
-                                                                   {4, "OPENCV", 8}};
+                                                                   {4, "OPENCV", 8},
+                                                                   {5, "OPENCV_FISHEYE", 8},
+                                                                   {8, "SIMPLE_RADIAL_FISHEYE", 4}};
   for (const auto& [id, name, num_params] : expected) {
     const auto model_id = static_cast<CameraModelId>(id);
     EXPECT_EQ(CameraModelIdToName(model_id), name);
@@ -24,7 +26,7 @@ TEST(CameraModels, IdsNamesAndParameterCountsMatchColmap) {
     EXPECT_EQ(CameraModelNumParams(model_id), num_params);
     EXPECT_TRUE(ExistsCameraModelWithId(id));
   }
-  EXPECT_FALSE(ExistsCameraModelWithId(5));
+  EXPECT_FALSE(ExistsCameraModelWithId(6));
   EXPECT_EQ(CameraModelNameToId("FISHEYE"), CameraModelId::kInvalid);
   EXPECT_EQ(CameraModelNumParams(CameraModelId::kInvalid), -1);
 }
@@ -58,6 +60,35 @@ TEST(CameraModels, ProjectsAKnownPoint) {
   const Eigen::Vector2d xy2 = opencv.ImgFromCam(Eigen::Vector3d(u, v, 1.0));
   EXPECT_NEAR(xy2.x(), 1000 * (u + du) + 320, 1e-9);
   EXPECT_NEAR(xy2.y(), 900 * (v + dv) + 240, 1e-9);
+
+  // OPENCV_FISHEYE as COLMAP (and cv::fisheye): theta = atan(r), radius theta_d =
+  // theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8) on the normalized plane.
+  Camera fisheye = Camera::Create(1, CameraModelId::kOpenCVFisheye, 300, 640, 480);
+  fisheye.params = {300, 310, 320, 240, 0.05, -0.01, 0.002, -0.0005};
+  const double theta = std::atan(std::hypot(u, v));
+  const double t2 = theta * theta;
+  const double theta_d =
+      theta * (1 + 0.05 * t2 - 0.01 * t2 * t2 + 0.002 * t2 * t2 * t2 - 0.0005 * t2 * t2 * t2 * t2);
+  const double scale = theta_d / std::hypot(u, v);
+  const Eigen::Vector2d xy3 = fisheye.ImgFromCam(Eigen::Vector3d(2 * u, 2 * v, 2.0));
+  EXPECT_NEAR(xy3.x(), 300 * u * scale + 320, 1e-9);
+  EXPECT_NEAR(xy3.y(), 310 * v * scale + 240, 1e-9);
+  // A ray at 80 degrees from the axis still lands in the image (a pinhole would put it
+  // at 5.7 focal lengths): theta_d = 1.396 (1 + k1 1.396^2 + ...).
+  const Eigen::Vector2d wide = fisheye.ImgFromCam(Eigen::Vector3d(std::tan(80 * M_PI / 180), 0, 1));
+  const double t = 80 * M_PI / 180, tt = t * t;
+  EXPECT_NEAR(
+      wide.x(),
+      300 * t *
+              (1 + 0.05 * tt - 0.01 * tt * tt + 0.002 * tt * tt * tt - 0.0005 * tt * tt * tt * tt) +
+          320,
+      1e-9);
+  EXPECT_NEAR(fisheye.ImgFromCam(Eigen::Vector3d(0, 0, 1)).x(), 320, 1e-12);  // the axis
+
+  Camera simple_fisheye = Camera::Create(1, CameraModelId::kSimpleRadialFisheye, 300, 640, 480);
+  simple_fisheye.params = {300, 320, 240, 0.05};
+  const Eigen::Vector2d xy4 = simple_fisheye.ImgFromCam(Eigen::Vector3d(u, v, 1));
+  EXPECT_NEAR(xy4.x(), 300 * u * theta * (1 + 0.05 * t2) / std::hypot(u, v) + 320, 1e-9);
 }
 
 class CameraModelRoundTrip : public ::testing::TestWithParam<CameraModelId> {};
@@ -87,7 +118,8 @@ TEST_P(CameraModelRoundTrip, UnprojectInvertsProject) {
 INSTANTIATE_TEST_SUITE_P(AllModels, CameraModelRoundTrip,
                          ::testing::Values(CameraModelId::kSimplePinhole, CameraModelId::kPinhole,
                                            CameraModelId::kSimpleRadial, CameraModelId::kRadial,
-                                           CameraModelId::kOpenCV),
+                                           CameraModelId::kOpenCV, CameraModelId::kOpenCVFisheye,
+                                           CameraModelId::kSimpleRadialFisheye),
                          [](const auto& info) { return CameraModelIdToName(info.param); });
 
 TEST(Camera, CalibrationMatrixAndThreshold) {

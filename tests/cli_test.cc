@@ -141,6 +141,43 @@ TEST(Cli, TooFewImagesIsExitCode2) {
       << result.output;
 }
 
+// Masks that cannot be used are warnings naming the image; the images are used without.
+TEST(Cli, UnusableMasksAreWarningsNamingTheImage) {
+  testing::TemporaryDir dir;
+  std::filesystem::create_directories(dir.path() / "images");
+  std::filesystem::create_directories(dir.path() / "masks");
+  std::filesystem::create_directories(dir.path() / "no_masks");
+  const std::filesystem::path sample =
+      testing::SourceDir() / "examples" / "fountain-P11-small" / "images";
+  for (const char* name : {"0000.jpg", "0001.jpg"}) {
+    std::filesystem::copy_file(sample / name, dir.path() / "images" / name);
+  }
+  std::ofstream(dir.path() / "masks" / "0001.jpg.png") << "not a PNG";
+  std::ofstream(dir.path() / "m.json")
+      << R"({"pipeline": {"detector": {"plugin": "orb", "options": {"max_num_features": 500}}}})";
+  const std::string common = "extract --images " + (dir.path() / "images").string() +
+                             " --manifest " + (dir.path() / "m.json").string() + " --masks ";
+  auto result = RunTessera(common + (dir.path() / "masks").string() + " --output " +
+                           (dir.path() / "out1").string());
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("'0000.jpg': no mask in"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("'0001.jpg': its mask " +
+                               (dir.path() / "masks" / "0001.jpg.png").string() +
+                               " cannot be decoded; used without a mask"),
+            std::string::npos)
+      << result.output;
+  result = RunTessera(common + (dir.path() / "no_masks").string() + " --output " +
+                      (dir.path() / "out2").string());
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("matches none of the 2 images"), std::string::npos) << result.output;
+  result = RunTessera(common + (dir.path() / "nothing").string() + " --output " +
+                      (dir.path() / "out3").string());
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find((dir.path() / "nothing").string() + ": no such mask folder"),
+            std::string::npos)
+      << result.output;
+}
+
 TEST(Cli, MissingManifestIsExitCode2) {
   const auto result =
       RunTessera("run --images /tmp --output /tmp/out --manifest /nonexistent/m.json");

@@ -60,12 +60,33 @@ TEST(Manifest, UnknownKeysNameTheirPathAndTheClosestKey) {
             "m.json: camera.modle: unknown key; did you mean 'model'?");
   EXPECT_EQ(ErrorOf({{"camera", {{"model", "PINHOL"}}}}),
             "m.json: camera.model: 'PINHOL' is not one of 'SIMPLE_PINHOLE', 'PINHOLE', "
-            "'SIMPLE_RADIAL', 'RADIAL', 'OPENCV'; did you mean 'PINHOLE'?");
+            "'SIMPLE_RADIAL', 'RADIAL', 'OPENCV', 'OPENCV_FISHEYE', 'SIMPLE_RADIAL_FISHEYE'; did "
+            "you mean 'PINHOLE'?");
   EXPECT_EQ(ErrorOf({{"verification", {{"max_error_px", -1}}}}),
             "m.json: verification.max_error_px: = -1 is out of range; must be in [0.1, 100]");
   EXPECT_EQ(ErrorOf({{"threads", "many"}}), "m.json: threads: expected an integer, got a string");
   EXPECT_EQ(ErrorOf({{"camera", {{"K", {1, 2, 3}}}}}),
             "m.json: camera.K: expected [fx, fy, cx, cy] in pixels");
+  EXPECT_EQ(ErrorOf({{"camera", {{"model", "OPENCV_FISHEYE"}, {"params", {300, 300, 320, 240}}}}}),
+            "m.json: camera.params: OPENCV_FISHEYE takes 8 parameters (fx, fy, cx, cy, k1, k2, "
+            "k3, k4), got 4");
+  EXPECT_EQ(ErrorOf({{"camera", {{"mask_path", 3}}}}),
+            "m.json: camera.mask_path: expected a folder path");
+}
+
+TEST(Manifest, FisheyeParamsAndMaskPath) {
+  const Manifest manifest =
+      Manifest::FromJson({{"camera",
+                           {{"model", "OPENCV_FISHEYE"},
+                            {"params", {300, 310, 320, 240, 0.05, -0.01, 0.002, -0.0005}},
+                            {"mask_path", "masks"}}}},
+                         "/base", "m.json");
+  EXPECT_EQ(manifest.camera.known_params,
+            (std::vector<double>{300, 310, 320, 240, 0.05, -0.01, 0.002, -0.0005}));
+  ASSERT_TRUE(manifest.camera.known_intrinsics);
+  EXPECT_EQ(*manifest.camera.known_intrinsics, Eigen::Vector4d(300, 310, 320, 240));
+  EXPECT_EQ(manifest.camera.known_intrinsics_source, "camera.params");
+  EXPECT_EQ(manifest.camera.mask_path, std::filesystem::path("/base/masks"));
 }
 
 TEST(Manifest, PairSelectorIsOneSlotOrAnArrayOfSlots) {

@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -50,6 +51,10 @@ struct SyntheticSceneOptions {
   double focal_length = 1000;  // px
   int width = 1600, height = 1200;
   double k1 = 0.0;  // SIMPLE_RADIAL distortion of the true camera
+  // OPENCV_FISHEYE cameras instead: the true camera has k1..k4 = fisheye_k (k1 above
+  // unused), the prior camera zeros there.
+  bool fisheye = false;
+  std::array<double, 4> fisheye_k = {0.03, -0.01, 0.002, 0.0};
   // Where the true principal point lies, in pixels from the image centre; the mapper is
   // told it is at the centre.
   double principal_point_offset_x = 0.0;
@@ -107,14 +112,20 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
   std::normal_distribution<double> noise(0.0, options.noise_px);
   SyntheticScene scene;
 
-  Camera true_camera = Camera::Create(1, CameraModelId::kSimpleRadial, options.focal_length,
-                                      options.width, options.height);
-  true_camera.params[3] = options.k1;
+  Camera true_camera = Camera::Create(
+      1, options.fisheye ? CameraModelId::kOpenCVFisheye : CameraModelId::kSimpleRadial,
+      options.focal_length, options.width, options.height);
+  const std::vector<int> extra_idx = true_camera.ExtraParamsIdx();
+  for (size_t k = 0; k < extra_idx.size(); ++k) {
+    true_camera.params[extra_idx[k]] = options.fisheye ? options.fisheye_k[k] : options.k1;
+  }
   Camera prior_camera = true_camera;
-  true_camera.params[1] += options.principal_point_offset_x;
-  true_camera.params[2] += options.principal_point_offset_y;
-  prior_camera.params[0] = options.focal_length * options.prior_focal_factor;
-  prior_camera.params[3] = 0;
+  true_camera.params[true_camera.PrincipalPointIdx()[0]] += options.principal_point_offset_x;
+  true_camera.params[true_camera.PrincipalPointIdx()[1]] += options.principal_point_offset_y;
+  for (const int idx : prior_camera.FocalIdx()) {
+    prior_camera.params[idx] = options.focal_length * options.prior_focal_factor;
+  }
+  for (const int idx : extra_idx) prior_camera.params[idx] = 0;
   prior_camera.has_prior_focal_length = options.focal_prior;
   scene.input.cameras[1] = prior_camera;
 

@@ -9,6 +9,13 @@
 //   2   SIMPLE_RADIAL   f, cx, cy, k
 //   3   RADIAL          f, cx, cy, k1, k2
 //   4   OPENCV          fx, fy, cx, cy, k1, k2, p1, p2
+//   5   OPENCV_FISHEYE  fx, fy, cx, cy, k1, k2, k3, k4
+//   8   SIMPLE_RADIAL_FISHEYE  f, cx, cy, k
+//
+// The fisheye models are COLMAP's equidistant projection: a ray at angle theta from
+// the optical axis lands at radius theta_d = theta (1 + k1 theta^2 + k2 theta^4 + ...)
+// on the normalized plane, as OpenCV's cv::fisheye; they cover fields of view up to
+// (not including) 180 degrees.
 //
 // ImgFromCam maps a point in the camera frame (u, v, w), w > 0, to pixels; it is
 // templated so that Ceres can differentiate it. CamFromImg maps pixels to the
@@ -29,6 +36,8 @@ enum class CameraModelId : int {
   kSimpleRadial = 2,
   kRadial = 3,
   kOpenCV = 4,
+  kOpenCVFisheye = 5,
+  kSimpleRadialFisheye = 8,
 };
 
 namespace camera_internal {
@@ -69,6 +78,25 @@ void IterativeUndistortion(const double* extra_params, double* u, double* v) {
   }
   *u = x;
   *v = y;
+}
+
+// COLMAP's fisheye distortion: (du, dv) moves the normalized point (u, v) of a ray at
+// angle theta = atan(r) from the axis to radius theta_d = theta * (1 + poly(theta^2)).
+template <typename T>
+void FisheyeDistortion(T u, T v, const T& poly, T* du, T* dv) {
+  using std::atan;
+  using std::sqrt;
+  const T r2 = u * u + v * v;
+  if (r2 > T(std::numeric_limits<double>::epsilon() * std::numeric_limits<double>::epsilon())) {
+    const T r = sqrt(r2);
+    const T theta = atan(r);
+    const T scale = theta * (T(1) + poly) / r;
+    *du = u * scale - u;
+    *dv = v * scale - v;
+  } else {
+    *du = T(0);
+    *dv = T(0);
+  }
 }
 
 }  // namespace camera_internal
@@ -230,6 +258,82 @@ struct OpenCVCameraModel {
   }
 };
 
+struct OpenCVFisheyeCameraModel {
+  static constexpr CameraModelId kModelId = CameraModelId::kOpenCVFisheye;
+  static constexpr int kNumParams = 8;
+  static constexpr const char* kName = "OPENCV_FISHEYE";
+  static constexpr const char* kParamsInfo = "fx, fy, cx, cy, k1, k2, k3, k4";
+  static constexpr int kFocalIdx[] = {0, 1};
+  static constexpr int kPrincipalPointIdx[] = {2, 3};
+  static constexpr int kNumExtraParams = 4;
+  static constexpr int kExtraParamsIdx = 4;
+
+  template <typename T>
+  static void Distortion(const T* extra, T u, T v, T* du, T* dv) {
+    using std::atan;
+    using std::sqrt;
+    const T r2 = u * u + v * v;
+    const T theta = r2 > T(0) ? T(atan(sqrt(r2))) : T(0);
+    const T t2 = theta * theta, t4 = t2 * t2;
+    const T poly = extra[0] * t2 + extra[1] * t4 + extra[2] * t4 * t2 + extra[3] * t4 * t4;
+    camera_internal::FisheyeDistortion(u, v, poly, du, dv);
+  }
+  template <typename T>
+  static void ImgFromCam(const T* params, T u, T v, T w, T* x, T* y) {
+    u /= w;
+    v /= w;
+    T du, dv;
+    Distortion(&params[4], u, v, &du, &dv);
+    *x = params[0] * (u + du) + params[2];
+    *y = params[1] * (v + dv) + params[3];
+  }
+  static void CamFromImg(const double* params, double x, double y, double* u, double* v) {
+    *u = (x - params[2]) / params[0];
+    *v = (y - params[3]) / params[1];
+    camera_internal::IterativeUndistortion<OpenCVFisheyeCameraModel>(&params[4], u, v);
+  }
+  static std::vector<double> InitialParams(double focal, double width, double height) {
+    return {focal, focal, width / 2, height / 2, 0, 0, 0, 0};
+  }
+};
+
+struct SimpleRadialFisheyeCameraModel {
+  static constexpr CameraModelId kModelId = CameraModelId::kSimpleRadialFisheye;
+  static constexpr int kNumParams = 4;
+  static constexpr const char* kName = "SIMPLE_RADIAL_FISHEYE";
+  static constexpr const char* kParamsInfo = "f, cx, cy, k";
+  static constexpr int kFocalIdx[] = {0};
+  static constexpr int kPrincipalPointIdx[] = {1, 2};
+  static constexpr int kNumExtraParams = 1;
+  static constexpr int kExtraParamsIdx = 3;
+
+  template <typename T>
+  static void Distortion(const T* extra, T u, T v, T* du, T* dv) {
+    using std::atan;
+    using std::sqrt;
+    const T r2 = u * u + v * v;
+    const T theta = r2 > T(0) ? T(atan(sqrt(r2))) : T(0);
+    camera_internal::FisheyeDistortion(u, v, T(extra[0] * theta * theta), du, dv);
+  }
+  template <typename T>
+  static void ImgFromCam(const T* params, T u, T v, T w, T* x, T* y) {
+    u /= w;
+    v /= w;
+    T du, dv;
+    Distortion(&params[3], u, v, &du, &dv);
+    *x = params[0] * (u + du) + params[1];
+    *y = params[0] * (v + dv) + params[2];
+  }
+  static void CamFromImg(const double* params, double x, double y, double* u, double* v) {
+    *u = (x - params[1]) / params[0];
+    *v = (y - params[2]) / params[0];
+    camera_internal::IterativeUndistortion<SimpleRadialFisheyeCameraModel>(&params[3], u, v);
+  }
+  static std::vector<double> InitialParams(double focal, double width, double height) {
+    return {focal, width / 2, height / 2, 0};
+  }
+};
+
 // Calls `fn` with a default-constructed value of the model type for `model_id`;
 // returns false for an unknown id. The one place that lists every model.
 template <typename Fn>
@@ -250,15 +354,25 @@ bool VisitCameraModel(CameraModelId model_id, Fn&& fn) {
     case CameraModelId::kOpenCV:
       fn(OpenCVCameraModel{});
       return true;
+    case CameraModelId::kOpenCVFisheye:
+      fn(OpenCVFisheyeCameraModel{});
+      return true;
+    case CameraModelId::kSimpleRadialFisheye:
+      fn(SimpleRadialFisheyeCameraModel{});
+      return true;
     default:
       return false;
   }
 }
 
 inline const std::vector<CameraModelId>& AllCameraModelIds() {
-  static const std::vector<CameraModelId> ids = {
-      CameraModelId::kSimplePinhole, CameraModelId::kPinhole, CameraModelId::kSimpleRadial,
-      CameraModelId::kRadial, CameraModelId::kOpenCV};
+  static const std::vector<CameraModelId> ids = {CameraModelId::kSimplePinhole,
+                                                 CameraModelId::kPinhole,
+                                                 CameraModelId::kSimpleRadial,
+                                                 CameraModelId::kRadial,
+                                                 CameraModelId::kOpenCV,
+                                                 CameraModelId::kOpenCVFisheye,
+                                                 CameraModelId::kSimpleRadialFisheye};
   return ids;
 }
 

@@ -122,6 +122,26 @@ std::optional<FocalLengthPrior> EstimateFocalLengthPrior(const ImageEntry& image
   return std::nullopt;
 }
 
+std::string FisheyeLensHint(const std::vector<ImageEntry>& images, const CameraSettings& settings) {
+  if (settings.model.find("FISHEYE") != std::string::npos) return "";
+  size_t count = 0;
+  const ImageEntry* first = nullptr;
+  for (const ImageEntry& image : images) {
+    if (image.exif.focal_length_35mm && *image.exif.focal_length_35mm > 0 &&
+        *image.exif.focal_length_35mm < kFisheyeHint35mm) {
+      if (!first) first = &image;
+      ++count;
+    }
+  }
+  if (!first) return "";
+  return "'" + first->name + "'" +
+         (count > 1 ? " and " + std::to_string(count - 1) + " other image(s)" : "") +
+         ": EXIF FocalLengthIn35mmFilm " + FormatNumber(*first->exif.focal_length_35mm) +
+         " mm suggests a fisheye or action-camera lens; camera.model OPENCV_FISHEYE models "
+         "one (keeping " +
+         settings.model + ")";
+}
+
 CameraAssignment AssignCameras(const std::vector<ImageEntry>& images,
                                const CameraSettings& settings) {
   const CameraModelId model_id = CameraModelNameToId(settings.model);
@@ -137,6 +157,8 @@ CameraAssignment AssignCameras(const std::vector<ImageEntry>& images,
     throw OptionError("camera.default_focal_length_factor", "must be positive");
   }
   CameraAssignment assignment;
+  const std::string hint = FisheyeLensHint(images, settings);
+  if (!hint.empty()) assignment.notes.push_back(hint);
 
   // The intrinsics each image would get on its own.
   std::vector<ImagePrior> priors;
@@ -199,6 +221,9 @@ CameraAssignment AssignCameras(const std::vector<ImageEntry>& images,
       const std::vector<int> pp_idx = camera.PrincipalPointIdx();
       camera.params[pp_idx[0]] = K(2);
       camera.params[pp_idx[1]] = K(3);
+      if (!settings.known_params.empty() && settings.known_intrinsics_source == "camera.params") {
+        camera.params = settings.known_params;  // K from the command line overrides them
+      }
       camera.has_prior_focal_length = true;
       camera.calibration_source = CalibrationSource::kUser;
     } else {

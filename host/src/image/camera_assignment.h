@@ -44,7 +44,19 @@ struct CameraAssignment {
   std::vector<Camera> cameras;             // camera ids 1..N
   std::vector<camera_t> image_camera_ids;  // one per input image, in input order
   std::vector<std::string> warnings;
+  // Suggestions for the log, never acted upon: a lens whose EXIF says it sees wider than
+  // a non-fisheye model describes well (see FisheyeLensHint).
+  std::vector<std::string> notes;
 };
+
+// EXIF 35 mm equivalent focal lengths below this (a diagonal field of view over 110
+// degrees) suggest a fisheye or action-camera lens.
+constexpr double kFisheyeHint35mm = 15.0;
+
+// A log line when `settings.model` is not a fisheye model and an image's EXIF 35 mm
+// equivalent focal length is below kFisheyeHint35mm, naming the first such image and
+// suggesting camera.model OPENCV_FISHEYE; the model is never switched. Empty otherwise.
+std::string FisheyeLensHint(const std::vector<ImageEntry>& images, const CameraSettings& settings);
 
 // Makes cameras for the images per CameraSettings:
 //  - known intrinsics (fx, fy, cx, cy) win: source kUser, has_prior_focal_length; models

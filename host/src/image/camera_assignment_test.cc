@@ -265,7 +265,7 @@ TEST(AssignCameras, RejectsAnUnknownModel) {
   } catch (const InputError& error) {
     EXPECT_EQ(std::string(error.what()),
               "camera.model: unknown camera model 'FISHEYE' (known models: SIMPLE_PINHOLE, "
-              "PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV)");
+              "PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, OPENCV_FISHEYE, SIMPLE_RADIAL_FISHEYE)");
   }
 }
 
@@ -289,6 +289,26 @@ TEST(EstimateFocalLengthPrior, SceauxCastleMatchesItsCalibration) {
   std::printf("sceaux-castle: EXIF prior %.2f px (sensor database), K.txt %.2f px, %+.2f%%\n",
               focal, focal_truth, 100 * (focal / focal_truth - 1));
   EXPECT_LT(std::abs(focal / focal_truth - 1), 0.06);
+}
+
+TEST(AssignCameras, AVeryWideLensSuggestsFisheyeButNeverSwitches) {
+  CameraSettings settings;  // SIMPLE_RADIAL
+  const std::vector<ImageEntry> images = {With35mm(Entry("a.jpg", 4000, 3000), 26),
+                                          With35mm(Entry("b.jpg", 4000, 3000), 12),
+                                          With35mm(Entry("c.jpg", 4000, 3000), 14)};
+  const CameraAssignment assignment = AssignCameras(images, settings);
+  ASSERT_EQ(assignment.notes.size(), 1u);
+  EXPECT_EQ(assignment.notes[0],
+            "'b.jpg' and 1 other image(s): EXIF FocalLengthIn35mmFilm 12 mm suggests a fisheye "
+            "or action-camera lens; camera.model OPENCV_FISHEYE models one (keeping "
+            "SIMPLE_RADIAL)");
+  for (const Camera& camera : assignment.cameras) {
+    EXPECT_EQ(camera.model_id, CameraModelId::kSimpleRadial);
+  }
+  settings.model = "OPENCV_FISHEYE";
+  EXPECT_TRUE(AssignCameras(images, settings).notes.empty());
+  EXPECT_EQ(AssignCameras(images, settings).cameras[0].model_id, CameraModelId::kOpenCVFisheye);
+  EXPECT_TRUE(FisheyeLensHint({images[0]}, CameraSettings()).empty());
 }
 
 }  // namespace

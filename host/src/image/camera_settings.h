@@ -1,8 +1,10 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace tessera {
 
@@ -18,6 +20,13 @@ struct CameraSettings {
   std::optional<Eigen::Vector4d> known_intrinsics;
   // Where known_intrinsics came from ("camera.K" or a K.txt file), for messages.
   std::string known_intrinsics_source;
+  // Every parameter of the model, in COLMAP's order (camera.params; e.g. fx, fy, cx, cy,
+  // k1..k4 for OPENCV_FISHEYE), set as the initial camera; empty: none. Sets
+  // known_intrinsics too.
+  std::vector<double> known_params;
+  // Folder of image masks (COLMAP's ImageReader.mask_path; see image/image_masks.h);
+  // empty: none.
+  std::filesystem::path mask_path;
 };
 
 }  // namespace tessera

@@ -68,6 +68,18 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
     }
   }
 
+  fs::path mask_folder;
+  if (!options.mask_folder.empty()) {
+    std::error_code canonical_error;
+    mask_folder = fs::weakly_canonical(fs::absolute(options.mask_folder), canonical_error);
+    std::error_code root_error;
+    if (!canonical_error && mask_folder == fs::weakly_canonical(root, root_error)) {
+      throw InputError(dir.string() +
+                       ": the image folder is the mask folder of this run; put the masks in a "
+                       "folder of their own");
+    }
+  }
+
   ImageScan scan;
   std::vector<std::pair<std::string, fs::path>> candidates;
   fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, error);
@@ -88,6 +100,10 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
       if (std::find(excluded.begin(), excluded.end(), canonical) != excluded.end()) {
         scan.skipped_folders.push_back("Skipped the folder '" + name +
                                        "': it is the output folder of this run.");
+        it.disable_recursion_pending();
+      } else if (!mask_folder.empty() && canonical == mask_folder) {
+        scan.skipped_folders.push_back("Skipped the folder '" + name +
+                                       "': it is the mask folder of this run.");
         it.disable_recursion_pending();
       } else if (IsTesseraWorkspace(path)) {
         scan.skipped_folders.push_back("Skipped the folder '" + name +

@@ -26,6 +26,8 @@ struct ImageScanOptions {
   // Folders never scanned (the run's own output folder): output never feeds input.
   std::vector<std::filesystem::path> excluded_folders;
   int64_t max_image_pixels = kDefaultMaxImagePixels;  // refused before decoding
+  // The mask folder (camera.mask_path), never scanned for images; empty: none.
+  std::filesystem::path mask_folder;
 };
 
 // A folder holding a Tessera workspace (a database.db or a .tessera.lock file).

@@ -311,6 +311,21 @@ TEST(ScanImageFolder, LeavesOutTheOutputFolderAndWorkspacesAndSaysSo) {
   EXPECT_THROW(ScanImageFolder(dir.path(), options), InputError);
 }
 
+TEST(ScanImageFolder, LeavesOutTheMaskFolder) {
+  TemporaryDir dir;
+  Write(dir.path() / "a.png", Pattern(32, 24));
+  Write(dir.path() / "masks" / "a.png.png", Pattern(32, 24));
+  ImageScanOptions options;
+  options.mask_folder = dir.path() / "masks";
+  const ImageScan scan = ScanImageFolder(dir.path(), options);
+  EXPECT_EQ(Names(scan), (std::vector<std::string>{"a.png"}));
+  EXPECT_EQ(scan.skipped_folders,
+            (std::vector<std::string>{"Skipped the folder 'masks': it is the mask folder of "
+                                      "this run."}));
+  options.mask_folder = dir.path();
+  EXPECT_THROW(ScanImageFolder(dir.path(), options), InputError);
+}
+
 TEST(ScanImageFolder, RecordsSizeAndContentHashAndRefusesOversizedOrLineBrokenNames) {
   TemporaryDir dir;
   Write(dir.path() / "a.png", Pattern(40, 30));

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "tessera/errors.h"
+#include "tessera/io/file_io.h"
 #include "test_support.h"
 
 namespace tessera {
@@ -167,6 +168,41 @@ TEST(ColmapModelIo, SyntheticRoundTripInBothFormats) {
     EXPECT_TRUE(read.points3D.at(1000).track.empty());
     EXPECT_EQ(read.images.at(2).name, "sub dir/with space.png");
     EXPECT_EQ(read.cameras.at(11).model_id, CameraModelId::kOpenCV);
+  }
+}
+
+// COLMAP's ids: OPENCV_FISHEYE is 5, SIMPLE_RADIAL_FISHEYE 8, in both formats.
+TEST(ColmapModelIo, FisheyeCamerasRoundTripWithColmapsIds) {
+  Reconstruction reconstruction;
+  reconstruction.cameras[1] = Camera::Create(1, CameraModelId::kOpenCVFisheye, 300, 640, 480);
+  reconstruction.cameras[1].params = {300, 301, 320.5, 239.5, 0.05, -0.01, 0.002, -0.0003};
+  reconstruction.cameras[2] = Camera::Create(2, CameraModelId::kSimpleRadialFisheye, 250, 64, 48);
+  reconstruction.cameras[2].params[3] = 0.04;
+  for (image_t id : {1, 2}) {
+    Image image;
+    image.image_id = id;
+    image.camera_id = id;
+    image.name = std::to_string(id) + ".jpg";
+    image.registered = true;
+    reconstruction.images[id] = image;
+  }
+  TemporaryDir dir;
+  WriteColmapModel(reconstruction, dir.path() / "text", ColmapModelFormat::kText);
+  EXPECT_NE(ReadFileContents(dir.path() / "text" / "cameras.txt")
+                .find("\n1 OPENCV_FISHEYE 640 480 300 301 320.5 239.5 "),
+            std::string::npos)
+      << ReadFileContents(dir.path() / "text" / "cameras.txt");
+  WriteColmapModel(reconstruction, dir.path() / "binary", ColmapModelFormat::kBinary);
+  const std::string binary = ReadFileContents(dir.path() / "binary" / "cameras.bin");
+  int32_t model_id = -1;
+  std::memcpy(&model_id, binary.data() + 8 + 4, 4);  // after the count and camera id
+  EXPECT_EQ(model_id, 5);
+  for (const char* format : {"text", "binary"}) {
+    const Reconstruction read = ReadColmapModel(dir.path() / format);
+    EXPECT_EQ(read.cameras.at(1).model_id, CameraModelId::kOpenCVFisheye) << format;
+    EXPECT_EQ(read.cameras.at(1).params, reconstruction.cameras[1].params) << format;
+    EXPECT_EQ(read.cameras.at(2).model_id, CameraModelId::kSimpleRadialFisheye) << format;
+    EXPECT_EQ(read.cameras.at(2).params, reconstruction.cameras[2].params) << format;
   }
 }
 

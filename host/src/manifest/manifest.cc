@@ -6,6 +6,7 @@
 #include <sstream>
 #include <thread>
 
+#include "tessera/camera.h"
 #include "tessera/camera_models.h"
 #include "tessera/errors.h"
 #include "tessera/options.h"
@@ -65,7 +66,15 @@ CameraSettings ParseCamera(const nlohmann::json& json, const std::filesystem::pa
       "default_focal_length_factor", camera.default_focal_length_factor, 0.1, 10);
   const nlohmann::json K = reader.GetJson("K", nullptr);
   const nlohmann::json K_file = reader.GetJson("K_file", nullptr);
+  const nlohmann::json mask_path = reader.GetJson("mask_path", nullptr);
+  const nlohmann::json params = reader.GetJson("params", nullptr);
   reader.Finish();
+  if (!mask_path.is_null()) {
+    if (!mask_path.is_string() || mask_path.get<std::string>().empty()) {
+      throw OptionError("camera.mask_path", "expected a folder path");
+    }
+    camera.mask_path = Resolve(base_dir, mask_path.get<std::string>());
+  }
   if (!K.is_null() && !K_file.is_null()) {
     throw OptionError("camera", "give either 'K' or 'K_file', not both");
   }
@@ -84,6 +93,30 @@ CameraSettings ParseCamera(const nlohmann::json& json, const std::filesystem::pa
     camera.known_intrinsics =
         Eigen::Vector4d(matrix(0, 0), matrix(1, 1), matrix(0, 2), matrix(1, 2));
     camera.known_intrinsics_source = file.string();
+  }
+  if (!params.is_null()) {
+    const CameraModelId model_id = CameraModelNameToId(camera.model);
+    std::string info;
+    VisitCameraModel(model_id, [&](auto model) { info = decltype(model)::kParamsInfo; });
+    const int num_params = CameraModelNumParams(model_id);
+    if (!params.is_array() ||
+        !std::all_of(params.begin(), params.end(), [](const auto& v) { return v.is_number(); })) {
+      throw OptionError("camera.params", "expected an array of numbers: " + info);
+    }
+    if (static_cast<int>(params.size()) != num_params) {
+      throw OptionError("camera.params", camera.model + " takes " + std::to_string(num_params) +
+                                             " parameters (" + info + "), got " +
+                                             std::to_string(params.size()));
+    }
+    if (camera.known_intrinsics) {
+      throw OptionError("camera", "give either 'params' or 'K'/'K_file', not both");
+    }
+    camera.known_params = params.get<std::vector<double>>();
+    Camera probe = Camera::Create(0, model_id, 1, 1, 1);
+    probe.params = camera.known_params;
+    camera.known_intrinsics = Eigen::Vector4d(probe.FocalLengthX(), probe.FocalLengthY(),
+                                              probe.PrincipalPointX(), probe.PrincipalPointY());
+    camera.known_intrinsics_source = "camera.params";
   }
   if (camera.known_intrinsics &&
       ((*camera.known_intrinsics)(0) <= 0 || (*camera.known_intrinsics)(1) <= 0)) {
@@ -206,6 +239,7 @@ Manifest Manifest::FromJson(const nlohmann::json& json, const std::filesystem::p
     const nlohmann::json camera = top.GetJson("camera", nlohmann::json::object());
     const nlohmann::json verification = top.GetJson("verification", nlohmann::json::object());
     manifest.mapper = top.GetJson("mapper", nlohmann::json::object());
+    manifest.video = top.GetJson("video", nlohmann::json::object());
     top.GetJson("description", "");
     top.Finish();
 
@@ -240,6 +274,7 @@ Manifest Manifest::FromJson(const nlohmann::json& json, const std::filesystem::p
     manifest.camera = ParseCamera(camera, base_dir);
     manifest.verification = ParseVerification(verification);
     if (!manifest.mapper.is_object()) throw OptionError("mapper", "expected a JSON object");
+    if (!manifest.video.is_object()) throw OptionError("video", "expected a JSON object");
     return manifest;
   } catch (const OptionError& error) {
     throw InputError(source + ": " + error.what());

@@ -44,6 +44,8 @@ struct Manifest {
   VerificationSettings verification;
   // Mapper settings, read by the incremental mapper.
   nlohmann::json mapper = nlohmann::json::object();
+  // Keyframe selection of video input, read by video/video_frames.h.
+  nlohmann::json video = nlohmann::json::object();
 
   // Parses a manifest file; relative paths inside are relative to its folder.
   // Throws InputError (file unreadable, invalid JSON, unknown key, bad value, a

@@ -10,6 +10,7 @@
 
 #include "image/camera_assignment.h"
 #include "image/image_io.h"
+#include "image/image_masks.h"
 #include "plugin/plugin_crash_log.h"
 #include "tessera/io/exif.h"
 #include "util/parallel.h"
@@ -104,6 +105,7 @@ std::vector<Image> RegisterImages(const ImageScan& scan, const CameraSettings& s
 
   const CameraAssignment assignment = AssignCameras(new_entries, settings);
   for (const auto& warning : assignment.warnings) spdlog::warn("{}", warning);
+  for (const auto& note : assignment.notes) spdlog::info("extract: {}", note);
   // With one camera per image size, an image added to a workspace (new, or ingested
   // again after a change) joins the workspace's camera identical to its own.
   std::vector<Camera> existing_cameras;
@@ -181,12 +183,34 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
                      " usable image(s); at least 2 are needed");
   }
 
-  const nlohmann::json provenance = FeaturesProvenance(detector);
+  ImageMasks masks;
+  if (!manifest.camera.mask_path.empty()) {
+    std::vector<std::string> names;
+    for (const ImageEntry& entry : scan.images) names.push_back(entry.name);
+    masks = FindImageMasks(manifest.camera.mask_path, names);
+    if (masks.files.empty()) {
+      spdlog::warn(
+          "extract: the mask folder {} matches none of the {} images (the mask of a/b.jpg is "
+          "a/b.jpg.png or a/b.png); every image is used without a mask",
+          masks.folder.string(), scan.images.size());
+    } else {
+      for (const std::string& name : masks.missing) {
+        spdlog::warn("'{}': no mask in {} (looked for {}.png); used without a mask", name,
+                     masks.folder.string(), name);
+      }
+      spdlog::info("extract: {} of {} images have a mask in {}", masks.files.size(),
+                   scan.images.size(), masks.folder.string());
+    }
+  }
+
+  nlohmann::json provenance = FeaturesProvenance(detector);
+  // Only with masks, so that the provenance of workspaces without them is unchanged.
+  if (!masks.files.empty()) provenance["masks"] = masks.digest;
   const auto stored = database->ReadStageProvenance(Database::kFeaturesStage);
   if (stored && *stored != provenance) {
     spdlog::info(
-        "extract: the detector or its options changed; discarding old features, matches "
-        "and geometries");
+        "extract: the detector, its options or the masks changed; discarding old features, "
+        "matches and geometries");
     database->ClearKeypointsAndDescriptors();
   } else if (database->DescriptorWidths().size() > 1) {
     spdlog::info(
@@ -241,6 +265,7 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
     // Any failure before mapping skips the image, never the run: the reason is
     // recorded with the file's hash, so the next run skips it too unless it changes.
     FeatureSet features;
+    size_t num_masked = 0;  // keypoints removed by the image's mask
     std::string failure;
     std::string stage;  // "" while decoding
     try {
@@ -257,6 +282,15 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
         failure = "detector '" + detector.name() + "' returned " +
                   std::to_string(features.keypoints.size()) + " keypoints but " +
                   std::to_string(features.descriptors.size()) + " descriptors";
+      }
+      const auto mask_file = masks.files.find(entry.name);
+      if (failure.empty() && mask_file != masks.files.end()) {
+        std::string problem;
+        if (const auto mask = ReadMask(mask_file->second, gray.cols, gray.rows, &problem)) {
+          num_masked = RemoveMaskedFeatures(*mask, &features);
+        } else {
+          spdlog::warn("'{}': {}; used without a mask", entry.name, problem);
+        }
       }
     } catch (const PluginError& error) {
       failure = error.what();  // names the plugin, the stage and the image
@@ -290,8 +324,10 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
     }
     num_features += features.keypoints.size();
     const size_t n = ++done;
-    spdlog::info("extract: [{}/{}] {}: {} features ({:.2f} images/s)", n, todo.size(), entry.name,
-                 features.keypoints.size(), n / std::max(1e-9, detect_timer.ElapsedSeconds()));
+    spdlog::info("extract: [{}/{}] {}: {} features{} ({:.2f} images/s)", n, todo.size(), entry.name,
+                 features.keypoints.size(),
+                 num_masked > 0 ? " (" + std::to_string(num_masked) + " masked out)" : "",
+                 n / std::max(1e-9, detect_timer.ElapsedSeconds()));
     report();
   });
   summary.num_failed += num_failed;

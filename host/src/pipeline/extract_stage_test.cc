@@ -76,5 +76,45 @@ TEST(ExtractStage, ProgressIsMonotoneAndEndsAtTotal) {
   EXPECT_EQ(calls[0], std::make_pair(size_t{0}, size_t{0}));
 }
 
+TEST(ExtractStage, NoKeypointLiesUnderTheBlackHalfOfAMask) {
+  const testing::TemporaryDir dir;
+  testing::WriteSampleImages(dir.path() / "images", 3);
+  const testing::CheapPlugins plugins;
+  Manifest manifest = testing::CheapManifest(2);
+  manifest.camera.mask_path = dir.path() / "masks";
+  // 0001.jpg: right half black. 0000.jpg: a mask of the wrong size (used without it).
+  // 0002.jpg: no mask.
+  const cv::Mat image = cv::imread((dir.path() / "images" / "0001.jpg").string());
+  cv::Mat mask(image.rows, image.cols, CV_8UC1, cv::Scalar(255));
+  mask(cv::Rect(image.cols / 2, 0, image.cols - image.cols / 2, image.rows)).setTo(0);
+  std::filesystem::create_directories(dir.path() / "masks");
+  cv::imwrite((dir.path() / "masks" / "0001.jpg.png").string(), mask);
+  cv::imwrite((dir.path() / "masks" / "0000.png").string(), mask(cv::Rect(0, 0, 100, 100)));
+  Database database(dir.path() / "database.db");
+  ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database);
+
+  const auto count_right = [&](const std::string& name, size_t* total) {
+    const FeatureKeypoints keypoints =
+        database.ReadKeypoints(database.ReadImageWithName(name)->image_id);
+    *total = keypoints.size();
+    size_t right = 0;
+    for (const FeatureKeypoint& keypoint : keypoints) right += keypoint.x >= image.cols / 2;
+    return right;
+  };
+  size_t total = 0;
+  EXPECT_EQ(count_right("0001.jpg", &total), 0u);
+  EXPECT_GT(total, 200u);  // the left half keeps its keypoints
+  EXPECT_GT(count_right("0000.jpg", &total), 200u);
+  EXPECT_GT(count_right("0002.jpg", &total), 200u);
+
+  // Another mask: the features are detected again.
+  mask.setTo(255);
+  cv::imwrite((dir.path() / "masks" / "0001.jpg.png").string(), mask);
+  const ExtractionSummary again =
+      ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database);
+  EXPECT_EQ(again.num_detected, 3u);
+  EXPECT_GT(count_right("0001.jpg", &total), 200u);
+}
+
 }  // namespace
 }  // namespace tessera

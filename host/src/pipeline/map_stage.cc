@@ -149,6 +149,7 @@ MapStageSummary MapWorkspace(const PipelineContext& context, Database* database,
       }
     }
     summary.num_registered += model.images.size();
+    summary.images_per_model.push_back(model.images.size());
     const MappingSummary::Model& entry = mapping.models[index];
     spdlog::info(
         "map: model {}: {} images, {} points, mean track length {:.2f}, mean reprojection "

@@ -35,6 +35,7 @@ PipelineContext PipelineContext::Create(Manifest manifest) {
           "bundle_adjuster", slot.plugin, slot.options, slot.json_path);
     }
     context.mapper_options = IncrementalMapperOptions::FromJson(manifest.mapper);
+    context.video_options = VideoFrameOptions::FromJson(manifest.video);
     for (const auto& slot : manifest.exporters) {
       context.exporters.push_back(
           context.registry.Create<Exporter>("exporter", slot.plugin, slot.options, slot.json_path));

@@ -8,6 +8,7 @@
 #include "plugin/plugin_registry.h"
 #include "sfm/incremental_mapper_options.h"
 #include "tessera/sdk.h"
+#include "video/video_frames.h"
 
 namespace tessera {
 
@@ -24,6 +25,7 @@ struct PipelineContext {
   PluginInstance<BundleAdjuster> bundle_adjuster;
   std::vector<PluginInstance<Exporter>> exporters;
   IncrementalMapperOptions mapper_options;  // the manifest's "mapper", checked
+  VideoFrameOptions video_options;          // the manifest's "video", checked
 
   // `manifest_file` empty: the default manifest. Throws InputError on any problem.
   static PipelineContext Create(const std::filesystem::path& manifest_file);

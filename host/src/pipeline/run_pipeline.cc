@@ -11,14 +11,27 @@
 #include "util/timer.h"
 
 namespace tessera {
+namespace {
+
+// The image folder of the run: options.image_dir, or the videos' keyframes.
+std::filesystem::path InputImages(const PipelineContext& context, const RunOptions& options) {
+  if (options.videos.empty()) return options.image_dir;
+  if (!options.image_dir.empty()) {
+    throw InputError("give either an image folder or videos, not both");
+  }
+  return IngestVideos(options.videos, options.output_dir, context.video_options);
+}
+
+}  // namespace
 
 ExtractionSummary RunExtract(const PipelineContext& context, const RunOptions& options,
                              const StageControl& control) {
   context.Require("detector", "extract");
   const auto lock = LockWorkspace(options.output_dir);
   Database database(PrepareWorkspace(options.output_dir));
-  return ExtractFeatures(options.image_dir, context.manifest, context.detector, &database,
-                         WorkspaceScanOptions(options.output_dir, context.manifest), control);
+  return ExtractFeatures(InputImages(context, options), context.manifest, context.detector,
+                         &database, WorkspaceScanOptions(options.output_dir, context.manifest),
+                         control);
 }
 
 MatchingSummary RunMatch(const PipelineContext& context, const RunOptions& options,
@@ -57,10 +70,11 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
   const std::filesystem::path database_file = PrepareWorkspace(options.output_dir);
   const auto lock = LockWorkspace(options.output_dir);
   Database database(database_file);
+  const std::filesystem::path image_dir = InputImages(context, options);
   RunResult run;
   RunSummary& summary = run.summary;
   summary.extract =
-      ExtractFeatures(options.image_dir, context.manifest, context.detector, &database,
+      ExtractFeatures(image_dir, context.manifest, context.detector, &database,
                       WorkspaceScanOptions(options.output_dir, context.manifest), control);
   if (summary.extract.status == StageStatus::kCancelled) {
     run.status = StageStatus::kCancelled;
@@ -74,7 +88,7 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
     run.status = StageStatus::kCancelled;
     return run;
   }
-  summary.map = MapWorkspace(context, &database, options.output_dir, options.image_dir, control);
+  summary.map = MapWorkspace(context, &database, options.output_dir, image_dir, control);
   if (summary.map.status == StageStatus::kCancelled) {
     run.status = StageStatus::kCancelled;
     return run;
@@ -83,6 +97,18 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
   spdlog::info("run: extract {:.2f} s, match {:.2f} s, map {:.2f} s, total {:.2f} s",
                summary.extract.seconds, summary.match.seconds, summary.map.seconds,
                summary.total_seconds);
+  // Say what each model holds, so that nobody trains on a fragment without knowing.
+  for (size_t index = 0; index < summary.map.images_per_model.size(); ++index) {
+    spdlog::info("run: model {} (sparse/{}) holds {} of {} images", index, index,
+                 summary.map.images_per_model[index], summary.extract.num_images);
+  }
+  if (summary.map.images_per_model.size() > 1) {
+    spdlog::warn(
+        "run: the images form {} separate models; each is exported on its own (model 0: {} of "
+        "{} images)",
+        summary.map.images_per_model.size(), summary.map.images_per_model[0],
+        summary.extract.num_images);
+  }
   WriteFileAtomically(options.output_dir / "run_summary.json", summary.ToJson().dump(2) + "\n");
   return run;
 }

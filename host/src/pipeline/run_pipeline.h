@@ -5,6 +5,8 @@
 // run_summary.json. Each checks the plugins it needs, prepares and locks the workspace.
 
 #include <filesystem>
+#include <utility>
+#include <vector>
 
 #include "pipeline/pipeline_context.h"
 #include "pipeline/run_summary.h"
@@ -13,8 +15,17 @@
 namespace tessera {
 
 struct RunOptions {
+  RunOptions(std::filesystem::path image_dir = {}, std::filesystem::path output_dir = {},
+             std::vector<std::filesystem::path> videos = {})
+      : image_dir(std::move(image_dir)),
+        output_dir(std::move(output_dir)),
+        videos(std::move(videos)) {}
+
   std::filesystem::path image_dir;
   std::filesystem::path output_dir;  // the workspace
+  // Videos instead of image_dir: their keyframes go to OUTPUT/video_frames (see
+  // video/video_frames.h), which then is the image folder.
+  std::vector<std::filesystem::path> videos;
 };
 
 struct RunResult {

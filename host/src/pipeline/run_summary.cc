@@ -34,7 +34,8 @@ nlohmann::json RunSummary::ToJson() const {
            {{"seconds", map.seconds},
             {"num_models", map.num_models},
             {"num_registered", map.num_registered},
-            {"num_images", map.num_images}}},
+            {"num_images", map.num_images},
+            {"images_per_model", map.images_per_model}}},
           {"total_seconds", total_seconds}};
 }
 
@@ -63,6 +64,8 @@ RunSummary RunSummary::FromJson(const nlohmann::json& json) {
   summary.map.num_models = map.at("num_models").get<size_t>();
   summary.map.num_registered = map.at("num_registered").get<size_t>();
   summary.map.num_images = map.at("num_images").get<size_t>();
+  summary.map.images_per_model =
+      map.value("images_per_model", nlohmann::json::array()).get<std::vector<size_t>>();
   summary.total_seconds = json.at("total_seconds").get<double>();
   return summary;
 }

@@ -36,6 +36,7 @@ ImageScanOptions WorkspaceScanOptions(const std::filesystem::path& output_dir,
                                       const Manifest& manifest) {
   ImageScanOptions scan;
   scan.excluded_folders.push_back(output_dir);
+  scan.mask_folder = manifest.camera.mask_path;
   scan.max_image_pixels = manifest.max_image_pixels;
   return scan;
 }

@@ -2,6 +2,7 @@
 // read as it is (the reference trainer accepts only PINHOLE and SIMPLE_PINHOLE cameras):
 //   OUTPUT/<folder>/images/<name>                         undistorted images
 //   OUTPUT/<folder>/sparse/0/{cameras,images,points3D}.bin the model of those images
+//   OUTPUT/<folder>/masks/<name>.png                      with mask_path: their masks
 
 #include <cctype>
 #include <map>
@@ -76,6 +77,18 @@ std::string EncodeImage(const cv::Mat& image, const std::filesystem::path& path,
   return std::string(bytes.begin(), bytes.end());
 }
 
+// The mask of image `name` as the extract stage finds it: DIR/NAME.png, else NAME with
+// its extension replaced by .png. Empty when neither exists.
+std::filesystem::path FindMask(const std::filesystem::path& dir, const std::string& name) {
+  std::error_code error;
+  const std::filesystem::path colmap = dir / (name + ".png");
+  if (std::filesystem::is_regular_file(colmap, error)) return colmap;
+  std::filesystem::path replaced = dir / name;
+  replaced.replace_extension(".png");
+  if (std::filesystem::is_regular_file(replaced, error)) return replaced;
+  return {};
+}
+
 }  // namespace
 
 class GaussianSplattingExporter : public Exporter {
@@ -84,6 +97,7 @@ class GaussianSplattingExporter : public Exporter {
     OptionReader reader(options);
     folder_ = reader.GetRelativePath("folder", "gaussian_splatting");
     jpeg_quality_ = reader.Get<int>("jpeg_quality", 95, 1, 100);
+    mask_path_ = reader.GetString("mask_path", "");
     reader.Finish();
     effective_options_ = reader.Effective();
   }
@@ -129,6 +143,24 @@ class GaussianSplattingExporter : public Exporter {
       const std::filesystem::path target = root / "images" / image.name;
       CreateFolder(target.parent_path());
       WriteFileAtomically(target, EncodeImage(pixels, target, jpeg_quality_));
+      if (!mask_path_.empty()) {
+        const std::filesystem::path mask_file = FindMask(mask_path_, image.name);
+        cv::Mat mask;
+        if (!mask_file.empty()) mask = cv::imread(mask_file.string(), cv::IMREAD_GRAYSCALE);
+        // No mask, or one of another size: none written (the extract stage warned).
+        if (mask.cols == pixels.cols && mask.rows == pixels.rows) {
+          if (camera.HasDistortion()) {
+            const UndistortionMaps& map = maps.at(camera.camera_id);
+            cv::Mat remapped;
+            cv::remap(mask, remapped, map.map_x, map.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                      cv::Scalar::all(0));
+            mask = remapped;
+          }
+          const std::filesystem::path mask_target = root / "masks" / (image.name + ".png");
+          CreateFolder(mask_target.parent_path());
+          WriteFileAtomically(mask_target, EncodeImage(mask, mask_target, jpeg_quality_));
+        }
+      }
     }
     // Last, so that a model in place means its images are complete.
     WriteColmapModel(undistorted, root / "sparse" / "0", ColmapModelFormat::kBinary);
@@ -137,6 +169,7 @@ class GaussianSplattingExporter : public Exporter {
  private:
   std::string folder_;
   int jpeg_quality_ = 95;
+  std::string mask_path_;  // empty: no masks written
 };
 
 }  // namespace tessera

@@ -85,6 +85,66 @@ TEST(GaussianSplattingExporter, UndistortsASimpleRadialCameraToPinhole) {
   EXPECT_GT(cv::mean(difference)[0], 5.0);
 }
 
+// The same checks on a fisheye camera (OPENCV_FISHEYE, 120 degrees across the diagonal),
+// and masks undistorted with the images.
+TEST(GaussianSplattingExporter, UndistortsAnOpenCVFisheyeCameraToPinholeWithItsMasks) {
+  Camera camera = Camera::Create(3, CameraModelId::kOpenCVFisheye, 70, 160, 120);
+  camera.params = {70, 72, 80, 60, 0.05, -0.01, 0.003, -0.0005};
+  const Reconstruction model = testing::MakeSyntheticModel(camera, 3, 150);
+  testing::TemporaryDir images, masks, output;
+  const cv::Mat original =
+      RenderPattern(camera, [&](const Eigen::Vector2d& xy) { return camera.CamFromImg(xy); });
+  cv::Mat mask(120, 160, CV_8UC1, cv::Scalar(255));
+  mask(cv::Rect(0, 0, 80, 120)).setTo(0);  // the left half
+  for (const auto& [image_id, image] : model.images) {
+    ASSERT_TRUE(cv::imwrite((images.path() / image.name).string(), original));
+    if (image_id != 2) {
+      ASSERT_TRUE(cv::imwrite((masks.path() / (image.name + ".png")).string(), mask));
+    }
+  }
+  auto exporter = testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting",
+                                                       {{"mask_path", masks.path().string()}});
+  ExportContext context;
+  context.output_dir = output.path();
+  context.image_dir = images.path();
+  exporter->Export(model, context);
+
+  const fs::path root = output.path() / "gaussian_splatting";
+  const Reconstruction undistorted = ReadColmapModel(root / "sparse" / "0");
+  const Camera& pinhole = undistorted.cameras.at(3);
+  EXPECT_EQ(pinhole.model_id, CameraModelId::kPinhole);
+  EXPECT_EQ(pinhole.params, (std::vector<double>{70, 72, 80, 60}));
+  double max_error = 0;
+  for (const auto& [point3D_id, point3D] : undistorted.points3D) {
+    for (const TrackElement& element : point3D.track) {
+      const Image& image = undistorted.images.at(element.image_id);
+      const Eigen::Vector2d projection = pinhole.ImgFromCam(image.cam_from_world * point3D.xyz);
+      max_error =
+          std::max(max_error, (projection - image.points2D.at(element.point2D_idx).xy).norm());
+    }
+  }
+  EXPECT_LT(max_error, 1e-3);
+  const cv::Mat written = cv::imread((root / "images" / "img_1.png").string(), cv::IMREAD_COLOR);
+  ASSERT_EQ(written.size(), original.size());
+  const cv::Mat expected =
+      RenderPattern(pinhole, [&](const Eigen::Vector2d& xy) { return pinhole.CamFromImg(xy); });
+  const cv::Rect inner(4, 4, 152, 112);
+  cv::Mat difference;
+  cv::absdiff(written(inner), expected(inner), difference);
+  EXPECT_LT(cv::mean(difference)[0], 1.0);
+  cv::absdiff(original(inner), expected(inner), difference);
+  EXPECT_GT(cv::mean(difference)[0], 5.0);
+
+  // Masks: PNG next to the images, undistorted (the optical axis splits the halves).
+  const cv::Mat written_mask =
+      cv::imread((root / "masks" / "img_1.png.png").string(), cv::IMREAD_GRAYSCALE);
+  ASSERT_EQ(written_mask.size(), mask.size());
+  EXPECT_EQ(written_mask.at<uchar>(60, 40), 0);
+  EXPECT_EQ(written_mask.at<uchar>(60, 120), 255);
+  EXPECT_EQ(cv::countNonZero(written_mask(cv::Rect(0, 0, 79, 120))), 0);
+  EXPECT_FALSE(fs::exists(root / "masks" / "img_2.png.png"));  // no mask given
+}
+
 TEST(GaussianSplattingExporter, FolderOptionAndErrorsNameTheFile) {
   const Camera camera = Camera::Create(1, CameraModelId::kSimplePinhole, 50, 40, 30);
   const Reconstruction model = testing::MakeSyntheticModel(camera, 2, 40);

@@ -18,11 +18,30 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// The camera as OPENCV intrinsics; models with one focal length give fl_x = fl_y, and
-// coefficients a model lacks are zero.
+bool IsFisheye(const Camera& camera) {
+  return camera.model_id == CameraModelId::kOpenCVFisheye ||
+         camera.model_id == CameraModelId::kSimpleRadialFisheye;
+}
+
+// The camera as OPENCV intrinsics, or OPENCV_FISHEYE ones (k1..k4) for the fisheye
+// models; models with one focal length give fl_x = fl_y, and coefficients a model lacks
+// are zero.
 nlohmann::json Intrinsics(const Camera& camera) {
   double k1 = 0, k2 = 0, p1 = 0, p2 = 0;
   const std::vector<double>& params = camera.params;
+  if (IsFisheye(camera)) {
+    const std::vector<int> extra = camera.ExtraParamsIdx();
+    nlohmann::json json = {{"fl_x", camera.FocalLengthX()},
+                           {"fl_y", camera.FocalLengthY()},
+                           {"cx", camera.PrincipalPointX()},
+                           {"cy", camera.PrincipalPointY()},
+                           {"w", camera.width},
+                           {"h", camera.height}};
+    for (size_t k = 0; k < 4; ++k) {
+      json["k" + std::to_string(k + 1)] = k < extra.size() ? params[extra[k]] : 0.0;
+    }
+    return json;
+  }
   switch (camera.model_id) {
     case CameraModelId::kSimpleRadial:
       k1 = params[3];
@@ -105,8 +124,17 @@ class TransformsJsonExporter : public Exporter {
     nlohmann::json json = nlohmann::json::object();
     try {
       if (shared_camera) json = Intrinsics(reconstruction.cameras.at(frames.front()->camera_id));
-      // Both readers take the camera model from the top level only.
-      json["camera_model"] = "OPENCV";
+      // Both readers take the camera model from the top level only: one for all frames.
+      size_t num_fisheye = 0;
+      for (const Image* image : frames) {
+        num_fisheye += IsFisheye(reconstruction.cameras.at(image->camera_id));
+      }
+      if (num_fisheye > 0 && num_fisheye < frames.size()) {
+        throw InputError(
+            "fisheye and other cameras in one model: transforms.json has one "
+            "camera_model for all frames");
+      }
+      json["camera_model"] = num_fisheye > 0 ? "OPENCV_FISHEYE" : "OPENCV";
       json["frames"] = nlohmann::json::array();
       for (const Image* image : frames) {
         nlohmann::json frame = shared_camera

@@ -85,5 +85,32 @@ TEST(TransformsJsonExporter, TheFileMustStayInsideTheOutputFolder) {
                                                        {{"file", "a/..b/transforms.json"}}));
 }
 
+TEST(TransformsJsonExporter, FisheyeCamerasAreWrittenAsOpenCVFisheye) {
+  Camera fisheye = Camera::Create(1, CameraModelId::kOpenCVFisheye, 100, 80, 60);
+  fisheye.params = {100, 101, 40, 30, 0.04, -0.01, 0.002, -0.0003};
+  Reconstruction model = testing::MakeSyntheticModel(fisheye, 2, 30);
+  testing::TemporaryDir output;
+  const auto exporter = testing::LoadBundledPlugin<Exporter>("exporter", "transforms_json");
+  exporter->Export(model, ContextFor(output.path(), ""));
+  const nlohmann::json json = ReadJson(output.path() / "transforms.json");
+  EXPECT_EQ(json["camera_model"], "OPENCV_FISHEYE");
+  EXPECT_EQ(json["fl_y"].get<double>(), 101.0);
+  EXPECT_EQ(json["k1"].get<double>(), 0.04);
+  EXPECT_EQ(json["k4"].get<double>(), -0.0003);
+  EXPECT_FALSE(json.contains("p1"));
+
+  // One fisheye camera among others cannot be one camera_model: refused, naming the file.
+  model.cameras[2] = Camera::Create(2, CameraModelId::kPinhole, 90, 80, 60);
+  model.images.at(2).camera_id = 2;
+  try {
+    exporter->Export(model, ContextFor(output.path(), ""));
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("transforms.json: fisheye and other cameras"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
 }  // namespace
 }  // namespace tessera

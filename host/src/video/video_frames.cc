@@ -1,0 +1,348 @@
+#include "video/video_frames.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <opencv2/videoio.hpp>
+#include <optional>
+#include <set>
+
+#include "tessera/errors.h"
+#include "tessera/io/file_io.h"
+#include "tessera/options.h"
+#include "util/timer.h"
+
+namespace tessera {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The analysis image: grey, longer side `size` (never enlarged).
+cv::Mat AnalysisImage(const cv::Mat& frame, int size) {
+  cv::Mat gray;
+  if (frame.channels() == 3) {
+    cv::cvtColor(frame, gray, cv::COLOR_BGR2GRAY);
+  } else if (frame.channels() == 4) {
+    cv::cvtColor(frame, gray, cv::COLOR_BGRA2GRAY);
+  } else {
+    gray = frame;
+  }
+  const int longer = std::max(gray.cols, gray.rows);
+  if (longer <= size) return gray.clone();
+  const double scale = static_cast<double>(size) / longer;
+  cv::Mat small;
+  cv::resize(gray, small, cv::Size(), scale, scale, cv::INTER_AREA);
+  return small;
+}
+
+// Median length of the optical flow, sampled on a 4-pixel grid.
+double MedianFlow(const cv::Mat& flow) {
+  std::vector<float> lengths;
+  lengths.reserve(static_cast<size_t>(flow.rows / 4 + 1) * (flow.cols / 4 + 1));
+  for (int y = 0; y < flow.rows; y += 4) {
+    const cv::Vec2f* row = flow.ptr<cv::Vec2f>(y);
+    for (int x = 0; x < flow.cols; x += 4) lengths.push_back(std::hypot(row[x][0], row[x][1]));
+  }
+  if (lengths.empty()) return 0;
+  std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
+  return lengths[lengths.size() / 2];
+}
+
+cv::VideoCapture OpenVideo(const fs::path& video) {
+  std::error_code error;
+  if (!fs::is_regular_file(video, error)) {
+    throw InputError(video.string() + ": no such video file");
+  }
+  cv::VideoCapture capture;
+  try {
+    capture.open(video.string(), cv::CAP_FFMPEG);
+  } catch (const cv::Exception&) {
+  }
+  if (!capture.isOpened()) {
+    throw InputError(video.string() +
+                     ": cannot open the video (not a format OpenCV's FFmpeg backend decodes)");
+  }
+  return capture;
+}
+
+double FrameTime(int index, double fps, const cv::VideoCapture& capture) {
+  if (fps > 0) return index / fps;
+  return capture.get(cv::CAP_PROP_POS_MSEC) / 1000;
+}
+
+nlohmann::json Record(const VideoFrames& result, const VideoFrameOptions& options) {
+  std::error_code error;
+  nlohmann::json frames = nlohmann::json::array();
+  std::map<size_t, std::string> image_of;
+  for (size_t k = 0; k < result.selection.selected.size(); ++k) {
+    image_of[result.selection.selected[k]] = result.images[k];
+  }
+  for (size_t i = 0; i < result.frames.size(); ++i) {
+    const FrameScore& frame = result.frames[i];
+    nlohmann::json entry = {{"index", frame.index},
+                            {"time_s", frame.time_s},
+                            {"sharpness", frame.sharpness},
+                            {"motion_px", frame.motion},
+                            {"segment", result.selection.segment[i]},
+                            {"selected", image_of.count(i) > 0}};
+    if (image_of.count(i)) entry["image"] = image_of[i];
+    frames.push_back(entry);
+  }
+  const fs::path absolute = fs::absolute(result.video).lexically_normal();
+  return {{"file", absolute.string()},
+          {"size", static_cast<uint64_t>(fs::file_size(result.video, error))},
+          {"modified", static_cast<int64_t>(
+                           fs::last_write_time(result.video, error).time_since_epoch().count())},
+          {"options", options.ToJson()},
+          {"folder", result.folder},
+          {"fps", result.fps},
+          {"width", result.width},
+          {"height", result.height},
+          {"num_frames", result.frames.size()},
+          {"num_selected", result.selection.selected.size()},
+          {"num_segments", result.selection.num_segments},
+          {"total_motion_px", result.selection.total_motion},
+          {"frames", frames}};
+}
+
+// The earlier run's selection of this video, when nothing it depends on changed.
+std::optional<VideoFrames> Reuse(const nlohmann::json& recorded, const VideoFrames& probe,
+                                 const VideoFrameOptions& options, const fs::path& frames_dir) {
+  const nlohmann::json now = Record(probe, options);
+  for (const nlohmann::json& video : recorded.value("videos", nlohmann::json::array())) {
+    if (!video.is_object() || video.value("file", "") != now["file"] ||
+        video.value("size", nlohmann::json()) != now["size"] ||
+        video.value("modified", nlohmann::json()) != now["modified"] ||
+        video.value("options", nlohmann::json()) != now["options"] ||
+        video.value("folder", "") != probe.folder) {
+      continue;
+    }
+    try {
+      VideoFrames result = probe;
+      result.reused = true;
+      result.fps = video.at("fps").get<double>();
+      result.width = video.at("width").get<int>();
+      result.height = video.at("height").get<int>();
+      result.selection.num_segments = video.at("num_segments").get<int>();
+      result.selection.total_motion = video.at("total_motion_px").get<double>();
+      for (const nlohmann::json& frame : video.at("frames")) {
+        result.frames.push_back({frame.at("index").get<int>(), frame.at("time_s").get<double>(),
+                                 frame.at("sharpness").get<double>(),
+                                 frame.at("motion_px").get<double>()});
+        result.selection.segment.push_back(frame.at("segment").get<int>());
+        if (frame.at("selected").get<bool>()) {
+          result.selection.selected.push_back(result.frames.size() - 1);
+          result.images.push_back(frame.at("image").get<std::string>());
+          std::error_code error;
+          if (!fs::is_regular_file(frames_dir / result.images.back(), error)) return std::nullopt;
+        }
+      }
+      return result;
+    } catch (const nlohmann::json::exception&) {
+      return std::nullopt;  // a damaged record: decode again
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+nlohmann::json VideoFrameOptions::ToJson() const {
+  return {
+      {"min_frames", selection.min_frames},       {"max_frames", selection.max_frames},
+      {"target_frames", selection.target_frames}, {"keyframe_motion", selection.keyframe_motion},
+      {"analysis_size", analysis_size},           {"jpeg_quality", jpeg_quality}};
+}
+
+VideoFrameOptions VideoFrameOptions::FromJson(const nlohmann::json& json) {
+  OptionReader reader(json, "video");
+  VideoFrameOptions options;
+  KeyframeSelectionOptions& s = options.selection;
+  s.min_frames = reader.Get<int>("min_frames", s.min_frames, 2, 100000);
+  s.max_frames = reader.Get<int>("max_frames", s.max_frames, 2, 100000);
+  s.target_frames = reader.Get<int>("target_frames", s.target_frames, 0, 100000);
+  s.keyframe_motion = reader.Get<double>("keyframe_motion", s.keyframe_motion, 0.001, 10);
+  options.analysis_size = reader.Get<int>("analysis_size", options.analysis_size, 64, 8192);
+  options.jpeg_quality = reader.Get<int>("jpeg_quality", options.jpeg_quality, 1, 100);
+  reader.Finish();
+  if (s.min_frames > s.max_frames) {
+    throw OptionError("video.min_frames",
+                      "must not exceed max_frames (" + std::to_string(s.max_frames) + ")");
+  }
+  return options;
+}
+
+std::string VideoFrameName(int index, double time_s) {
+  char name[64];
+  std::snprintf(name, sizeof(name), "frame_%06d_%.3fs.jpg", index, time_s);
+  return name;
+}
+
+VideoFrames ExtractVideoFrames(const fs::path& video, const std::string& folder,
+                               const fs::path& frames_dir, const VideoFrameOptions& options) {
+  VideoFrames result;
+  result.video = video;
+  result.folder = folder;
+  cv::VideoCapture capture = OpenVideo(video);
+  result.fps = capture.get(cv::CAP_PROP_FPS);
+  if (!(result.fps > 0 && result.fps < 10000)) result.fps = 0;
+
+  Timer decode_timer;
+  double decode_seconds = 0, select_seconds = 0;
+  cv::Ptr<cv::DISOpticalFlow> flow_estimator =
+      cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_FAST);
+  cv::Mat frame, previous, flow;
+  double flow_scale = 1;
+  for (int index = 0;; ++index) {
+    const Timer read_timer;
+    bool read = false;
+    try {
+      read = capture.read(frame);
+    } catch (const cv::Exception&) {
+      read = false;
+    }
+    decode_seconds += read_timer.ElapsedSeconds();
+    if (!read || frame.empty()) break;
+    const Timer score_timer;
+    if (index == 0) {
+      result.width = frame.cols;
+      result.height = frame.rows;
+    }
+    const cv::Mat gray = AnalysisImage(frame, options.analysis_size);
+    flow_scale =
+        static_cast<double>(std::max(frame.cols, frame.rows)) / std::max(gray.cols, gray.rows);
+    FrameScore score;
+    score.index = index;
+    score.time_s = FrameTime(index, result.fps, capture);
+    score.sharpness = LocalLaplacianSharpness(gray);
+    if (!previous.empty() && previous.size() == gray.size()) {
+      flow_estimator->calc(previous, gray, flow);
+      score.motion = MedianFlow(flow) * flow_scale;
+    }
+    previous = gray;
+    result.frames.push_back(score);
+    select_seconds += score_timer.ElapsedSeconds();
+  }
+  if (result.frames.empty()) {
+    throw InputError(video.string() + ": the video has no decodable frame");
+  }
+  const Timer select_timer;
+  result.selection =
+      SelectKeyframes(result.frames, std::max(result.width, result.height), options.selection);
+  select_seconds += select_timer.ElapsedSeconds();
+  if (result.selection.too_few_frames) {
+    spdlog::warn("{}: {} usable frames, fewer than min_frames ({}); every one is kept",
+                 video.string(), result.frames.size(), options.selection.min_frames);
+  }
+
+  // Second pass: write the selected frames.
+  const fs::path dir = frames_dir / folder;
+  CreateFolder(dir);
+  std::set<std::string> names;
+  for (const size_t i : result.selection.selected) {
+    result.images.push_back(folder + "/" +
+                            VideoFrameName(result.frames[i].index, result.frames[i].time_s));
+    names.insert(VideoFrameName(result.frames[i].index, result.frames[i].time_s));
+  }
+  std::error_code error;
+  for (const auto& entry : fs::directory_iterator(dir, error)) {
+    if (entry.path().extension() == ".jpg" && !names.count(entry.path().filename().string())) {
+      fs::remove(entry.path(), error);  // an earlier selection's
+    }
+  }
+  capture = OpenVideo(video);
+  size_t next = 0;
+  for (int index = 0; next < result.selection.selected.size(); ++index) {
+    const Timer read_timer;
+    bool read = false;
+    try {
+      read = capture.grab();
+      const bool wanted = read && index == result.frames[result.selection.selected[next]].index;
+      if (wanted) read = capture.retrieve(frame);
+      decode_seconds += read_timer.ElapsedSeconds();
+      if (!read) break;
+      if (!wanted) continue;
+    } catch (const cv::Exception&) {
+      break;
+    }
+    std::vector<uchar> bytes;
+    cv::imencode(".jpg", frame, bytes, {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
+    WriteFileAtomically(frames_dir / result.images[next], std::string(bytes.begin(), bytes.end()));
+    ++next;
+  }
+  if (next < result.selection.selected.size()) {
+    throw InputError(video.string() + ": frame " +
+                     std::to_string(result.frames[result.selection.selected[next]].index) +
+                     " could not be decoded again (the file changed while it was read?)");
+  }
+  result.decode_seconds = decode_seconds;
+  result.select_seconds = select_seconds;
+  (void)decode_timer;
+  return result;
+}
+
+fs::path IngestVideos(const std::vector<fs::path>& videos, const fs::path& output_dir,
+                      const VideoFrameOptions& options, std::vector<VideoFrames>* results) {
+  const fs::path frames_dir = output_dir / "video_frames";
+  const fs::path record_file = output_dir / "frames.json";
+  nlohmann::json recorded = nlohmann::json::object();
+  std::error_code error;
+  if (fs::exists(record_file, error)) {
+    try {
+      recorded = nlohmann::json::parse(ReadFileContents(record_file));
+    } catch (const std::exception&) {
+      recorded = nlohmann::json::object();  // damaged: every video is decoded again
+    }
+  }
+  CreateFolder(frames_dir);
+  nlohmann::json record = {{"videos", nlohmann::json::array()}};
+  std::set<std::string> folders;
+  for (const fs::path& video : videos) {
+    std::string folder = video.stem().string();
+    if (folder.empty() || folder[0] == '.') folder = "video" + folder;
+    for (int k = 2; folders.count(folder); ++k)
+      folder = video.stem().string() + "_" + std::to_string(k);
+    folders.insert(folder);
+    VideoFrames probe;
+    probe.video = video;
+    probe.folder = folder;
+    std::optional<VideoFrames> reused;
+    if (fs::is_regular_file(video, error)) reused = Reuse(recorded, probe, options, frames_dir);
+    VideoFrames result;
+    if (reused) {
+      result = *reused;
+      spdlog::info("video: {}: the {} frames selected by an earlier run are unchanged; reused",
+                   video.string(), result.images.size());
+    } else {
+      result = ExtractVideoFrames(video, folder, frames_dir, options);
+      spdlog::info(
+          "video: {}: {} frames decoded ({}x{}, {:.2f} fps), accumulated motion {:.0f} px, {} "
+          "kept in {} segments, into {}; {:.1f} frames/s decoded, selection {:.2f} ms per "
+          "frame",
+          video.string(), result.frames.size(), result.width, result.height, result.fps,
+          result.selection.total_motion, result.images.size(), result.selection.num_segments,
+          (frames_dir / folder).string(),
+          result.frames.size() / std::max(1e-9, result.decode_seconds),
+          1000 * result.select_seconds / result.frames.size());
+    }
+    record["videos"].push_back(Record(result, options));
+    if (results) results->push_back(std::move(result));
+  }
+  // Folders of videos no longer given: their frames would be scanned as images.
+  for (const auto& entry : fs::directory_iterator(frames_dir, error)) {
+    if (entry.is_directory() && !folders.count(entry.path().filename().string())) {
+      spdlog::info("video: removing {}: its video is not among this run's", entry.path().string());
+      fs::remove_all(entry.path(), error);
+    }
+  }
+  WriteFileAtomically(record_file, record.dump(2) + "\n");
+  return frames_dir;
+}
+
+}  // namespace tessera

@@ -1,0 +1,193 @@
+#include "video/video_frames.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/videoio.hpp>
+
+#include "tessera/errors.h"
+#include "tessera/io/file_io.h"
+#include "test_support.h"
+
+namespace tessera {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kStep = 6;  // px the window moves per frame
+
+// What each frame of the test video shows.
+struct TestFrame {
+  int position;  // the window's x offset: frames with the same position show the same
+  bool blurred;
+};
+
+// A pan across a sample photo: a 320x240 window moving kStep px per frame, with a
+// blurred copy after every third frame and the camera held still for 10 frames twice.
+// H.264 in MP4 (fourcc avc1), as phones write it.
+std::vector<TestFrame> WritePanVideo(const fs::path& file, int num_positions) {
+  const cv::Mat photo = cv::imread(
+      (testing::SourceDir() / "examples" / "fountain-P11-small" / "images" / "0005.jpg").string());
+  std::vector<TestFrame> frames;
+  cv::VideoWriter writer(file.string(), cv::VideoWriter::fourcc('a', 'v', 'c', '1'), 10,
+                         cv::Size(320, 240));
+  EXPECT_TRUE(writer.isOpened());
+  for (int p = 0; p < num_positions; ++p) {
+    const cv::Mat window = photo(cv::Rect(p * kStep, 200, 320, 240)).clone();
+    writer << window;
+    frames.push_back({p, false});
+    if (p % 3 == 1) {
+      cv::Mat blurred;
+      cv::GaussianBlur(window, blurred, cv::Size(), 2.5);
+      writer << blurred;
+      frames.push_back({p, true});
+    }
+    if (p == 20 || p == 50) {
+      for (int k = 0; k < 10; ++k) {
+        writer << window;
+        frames.push_back({p, false});
+      }
+    }
+  }
+  return frames;
+}
+
+TEST(VideoFrames, NamesCarryTheFrameIndexFirstThenTheTime) {
+  EXPECT_EQ(VideoFrameName(123, 4.1), "frame_000123_4.100s.jpg");
+  EXPECT_EQ(VideoFrameName(0, 0), "frame_000000_0.000s.jpg");
+}
+
+TEST(VideoFrames, KeepsNoBlurredFrameAndCoversThePan) {
+  const testing::TemporaryDir dir;
+  const std::vector<TestFrame> truth = WritePanVideo(dir.path() / "pan.mp4", 100);
+  VideoFrameOptions options;
+  options.selection.keyframe_motion = 0.1;  // 32 px: about 5 positions per keyframe
+  std::vector<VideoFrames> results;
+  const fs::path frames_dir = IngestVideos({dir.path() / "pan.mp4"}, dir.path(), options, &results);
+  EXPECT_EQ(frames_dir, dir.path() / "video_frames");
+  ASSERT_EQ(results.size(), 1u);
+  const VideoFrames& video = results[0];
+  ASSERT_EQ(video.frames.size(), truth.size());  // every frame decoded
+  EXPECT_EQ(video.width, 320);
+  EXPECT_NEAR(video.fps, 10, 1e-6);
+  EXPECT_NEAR(video.frames[5].time_s, 0.5, 1e-9);
+
+  // The flow measures the pan: kStep px per moving frame, none while still.
+  size_t num_moving_right = 0, num_moving = 0;
+  for (size_t i = 1; i < truth.size(); ++i) {
+    if (truth[i].position != truth[i - 1].position && !truth[i].blurred && !truth[i - 1].blurred) {
+      ++num_moving;
+      num_moving_right += std::abs(video.frames[i].motion - kStep) < 1.0;
+    }
+    if (truth[i].position == truth[i - 1].position && !truth[i].blurred && !truth[i - 1].blurred) {
+      EXPECT_LT(video.frames[i].motion, 0.5) << "frame " << i;
+    }
+  }
+  EXPECT_GT(num_moving_right, 0.9 * num_moving);
+
+  // No blurred frame kept; no gap of more than two keyframe distances; each still
+  // stretch gives at most one frame.
+  const double total = video.selection.total_motion;
+  const int max_gap = static_cast<int>(2 * total / video.selection.num_segments / kStep) + 2;
+  EXPECT_GE(video.selection.selected.size(), 15u);
+  int previous = -1;
+  std::map<int, int> kept_per_position;
+  for (const size_t i : video.selection.selected) {
+    EXPECT_FALSE(truth[i].blurred) << "blurred frame " << i << " kept";
+    const int position = truth[i].position;
+    ++kept_per_position[position];
+    if (previous >= 0) {
+      EXPECT_LE(position - previous, max_gap) << "after position " << previous;
+    }
+    previous = position;
+  }
+  EXPECT_LE(truth[video.selection.selected.front()].position, max_gap);
+  EXPECT_GE(truth[video.selection.selected.back()].position, 99 - max_gap);
+  EXPECT_LE(kept_per_position[20], 1);
+  EXPECT_LE(kept_per_position[50], 1);
+
+  // Written as named, and recorded with every frame's scores.
+  for (size_t k = 0; k < video.images.size(); ++k) {
+    const size_t i = video.selection.selected[k];
+    EXPECT_EQ(video.images[k], "pan/" + VideoFrameName(static_cast<int>(i), i / 10.0));
+    const cv::Mat image = cv::imread((frames_dir / video.images[k]).string());
+    EXPECT_EQ(image.cols, 320);
+  }
+  const nlohmann::json record = nlohmann::json::parse(ReadFileContents(dir.path() / "frames.json"));
+  ASSERT_EQ(record["videos"].size(), 1u);
+  const nlohmann::json& recorded = record["videos"][0];
+  EXPECT_EQ(recorded["frames"].size(), truth.size());
+  EXPECT_EQ(recorded["num_selected"], video.images.size());
+  EXPECT_TRUE(recorded["frames"][0].contains("sharpness"));
+  EXPECT_TRUE(recorded["frames"][0].contains("motion_px"));
+
+  // A second run with the same video and options decodes nothing again.
+  std::vector<VideoFrames> again;
+  IngestVideos({dir.path() / "pan.mp4"}, dir.path(), options, &again);
+  ASSERT_EQ(again.size(), 1u);
+  EXPECT_TRUE(again[0].reused);
+  EXPECT_EQ(again[0].images, video.images);
+  // Other options: selected again, and the frames of the earlier selection not kept
+  // are removed.
+  options.selection.target_frames = 12;
+  again.clear();
+  IngestVideos({dir.path() / "pan.mp4"}, dir.path(), options, &again);
+  EXPECT_FALSE(again[0].reused);
+  EXPECT_EQ(again[0].images.size(), 12u);
+  size_t num_files = 0;
+  for (const auto& entry : fs::directory_iterator(frames_dir / "pan"))
+    num_files += entry.is_regular_file();
+  EXPECT_EQ(num_files, 12u);
+}
+
+TEST(VideoFrames, AShortVideoKeepsEveryFrame) {
+  const testing::TemporaryDir dir;
+  WritePanVideo(dir.path() / "short.mp4", 4);  // 4 positions, one blurred copy: 5 frames
+  std::vector<VideoFrames> results;
+  IngestVideos({dir.path() / "short.mp4"}, dir.path(), {}, &results);  // min_frames 10
+  ASSERT_EQ(results.size(), 1u);
+  EXPECT_TRUE(results[0].selection.too_few_frames);
+  EXPECT_EQ(results[0].images.size(), 5u);
+}
+
+TEST(VideoFrames, AnUnreadableOrEmptyVideoIsAnInputErrorNamingTheFile) {
+  const testing::TemporaryDir dir;
+  const auto error_of = [&](const fs::path& file) {
+    try {
+      IngestVideos({file}, dir.path() / "out", {});
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error_of(dir.path() / "missing.mp4"),
+            (dir.path() / "missing.mp4").string() + ": no such video file");
+  std::ofstream(dir.path() / "text.mp4") << "not a video";
+  EXPECT_EQ(error_of(dir.path() / "text.mp4").rfind((dir.path() / "text.mp4").string() + ": ", 0),
+            0u);
+  std::ofstream(dir.path() / "empty.mp4");
+  EXPECT_EQ(error_of(dir.path() / "empty.mp4").rfind((dir.path() / "empty.mp4").string() + ": ", 0),
+            0u);
+}
+
+TEST(VideoFrames, OptionsComeFromTheManifestsVideoObject) {
+  const VideoFrameOptions options = VideoFrameOptions::FromJson(
+      {{"min_frames", 5}, {"max_frames", 50}, {"target_frames", 20}, {"analysis_size", 320}});
+  EXPECT_EQ(options.selection.min_frames, 5);
+  EXPECT_EQ(options.selection.target_frames, 20);
+  EXPECT_EQ(options.analysis_size, 320);
+  try {
+    VideoFrameOptions::FromJson({{"min_frame", 5}});
+    ADD_FAILURE();
+  } catch (const OptionError& error) {
+    EXPECT_NE(std::string(error.what()).find("video.min_frame"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW(VideoFrameOptions::FromJson({{"min_frames", 60}, {"max_frames", 50}}), OptionError);
+}
+
+}  // namespace
+}  // namespace tessera
