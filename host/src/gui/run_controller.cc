@@ -1,6 +1,12 @@
 #include "gui/run_controller.h"
 
 #include <spdlog/spdlog.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
 
 #include "cli/exit_codes.h"
 #include "pipeline/pipeline_context.h"
@@ -86,6 +92,16 @@ void RunController::Notify() {
 }
 
 void RunController::Work(RunRequest request) {
+  // The window comes first: on a machine with few cores the renderer (with Mesa's
+  // llvmpipe, its rasteriser threads too) must not queue behind the pipeline. Linux
+  // keeps the nice value per thread, and the threads the pipeline starts inherit it.
+  const auto thread_id = static_cast<id_t>(syscall(SYS_gettid));
+  errno = 0;
+  const int niceness = getpriority(PRIO_PROCESS, thread_id);
+  if (errno != 0 ||
+      setpriority(PRIO_PROCESS, thread_id, std::min(19, niceness + kWorkerNiceness)) != 0) {
+    spdlog::debug("gui: the pipeline's worker keeps its priority (setpriority failed)");
+  }
   StageControl control;
   {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -50,6 +50,11 @@ struct RunStatus {
   std::filesystem::path output_dir;
 };
 
+// Added to the nice value of the worker thread, and so of the threads the pipeline
+// starts from it (at most 19; the UI thread keeps its own): rendering never waits
+// behind the pipeline for a core.
+inline constexpr int kWorkerNiceness = 10;
+
 class RunController {
  public:
   // on_change is called from the worker thread whenever the status or scene changed.
