@@ -326,8 +326,10 @@ struct Database::Impl {
     const std::string message =
         std::string(db != nullptr ? sqlite3_errmsg(db) : sqlite3_errstr(rc));
     const int primary = rc & 0xff;
+    // While opening, SQLite reports a damaged header or schema also as SQLITE_ERROR or as
+    // SQLITE_NOMEM (sizes read from the file that it cannot allocate).
     if (primary == SQLITE_NOTADB || primary == SQLITE_CORRUPT ||
-        (opening && primary == SQLITE_ERROR)) {
+        (opening && (primary == SQLITE_ERROR || primary == SQLITE_NOMEM))) {
       throw InputError("Database file '" + path.string() + "' is not a valid SQLite database (" +
                        message + ") while trying to " + operation + ".");
     }

@@ -205,7 +205,7 @@ TEST_F(DatabaseTest, CamerasOfAllModelsRoundTrip) {
     explicit_id.camera_id = 42;
     EXPECT_EQ(database.WriteCamera(explicit_id, /*use_camera_id=*/true), 42u);
     written.push_back(explicit_id);
-    EXPECT_EQ(database.NumCameras(), 6u);
+    EXPECT_EQ(database.NumCameras(), AllCameraModelIds().size() + 1);
   }
 
   Database database(DatabasePath());  // reopened: what is read comes from the file
@@ -239,8 +239,8 @@ TEST_F(DatabaseTest, CamerasOfAllModelsRoundTrip) {
   database.UpdateCamera(updated);
   EXPECT_EQ(database.ReadCamera(2)->params[0], 1234.5);
   EXPECT_EQ(database.ReadCamera(2)->calibration_source, CalibrationSource::kUser);
-  EXPECT_FALSE(database.ReadCamera(7).has_value());
-  updated.camera_id = 7;
+  EXPECT_FALSE(database.ReadCamera(41).has_value());
+  updated.camera_id = 41;
   EXPECT_THROW(database.UpdateCamera(updated), std::runtime_error);
 
   database.WriteCalibrationSource(3, CalibrationSource::kDefault);
@@ -256,14 +256,14 @@ TEST_F(DatabaseTest, UnknownCameraModelIsAnInputError) {
   const double params[4] = {1, 2, 3, 4};
   raw.WriteBlobRow(
       "INSERT INTO cameras(model, width, height, params, prior_focal_length) "
-      "VALUES(5, 100, 100, ?, 0);",  // COLMAP's OPENCV_FISHEYE
+      "VALUES(10, 100, 100, ?, 0);",  // COLMAP's THIN_PRISM_FISHEYE
       params, sizeof(params));
   Database database(DatabasePath());
   try {
     database.ReadAllCameras();
     FAIL() << "expected an error";
   } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find("camera 1 has camera model id 5"), std::string::npos)
+    EXPECT_NE(std::string(error.what()).find("camera 1 has camera model id 10"), std::string::npos)
         << error.what();
   }
 }

@@ -209,11 +209,15 @@ TEST_F(GuiWindowTest, CancelDuringMatchingThenRunReusesFeaturesAndPairs) {
       app, std::regex(R"(match: .* to match with 'brute_force' \([1-9][0-9]* already done\))")));
 
   // The match matrix of the workspace: click the cell of images 1 and 2 (row 0, column 1).
-  Click(&app, "match matrix");
+  const std::optional<WidgetRect> button = app.Widget("match matrix");
+  ASSERT_TRUE(button.has_value());
+  Click(&app, *button);
   ASSERT_EQ(app.MatchError(), "");
-  app.Frame();
-  app.Frame();
-  const WidgetRect cells = app.Widget("match cells").value();
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return app.Widget("match cells").has_value(); }, 5))
+      << "no match matrix after a click at (" << button->CenterX() << ", " << button->CenterY()
+      << ")";
+  const WidgetRect cells = *app.Widget("match cells");
   const float cell = (cells.max_x - cells.min_x) / 8;
   Click(&app, WidgetRect{cells.min_x + 1.5f * cell, cells.min_y + 0.5f * cell,
                          cells.min_x + 1.5f * cell, cells.min_y + 0.5f * cell});
