@@ -20,10 +20,10 @@
 #include <memory>
 #include <mutex>
 #include <string>
-#include <type_traits>
 
 #include "tessera/match_filter.h"
 #include "tessera/sdk.h"
+#include "vectorized_l2.h"
 
 namespace tessera {
 
@@ -54,8 +54,14 @@ struct FlannMatchOptions {
   // Seed of std::rand() while kmeans and hierarchical indexes are built.
   int random_seed = 1;
   // Deterministic (kmeans, hierarchical) indexes kept for reuse: an image takes part in
-  // many pairs, and its index is built once instead of once per pair. 0 disables it.
-  int index_cache_size = 64;
+  // many pairs, and its index is built once instead of once per pair. At most this many
+  // indexes (0 disables the cache) ...
+  int index_cache_size = 100000;
+  // ... holding at most this many MiB of descriptors and trees together, least recently
+  // used dropped first (the newest always stays). A build costs about twice a pair's
+  // searches, so a cache that holds every image of a large set pays for its memory:
+  // 1 GiB holds about 2,500 images of 2,000 SIFT features or 400 of 12,000.
+  int index_cache_mb = 1024;
 };
 
 namespace {
@@ -117,18 +123,24 @@ uint64_t HashDescriptors(const FeatureDescriptors& descriptors) {
 
 // Indexes of one type built over their own copy of the descriptors (FLANN keeps a
 // pointer to the data), shared by every pair that searches the same image, least
-// recently used evicted first. Thread-safe; a second caller of an index being built
-// waits for it instead of building it again.
+// recently used evicted first once there are more than `capacity` of them or they hold
+// more than `max_bytes` (descriptors plus the index's own memory; the newest always
+// stays). Thread-safe; a second caller of an index being built waits for it instead of
+// building it again, and an evicted index lives on while a pair still searches it.
 template <typename Index>
 class IndexCache {
  public:
   struct Entry {
     FeatureDescriptors descriptors;
     std::unique_ptr<Index> index;
+    size_t Bytes() const {
+      return static_cast<size_t>(descriptors.data.size()) +
+             static_cast<size_t>(std::max(0, index->usedMemory()));
+    }
   };
   using Builder = std::function<std::unique_ptr<Index>(const FeatureDescriptors&)>;
 
-  explicit IndexCache(size_t capacity) : capacity_(capacity) {}
+  IndexCache(size_t capacity, size_t max_bytes) : capacity_(capacity), max_bytes_(max_bytes) {}
 
   std::shared_ptr<const Entry> Get(const FeatureDescriptors& descriptors, const Builder& build) {
     const uint64_t key = HashDescriptors(descriptors);
@@ -138,16 +150,16 @@ class IndexCache {
     {
       std::lock_guard<std::mutex> lock(mutex_);
       for (auto it = entries_.begin(); it != entries_.end(); ++it) {
-        if (it->first == key) {
+        if (it->key == key) {
           entries_.splice(entries_.begin(), entries_, it);  // most recently used first
-          future = it->second;
+          future = it->future;
           break;
         }
       }
       if (!future.valid()) {
         future = promise.get_future().share();
-        entries_.emplace_front(key, future);
-        while (entries_.size() > capacity_) entries_.pop_back();
+        entries_.push_front({key, future, 0});
+        Evict();
         must_build = true;
       }
     }
@@ -156,7 +168,17 @@ class IndexCache {
         auto entry = std::make_shared<Entry>();
         entry->descriptors = descriptors;
         entry->index = build(entry->descriptors);
+        const size_t bytes = entry->Bytes();
         promise.set_value(std::move(entry));
+        std::lock_guard<std::mutex> lock(mutex_);
+        for (Slot& slot : entries_) {
+          if (slot.key == key && slot.bytes == 0) {
+            slot.bytes = bytes;
+            bytes_ += bytes;
+            break;
+          }
+        }
+        Evict();
       } catch (...) {
         promise.set_exception(std::current_exception());
         Forget(key);
@@ -179,68 +201,37 @@ class IndexCache {
   }
 
  private:
-  void Forget(uint64_t key) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    entries_.remove_if([key](const auto& item) { return item.first == key; });
-  }
+  struct Slot {
+    uint64_t key;
+    std::shared_future<std::shared_ptr<const Entry>> future;
+    size_t bytes;  // 0 while it is being built
+  };
 
-  size_t capacity_;
-  std::mutex mutex_;
-  std::list<std::pair<uint64_t, std::shared_future<std::shared_ptr<const Entry>>>> entries_;
-};
-
-// FLANN's L2 for uint8 descriptors, written so that the compiler vectorises it: FLANN's
-// own adds four squared differences per step into one float sum, a dependency chain
-// that no compiler may reorder. Here byte against byte is summed in integers (exact,
-// so any order gives the same value), and byte against a float cluster centre in
-// eight independent lanes that are added up in a fixed order at the end: the same
-// value on every run. Together with the shorter backward search below, it took the
-// matching of fountain-P11 (55 pairs, 12,000 SIFT features per image) from 38.8 s to
-// 15.2 s of thread time.
-struct VectorizedL2Uint8 {
-  typedef bool is_kdtree_distance;
-  typedef unsigned char ElementType;
-  typedef float ResultType;
-
-  template <typename Iterator1, typename Iterator2>
-  ResultType operator()(Iterator1 a, Iterator2 b, size_t size,
-                        ResultType /*worst_dist*/ = -1) const {
-    using A = std::remove_cv_t<std::remove_reference_t<decltype(*a)>>;
-    using B = std::remove_cv_t<std::remove_reference_t<decltype(*b)>>;
-    if constexpr (std::is_integral_v<A> && std::is_integral_v<B>) {
-      int32_t sum = 0;  // at most 255^2 per dimension: exact up to 33,000 dimensions
-      for (size_t i = 0; i < size; ++i) {
-        const int32_t diff = static_cast<int32_t>(a[i]) - static_cast<int32_t>(b[i]);
-        sum += diff * diff;
-      }
-      return static_cast<ResultType>(sum);
-    } else {
-      constexpr size_t kLanes = 8;
-      ResultType lanes[kLanes] = {};
-      size_t i = 0;
-      for (; i + kLanes <= size; i += kLanes) {
-        for (size_t lane = 0; lane < kLanes; ++lane) {
-          const ResultType diff =
-              static_cast<ResultType>(a[i + lane]) - static_cast<ResultType>(b[i + lane]);
-          lanes[lane] += diff * diff;
-        }
-      }
-      for (; i < size; ++i) {
-        const ResultType diff = static_cast<ResultType>(a[i]) - static_cast<ResultType>(b[i]);
-        lanes[0] += diff * diff;
-      }
-      return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) +
-             ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]));
+  // Under mutex_: drops least recently used entries beyond either limit, never the newest.
+  void Evict() {
+    while (entries_.size() > 1 && (entries_.size() > capacity_ || bytes_ > max_bytes_)) {
+      bytes_ -= entries_.back().bytes;
+      entries_.pop_back();
     }
   }
 
-  // Used by kd-trees only (one dimension of a partial distance).
-  template <typename U, typename V>
-  ResultType accum_dist(const U& a, const V& b, int) const {
-    return static_cast<ResultType>((a - b) * (a - b));
+  void Forget(uint64_t key) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    entries_.remove_if([this, key](const Slot& slot) {
+      if (slot.key != key) return false;
+      bytes_ -= slot.bytes;
+      return true;
+    });
   }
+
+  size_t capacity_;
+  size_t max_bytes_;
+  std::mutex mutex_;
+  std::list<Slot> entries_;
+  size_t bytes_ = 0;  // of the built entries in entries_
 };
 
+using VectorizedL2Uint8 = flann_l2::VectorizedL2Uint8;
 using KMeansL2Index = flann::KMeansIndex<VectorizedL2Uint8>;
 using HierarchicalHammingIndex = flann::HierarchicalClusteringIndex<flann::Hamming<unsigned char>>;
 
@@ -267,11 +258,14 @@ class FlannMatcher : public Matcher {
     options_.random_seed =
         reader.Get<int>("random_seed", options_.random_seed, 0, std::numeric_limits<int>::max());
     options_.index_cache_size =
-        reader.Get<int>("index_cache_size", options_.index_cache_size, 0, 100000);
+        reader.Get<int>("index_cache_size", options_.index_cache_size, 0, 1000000);
+    options_.index_cache_mb = reader.Get<int>("index_cache_mb", options_.index_cache_mb, 1, 1000000);
     reader.Finish();
-    kmeans_cache_ = std::make_unique<IndexCache<KMeansL2Index>>(options_.index_cache_size);
-    hierarchical_cache_ =
-        std::make_unique<IndexCache<HierarchicalHammingIndex>>(options_.index_cache_size);
+    const size_t cache_bytes = static_cast<size_t>(options_.index_cache_mb) << 20;
+    kmeans_cache_ =
+        std::make_unique<IndexCache<KMeansL2Index>>(options_.index_cache_size, cache_bytes);
+    hierarchical_cache_ = std::make_unique<IndexCache<HierarchicalHammingIndex>>(
+        options_.index_cache_size, cache_bytes);
     effective_options_ = reader.Effective();
   }
 

@@ -235,6 +235,33 @@ TEST(FlannMatcher, CachedIndexesGiveTheSameMatchesAsFreshOnes) {
   EXPECT_GT(total, 1000u);
 }
 
+TEST(FlannMatcher, AMemoryBoundCacheGivesTheSameMatchesAsFreshIndexes) {
+  // Eight images of 1,500 to 1,600 descriptors (about 200 KB each, plus their trees)
+  // against a 1 MiB budget: only a few indexes stay, so most lookups evict and rebuild.
+  std::vector<SyntheticPair> pairs;
+  for (uint32_t seed = 40; seed < 44; ++seed) pairs.push_back(MakeL2Pair(1500, 100, 10, seed));
+  const auto fresh = Load({{"checks", 16}, {"index_cache_size", 0}});
+  const auto bounded = Load({{"checks", 16}, {"index_cache_mb", 1}});
+  EXPECT_EQ(bounded->EffectiveOptions().at("index_cache_mb"), 1);
+  std::vector<std::pair<const FeatureDescriptors*, const FeatureDescriptors*>> jobs;
+  for (const auto& a : pairs) {
+    for (const auto& b : pairs) jobs.emplace_back(&a.descriptors1, &b.descriptors2);
+  }
+  std::vector<FeatureMatches> expected;
+  for (const auto& [d1, d2] : jobs) expected.push_back(fresh->Match(*d1, *d2));
+  std::vector<FeatureMatches> actual(jobs.size());
+  std::vector<std::thread> threads;
+  for (int t = 0; t < 2; ++t) {
+    threads.emplace_back([&, t] {
+      for (size_t k = t; k < jobs.size(); k += 2)
+        actual[k] = bounded->Match(*jobs[k].first, *jobs[k].second);
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  EXPECT_EQ(actual, expected);
+  EXPECT_GT(expected[0].size(), 200u);
+}
+
 TEST(FlannMatcher, ValidatesOptions) {
   try {
     Load({{"l2_index", "kd_tree"}});
@@ -257,8 +284,9 @@ TEST(FlannMatcher, ValidatesOptions) {
         << error.what();
   }
   const nlohmann::json effective = Load()->EffectiveOptions();
-  EXPECT_EQ(effective.size(), 15u);
-  EXPECT_EQ(effective.at("index_cache_size"), 64);
+  EXPECT_EQ(effective.size(), 16u);
+  EXPECT_EQ(effective.at("index_cache_size"), 100000);
+  EXPECT_EQ(effective.at("index_cache_mb"), 1024);
   EXPECT_EQ(effective.at("l2_index"), "kmeans");
   EXPECT_EQ(effective.at("hamming_index"), "hierarchical");
   EXPECT_EQ(effective.at("checks"), 128);
