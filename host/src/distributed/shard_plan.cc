@@ -1,8 +1,9 @@
 #include "distributed/shard_plan.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <numeric>
-#include <queue>
 #include <stdexcept>
 #include <utility>
 
@@ -18,6 +19,25 @@ long long ParseCount(const std::string& text) {
     if (c < '0' || c > '9') return -1;
   }
   return std::stoll(text);
+}
+
+// The position of cell (x, y) along the Hilbert curve that fills a side x side grid
+// (side a power of two); cells close on the curve are close in the grid.
+uint64_t HilbertPosition(uint64_t side, uint64_t x, uint64_t y) {
+  uint64_t position = 0;
+  for (uint64_t half = side / 2; half > 0; half /= 2) {
+    const uint64_t in_right = (x & half) != 0 ? 1 : 0;
+    const uint64_t in_top = (y & half) != 0 ? 1 : 0;
+    position += half * half * ((3 * in_right) ^ in_top);
+    if (in_top == 0) {  // rotate the quadrant so that the curve runs on inside it
+      if (in_right == 1) {
+        x = side - 1 - x;
+        y = side - 1 - y;
+      }
+      std::swap(x, y);
+    }
+  }
+  return position;
 }
 
 }  // namespace
@@ -48,22 +68,38 @@ double PairCost(size_t num_features1, size_t num_features2) {
   return std::max(1.0, static_cast<double>(num_features1) * static_cast<double>(num_features2));
 }
 
-std::vector<int> AssignPairsToShards(const std::vector<double>& costs, int num_shards) {
+std::vector<int> AssignPairsToShards(const std::vector<std::pair<size_t, size_t>>& pairs,
+                                     const std::vector<double>& costs, size_t num_images,
+                                     int num_shards) {
   if (num_shards < 1) throw std::invalid_argument("AssignPairsToShards: no shards");
-  std::vector<size_t> order(costs.size());
+  if (pairs.size() != costs.size()) {
+    throw std::invalid_argument("AssignPairsToShards: " + std::to_string(pairs.size()) +
+                                " pairs and " + std::to_string(costs.size()) + " costs");
+  }
+  uint64_t side = 1;
+  while (side < num_images) side *= 2;
+  std::vector<uint64_t> position(pairs.size());
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    const auto [i, j] = pairs[p];
+    if (i >= num_images || j >= num_images) {
+      throw std::invalid_argument("AssignPairsToShards: pair of image " +
+                                  std::to_string(std::max(i, j)) + " of " +
+                                  std::to_string(num_images));
+    }
+    position[p] = HilbertPosition(side, std::min(i, j), std::max(i, j));
+  }
+  std::vector<size_t> order(pairs.size());
   std::iota(order.begin(), order.end(), size_t{0});
   std::stable_sort(order.begin(), order.end(),
-                   [&](size_t a, size_t b) { return costs[a] > costs[b]; });
-  // (load, shard): the least loaded shard on top, the lowest index among equals.
-  using Load = std::pair<double, int>;
-  std::priority_queue<Load, std::vector<Load>, std::greater<Load>> loads;
-  for (int k = 0; k < num_shards; ++k) loads.emplace(0.0, k);
-  std::vector<int> shard_of(costs.size(), 0);
-  for (const size_t pair : order) {
-    auto [load, shard] = loads.top();
-    loads.pop();
-    shard_of[pair] = shard;
-    loads.emplace(load + costs[pair], shard);
+                   [&](size_t a, size_t b) { return position[a] < position[b]; });
+  const double total = std::accumulate(costs.begin(), costs.end(), 0.0);
+  std::vector<int> shard_of(pairs.size(), 0);
+  double before = 0.0;  // summed cost of the pairs earlier on the curve
+  for (const size_t p : order) {
+    const double middle = before + 0.5 * costs[p];
+    const auto shard = static_cast<int>(std::floor(middle / total * num_shards));
+    shard_of[p] = std::clamp(shard, 0, num_shards - 1);
+    before += costs[p];
   }
   return shard_of;
 }

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace tessera {
@@ -31,10 +32,17 @@ bool ImageInShard(size_t image_index, const Shard& shard);
 // every descriptor of the other), at least 1.
 double PairCost(size_t num_features1, size_t num_features2);
 
-// Matching: the shard of each pair, balancing the summed cost (longest processing time
-// first: pairs by decreasing cost, ties by index, each to the shard with the least
-// cost so far, ties to the lowest shard). Every pair gets exactly one shard in
-// 0..num_shards-1.
-std::vector<int> AssignPairsToShards(const std::vector<double>& costs, int num_shards);
+// Matching: the shard of each pair (i, j) of images i and j, out of `num_images`.
+// Pairs are ordered along a Hilbert curve over the image-by-image matrix, and that order
+// is cut into `num_shards` runs of equal summed cost (each pair to the run that holds
+// the middle of its cost). A run of the curve covers a nearly square block of the
+// matrix, so a shard involves few images: about 2n/sqrt(2N) of n when every pair is
+// matched, against nearly all n when pairs are dealt out one by one. A matcher builds a
+// search index per image, which costs about twice a pair's searches, so this is most of
+// a shard's overhead. Every pair gets exactly one shard in 0..num_shards-1, and the
+// same inputs give the same shards everywhere.
+std::vector<int> AssignPairsToShards(const std::vector<std::pair<size_t, size_t>>& pairs,
+                                     const std::vector<double>& costs, size_t num_images,
+                                     int num_shards);
 
 }  // namespace tessera

@@ -162,7 +162,8 @@ MatchingSummary RunMatchShard(const PipelineContext& context, const RunOptions& 
   for (const auto& [i, j] : plan.pairs) {
     costs.push_back(PairCost(features_of(plan.images[i]), features_of(plan.images[j])));
   }
-  const std::vector<int> shard_of = AssignPairsToShards(costs, shard.count);
+  const std::vector<int> shard_of =
+      AssignPairsToShards(plan.pairs, costs, plan.images.size(), shard.count);
   // Pairs database.db holds with this run's provenance are done; others are redone.
   const bool source_current =
       source.ReadStageProvenance(Database::kMatchesStage) == provenance.matches &&
