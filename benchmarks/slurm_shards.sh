@@ -9,7 +9,9 @@
 #    shard times (shards placed longest first on the least loaded worker, merges added);
 #  - measured: N = 2 shards run side by side (2 workers on this machine), merges
 #    included, against the single run's wall-clock time.
-# Every time is wall-clock seconds of one process. On a shared machine they are inflated.
+# Shard and single-run times are CPU seconds (user + system) of each process, one thread
+# each, so that other work on the machine hardly changes them; the two-worker figure is
+# wall-clock time and needs an idle machine.
 # All of fox with one thread per process takes about an hour here; IMAGES may be a
 # subset (the figures in distributed/README.md are for its first 20 images).
 # usage: slurm_shards.sh TESSERA [IMAGES] [MANIFEST]
@@ -20,23 +22,25 @@ manifest=${3:-$(dirname "$0")/../manifests/default.json}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 now() { date +%s.%N; }
-# timed FILE COMMAND...: runs COMMAND, appends its wall-clock seconds to FILE.
+# timed FILE COMMAND...: runs COMMAND, appends its CPU seconds (user + system) to FILE.
 timed() {
-  local file=$1 start
+  local file=$1
   shift
-  start=$(now)
-  "$@" > /dev/null 2>> "$work/log" || { tail -5 "$work/log"; echo "failed: $*"; exit 1; }
-  echo "$(now) - $start" | bc -l >> "$file"
+  /usr/bin/time -f "%U %S" -o "$work/cpu" "$@" > /dev/null 2>> "$work/log" ||
+    { tail -5 "$work/log"; echo "failed: $*"; exit 1; }
+  awk '{ print $1 + $2 }' "$work/cpu" >> "$file"
 }
 run() { timed "$@" ; }
 t() { "$tessera" "$@" --manifest "$manifest" --threads 1; }
 
 echo "images: $images ($(ls "$images" | wc -l) files), manifest: $manifest, 1 thread per process"
+single_start=$(now)
 run "$work/single_extract" t extract --images "$images" --output "$work/single"
 run "$work/single_match" t match --output "$work/single"
+single_wall=$(echo "$(now) - $single_start" | bc -l)
 single_e=$(cat "$work/single_extract")
 single_m=$(cat "$work/single_match")
-printf "single process: extract %.1f s, match %.1f s\n" "$single_e" "$single_m"
+printf "single process: extract %.1f s, match %.1f s (CPU)\n" "$single_e" "$single_m"
 
 for n in 4 16; do
   out=$work/n$n
@@ -56,7 +60,7 @@ read = lambda f: [float(x) for x in open(f)]
 e, m, me, mm = read(sys.argv[4]), read(sys.argv[5]), read(sys.argv[6])[0], read(sys.argv[7])[0]
 for name, shards, single, merge in (("extract", e, single_e, me), ("match", m, single_m, mm)):
     mean = sum(shards) / len(shards)
-    print(f"N={n:2d} {name:7s}: shard work {sum(shards):7.1f} s vs single {single:7.1f} s "
+    print(f"N={n:2d} {name:7s}: shard work {sum(shards):7.1f} s vs single {single:7.1f} s CPU "
           f"(overhead {100 * (sum(shards) / single - 1):+.1f}%), slowest/mean shard "
           f"{max(shards) / mean:.2f}, merge {merge:.2f} s")
 def makespan(times, workers):
@@ -88,5 +92,5 @@ b=$!
 wait $a && wait $b
 "$tessera" merge --output "$out" --stage match > /dev/null 2>> "$work/log"
 two=$(echo "$(now) - $start" | bc -l)
-printf "measured with 2 workers (N=2 side by side, merges included): %.1f s vs single %.1f s: speed-up %.2fx\n" \
-  "$two" "$(echo "$single_e + $single_m" | bc -l)" "$(echo "($single_e + $single_m) / $two" | bc -l)"
+printf "measured with 2 workers (N=2 side by side, merges included): %.1f s vs single %.1f s wall-clock: speed-up %.2fx\n" \
+  "$two" "$single_wall" "$(echo "$single_wall / $two" | bc -l)"
