@@ -200,6 +200,31 @@ TEST(FlannMatcher, DeterministicAcrossCallsInstancesAndThreads) {
   EXPECT_TRUE(any_difference);
 }
 
+// Descriptor sets to match, as (first, second).
+using MatchJobs = std::vector<std::pair<const FeatureDescriptors*, const FeatureDescriptors*>>;
+
+std::vector<FeatureMatches> MatchInTurn(const PluginInstance<Matcher>& matcher,
+                                        const MatchJobs& jobs) {
+  std::vector<FeatureMatches> matches;
+  for (const auto& [d1, d2] : jobs) matches.push_back(matcher->Match(*d1, *d2));
+  return matches;
+}
+
+// The jobs dealt out to `num_threads` threads that match at once with one matcher.
+std::vector<FeatureMatches> MatchInThreads(const PluginInstance<Matcher>& matcher,
+                                           const MatchJobs& jobs, size_t num_threads) {
+  std::vector<FeatureMatches> matches(jobs.size());
+  std::vector<std::thread> threads;
+  for (size_t t = 0; t < num_threads; ++t) {
+    threads.emplace_back([&, t] {
+      for (size_t k = t; k < jobs.size(); k += num_threads)
+        matches[k] = matcher->Match(*jobs[k].first, *jobs[k].second);
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  return matches;
+}
+
 TEST(FlannMatcher, CachedIndexesGiveTheSameMatchesAsFreshOnes) {
   // Images shared by several pairs, searched from several threads, with a cache smaller
   // than the number of images so that entries are evicted and rebuilt.
@@ -210,7 +235,7 @@ TEST(FlannMatcher, CachedIndexesGiveTheSameMatchesAsFreshOnes) {
   }
   const auto fresh = Load({{"ratio", 0.9}, {"checks", 16}, {"index_cache_size", 0}});
   const auto cached = Load({{"ratio", 0.9}, {"checks", 16}, {"index_cache_size", 2}});
-  std::vector<std::pair<const FeatureDescriptors*, const FeatureDescriptors*>> jobs;
+  MatchJobs jobs;
   for (const auto& a : pairs) {
     for (const auto& b : pairs) {
       if (a.descriptors1.metric != b.descriptors1.metric) continue;
@@ -218,18 +243,8 @@ TEST(FlannMatcher, CachedIndexesGiveTheSameMatchesAsFreshOnes) {
       jobs.emplace_back(&b.descriptors2, &a.descriptors1);
     }
   }
-  std::vector<FeatureMatches> expected;
-  for (const auto& [d1, d2] : jobs) expected.push_back(fresh->Match(*d1, *d2));
-  std::vector<FeatureMatches> actual(jobs.size());
-  std::vector<std::thread> threads;
-  for (int t = 0; t < 3; ++t) {
-    threads.emplace_back([&, t] {
-      for (size_t k = t; k < jobs.size(); k += 3)
-        actual[k] = cached->Match(*jobs[k].first, *jobs[k].second);
-    });
-  }
-  for (std::thread& thread : threads) thread.join();
-  EXPECT_EQ(actual, expected);
+  const std::vector<FeatureMatches> expected = MatchInTurn(fresh, jobs);
+  EXPECT_EQ(MatchInThreads(cached, jobs, 3), expected);
   size_t total = 0;
   for (const auto& matches : expected) total += matches.size();
   EXPECT_GT(total, 1000u);
@@ -243,22 +258,12 @@ TEST(FlannMatcher, AMemoryBoundCacheGivesTheSameMatchesAsFreshIndexes) {
   const auto fresh = Load({{"checks", 16}, {"index_cache_size", 0}});
   const auto bounded = Load({{"checks", 16}, {"index_cache_mb", 1}});
   EXPECT_EQ(bounded->EffectiveOptions().at("index_cache_mb"), 1);
-  std::vector<std::pair<const FeatureDescriptors*, const FeatureDescriptors*>> jobs;
+  MatchJobs jobs;
   for (const auto& a : pairs) {
     for (const auto& b : pairs) jobs.emplace_back(&a.descriptors1, &b.descriptors2);
   }
-  std::vector<FeatureMatches> expected;
-  for (const auto& [d1, d2] : jobs) expected.push_back(fresh->Match(*d1, *d2));
-  std::vector<FeatureMatches> actual(jobs.size());
-  std::vector<std::thread> threads;
-  for (int t = 0; t < 2; ++t) {
-    threads.emplace_back([&, t] {
-      for (size_t k = t; k < jobs.size(); k += 2)
-        actual[k] = bounded->Match(*jobs[k].first, *jobs[k].second);
-    });
-  }
-  for (std::thread& thread : threads) thread.join();
-  EXPECT_EQ(actual, expected);
+  const std::vector<FeatureMatches> expected = MatchInTurn(fresh, jobs);
+  EXPECT_EQ(MatchInThreads(bounded, jobs, 2), expected);
   EXPECT_GT(expected[0].size(), 200u);
 }
 
