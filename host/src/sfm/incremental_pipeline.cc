@@ -228,6 +228,30 @@ void MergeAlignedModels(const IncrementalMapperOptions& options,
   SortModels(models);
 }
 
+// A first model of at most kMaxCalibrationImages images from `pairs`, with `cameras`, for
+// the focal lengths its bundle adjustments refine; empty when no pair initialises one.
+Reconstruction MapFirstModel(const IncrementalMapperOptions& options, const MapperRunState& run,
+                             const std::map<camera_t, Camera>& cameras,
+                             const std::vector<const MapperInput::Pair*>& pairs) {
+  MapperRunState calibration(run.input, run.bundle_adjuster, run.seed);
+  calibration.ransac = run.ransac;
+  calibration.cameras = cameras;
+  const spdlog::level::level_enum level = spdlog::get_level();
+  if (level > spdlog::level::debug) spdlog::set_level(spdlog::level::warn);
+  calibration.Prepare(options, pairs);
+  IncrementalMapper mapper(options, &calibration);
+  Reconstruction model;
+  if (mapper.Initialize() == IncrementalMapper::Status::kSuccess) {
+    // Global bundle adjustments as it grew refined the focal length; the final rounds
+    // of refinement would cost as much again for little more.
+    RunControl no_observer;
+    Grow(&mapper, &no_observer, kMaxCalibrationImages);
+    model = mapper.TakeModel();
+  }
+  spdlog::set_level(level);
+  return model;
+}
+
 // Focal lengths of the cameras without a prior, in `cameras`: from the view graph where
 // it determines them, then refined in a first model.
 void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
@@ -263,41 +287,50 @@ void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
 
   // 2. Refined by bundle adjustment in a first model, mapped once for that alone: with
   // the structure of many views the focal length is well determined even where pairs
-  // leave it open, and the view-graph checks of the real pass need it to be right.
-  MapperRunState calibration(run.input, run.bundle_adjuster, run.seed);
-  calibration.ransac = run.ransac;
-  calibration.cameras = *cameras;
-  const spdlog::level::level_enum level = spdlog::get_level();
-  if (level > spdlog::level::debug) spdlog::set_level(spdlog::level::warn);
-  calibration.Prepare(options, verified_pairs);
-  IncrementalMapper mapper(options, &calibration);
-  Reconstruction model;
-  if (mapper.Initialize() == IncrementalMapper::Status::kSuccess) {
-    // Global bundle adjustments as it grew refined the focal length; the final rounds
-    // of refinement would cost as much again for little more.
-    RunControl no_observer;
-    Grow(&mapper, &no_observer, kMaxCalibrationImages);
-    model = mapper.TakeModel();
-  }
-  spdlog::set_level(level);
-
-  for (auto& [camera_id, report] : by_camera) {
-    const auto it = model.cameras.find(camera_id);
-    if (model.images.size() < kMinCalibrationImages || it == model.cameras.end()) {
-      spdlog::info(
-          "map: camera {}: no first model of {} images or more to refine its focal length "
-          "from; mapping starts from {:.1f} px",
-          camera_id, kMinCalibrationImages, report.estimated);
-      continue;
+  // leave it open, and the view-graph checks of the real pass need it to be right. The
+  // first model holds one scene; where the photos hold several (several cameras, as in a
+  // mixed folder), the cameras it leaves out get first models of their own, from the
+  // pairs among their images.
+  std::set<camera_t> unrefined;
+  for (const auto& [camera_id, report] : by_camera) unrefined.insert(camera_id);
+  std::vector<const MapperInput::Pair*> pairs = verified_pairs;
+  for (bool first = true; !unrefined.empty() && !pairs.empty(); first = false) {
+    const Reconstruction model = MapFirstModel(options, run, *cameras, pairs);
+    size_t num_refined = 0;
+    for (auto& [camera_id, report] : by_camera) {
+      const auto it = model.cameras.find(camera_id);
+      if (unrefined.count(camera_id) == 0 || model.images.size() < kMinCalibrationImages ||
+          it == model.cameras.end()) {
+        continue;
+      }
+      unrefined.erase(camera_id);
+      ++num_refined;
+      const Camera& camera = cameras->at(camera_id);
+      const double side = static_cast<double>(std::max(camera.width, camera.height));
+      const double focal = it->second.MeanFocalLength();
+      if (!(focal > 0.25 * side && focal < 5 * side)) continue;
+      cameras->at(camera_id).SetFocalLength(focal);
+      report.estimated = focal;
+      report.method = report.method.empty() ? "first model" : report.method + ", first model";
+      report.num_images = model.images.size();
     }
-    const Camera& camera = cameras->at(camera_id);
-    const double side = static_cast<double>(std::max(camera.width, camera.height));
-    const double focal = it->second.MeanFocalLength();
-    if (!(focal > 0.25 * side && focal < 5 * side)) continue;
-    cameras->at(camera_id).SetFocalLength(focal);
-    report.estimated = focal;
-    report.method = report.method.empty() ? "first model" : report.method + ", first model";
-    report.num_images = model.images.size();
+    if (num_refined == 0 && !first) break;
+    // The pairs among images of the cameras still to refine.
+    std::vector<const MapperInput::Pair*> remaining;
+    for (const MapperInput::Pair* pair : pairs) {
+      if (unrefined.count(run.input.images.at(pair->image_id1).camera_id) > 0 &&
+          unrefined.count(run.input.images.at(pair->image_id2).camera_id) > 0) {
+        remaining.push_back(pair);
+      }
+    }
+    if (remaining.size() == pairs.size()) break;  // the same pairs would give the same model
+    pairs = std::move(remaining);
+  }
+  for (const camera_t camera_id : unrefined) {
+    spdlog::info(
+        "map: camera {}: no first model of {} images or more to refine its focal length "
+        "from; mapping starts from {:.1f} px",
+        camera_id, kMinCalibrationImages, by_camera.at(camera_id).estimated);
   }
   for (const auto& [camera_id, report] : by_camera) {
     if (report.method.empty()) continue;

@@ -148,6 +148,29 @@ TEST(IncrementalPipeline, AnImplausiblePrincipalPointIsPutBackAtTheCentre) {
   EXPECT_EQ(camera.PrincipalPointY(), 0.5 * options.height);
 }
 
+// Adds `other`'s images (ids shifted by `offset`, names prefixed), with its camera 1 as
+// `camera_id`, and its pairs to `scene`; nothing matches across the two.
+void AppendScene(const SyntheticScene& other, image_t offset, const std::string& prefix,
+                 camera_t camera_id, SyntheticScene* scene) {
+  if (camera_id != 1) {
+    Camera camera = other.input.cameras.at(1);
+    camera.camera_id = camera_id;
+    scene->input.cameras[camera_id] = camera;
+  }
+  for (const auto& [image_id, image] : other.input.images) {
+    Image shifted = image;
+    shifted.image_id = image_id + offset;
+    shifted.camera_id = camera_id;
+    shifted.name = prefix + image.name;
+    scene->input.images[shifted.image_id] = shifted;
+  }
+  for (MapperInput::Pair pair : other.input.pairs) {
+    pair.image_id1 += offset;
+    pair.image_id2 += offset;
+    scene->input.pairs.push_back(pair);
+  }
+}
+
 TEST(IncrementalPipeline, DisconnectedGroupsBecomeSeparateModelsLargestFirst) {
   // Two scenes of 5 and 8 images with no match between them: ids 1-5 and 6-13.
   SyntheticSceneOptions small_options;
@@ -157,19 +180,7 @@ TEST(IncrementalPipeline, DisconnectedGroupsBecomeSeparateModelsLargestFirst) {
   large_options.num_images = 8;
   large_options.seed = 5;
   SyntheticScene scene = MakeSyntheticScene(small_options);
-  const SyntheticScene large = MakeSyntheticScene(large_options);
-  const image_t offset = 5;
-  for (const auto& [image_id, image] : large.input.images) {
-    Image shifted = image;
-    shifted.image_id = image_id + offset;
-    shifted.name = "large_" + image.name;
-    scene.input.images[shifted.image_id] = shifted;
-  }
-  for (MapperInput::Pair pair : large.input.pairs) {
-    pair.image_id1 += offset;
-    pair.image_id2 += offset;
-    scene.input.pairs.push_back(pair);
-  }
+  AppendScene(MakeSyntheticScene(large_options), 5, "large_", 1, &scene);
   // And one image that matches nothing.
   Image lonely = scene.input.images.at(1);
   lonely.image_id = 100;
@@ -215,6 +226,36 @@ TEST(IncrementalPipeline, EstimatesTheFocalLengthWhenThereIsNoPrior) {
   EXPECT_NEAR(result.models[0].cameras.at(1).FocalLengthX(), options.focal_length,
               0.005 * options.focal_length);
   ExpectNoCameraOff(scene, result.models[0], 0.1);
+}
+
+TEST(IncrementalPipeline, EstimatesTheFocalLengthOfEachSceneInAMixedSet) {
+  // Two unrelated scenes, each with its own camera and no prior (as in a folder that mixes
+  // photos of two captures): a first model holds one scene only, so the other camera
+  // needs a first model of its own.
+  SyntheticSceneOptions first;
+  first.focal_prior = false;
+  first.prior_focal_factor = 1.6;
+  first.seed = 11;
+  SyntheticSceneOptions second = first;
+  second.focal_length = 1400;
+  second.prior_focal_factor = 0.7;
+  second.seed = 13;
+  SyntheticScene scene = MakeSyntheticScene(first);
+  AppendScene(MakeSyntheticScene(second), 100, "second_", 2, &scene);
+  const MapperResult result = Map(scene);
+  ASSERT_EQ(result.focal_lengths.size(), 2u);
+  for (const FocalLengthReport& report : result.focal_lengths) {
+    const double truth = report.camera_id == 1 ? first.focal_length : second.focal_length;
+    EXPECT_NEAR(report.estimated, truth, 0.02 * truth) << "camera " << report.camera_id;
+    EXPECT_GE(report.num_images, 5u) << "camera " << report.camera_id << ": " << report.method;
+  }
+  ASSERT_EQ(result.models.size(), 2u);
+  for (const Reconstruction& model : result.models) {
+    EXPECT_EQ(model.images.size(), 12u);
+    const Camera& camera = model.cameras.begin()->second;
+    const double truth = camera.camera_id == 1 ? first.focal_length : second.focal_length;
+    EXPECT_NEAR(camera.FocalLengthX(), truth, 0.005 * truth);
+  }
 }
 
 // An object seen from all around whose back half repeats its front half turned by half a
