@@ -112,15 +112,16 @@ def main():
         print(f"## {label}: {num_matched} pairs matched, {len(pairs)} verified, "
               f"{len(models)} models of {[len(m) for m in models]} images")
         print("| scene | images | models holding it | registered (best model) | "
-              "position error mean | position error % extent | rotation error mean deg |")
-        print("| --- | --- | --- | --- | --- | --- | --- |")
+              "position error mean | position error % extent | rotation error mean deg | "
+              "rotation error max deg |")
+        print("| --- | --- | --- | --- | --- | --- | --- | --- |")
         for scene in scenes:
             per_model = [sum(1 for n in m if scene_of.get(n) == scene) for m in models]
             holding = sum(1 for c in per_model if c > 0)
             best = int(np.argmax(per_model)) if models else -1
             registered = per_model[best] if models else 0
             truth = read_ground_truth(datasets, scene)
-            errors = "| - | - | -"
+            errors = "| - | - | - | -"
             if models and truth and registered >= 3:
                 names = [n for n in models[best] if scene_of.get(n) == scene
                          and lookup(truth, original_of[n]) is not None]
@@ -139,7 +140,7 @@ def main():
                         cos = (np.trace(R_aligned @ g[0].T) - 1) / 2
                         rotation.append(np.degrees(np.arccos(np.clip(cos, -1, 1))))
                     errors = (f"| {position.mean():.4g} | {100 * position.mean() / extent:.2f} "
-                              f"| {np.mean(rotation):.3f}")
+                              f"| {np.mean(rotation):.3f} | {np.max(rotation):.3f}")
             print(f"| {scene} | {count[scene]} | {holding} | {registered} {errors} |")
     exhaustive_pairs, exhaustive_matched = results["exhaustive"]
     retrieval_pairs, retrieval_matched = results["retrieval"]
