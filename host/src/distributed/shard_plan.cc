@@ -65,17 +65,20 @@ bool ImageInShard(size_t image_index, const Shard& shard) {
 }
 
 double PairCost(size_t num_features1, size_t num_features2) {
-  return std::max(1.0, static_cast<double>(num_features1) * static_cast<double>(num_features2));
+  return std::max(1.0, static_cast<double>(num_features1) + static_cast<double>(num_features2));
 }
 
+double ImageCost(size_t num_features) { return 2.0 * static_cast<double>(num_features); }
+
 std::vector<int> AssignPairsToShards(const std::vector<std::pair<size_t, size_t>>& pairs,
-                                     const std::vector<double>& costs, size_t num_images,
-                                     int num_shards) {
+                                     const std::vector<double>& pair_costs,
+                                     const std::vector<double>& image_costs, int num_shards) {
   if (num_shards < 1) throw std::invalid_argument("AssignPairsToShards: no shards");
-  if (pairs.size() != costs.size()) {
+  if (pairs.size() != pair_costs.size()) {
     throw std::invalid_argument("AssignPairsToShards: " + std::to_string(pairs.size()) +
-                                " pairs and " + std::to_string(costs.size()) + " costs");
+                                " pairs and " + std::to_string(pair_costs.size()) + " costs");
   }
+  const size_t num_images = image_costs.size();
   uint64_t side = 1;
   while (side < num_images) side *= 2;
   std::vector<uint64_t> position(pairs.size());
@@ -92,15 +95,51 @@ std::vector<int> AssignPairsToShards(const std::vector<std::pair<size_t, size_t>
   std::iota(order.begin(), order.end(), size_t{0});
   std::stable_sort(order.begin(), order.end(),
                    [&](size_t a, size_t b) { return position[a] < position[b]; });
-  const double total = std::accumulate(costs.begin(), costs.end(), 0.0);
+
+  // Cuts the curve greedily into runs of cost at most `limit` (a run takes at least one
+  // pair); returns the number of runs, and each pair's run in `run_of` when given.
+  std::vector<size_t> seen_in_run(num_images, 0);  // run + 1 that last involved the image
+  const auto cut = [&](double limit, std::vector<int>* run_of) {
+    std::fill(seen_in_run.begin(), seen_in_run.end(), 0);
+    size_t run = 0;
+    double load = 0.0;
+    bool empty = true;
+    for (const size_t p : order) {
+      const auto [i, j] = pairs[p];
+      const auto added = [&](size_t r) {
+        double cost = pair_costs[p];
+        if (seen_in_run[i] != r + 1) cost += image_costs[i];
+        if (seen_in_run[j] != r + 1 && j != i) cost += image_costs[j];
+        return cost;
+      };
+      if (!empty && load + added(run) > limit) {
+        ++run;
+        load = 0.0;
+      }
+      load += added(run);
+      seen_in_run[i] = seen_in_run[j] = run + 1;
+      empty = false;
+      if (run_of != nullptr) (*run_of)[p] = static_cast<int>(run);
+    }
+    return empty ? size_t{0} : run + 1;
+  };
+
+  // The smallest limit that needs at most num_shards runs, by bisection between a bound
+  // that needs one run (everything) and one that no run can go below (the mean).
+  double high = std::accumulate(pair_costs.begin(), pair_costs.end(), 0.0) +
+                std::accumulate(image_costs.begin(), image_costs.end(), 0.0);
+  double low = high / num_shards;
   std::vector<int> shard_of(pairs.size(), 0);
-  double before = 0.0;  // summed cost of the pairs earlier on the curve
-  for (const size_t p : order) {
-    const double middle = before + 0.5 * costs[p];
-    const auto shard = static_cast<int>(std::floor(middle / total * num_shards));
-    shard_of[p] = std::clamp(shard, 0, num_shards - 1);
-    before += costs[p];
+  if (pairs.empty()) return shard_of;
+  for (int step = 0; step < 60 && high - low > 1e-9 * high; ++step) {
+    const double middle = 0.5 * (low + high);
+    if (cut(middle, nullptr) <= static_cast<size_t>(num_shards)) {
+      high = middle;
+    } else {
+      low = middle;
+    }
   }
+  cut(high, &shard_of);
   return shard_of;
 }
 

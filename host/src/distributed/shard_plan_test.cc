@@ -48,39 +48,76 @@ TEST(ShardPlan, ImagesByIndexAreCompleteDisjointAndEven) {
   }
 }
 
-TEST(ShardPlan, PairCostIsTheProductOfFeatureCounts) {
-  EXPECT_DOUBLE_EQ(PairCost(1000, 2000), 2e6);
-  EXPECT_DOUBLE_EQ(PairCost(0, 2000), 1.0);
+TEST(ShardPlan, CostsGrowWithTheFeatureCounts) {
+  EXPECT_DOUBLE_EQ(PairCost(1000, 2000), 3000.0);
+  EXPECT_DOUBLE_EQ(PairCost(0, 0), 1.0);
+  EXPECT_DOUBLE_EQ(ImageCost(1000), 2000.0);
+}
+
+// Every pair of `n` images, their costs, and each image's.
+struct AllPairs {
+  std::vector<std::pair<size_t, size_t>> pairs;
+  std::vector<double> pair_costs;
+  std::vector<double> image_costs;
+};
+
+AllPairs MakeAllPairs(const std::vector<size_t>& features) {
+  AllPairs all;
+  for (size_t i = 0; i < features.size(); ++i) {
+    all.image_costs.push_back(ImageCost(features[i]));
+    for (size_t j = i + 1; j < features.size(); ++j) {
+      all.pairs.emplace_back(i, j);
+      all.pair_costs.push_back(PairCost(features[i], features[j]));
+    }
+  }
+  return all;
+}
+
+// Each shard's cost: its pairs and the images it involves, and those images.
+std::vector<double> ShardLoads(const AllPairs& all, const std::vector<int>& shard_of, int count,
+                               std::vector<std::set<size_t>>* images) {
+  images->assign(count, {});
+  std::vector<double> load(count, 0.0);
+  for (size_t p = 0; p < all.pairs.size(); ++p) {
+    load[shard_of[p]] += all.pair_costs[p];
+    (*images)[shard_of[p]].insert(all.pairs[p].first);
+    (*images)[shard_of[p]].insert(all.pairs[p].second);
+  }
+  for (int k = 0; k < count; ++k) {
+    for (const size_t image : (*images)[k]) load[k] += all.image_costs[image];
+  }
+  return load;
 }
 
 TEST(ShardPlan, PairsAreBalancedCompleteAndDeterministic) {
-  // 1225 pairs of 50 images with feature counts from 2000 to 8000.
+  // 1225 pairs of 50 images with feature counts from 2000 to 8000. A shard's cost counts
+  // the indexes of the images it involves: shards of the same number of pairs that
+  // involve more images must take fewer pairs.
   std::vector<size_t> features(50);
   for (size_t i = 0; i < features.size(); ++i) features[i] = 2000 + (i * 7919) % 6000;
-  std::vector<std::pair<size_t, size_t>> pairs;
-  std::vector<double> costs;
-  for (size_t i = 0; i < features.size(); ++i) {
-    for (size_t j = i + 1; j < features.size(); ++j) {
-      pairs.emplace_back(i, j);
-      costs.push_back(PairCost(features[i], features[j]));
-    }
-  }
-  const double total = std::accumulate(costs.begin(), costs.end(), 0.0);
-  const double costliest = *std::max_element(costs.begin(), costs.end());
+  const AllPairs all = MakeAllPairs(features);
+  const double costliest_pair = *std::max_element(all.pair_costs.begin(), all.pair_costs.end());
+  const double costliest_image =
+      *std::max_element(all.image_costs.begin(), all.image_costs.end());
   for (const int count : {1, 4, 16, 32}) {
-    const std::vector<int> shard_of = AssignPairsToShards(pairs, costs, features.size(), count);
-    ASSERT_EQ(shard_of.size(), costs.size());
-    EXPECT_EQ(shard_of, AssignPairsToShards(pairs, costs, features.size(), count));
-    std::vector<double> load(count, 0.0);
-    for (size_t p = 0; p < costs.size(); ++p) {
-      ASSERT_GE(shard_of[p], 0);
-      ASSERT_LT(shard_of[p], count);
-      load[shard_of[p]] += costs[p];
+    const std::vector<int> shard_of =
+        AssignPairsToShards(all.pairs, all.pair_costs, all.image_costs, count);
+    ASSERT_EQ(shard_of.size(), all.pairs.size());
+    EXPECT_EQ(shard_of, AssignPairsToShards(all.pairs, all.pair_costs, all.image_costs, count));
+    for (const int shard : shard_of) {
+      ASSERT_GE(shard, 0);
+      ASSERT_LT(shard, count);
     }
-    // Runs are cut at pair boundaries: a shard is off the mean by at most one pair.
-    const double mean = total / count;
+    std::vector<std::set<size_t>> images;
+    const std::vector<double> load = ShardLoads(all, shard_of, count, &images);
+    // Runs are cut at pair boundaries: the slowest shard exceeds the mean by at most one
+    // pair and its two images.
+    const double mean = std::accumulate(load.begin(), load.end(), 0.0) / count;
     const double slowest = *std::max_element(load.begin(), load.end());
-    EXPECT_LE(slowest, mean + costliest) << count << " shards";
+    EXPECT_LE(slowest, mean + costliest_pair + 2 * costliest_image) << count << " shards";
+    if (count == 16) {
+      EXPECT_LT(slowest / mean, 1.05);  // 1.16 when runs were cut by pair costs alone
+    }
   }
 }
 
@@ -89,19 +126,12 @@ TEST(ShardPlan, AShardInvolvesFewImages) {
   // 2n/sqrt(2N) images (45 for N = 4, 23 for N = 16); the curve's runs come close, at
   // most 3/4 and 7/16 of the images. Pairs dealt out by cost alone, longest first to the
   // least loaded shard, gave every shard all 64.
-  const size_t n = 64;
-  std::vector<std::pair<size_t, size_t>> pairs;
-  for (size_t i = 0; i < n; ++i) {
-    for (size_t j = i + 1; j < n; ++j) pairs.emplace_back(i, j);
-  }
-  const std::vector<double> costs(pairs.size(), 1.0);
+  const AllPairs all = MakeAllPairs(std::vector<size_t>(64, 1000));
   for (const auto& [count, most_images] : {std::pair{4, 48u}, std::pair{16, 28u}}) {
-    const std::vector<int> shard_of = AssignPairsToShards(pairs, costs, n, count);
-    std::vector<std::set<size_t>> images(count);
-    for (size_t p = 0; p < pairs.size(); ++p) {
-      images[shard_of[p]].insert(pairs[p].first);
-      images[shard_of[p]].insert(pairs[p].second);
-    }
+    const std::vector<int> shard_of =
+        AssignPairsToShards(all.pairs, all.pair_costs, all.image_costs, count);
+    std::vector<std::set<size_t>> images;
+    ShardLoads(all, shard_of, count, &images);
     for (int k = 0; k < count; ++k) {
       EXPECT_LE(images[k].size(), most_images) << "shard " << k << " of " << count;
     }
@@ -109,13 +139,14 @@ TEST(ShardPlan, AShardInvolvesFewImages) {
 }
 
 TEST(ShardPlan, EmptyAndMismatchedPairLists) {
-  EXPECT_EQ(AssignPairsToShards({}, {}, 0, 3).size(), 0u);
-  const std::vector<int> one = AssignPairsToShards({{0, 1}}, {1.0}, 2, 4);
+  EXPECT_EQ(AssignPairsToShards({}, {}, {}, 3).size(), 0u);
+  const std::vector<int> one = AssignPairsToShards({{0, 1}}, {1.0}, {1.0, 1.0}, 4);
   ASSERT_EQ(one.size(), 1u);
   EXPECT_GE(one[0], 0);
   EXPECT_LT(one[0], 4);
-  EXPECT_THROW(AssignPairsToShards({{0, 1}}, {}, 2, 2), std::invalid_argument);
-  EXPECT_THROW(AssignPairsToShards({{0, 5}}, {1.0}, 2, 2), std::invalid_argument);
+  EXPECT_THROW(AssignPairsToShards({{0, 1}}, {}, {1.0, 1.0}, 2), std::invalid_argument);
+  EXPECT_THROW(AssignPairsToShards({{0, 5}}, {1.0}, {1.0, 1.0}, 2), std::invalid_argument);
+  EXPECT_THROW(AssignPairsToShards({{0, 1}}, {1.0}, {1.0, 1.0}, 0), std::invalid_argument);
 }
 
 }  // namespace

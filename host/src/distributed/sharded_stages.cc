@@ -158,12 +158,13 @@ MatchingSummary RunMatchShard(const PipelineContext& context, const RunOptions& 
     const auto it = num_features.find(image.image_id);
     return it == num_features.end() ? size_t{0} : it->second;
   };
-  std::vector<double> costs;
+  std::vector<double> pair_costs, image_costs;
   for (const auto& [i, j] : plan.pairs) {
-    costs.push_back(PairCost(features_of(plan.images[i]), features_of(plan.images[j])));
+    pair_costs.push_back(PairCost(features_of(plan.images[i]), features_of(plan.images[j])));
   }
+  for (const Image& image : plan.images) image_costs.push_back(ImageCost(features_of(image)));
   const std::vector<int> shard_of =
-      AssignPairsToShards(plan.pairs, costs, plan.images.size(), shard.count);
+      AssignPairsToShards(plan.pairs, pair_costs, image_costs, shard.count);
   // Pairs database.db holds with this run's provenance are done; others are redone.
   const bool source_current =
       source.ReadStageProvenance(Database::kMatchesStage) == provenance.matches &&
