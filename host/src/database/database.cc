@@ -612,6 +612,13 @@ void Database::Impl::Open() {
   // The first read of the file: a file that is not a database fails here.
   Exec("SELECT COUNT(*) FROM sqlite_master;", "read the schema");
   if (read_only) return;
+  // SQLite opens a file it may not write read-only without an error: a file without
+  // write permission, or one whose header asks for a newer writer (a damaged header).
+  if (sqlite3_db_readonly(db, "main") == 1) {
+    throw InputError("Database file '" + path.string() +
+                     "' can only be read: the file is not writable, or its header names a file "
+                     "format version that SQLite does not write (a damaged or newer file).");
+  }
   // WAL, as COLMAP uses: readers do not block the writer, and a killed process leaves
   // the last committed state. NORMAL sync is durable against process crashes (only a
   // power loss may drop the last commits, never corrupt the file).

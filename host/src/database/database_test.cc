@@ -822,6 +822,27 @@ TEST_F(DatabaseTest, UnsupportedSchemaFormatIsAnInputError) {
   }
 }
 
+// Found by tests/fuzz (database target): a header whose file format write version is
+// above 2 makes SQLite open the file read-only without an error; writing the journal
+// mode then failed as an internal error. It is bad input, named before any write.
+TEST_F(DatabaseTest, AHeaderSQLiteMayNotWriteIsAnInputError) {
+  { Database database(DatabasePath()); }
+  {
+    std::fstream file(DatabasePath(), std::ios::in | std::ios::out | std::ios::binary);
+    file.seekp(18);  // the file format write version
+    file.write("\x41", 1);
+  }
+  try {
+    Database database(DatabasePath());
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "Database file '" + DatabasePath().string() +
+                  "' can only be read: the file is not writable, or its header names a file "
+                  "format version that SQLite does not write (a damaged or newer file).");
+  }
+}
+
 // Found by tests/fuzz (database target): a NULL image name and row counts far beyond
 // the stored bytes are refused, not dereferenced or allocated.
 TEST_F(DatabaseTest, CorruptRowsAreInputErrors) {
