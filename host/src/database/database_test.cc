@@ -804,43 +804,42 @@ TEST_F(DatabaseTest, ForeignSchemaIsAnInputError) {
   }
 }
 
+// The message of the InputError that opening a new database at `path` gives after
+// `bytes` are written over its header at `offset`; empty when it opens.
+std::string OpenErrorAfterOverwritingHeader(const fs::path& path, std::streamoff offset,
+                                            const std::string& bytes) {
+  { Database database(path); }
+  {
+    std::fstream file(path, std::ios::in | std::ios::out | std::ios::binary);
+    file.seekp(offset);
+    file.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  try {
+    Database database(path);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
+
 // Found by tests/fuzz (database target): a file SQLite refuses to read ("unsupported
 // file format": a schema format number above 4) is bad input, not an internal failure.
 TEST_F(DatabaseTest, UnsupportedSchemaFormatIsAnInputError) {
-  { Database database(DatabasePath()); }
-  {
-    std::fstream file(DatabasePath(), std::ios::in | std::ios::out | std::ios::binary);
-    file.seekp(44);  // the schema format number, big-endian
-    file.write("\0\0\0\x09", 4);
-  }
-  try {
-    Database database(DatabasePath());
-    FAIL() << "expected an error";
-  } catch (const InputError& error) {
-    EXPECT_NE(std::string(error.what()).find("unsupported file format"), std::string::npos)
-        << error.what();
-  }
+  // 44: the schema format number, big-endian.
+  const std::string error =
+      OpenErrorAfterOverwritingHeader(DatabasePath(), 44, std::string("\0\0\0\x09", 4));
+  EXPECT_NE(error.find("unsupported file format"), std::string::npos) << error;
 }
 
 // Found by tests/fuzz (database target): a header whose file format write version is
 // above 2 makes SQLite open the file read-only without an error; writing the journal
 // mode then failed as an internal error. It is bad input, named before any write.
 TEST_F(DatabaseTest, AHeaderSQLiteMayNotWriteIsAnInputError) {
-  { Database database(DatabasePath()); }
-  {
-    std::fstream file(DatabasePath(), std::ios::in | std::ios::out | std::ios::binary);
-    file.seekp(18);  // the file format write version
-    file.write("\x41", 1);
-  }
-  try {
-    Database database(DatabasePath());
-    FAIL() << "expected an error";
-  } catch (const InputError& error) {
-    EXPECT_EQ(std::string(error.what()),
-              "Database file '" + DatabasePath().string() +
-                  "' can only be read: the file is not writable, or its header names a file "
-                  "format version that SQLite does not write (a damaged or newer file).");
-  }
+  // 18: the file format write version.
+  EXPECT_EQ(OpenErrorAfterOverwritingHeader(DatabasePath(), 18, "\x41"),
+            "Database file '" + DatabasePath().string() +
+                "' can only be read: the file is not writable, or its header names a file "
+                "format version that SQLite does not write (a damaged or newer file).");
 }
 
 // Found by tests/fuzz (database target): a NULL image name and row counts far beyond

@@ -97,8 +97,7 @@ TEST(ShardPlan, PairsAreBalancedCompleteAndDeterministic) {
   for (size_t i = 0; i < features.size(); ++i) features[i] = 2000 + (i * 7919) % 6000;
   const AllPairs all = MakeAllPairs(features);
   const double costliest_pair = *std::max_element(all.pair_costs.begin(), all.pair_costs.end());
-  const double costliest_image =
-      *std::max_element(all.image_costs.begin(), all.image_costs.end());
+  const double costliest_image = *std::max_element(all.image_costs.begin(), all.image_costs.end());
   for (const int count : {1, 4, 16, 32}) {
     const std::vector<int> shard_of =
         AssignPairsToShards(all.pairs, all.pair_costs, all.image_costs, count);

@@ -259,7 +259,8 @@ class FlannMatcher : public Matcher {
         reader.Get<int>("random_seed", options_.random_seed, 0, std::numeric_limits<int>::max());
     options_.index_cache_size =
         reader.Get<int>("index_cache_size", options_.index_cache_size, 0, 1000000);
-    options_.index_cache_mb = reader.Get<int>("index_cache_mb", options_.index_cache_mb, 1, 1000000);
+    options_.index_cache_mb =
+        reader.Get<int>("index_cache_mb", options_.index_cache_mb, 1, 1000000);
     reader.Finish();
     const size_t cache_bytes = static_cast<size_t>(options_.index_cache_mb) << 20;
     kmeans_cache_ =

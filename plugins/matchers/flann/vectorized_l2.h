@@ -77,8 +77,8 @@ float SseL2ToCentre(const uint8_t* a, const Centre* b, size_t size) {
   __m128 sum_low = _mm_setzero_ps(), sum_high = _mm_setzero_ps();
   size_t i = 0;
   for (; i + kLanes <= size; i += kLanes) {
-    const __m128i bytes = _mm_unpacklo_epi8(
-        _mm_loadl_epi64(reinterpret_cast<const __m128i*>(a + i)), zero);
+    const __m128i bytes =
+        _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(a + i)), zero);
     const __m128 a_low = _mm_cvtepi32_ps(_mm_unpacklo_epi16(bytes, zero));
     const __m128 a_high = _mm_cvtepi32_ps(_mm_unpackhi_epi16(bytes, zero));
     __m128 b_low, b_high;

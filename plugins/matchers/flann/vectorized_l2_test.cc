@@ -17,8 +17,8 @@ void ExpectKernelsMatchTheReference(uint32_t seed) {
   std::mt19937 rng(seed);
   std::uniform_int_distribution<int> byte(0, 255);
   std::uniform_real_distribution<double> centre(-10.0, 265.0);
-  for (const size_t size : {size_t{0}, size_t{3}, size_t{8}, size_t{61}, size_t{64},
-                            size_t{128}, size_t{131}}) {
+  for (const size_t size :
+       {size_t{0}, size_t{3}, size_t{8}, size_t{61}, size_t{64}, size_t{128}, size_t{131}}) {
     for (int trial = 0; trial < 200; ++trial) {
       std::vector<uint8_t> a(size);
       std::vector<Centre> b(size);
