@@ -294,9 +294,8 @@ void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
   std::set<camera_t> unrefined;
   for (const auto& [camera_id, report] : by_camera) unrefined.insert(camera_id);
   std::vector<const MapperInput::Pair*> pairs = verified_pairs;
-  for (bool first = true; !unrefined.empty() && !pairs.empty(); first = false) {
+  while (!unrefined.empty() && !pairs.empty()) {
     const Reconstruction model = MapFirstModel(options, run, *cameras, pairs);
-    size_t num_refined = 0;
     for (auto& [camera_id, report] : by_camera) {
       const auto it = model.cameras.find(camera_id);
       if (unrefined.count(camera_id) == 0 || model.images.size() < kMinCalibrationImages ||
@@ -304,7 +303,6 @@ void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
         continue;
       }
       unrefined.erase(camera_id);
-      ++num_refined;
       const Camera& camera = cameras->at(camera_id);
       const double side = static_cast<double>(std::max(camera.width, camera.height));
       const double focal = it->second.MeanFocalLength();
@@ -314,8 +312,8 @@ void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
       report.method = report.method.empty() ? "first model" : report.method + ", first model";
       report.num_images = model.images.size();
     }
-    if (num_refined == 0 && !first) break;
-    // The pairs among images of the cameras still to refine.
+    // The pairs among images of the cameras still to refine; the same pairs as before
+    // (nothing refined) would give the same model again.
     std::vector<const MapperInput::Pair*> remaining;
     for (const MapperInput::Pair* pair : pairs) {
       if (unrefined.count(run.input.images.at(pair->image_id1).camera_id) > 0 &&
@@ -323,7 +321,7 @@ void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
         remaining.push_back(pair);
       }
     }
-    if (remaining.size() == pairs.size()) break;  // the same pairs would give the same model
+    if (remaining.size() == pairs.size()) break;
     pairs = std::move(remaining);
   }
   for (const camera_t camera_id : unrefined) {
