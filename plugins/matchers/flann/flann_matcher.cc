@@ -58,8 +58,8 @@ struct FlannMatchOptions {
   // indexes (0 disables the cache) ...
   int index_cache_size = 100000;
   // ... holding at most this many MiB of descriptors and trees together, least recently
-  // used dropped first (the newest always stays). A build costs about twice a pair's
-  // searches, so a cache that holds every image of a large set pays for its memory
+  // used dropped first (the newest always stays). A build costs about as much as a
+  // pair's searches, so a cache that holds every image of a large set pays for its memory
   // (descriptors alone: 256 KB for 2,000 SIFT features, 1.5 MB for 12,000).
   int index_cache_mb = 1024;
 };
