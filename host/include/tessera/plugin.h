@@ -17,8 +17,8 @@
 // Bumped whenever TesseraPluginInfo, a plugin interface, a type that crosses the
 // boundary or the API of Tessera::io (tessera/io/) changes; the host refuses a plugin
 // built against another version. libtessera_io's SONAME carries this number
-// (libtessera_io.so.3), so a plugin linked against another Tessera::io does not load.
-#define TESSERA_PLUGIN_ABI_VERSION 3
+// (libtessera_io.so.4), so a plugin linked against another Tessera::io does not load.
+#define TESSERA_PLUGIN_ABI_VERSION 4
 
 extern "C" {
 // The info record. `abi_version` stays the first member in every version so that

@@ -79,6 +79,7 @@ PipelineContext LoadContext(const StageOptions& options) {
     context.manifest.camera.known_intrinsics_source = options.camera_K;
   }
   if (!options.masks.empty()) context.manifest.camera.mask_path = options.masks;
+  context.LimitLibraryThreads();
   return context;
 }
 

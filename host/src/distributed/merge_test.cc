@@ -1,8 +1,10 @@
 #include "distributed/merge.h"
 
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <fstream>
+#include <map>
 
 #include "distributed/shard_database.h"
 #include "distributed/sharded_stages.h"
@@ -123,6 +125,39 @@ TEST_F(MergeTest, ShardsMergeIntoWhatOneProcessMakes) {
   MatchShards(2);
   const MergeSummary matching = MergeShards({output(), kMatchStage, std::nullopt});
   EXPECT_EQ(matching.num_pairs, 6u);
+  const Database database(output() / "database.db");
+  EXPECT_EQ(Rows(database, "matches"), matches_);
+  EXPECT_EQ(Rows(database, "geometries"), geometries_);
+}
+
+// The index files of the workspace's matcher cache, with their inode numbers (a file
+// written again gets a new one).
+std::map<std::string, ino_t> CacheFiles(const std::filesystem::path& output) {
+  std::map<std::string, ino_t> files;
+  const std::filesystem::path folder = output / "cache" / "matcher" / "flann";
+  if (!std::filesystem::exists(folder)) return files;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    struct stat status {};
+    EXPECT_EQ(::stat(entry.path().c_str(), &status), 0);
+    files[entry.path().filename().string()] = status.st_ino;
+  }
+  return files;
+}
+
+TEST_F(MergeTest, ExtractionShardsBuildEachIndexOnceAndMatchingShardsReadIt) {
+  // With flann (hierarchical trees over ORB's binary descriptors), each extraction shard
+  // writes the index of every image it detects; the matching shards read them, write
+  // none, and find the matches of one process that builds its own.
+  context_.matcher = testing::LoadBundledPlugin<Matcher>(
+      "matcher", "flann", nlohmann::json::object(), "pipeline.matcher");
+  Single();
+  ExtractShards(3);
+  const auto prepared = CacheFiles(output());
+  EXPECT_EQ(prepared.size(), 4u);
+  MergeShards({output(), kExtractStage, std::nullopt});
+  MatchShards(3);
+  EXPECT_EQ(CacheFiles(output()), prepared);
+  MergeShards({output(), kMatchStage, std::nullopt});
   const Database database(output() / "database.db");
   EXPECT_EQ(Rows(database, "matches"), matches_);
   EXPECT_EQ(Rows(database, "geometries"), geometries_);

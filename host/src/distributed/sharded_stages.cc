@@ -98,12 +98,13 @@ ExtractionSummary RunExtractShard(const PipelineContext& context, const RunOptio
   record.manifest = ManifestFingerprint(context.manifest);
   record.options = ExtractShardOptions(options.image_dir);
   const std::unique_ptr<Database> database = OpenShardDatabase(options.output_dir, record);
+  context.UseWorkspaceCaches(options.output_dir);
   spdlog::info("extract {}: detecting images {}, {}, ... (every {}) into {}", ShardName(shard),
                shard.index, shard.index + shard.count, shard.count, database->path().string());
-  ExtractionSummary summary =
-      ExtractFeatures(options.image_dir, context.manifest, context.detector, database.get(),
-                      WorkspaceScanOptions(options.output_dir, context.manifest), control,
-                      [&](size_t image_index) { return ImageInShard(image_index, shard); });
+  ExtractionSummary summary = ExtractFeatures(
+      options.image_dir, context.manifest, context.detector, database.get(),
+      WorkspaceScanOptions(options.output_dir, context.manifest), control,
+      [&](size_t image_index) { return ImageInShard(image_index, shard); }, &context.matcher);
   if (summary.status == StageStatus::kCompleted) {
     record.images = ImageListFingerprint(database->ReadImageFiles());
     record.complete = true;
@@ -191,6 +192,7 @@ MatchingSummary RunMatchShard(const PipelineContext& context, const RunOptions& 
                ShardName(shard), summary.num_pairs, plan.pairs.size(), todo.size(),
                context.matcher.name(), summary.num_reused, database->path().string());
 
+  context.UseWorkspaceCaches(options.output_dir);
   PairMatchVerifier verifier(context.manifest, context.matcher, plan, descriptors, &source,
                              database.get());
   std::mutex progress_mutex;

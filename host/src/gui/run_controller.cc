@@ -145,6 +145,7 @@ void RunController::Work(RunRequest request) {
   int exit_code = kExitInternalError;
   try {
     const PipelineContext context = PipelineContext::Create(request.manifest_file);
+    context.LimitLibraryThreads();
     const RunResult result = RunPipeline(context, {request.image_dir, request.output_dir}, control);
     num_models = result.summary.map.num_models;
     if (result.status == StageStatus::kCancelled) {

@@ -169,7 +169,8 @@ void WriteImageMetadata(const ImageScan& scan, const std::vector<Image>& images,
 ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const Manifest& manifest,
                                   const PluginInstance<Detector>& detector, Database* database,
                                   const ImageScanOptions& scan_options, const StageControl& control,
-                                  const std::function<bool(size_t)>& select) {
+                                  const std::function<bool(size_t)>& select,
+                                  const PluginInstance<Matcher>* matcher) {
   const Timer timer;
   ExtractionSummary summary;
 
@@ -257,6 +258,8 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
   std::atomic<size_t> done{0};
   std::atomic<size_t> num_features{0};
   std::atomic<size_t> num_failed{0};
+  std::atomic<bool> prepare_failed{false};  // warned once
+  const bool prepare = matcher != nullptr && static_cast<bool>(*matcher);
   const Timer detect_timer;
   ParallelFor(todo.size(), manifest.EffectiveNumThreads(), [&](size_t k) {
     if (control.Cancelled()) return;
@@ -321,6 +324,18 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
       database->WriteKeypoints(image.image_id, features.keypoints);
       database->WriteDescriptors(image.image_id, features.descriptors);
       transaction.Commit();
+    }
+    if (prepare &&
+        !IsQuarantined(matcher->name(), PluginStage::kPrepare, ImageSubject(entry.name))) {
+      try {
+        CallPlugin(matcher->name(), PluginStage::kPrepare, ImageSubject(entry.name),
+                   [&] { (*matcher)->Prepare(features.descriptors); });
+      } catch (const PluginError& error) {
+        if (!prepare_failed.exchange(true)) {
+          spdlog::warn("{}; matching builds what it needs (later such failures are not shown)",
+                       error.what());
+        }
+      }
     }
     num_features += features.keypoints.size();
     const size_t n = ++done;

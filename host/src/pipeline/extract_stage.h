@@ -36,11 +36,17 @@ namespace tessera {
 // `select` (a shard of the images, distributed/): when set, only the images whose index
 // in the scan (natural name order) it accepts are detected; the others are ingested
 // and left without features.
+//
+// `matcher`: when set, it prepares each image's descriptors for matching as soon as they
+// are detected (Matcher::Prepare: the flann matcher writes the image's search index into
+// the workspace's cache), so that this work is done once per image and spread over the
+// extraction shards. A failure there is a warning: matching then builds what it needs.
 ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const Manifest& manifest,
                                   const PluginInstance<Detector>& detector, Database* database,
                                   const ImageScanOptions& scan_options = {},
                                   const StageControl& control = {},
-                                  const std::function<bool(size_t)>& select = {});
+                                  const std::function<bool(size_t)>& select = {},
+                                  const PluginInstance<Matcher>* matcher = nullptr);
 
 // The stage's closing log line.
 void LogExtraction(const ExtractionSummary& summary);

@@ -331,6 +331,11 @@ PairResult PairMatchVerifier::Run(const ImageIndexPair& pair) {
   }
   result.num_putative_matches = matches.size();
   result.num_inlier_matches = geometry.inlier_matches.size();
+  spdlog::debug(
+      "match: {} and {}: {} putative, {} inlier matches; matching {:.4f} s, "
+      "verification {:.4f} s",
+      image1.name, image2.name, result.num_putative_matches, result.num_inlier_matches,
+      result.match_seconds, result.verify_seconds);
   return result;
 }
 

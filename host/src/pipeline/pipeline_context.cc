@@ -1,6 +1,9 @@
 #include "pipeline/pipeline_context.h"
 
+#include <opencv2/core/utility.hpp>
+
 #include "pipeline/match_stage.h"
+#include "plugin/plugin_call.h"
 #include "util/paths.h"
 
 namespace tessera {
@@ -61,6 +64,18 @@ void PipelineContext::Require(const std::string& slot, const std::string& stage)
 }  // namespace tessera
 
 namespace tessera {
+
+void PipelineContext::LimitLibraryThreads() const {
+  cv::setNumThreads(manifest.EffectiveNumThreads());
+}
+
+void PipelineContext::UseWorkspaceCaches(const std::filesystem::path& output_dir) const {
+  if (matcher) {
+    const std::filesystem::path folder = output_dir / "cache" / "matcher" / matcher.name();
+    CallPlugin(matcher.name(), PluginStage::kOptions, "",
+               [&] { matcher->SetCacheFolder(std::filesystem::absolute(folder)); });
+  }
+}
 
 void PipelineContext::CheckPairSelectorDescriptors(DescriptorMetric metric, int dimension) const {
   CheckPairSelectors(manifest, pair_selectors, metric, dimension);

@@ -35,6 +35,17 @@ struct PipelineContext {
   // Throws InputError naming the missing slot when a stage needs it.
   void Require(const std::string& slot, const std::string& stage) const;
 
+  // Holds the libraries that parallelise on their own (OpenCV, inside the detectors) to
+  // the manifest's thread count, so that `--threads N` keeps a run to N cores (a Slurm
+  // task to its --cpus-per-task, and CPU times honest). Process-wide: the CLI and the
+  // GUI call it before a run.
+  void LimitLibraryThreads() const;
+
+  // Points the plugins that keep caches in the workspace at their folders (the
+  // matcher's: OUTPUT/cache/matcher/NAME, Matcher::SetCacheFolder). Every stage that
+  // extracts or matches into `output_dir` calls it first, before any thread starts.
+  void UseWorkspaceCaches(const std::filesystem::path& output_dir) const;
+
   // Asks every pair selector whether it works with descriptors of this metric and width
   // (PairSelector::CheckDescriptors) before any image is read: `tessera run` calls it
   // with the detector's metric (dimension 0: not known before detection); MatchFeatures

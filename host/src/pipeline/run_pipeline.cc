@@ -29,9 +29,10 @@ ExtractionSummary RunExtract(const PipelineContext& context, const RunOptions& o
   context.Require("detector", "extract");
   const auto lock = LockWorkspace(options.output_dir);
   Database database(PrepareWorkspace(options.output_dir));
+  context.UseWorkspaceCaches(options.output_dir);
   return ExtractFeatures(InputImages(context, options), context.manifest, context.detector,
                          &database, WorkspaceScanOptions(options.output_dir, context.manifest),
-                         control);
+                         control, {}, &context.matcher);
 }
 
 MatchingSummary RunMatch(const PipelineContext& context, const RunOptions& options,
@@ -40,6 +41,7 @@ MatchingSummary RunMatch(const PipelineContext& context, const RunOptions& optio
   context.Require("matcher", "match");
   const auto lock = LockWorkspace(options.output_dir);
   Database database(PrepareWorkspace(options.output_dir));
+  context.UseWorkspaceCaches(options.output_dir);
   return MatchFeatures(context.manifest, context.pair_selectors, context.matcher, &database,
                        control);
 }
@@ -70,12 +72,13 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
   const std::filesystem::path database_file = PrepareWorkspace(options.output_dir);
   const auto lock = LockWorkspace(options.output_dir);
   Database database(database_file);
+  context.UseWorkspaceCaches(options.output_dir);
   const std::filesystem::path image_dir = InputImages(context, options);
   RunResult run;
   RunSummary& summary = run.summary;
-  summary.extract =
-      ExtractFeatures(image_dir, context.manifest, context.detector, &database,
-                      WorkspaceScanOptions(options.output_dir, context.manifest), control);
+  summary.extract = ExtractFeatures(image_dir, context.manifest, context.detector, &database,
+                                    WorkspaceScanOptions(options.output_dir, context.manifest),
+                                    control, {}, &context.matcher);
   if (summary.extract.status == StageStatus::kCancelled) {
     run.status = StageStatus::kCancelled;
     return run;

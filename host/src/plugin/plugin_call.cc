@@ -162,6 +162,8 @@ const char* PluginStageName(PluginStage stage) {
       return "export";
     case PluginStage::kTrain:
       return "train";
+    case PluginStage::kPrepare:
+      return "prepare";
   }
   return "call";
 }
@@ -186,6 +188,8 @@ const char* PluginStageActivity(PluginStage stage) {
       return "exporting";
     case PluginStage::kTrain:
       return "training on";
+    case PluginStage::kPrepare:
+      return "preparing";
   }
   return "being called";
 }

@@ -26,7 +26,8 @@ enum class PluginStage {
   kSelectPairs,
   kAdjust,
   kExport,
-  kTrain,  // a pair selector learning from images (tessera vocab)
+  kTrain,    // a pair selector learning from images (tessera vocab)
+  kPrepare,  // a matcher preparing an image's descriptors (Matcher::Prepare)
 };
 
 // "detect", as stored in crash records.

@@ -10,9 +10,9 @@ namespace tessera {
 namespace {
 
 constexpr PluginStage kStages[] = {
-    PluginStage::kLoad,   PluginStage::kCreate, PluginStage::kOptions,
-    PluginStage::kDetect, PluginStage::kMatch,  PluginStage::kSelectPairs,
-    PluginStage::kAdjust, PluginStage::kExport, PluginStage::kTrain};
+    PluginStage::kLoad,  PluginStage::kCreate,      PluginStage::kOptions, PluginStage::kDetect,
+    PluginStage::kMatch, PluginStage::kSelectPairs, PluginStage::kAdjust,  PluginStage::kExport,
+    PluginStage::kTrain, PluginStage::kPrepare};
 
 // Lines "SIGNAL\tplugin\tstage\tsubject"; a line cut short by a crash is skipped.
 std::vector<PluginCrash> ParseCrashes(const std::string& text) {

@@ -21,6 +21,7 @@
 #include <mutex>
 #include <string>
 
+#include "index_files.h"
 #include "tessera/match_filter.h"
 #include "tessera/sdk.h"
 #include "vectorized_l2.h"
@@ -105,22 +106,6 @@ NearestNeighbors Search(const Index& index, const FeatureDescriptors& query, siz
   return neighbors;
 }
 
-// FNV-1a over the descriptor bytes and shape: the cache key of an image's descriptors.
-uint64_t HashDescriptors(const FeatureDescriptors& descriptors) {
-  uint64_t hash = 1469598103934665603ull;
-  auto mix = [&hash](uint64_t value) {
-    hash ^= value;
-    hash *= 1099511628211ull;
-  };
-  mix(static_cast<uint64_t>(descriptors.size()));
-  mix(static_cast<uint64_t>(descriptors.dimension()));
-  mix(static_cast<uint64_t>(descriptors.metric));
-  const uint8_t* bytes = descriptors.data.data();
-  const size_t num_bytes = static_cast<size_t>(descriptors.data.size());
-  for (size_t i = 0; i < num_bytes; ++i) mix(bytes[i]);
-  return hash;
-}
-
 // Indexes of one type built over their own copy of the descriptors (FLANN keeps a
 // pointer to the data), shared by every pair that searches the same image, least
 // recently used evicted first once there are more than `capacity` of them or they hold
@@ -138,12 +123,15 @@ class IndexCache {
              static_cast<size_t>(std::max(0, index->usedMemory()));
     }
   };
-  using Builder = std::function<std::unique_ptr<Index>(const FeatureDescriptors&)>;
+  // Builds (or loads) the index of descriptors with this key; `shared` false: for this
+  // caller alone, without the index files.
+  using Builder = std::function<std::unique_ptr<Index>(
+      const FeatureDescriptors&, const flann_index_files::DescriptorsKey&, bool shared)>;
 
   IndexCache(size_t capacity, size_t max_bytes) : capacity_(capacity), max_bytes_(max_bytes) {}
 
   std::shared_ptr<const Entry> Get(const FeatureDescriptors& descriptors, const Builder& build) {
-    const uint64_t key = HashDescriptors(descriptors);
+    const flann_index_files::DescriptorsKey key = flann_index_files::KeyOf(descriptors);
     std::shared_future<std::shared_ptr<const Entry>> future;
     std::promise<std::shared_ptr<const Entry>> promise;
     bool must_build = false;
@@ -167,7 +155,7 @@ class IndexCache {
       try {
         auto entry = std::make_shared<Entry>();
         entry->descriptors = descriptors;
-        entry->index = build(entry->descriptors);
+        entry->index = build(entry->descriptors, key, /*shared=*/true);
         const size_t bytes = entry->Bytes();
         promise.set_value(std::move(entry));
         std::lock_guard<std::mutex> lock(mutex_);
@@ -194,7 +182,7 @@ class IndexCache {
                     static_cast<size_t>(descriptors.data.size())) != 0) {
       auto own = std::make_shared<Entry>();
       own->descriptors = descriptors;
-      own->index = build(own->descriptors);
+      own->index = build(own->descriptors, key, /*shared=*/false);
       return own;
     }
     return entry;
@@ -202,7 +190,7 @@ class IndexCache {
 
  private:
   struct Slot {
-    uint64_t key;
+    flann_index_files::DescriptorsKey key;
     std::shared_future<std::shared_ptr<const Entry>> future;
     size_t bytes;  // 0 while it is being built
   };
@@ -215,7 +203,7 @@ class IndexCache {
     }
   }
 
-  void Forget(uint64_t key) {
+  void Forget(const flann_index_files::DescriptorsKey& key) {
     std::lock_guard<std::mutex> lock(mutex_);
     entries_.remove_if([this, key](const Slot& slot) {
       if (slot.key != key) return false;
@@ -285,7 +273,72 @@ class FlannMatcher : public Matcher {
     return FilterMatches(options_.filter, forward, backward, descriptors2.size());
   }
 
+  // The deterministic indexes (kmeans, hierarchical) are kept in `folder`: kdtree and lsh
+  // are random, so a file of theirs would not give the matches of a fresh build.
+  void SetCacheFolder(const std::filesystem::path& folder) override {
+    const std::string flann = std::string("flann ") + FLANN_VERSION_ + " format 1 seed " +
+                              std::to_string(options_.random_seed) + " branching " +
+                              std::to_string(options_.branching);
+    kmeans_files_ = flann_index_files::IndexFiles(
+        folder, flann + " kmeans kmeanspp iterations " +
+                    std::to_string(options_.kmeans_iterations) + " distance vectorized_l2");
+    hierarchical_files_ = flann_index_files::IndexFiles(
+        folder, flann + " hierarchical kmeanspp trees " + std::to_string(options_.trees) +
+                    " leaf_max_size " + std::to_string(options_.leaf_max_size));
+  }
+
+  // Builds and writes the index that Match searches for these descriptors, unless its file
+  // is there already. Both directions of a pair search such an index (the cross check
+  // searches image 1's), so every image needs one.
+  void Prepare(const FeatureDescriptors& descriptors) const override {
+    if (descriptors.size() == 0) return;
+    const flann_index_files::DescriptorsKey key = flann_index_files::KeyOf(descriptors);
+    if (descriptors.metric == DescriptorMetric::kL2 && options_.l2_index == "kmeans" &&
+        kmeans_files_.enabled() && !kmeans_files_.Exists(key)) {
+      kmeans_files_.Save(key, *Build<KMeansL2Index>(descriptors, KMeansParams(), true));
+    } else if (descriptors.metric == DescriptorMetric::kHamming &&
+               options_.hamming_index == "hierarchical" && hierarchical_files_.enabled() &&
+               !hierarchical_files_.Exists(key)) {
+      hierarchical_files_.Save(
+          key, *Build<HierarchicalHammingIndex>(descriptors, HierarchicalParams(), true));
+    }
+  }
+
  private:
+  flann::KMeansIndexParams KMeansParams() const {
+    return flann::KMeansIndexParams(options_.branching, options_.kmeans_iterations,
+                                    flann::FLANN_CENTERS_KMEANSPP);
+  }
+
+  flann::HierarchicalClusteringIndexParams HierarchicalParams() const {
+    return flann::HierarchicalClusteringIndexParams(
+        options_.branching, flann::FLANN_CENTERS_KMEANSPP, options_.trees, options_.leaf_max_size);
+  }
+
+  // The index of `data` from its file in `files` when there is a whole one; otherwise
+  // built, and written there (a file that cannot be written only costs a later build).
+  template <typename Index>
+  std::unique_ptr<Index> LoadOrBuild(const FeatureDescriptors& data,
+                                     const flann_index_files::DescriptorsKey& key,
+                                     const flann::IndexParams& params,
+                                     const flann_index_files::IndexFiles* files) const {
+    if (files != nullptr && files->enabled()) {
+      auto index = std::make_unique<Index>(WrapDescriptors(data), params);
+      if (files->Load(key, index.get()) && index->size() == static_cast<size_t>(data.size()) &&
+          index->veclen() == static_cast<size_t>(data.dimension())) {
+        return index;
+      }
+    }
+    auto index = Build<Index>(data, params, /*seeded=*/true);
+    if (files != nullptr && files->enabled()) {
+      try {
+        files->Save(key, *index);
+      } catch (const std::exception&) {
+      }
+    }
+    return index;
+  }
+
   void CheckCompatible(const FeatureDescriptors& descriptors1,
                        const FeatureDescriptors& descriptors2) const {
     CheckDescriptorsMatchable(descriptors1, descriptors2);
@@ -321,18 +374,17 @@ class FlannMatcher : public Matcher {
     if (data.metric == DescriptorMetric::kL2) {
       using Distance = flann::L2<unsigned char>;
       if (options_.l2_index == "kmeans") {
-        const auto build = [this](const FeatureDescriptors& descriptors) {
-          return Build<KMeansL2Index>(
-              descriptors,
-              flann::KMeansIndexParams(options_.branching, options_.kmeans_iterations,
-                                       flann::FLANN_CENTERS_KMEANSPP),
-              /*seeded=*/true);
+        const auto build = [this](const FeatureDescriptors& descriptors,
+                                  const flann_index_files::DescriptorsKey& key, bool shared) {
+          return LoadOrBuild<KMeansL2Index>(descriptors, key, KMeansParams(),
+                                            shared ? &kmeans_files_ : nullptr);
         };
         if (options_.index_cache_size > 0) {
           const auto entry = kmeans_cache_->Get(data, build);
           return Search(*entry->index, query, k, search_params, /*squared_distances=*/true);
         }
-        return Search(*build(data), query, k, search_params, /*squared_distances=*/true);
+        return Search(*build(data, flann_index_files::KeyOf(data), /*shared=*/true), query, k,
+                      search_params, /*squared_distances=*/true);
       }
       const auto index = Build<flann::KDTreeIndex<Distance>>(
           data, flann::KDTreeIndexParams(options_.trees), /*seeded=*/false);
@@ -340,19 +392,17 @@ class FlannMatcher : public Matcher {
     }
     using Distance = flann::Hamming<unsigned char>;
     if (options_.hamming_index == "hierarchical") {
-      const auto build = [this](const FeatureDescriptors& descriptors) {
-        return Build<HierarchicalHammingIndex>(
-            descriptors,
-            flann::HierarchicalClusteringIndexParams(options_.branching,
-                                                     flann::FLANN_CENTERS_KMEANSPP, options_.trees,
-                                                     options_.leaf_max_size),
-            /*seeded=*/true);
+      const auto build = [this](const FeatureDescriptors& descriptors,
+                                const flann_index_files::DescriptorsKey& key, bool shared) {
+        return LoadOrBuild<HierarchicalHammingIndex>(descriptors, key, HierarchicalParams(),
+                                                     shared ? &hierarchical_files_ : nullptr);
       };
       if (options_.index_cache_size > 0) {
         const auto entry = hierarchical_cache_->Get(data, build);
         return Search(*entry->index, query, k, search_params, /*squared_distances=*/false);
       }
-      return Search(*build(data), query, k, search_params, /*squared_distances=*/false);
+      return Search(*build(data, flann_index_files::KeyOf(data), /*shared=*/true), query, k,
+                    search_params, /*squared_distances=*/false);
     }
     const auto index = Build<flann::LshIndex<Distance>>(
         data,
@@ -399,6 +449,8 @@ class FlannMatcher : public Matcher {
   FlannMatchOptions options_;
   std::unique_ptr<IndexCache<KMeansL2Index>> kmeans_cache_;
   std::unique_ptr<IndexCache<HierarchicalHammingIndex>> hierarchical_cache_;
+  flann_index_files::IndexFiles kmeans_files_;  // none until SetCacheFolder
+  flann_index_files::IndexFiles hierarchical_files_;
 };
 
 }  // namespace tessera

@@ -1,6 +1,10 @@
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <map>
 #include <set>
 #include <thread>
 
@@ -265,6 +269,138 @@ TEST(FlannMatcher, AMemoryBoundCacheGivesTheSameMatchesAsFreshIndexes) {
   const std::vector<FeatureMatches> expected = MatchInTurn(fresh, jobs);
   EXPECT_EQ(MatchInThreads(bounded, jobs, 2), expected);
   EXPECT_GT(expected[0].size(), 200u);
+}
+
+// The index files of a folder, with their inode numbers (a rewritten file gets a new one).
+std::map<std::filesystem::path, ino_t> IndexFiles(const std::filesystem::path& folder) {
+  std::map<std::filesystem::path, ino_t> files;
+  if (!std::filesystem::exists(folder)) return files;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    struct stat status {};
+    EXPECT_EQ(::stat(entry.path().c_str(), &status), 0);
+    files[entry.path()] = status.st_ino;
+  }
+  return files;
+}
+
+TEST(FlannMatcher, PreparedIndexFilesGiveTheMatchesOfFreshIndexes) {
+  // Prepare writes one file per image; a matcher of another process (another instance)
+  // reads them instead of building, and finds the same matches, in both directions.
+  const TemporaryDir folder;
+  const SyntheticPair l2 = MakeL2Pair(800, 200, 20, 50);
+  const SyntheticPair binary = MakeHammingPair(800, 200, 20, 51);
+  const auto fresh = Load({{"index_cache_size", 0}});
+  {
+    auto preparing = Load();
+    preparing->SetCacheFolder(folder.path() / "flann");
+    for (const SyntheticPair* pair : {&l2, &binary}) {
+      preparing->Prepare(pair->descriptors1);
+      preparing->Prepare(pair->descriptors2);
+    }
+  }
+  const auto written = IndexFiles(folder.path() / "flann");
+  ASSERT_EQ(written.size(), 4u);
+  for (const auto& [file, inode] : written) EXPECT_EQ(file.extension(), ".flann");
+  for (const auto& options : {nlohmann::json::object(), nlohmann::json{{"index_cache_size", 0}}}) {
+    auto reading = Load(options);
+    reading->SetCacheFolder(folder.path() / "flann");
+    for (const SyntheticPair* pair : {&l2, &binary}) {
+      const FeatureMatches expected = fresh->Match(pair->descriptors1, pair->descriptors2);
+      EXPECT_GT(expected.size(), 150u);
+      EXPECT_EQ(reading->Match(pair->descriptors1, pair->descriptors2), expected);
+      EXPECT_EQ(reading->Match(pair->descriptors2, pair->descriptors1),
+                fresh->Match(pair->descriptors2, pair->descriptors1));
+    }
+  }
+  EXPECT_EQ(IndexFiles(folder.path() / "flann"), written) << "a whole file was written again";
+}
+
+TEST(FlannMatcher, MatchWritesTheIndexFilesPrepareDidNot) {
+  const TemporaryDir folder;
+  const SyntheticPair pair = MakeL2Pair(500, 100, 10, 52);
+  auto matcher = Load();
+  matcher->SetCacheFolder(folder.path());
+  const FeatureMatches matches = matcher->Match(pair.descriptors1, pair.descriptors2);
+  EXPECT_EQ(IndexFiles(folder.path()).size(), 2u);  // image 2's, and image 1's (cross check)
+  EXPECT_EQ(matches, Load({{"index_cache_size", 0}})->Match(pair.descriptors1, pair.descriptors2));
+}
+
+TEST(FlannMatcher, ACorruptOrTruncatedIndexFileIsBuiltAgain) {
+  const TemporaryDir folder;
+  const SyntheticPair pair = MakeL2Pair(600, 200, 10, 53);
+  const FeatureMatches expected =
+      Load({{"index_cache_size", 0}})->Match(pair.descriptors1, pair.descriptors2);
+  auto preparing = Load();
+  preparing->SetCacheFolder(folder.path());
+  preparing->Prepare(pair.descriptors1);
+  preparing->Prepare(pair.descriptors2);
+  auto files = IndexFiles(folder.path());
+  ASSERT_EQ(files.size(), 2u);
+  const std::filesystem::path flipped = files.begin()->first;
+  const std::filesystem::path truncated = std::next(files.begin())->first;
+  const uintmax_t flipped_size = std::filesystem::file_size(flipped);
+  {
+    std::fstream file(flipped, std::ios::in | std::ios::out | std::ios::binary);
+    file.seekp(static_cast<std::streamoff>(flipped_size / 2));
+    file.put('\x5a');
+  }
+  std::filesystem::resize_file(truncated, std::filesystem::file_size(truncated) / 3);
+  auto reading = Load();
+  reading->SetCacheFolder(folder.path());
+  EXPECT_EQ(reading->Match(pair.descriptors1, pair.descriptors2), expected);
+  const auto rewritten = IndexFiles(folder.path());
+  ASSERT_EQ(rewritten.size(), 2u);
+  EXPECT_NE(rewritten.at(flipped), files.at(flipped));
+  EXPECT_NE(rewritten.at(truncated), files.at(truncated));
+  EXPECT_EQ(std::filesystem::file_size(flipped), flipped_size);
+  // The rewritten files are whole: a third matcher reads them without writing.
+  auto third = Load();
+  third->SetCacheFolder(folder.path());
+  EXPECT_EQ(third->Match(pair.descriptors1, pair.descriptors2), expected);
+  EXPECT_EQ(IndexFiles(folder.path()), rewritten);
+}
+
+TEST(FlannMatcher, IndexFilesDependOnTheIndexOptions) {
+  // Other index options give other trees: their files never serve each other.
+  const TemporaryDir folder;
+  const SyntheticPair pair = MakeL2Pair(500, 100, 10, 54);
+  for (const nlohmann::json& options :
+       {nlohmann::json::object(), nlohmann::json{{"branching", 16}},
+        nlohmann::json{{"kmeans_iterations", 3}}, nlohmann::json{{"random_seed", 7}}}) {
+    auto matcher = Load(options);
+    matcher->SetCacheFolder(folder.path());
+    matcher->Prepare(pair.descriptors2);
+  }
+  EXPECT_EQ(IndexFiles(folder.path()).size(), 4u);
+}
+
+TEST(FlannMatcher, PrepareKeepsNothingWithoutAFolderOrForRandomIndexes) {
+  const TemporaryDir folder;
+  const SyntheticPair pair = MakeL2Pair(300, 100, 10, 55);
+  Load()->Prepare(pair.descriptors1);  // no folder: nothing to do, nowhere to write
+  auto kdtree = Load({{"l2_index", "kdtree"}});
+  kdtree->SetCacheFolder(folder.path());
+  kdtree->Prepare(pair.descriptors1);
+  kdtree->Match(pair.descriptors1, pair.descriptors2);
+  EXPECT_TRUE(IndexFiles(folder.path()).empty());
+}
+
+TEST(FlannMatcher, PrepareNamesTheFileItCannotWrite) {
+  const TemporaryDir folder;
+  const std::filesystem::path blocked = folder.path() / "not_a_folder";
+  std::ofstream(blocked) << "a file where the cache folder should be";
+  const SyntheticPair pair = MakeL2Pair(300, 100, 10, 56);
+  auto matcher = Load();
+  matcher->SetCacheFolder(blocked);
+  try {
+    matcher->Prepare(pair.descriptors1);
+    FAIL() << "expected an error";
+  } catch (const std::exception& error) {
+    EXPECT_NE(std::string(error.what()).find(blocked.string()), std::string::npos) << error.what();
+  }
+  // Matching still works, without the files.
+  EXPECT_EQ(matcher->Match(pair.descriptors1, pair.descriptors2),
+            Load({{"index_cache_size", 0}})->Match(pair.descriptors1, pair.descriptors2));
 }
 
 TEST(FlannMatcher, ValidatesOptions) {
