@@ -43,6 +43,14 @@ single_wall=$(echo "$(now) - $single_start" | bc -l)
 single_e=$(cat "$work/single_extract")
 single_m=$(cat "$work/single_match")
 printf "single process: extract %.1f s, match %.1f s (CPU)\n" "$single_e" "$single_m"
+# What a process costs before it does any work (loading libraries and plugins, scanning
+# and ingesting the image list): an extraction shard that owns no image, the least of
+# five runs.
+for k in 1 2 3 4 5; do
+  run "$work/startup" t extract --images "$images" --output "$work/startup$k" --shard 1023/1024
+done
+startup=$(sort -n "$work/startup" | head -1)
+printf "one process with no work (extract --shard 1023/1024, least of 5): %.2f s (CPU)\n" "$startup"
 
 for n in 4 16; do
   out=$work/n$n
@@ -55,15 +63,20 @@ for n in 4 16; do
   [ "$(sqlite3 "$work/single/database.db" "SELECT COUNT(*) FROM two_view_geometries")" = \
     "$(sqlite3 "$out/database.db" "SELECT COUNT(*) FROM two_view_geometries")" ] ||
     { echo "N=$n: not the single run's pairs"; exit 1; }
-  python3 - "$n" "$single_e" "$single_m" "$work/e$n" "$work/m$n" "$work/me$n" "$work/mm$n" <<'PY'
+  python3 - "$n" "$single_e" "$single_m" "$work/e$n" "$work/m$n" "$work/me$n" "$work/mm$n" \
+    "$startup" <<'PY'
 import sys
 n, single_e, single_m = int(sys.argv[1]), float(sys.argv[2]), float(sys.argv[3])
 read = lambda f: [float(x) for x in open(f)]
 e, m, me, mm = read(sys.argv[4]), read(sys.argv[5]), read(sys.argv[6])[0], read(sys.argv[7])[0]
+startup = float(sys.argv[8])
 for name, shards, single, merge in (("extract", e, single_e, me), ("match", m, single_m, mm)):
     mean = sum(shards) / len(shards)
+    # The same without each process's start-up (N of them against the single run's one).
+    work = sum(shards) - n * startup
     print(f"N={n:2d} {name:7s}: shard work {sum(shards):7.1f} s vs single {single:7.1f} s CPU "
-          f"(overhead {100 * (sum(shards) / single - 1):+.1f}%), slowest/mean shard "
+          f"(overhead {100 * (sum(shards) / single - 1):+.1f}%; without start-up "
+          f"{100 * (work / (single - startup) - 1):+.1f}%), slowest/mean shard "
           f"{max(shards) / mean:.2f}, merge {merge:.2f} s")
 def makespan(times, workers):
     loads = [0.0] * workers

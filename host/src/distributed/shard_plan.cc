@@ -65,10 +65,11 @@ bool ImageInShard(size_t image_index, const Shard& shard) {
 }
 
 double PairCost(size_t num_features1, size_t num_features2) {
-  return std::max(1.0, static_cast<double>(num_features1) + static_cast<double>(num_features2));
+  return std::max(1.0,
+                  static_cast<double>(num_features1) + static_cast<double>(num_features2) / 8.0);
 }
 
-double ImageCost(size_t num_features) { return 2.0 * static_cast<double>(num_features); }
+double ImageCost(size_t num_features) { return static_cast<double>(num_features) / 4.0; }
 
 std::vector<int> AssignPairsToShards(const std::vector<std::pair<size_t, size_t>>& pairs,
                                      const std::vector<double>& pair_costs,
@@ -124,22 +125,31 @@ std::vector<int> AssignPairsToShards(const std::vector<std::pair<size_t, size_t>
     return empty ? size_t{0} : run + 1;
   };
 
-  // The smallest limit that needs at most num_shards runs, by bisection between a bound
+  // The smallest limit that needs at most num_blocks runs, by bisection between a bound
   // that needs one run (everything) and one that no run can go below (the mean).
+  const size_t num_blocks = static_cast<size_t>(num_shards) * kBlocksPerShard;
   double high = std::accumulate(pair_costs.begin(), pair_costs.end(), 0.0) +
                 std::accumulate(image_costs.begin(), image_costs.end(), 0.0);
-  double low = high / num_shards;
-  std::vector<int> shard_of(pairs.size(), 0);
-  if (pairs.empty()) return shard_of;
+  double low = high / static_cast<double>(num_blocks);
+  std::vector<int> block_of(pairs.size(), 0);
+  if (pairs.empty()) return block_of;
   for (int step = 0; step < 60 && high - low > 1e-9 * high; ++step) {
     const double middle = 0.5 * (low + high);
-    if (cut(middle, nullptr) <= static_cast<size_t>(num_shards)) {
+    if (cut(middle, nullptr) <= num_blocks) {
       high = middle;
     } else {
       low = middle;
     }
   }
-  cut(high, &shard_of);
+  cut(high, &block_of);
+  // Block b to shard b mod N going forth in even rounds and back in odd ones, so that no
+  // shard always gets the first (or last) block of a round.
+  std::vector<int> shard_of(pairs.size(), 0);
+  for (size_t p = 0; p < pairs.size(); ++p) {
+    const int round = block_of[p] / num_shards;
+    const int place = block_of[p] % num_shards;
+    shard_of[p] = round % 2 == 0 ? place : num_shards - 1 - place;
+  }
   return shard_of;
 }
 
