@@ -9,7 +9,6 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
-#include <opencv2/videoio.hpp>
 #include <optional>
 #include <set>
 
@@ -17,6 +16,7 @@
 #include "tessera/io/file_io.h"
 #include "tessera/options.h"
 #include "util/timer.h"
+#include "video/video_decoder.h"
 
 namespace tessera {
 namespace {
@@ -54,26 +54,9 @@ double MedianFlow(const cv::Mat& flow) {
   return lengths[lengths.size() / 2];
 }
 
-cv::VideoCapture OpenVideo(const fs::path& video) {
-  std::error_code error;
-  if (!fs::is_regular_file(video, error)) {
-    throw InputError(video.string() + ": no such video file");
-  }
-  cv::VideoCapture capture;
-  try {
-    capture.open(video.string(), cv::CAP_FFMPEG);
-  } catch (const cv::Exception&) {
-  }
-  if (!capture.isOpened()) {
-    throw InputError(video.string() +
-                     ": cannot open the video (not a format OpenCV's FFmpeg backend decodes)");
-  }
-  return capture;
-}
-
-double FrameTime(int index, double fps, const cv::VideoCapture& capture) {
+double FrameTime(int index, double fps, const VideoDecoder& decoder) {
   if (fps > 0) return index / fps;
-  return capture.get(cv::CAP_PROP_POS_MSEC) / 1000;
+  return decoder.PositionSeconds();
 }
 
 nlohmann::json Record(const VideoFrames& result, const VideoFrameOptions& options) {
@@ -189,8 +172,8 @@ VideoFrames ExtractVideoFrames(const fs::path& video, const std::string& folder,
   VideoFrames result;
   result.video = video;
   result.folder = folder;
-  cv::VideoCapture capture = OpenVideo(video);
-  result.fps = capture.get(cv::CAP_PROP_FPS);
+  std::unique_ptr<VideoDecoder> decoder = OpenVideoDecoder(video);
+  result.fps = decoder->FramesPerSecond();
   if (!(result.fps > 0 && result.fps < 10000)) result.fps = 0;
 
   Timer decode_timer;
@@ -201,12 +184,7 @@ VideoFrames ExtractVideoFrames(const fs::path& video, const std::string& folder,
   double flow_scale = 1;
   for (int index = 0;; ++index) {
     const Timer read_timer;
-    bool read = false;
-    try {
-      read = capture.read(frame);
-    } catch (const cv::Exception&) {
-      read = false;
-    }
+    const bool read = decoder->Read(&frame);
     decode_seconds += read_timer.ElapsedSeconds();
     if (!read || frame.empty()) break;
     const Timer score_timer;
@@ -219,7 +197,7 @@ VideoFrames ExtractVideoFrames(const fs::path& video, const std::string& folder,
         static_cast<double>(std::max(frame.cols, frame.rows)) / std::max(gray.cols, gray.rows);
     FrameScore score;
     score.index = index;
-    score.time_s = FrameTime(index, result.fps, capture);
+    score.time_s = FrameTime(index, result.fps, *decoder);
     score.sharpness = LocalLaplacianSharpness(gray);
     if (!previous.empty() && previous.size() == gray.size()) {
       flow_estimator->calc(previous, gray, flow);
@@ -256,21 +234,16 @@ VideoFrames ExtractVideoFrames(const fs::path& video, const std::string& folder,
       fs::remove(entry.path(), error);  // an earlier selection's
     }
   }
-  capture = OpenVideo(video);
+  decoder = OpenVideoDecoder(video);
   size_t next = 0;
   for (int index = 0; next < result.selection.selected.size(); ++index) {
     const Timer read_timer;
-    bool read = false;
-    try {
-      read = capture.grab();
-      const bool wanted = read && index == result.frames[result.selection.selected[next]].index;
-      if (wanted) read = capture.retrieve(frame);
-      decode_seconds += read_timer.ElapsedSeconds();
-      if (!read) break;
-      if (!wanted) continue;
-    } catch (const cv::Exception&) {
-      break;
-    }
+    bool read = decoder->Grab();
+    const bool wanted = read && index == result.frames[result.selection.selected[next]].index;
+    if (wanted) read = decoder->Retrieve(&frame);
+    decode_seconds += read_timer.ElapsedSeconds();
+    if (!read) break;
+    if (!wanted) continue;
     std::vector<uchar> bytes;
     cv::imencode(".jpg", frame, bytes, {cv::IMWRITE_JPEG_QUALITY, options.jpeg_quality});
     WriteFileAtomically(frames_dir / result.images[next], std::string(bytes.begin(), bytes.end()));
