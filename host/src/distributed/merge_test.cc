@@ -163,6 +163,24 @@ TEST_F(MergeTest, ExtractionShardsBuildEachIndexOnceAndMatchingShardsReadIt) {
   EXPECT_EQ(Rows(database, "geometries"), geometries_);
 }
 
+TEST_F(MergeTest, AnUnwritableCacheCostsOnlyTheIndexFiles) {
+  // OUTPUT/cache is a file: Prepare fails (one warning), and every image is still
+  // extracted and every pair matched as one process does.
+  context_.matcher = testing::LoadBundledPlugin<Matcher>(
+      "matcher", "flann", nlohmann::json::object(), "pipeline.matcher");
+  Single();
+  std::filesystem::create_directories(output());
+  std::ofstream(output() / "cache") << "not a folder";
+  ExtractShards(2);
+  MergeShards({output(), kExtractStage, std::nullopt});
+  MatchShards(2);
+  MergeShards({output(), kMatchStage, std::nullopt});
+  const Database database(output() / "database.db");
+  EXPECT_EQ(Rows(database, "features"), features_);
+  EXPECT_EQ(Rows(database, "matches"), matches_);
+  EXPECT_EQ(Rows(database, "geometries"), geometries_);
+}
+
 TEST_F(MergeTest, MergingAgainChangesNothing) {
   ExtractShards(2);
   MergeShards({output(), kExtractStage, std::nullopt});

@@ -152,8 +152,7 @@ class IndexFiles {
       if (!out) {
         const std::string reason = std::strerror(errno);
         std::filesystem::remove(temporary, error);
-        throw std::runtime_error(temporary.string() + ": cannot write a search index (" + reason +
-                                 ")");
+        throw std::runtime_error(file.string() + ": cannot write a search index (" + reason + ")");
       }
     }
     std::filesystem::rename(temporary, file, error);
