@@ -10,10 +10,10 @@
 #  - measured: N = 2 shards run side by side (2 workers on this machine), merges
 #    included, against the single run's wall-clock time.
 # Shard and single-run times are CPU seconds (user + system) of each process, one thread
-# each, so that other work on the machine hardly changes them; the two-worker figure is
-# wall-clock time and needs an idle machine.
-# All of fox with one thread per process takes about an hour here; IMAGES may be a
-# subset (the figures in distributed/README.md are for its first 20 images).
+# each (OpenCV's too), so that they add up to the work done; on a shared virtual machine
+# they still vary by several percent between runs, and other work beside them inflates
+# them. The two-worker figure is wall-clock time and needs an idle machine.
+# All of fox takes about 11 minutes here; IMAGES may be a subset.
 # usage: slurm_shards.sh TESSERA [IMAGES] [MANIFEST]
 set -euo pipefail
 tessera=$1
