@@ -62,10 +62,10 @@ TEST(PluginLoader, RefusesAnotherAbiVersionNamingBothNumbers) {
 }
 
 TEST(PluginLoader, RefusesAPluginBuiltAgainstAbiOne) {
-  ASSERT_EQ(kPluginAbiVersion, 3u);
+  ASSERT_EQ(kPluginAbiVersion, 4u);
   const auto file = File("abi_one", "abi_one");
   EXPECT_EQ(InspectPluginFile(file).refusal,
-            file.string() + ": wrong plugin ABI version: got version 1, supported version is 3");
+            file.string() + ": wrong plugin ABI version: got version 1, supported version is 4");
   const PluginRegistry registry = PluginRegistry::Discover({kRoot / "abi_one"});
   EXPECT_TRUE(registry.NamesOfKind("pair_selector").empty());
 }
