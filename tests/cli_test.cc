@@ -364,5 +364,62 @@ TEST(Cli, ASecondWriterOfAWorkspaceIsRefusedNamingTheFirst) {
   EXPECT_FALSE(std::filesystem::exists(workspace / "database.db"));
 }
 
+// An image folder that is the output folder, or lies where models are replaced, is
+// refused before anything is written: the photos stay as they were, and no lock or
+// database is left among them.
+TEST(Cli, AnImageFolderInTheOutputsPlaceIsRefusedBeforeAnythingIsWritten) {
+  testing::TemporaryDir dir;
+  const auto images = dir.path() / "out" / "sparse" / "3";
+  std::filesystem::create_directories(images);
+  std::ofstream(images / "a.jpg") << "not really a photo";
+  for (const std::string& verb : {std::string("run"), std::string("extract")}) {
+    const auto inside = RunTessera(verb + " --images " + images.string() + " --output " +
+                                   (dir.path() / "out").string());
+    EXPECT_EQ(inside.exit_code, 2) << inside.output;
+    EXPECT_NE(inside.output.find(images.string() + ": the image folder lies in " +
+                                 (dir.path() / "out" / "sparse").string()),
+              std::string::npos)
+        << inside.output;
+    const auto same =
+        RunTessera(verb + " --images " + images.string() + " --output " + images.string());
+    EXPECT_EQ(same.exit_code, 2) << same.output;
+    EXPECT_NE(same.output.find("the image folder is the output folder of this run"),
+              std::string::npos)
+        << same.output;
+  }
+  EXPECT_TRUE(std::filesystem::exists(images / "a.jpg"));
+  EXPECT_FALSE(std::filesystem::exists(images / ".tessera.lock"));
+  EXPECT_FALSE(std::filesystem::exists(images / "database.db"));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "database.db"));
+}
+
+// The verbs beside the stages take the same lock: `vocab --workspace`, `merge`, and
+// `export` and `eval` of a model in the workspace (or `export` into it).
+TEST(Cli, EveryVerbThatTouchesAWorkspaceTakesItsLock) {
+  testing::TemporaryDir dir;
+  const auto workspace = dir.path() / "out";
+  const WorkspaceLock lock(workspace);
+  WriteSmallTextModel(workspace / "sparse" / "0");
+  WriteSmallTextModel(dir.path() / "model");
+  const std::string model = (workspace / "sparse" / "0").string();
+  for (const std::string& verb :
+       {"vocab --images " + dir.path().string() + " --output " + (dir.path() / "c.bin").string() +
+            " --workspace " + workspace.string(),
+        "merge --output " + workspace.string() + " --stage extract",
+        "export --model " + model + " --format ply --output " + (dir.path() / "e").string(),
+        "export --model " + (dir.path() / "model").string() + " --format ply --output " +
+            workspace.string(),
+        "eval " + model + " " + model}) {
+    const auto result = RunTessera(verb);
+    EXPECT_EQ(result.exit_code, 2) << verb << ": " << result.output;
+    EXPECT_NE(result.output.find("workspace " + workspace.string() + " is in use by process " +
+                                 std::to_string(getpid()) + " (since "),
+              std::string::npos)
+        << verb << ": " << result.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(workspace / "database.db"));
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "e"));
+}
+
 }  // namespace
 }  // namespace tessera

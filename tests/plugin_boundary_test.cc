@@ -57,19 +57,19 @@ void CallFailingPlugin(const std::string& kind, const std::string& how) {
     view.width = view.height = 16;
     view.stride = 16;
     view.data = pixels.data();
-    CallPlugin(detector.name(), PluginStage::kDetect, ImageSubject("a.png"),
-               [&] { return detector->Detect(view); });
+    detector.Call(PluginStage::kDetect, ImageSubject("a.png"),
+                  [&](const Detector& plugin) { return plugin.Detect(view); });
   } else if (kind == "matcher") {
     const auto matcher = registry.Create<Matcher>(kind, name, options, "pipeline.matcher");
-    CallPlugin(matcher.name(), PluginStage::kMatch, PairSubject("a.png", "b.png"),
-               [&] { return matcher->Match({}, {}); });
+    matcher.Call(PluginStage::kMatch, PairSubject("a.png", "b.png"),
+                 [&](const Matcher& plugin) { return plugin.Match({}, {}); });
   } else if (kind == "pair_selector") {
     const auto selector =
         registry.Create<PairSelector>(kind, name, options, "pipeline.pair_selector");
     PairSelectionInput input;
     input.images.resize(3);
-    CallPlugin(selector.name(), PluginStage::kSelectPairs, "3 images",
-               [&] { return selector->SelectPairs(input); });
+    selector.Call(PluginStage::kSelectPairs, "3 images",
+                  [&](const PairSelector& plugin) { return plugin.SelectPairs(input); });
   } else if (kind == "bundle_adjuster") {
     const auto adjuster =
         registry.Create<BundleAdjuster>(kind, name, options, "pipeline.bundle_adjuster");
@@ -77,8 +77,9 @@ void CallFailingPlugin(const std::string& kind, const std::string& how) {
     BundleAdjusterGuard(adjuster).Adjust({}, &reconstruction);
   } else {
     const auto exporter = registry.Create<Exporter>(kind, name, options, "pipeline.exporters[0]");
-    CallPlugin(exporter.name(), PluginStage::kExport, "model 0",
-               [&] { exporter->Export(Reconstruction(), ExportContext()); });
+    exporter.Call(PluginStage::kExport, "model 0", [&](const Exporter& plugin) {
+      plugin.Export(Reconstruction(), ExportContext());
+    });
   }
 }
 
@@ -325,6 +326,44 @@ TEST(PluginBoundaryCli, CrashInDetectIsOneLineAndExit4ThenReportedResumedAndQuar
       << third.output;
   EXPECT_TRUE(Contains(third.output, "[1/1] c.png: 16 features")) << third.output;
   EXPECT_FALSE(Contains(third.output, "[error]")) << third.output;
+}
+
+// Shards open the workspace as one process does (Workspace::OpenShard): a crash in an
+// extraction shard or a matching shard is recorded in the shard's own crash log,
+// reported by the shard run again, and its image or pair quarantined on the second.
+TEST(PluginBoundaryCli, CrashesInShardsAreRecordedAndQuarantinedAsInOneProcess) {
+  testing::TemporaryDir dir;
+  WriteImages(dir.path());
+  const auto crashing = WriteManifest(dir.path(), {{"fail", "segv"}, {"on_width", 48}});
+  const std::string shard = Extract(dir.path(), crashing) + " --shard 0/1";
+  const auto first = RunTessera(shard);
+  EXPECT_EQ(first.exit_code, 4) << first.output;
+  EXPECT_TRUE(
+      std::filesystem::exists(dir.path() / "out" / "shards" / "extract-0-of-1.plugin_crashes.new"));
+  const auto second = RunTessera(shard);
+  EXPECT_EQ(second.exit_code, 4) << second.output;
+  EXPECT_TRUE(Contains(second.output,
+                       "the previous run ended in a crash: plugin 'failing_detector' crashed "
+                       "(SIGSEGV) while detecting image b.png\n"))
+      << second.output;
+  const auto third = RunTessera(shard);
+  EXPECT_EQ(third.exit_code, 0) << third.output;
+  EXPECT_TRUE(Contains(third.output,
+                       "extract: skipping b.png: it crashed detector 'failing_detector' twice"))
+      << third.output;
+  // The workspace's own crash log holds none of it: shards never write it.
+  EXPECT_FALSE(std::filesystem::exists(PluginCrashLog::HistoryFile(dir.path() / "out")));
+
+  // Matching shards: the merged extraction, then a matcher that crashes on every pair.
+  ASSERT_EQ(RunTessera("merge --output " + (dir.path() / "out").string()).exit_code, 0);
+  const auto matcher = WriteManifest(dir.path(), nlohmann::json::object(), {}, {{"fail", "segv"}});
+  const std::string match_shard = "match --output " + (dir.path() / "out").string() +
+                                  " --manifest " + matcher.string() + " --shard 0/1";
+  EXPECT_EQ(RunTessera(match_shard).exit_code, 4);
+  EXPECT_EQ(RunTessera(match_shard).exit_code, 4);
+  const auto quarantined = RunTessera(match_shard);
+  EXPECT_TRUE(Contains(quarantined.output, ": they crashed matcher 'failing_matcher' twice"))
+      << quarantined.output;
 }
 
 TEST(PluginBoundaryCli, AbortInDetectAndCrashInTheFactoryNameThePlugin) {

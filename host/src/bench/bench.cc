@@ -18,6 +18,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -33,6 +34,7 @@
 #include "eval/ground_truth.h"
 #include "pipeline/mapping_summary.h"
 #include "pipeline/run_summary.h"
+#include "pipeline/workspace.h"
 #include "sfm/incremental_pipeline.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
@@ -109,7 +111,10 @@ ChildResult RunChild(const std::vector<std::string>& argv, const fs::path& log) 
   int status = 0;
   struct rusage usage {};
   while (wait4(pid, &status, 0, &usage) < 0) {
-    if (errno != EINTR) throw std::runtime_error("waiting for " + argv[0] + " failed");
+    if (errno != EINTR) {
+      throw InputError(argv[0] + ": cannot wait for the row's process " + std::to_string(pid) +
+                       ": " + std::strerror(errno));
+    }
   }
   result.seconds = timer.ElapsedSeconds();
   result.peak_memory_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss: KiB
@@ -202,7 +207,7 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
                   workspace / "database.db");
     // Only the features are shared: a workspace keeps pairs matched under another pair
     // selector, and those would make this row map pairs its own selector never chose.
-    Database(workspace / "database.db").ClearMatches();
+    Workspace::Open(workspace)->database().ClearMatches();
     row.extract_shared_with = shared_from;
   }
   std::vector<std::string> argv = {fs::read_symlink("/proc/self/exe").string(),

@@ -13,6 +13,7 @@
 #include "distributed/sharded_stages.h"
 #include "distributed/slurm.h"
 #include "pipeline/pipeline_context.h"
+#include "pipeline/workspace.h"
 
 namespace tessera {
 namespace {
@@ -62,12 +63,18 @@ CommandRegistration RegisterMergeCommand(CLI::App& app, const GlobalOptions&) {
                 throw InputError(options->output + "/shards: no shards to merge");
               }
             }
+            std::error_code error;
+            if (!std::filesystem::is_directory(options->output, error)) {
+              throw InputError(options->output + ": no such workspace folder");
+            }
+            Workspace::Options open;
+            open.open_database = false;  // opened by the merge, only when it exists
+            const auto workspace = Workspace::Open(options->output, open);
             for (const std::string& stage : stages) {
               MergeOptions merge;
-              merge.output_dir = options->output;
               merge.stage = stage;
               if (options->shards != 0) merge.num_shards = options->shards;
-              const MergeSummary summary = MergeShards(merge);
+              const MergeSummary summary = MergeShards(*workspace, merge);
               if (summary.already_merged) {
                 spdlog::info("merge: the {} {} shards are already in {}/database.db",
                              summary.num_shards, stage, options->output);

@@ -9,6 +9,7 @@
 #include "cli/exit_codes.h"
 #include "eval/evaluation.h"
 #include "eval/ground_truth.h"
+#include "pipeline/workspace.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
 
@@ -31,6 +32,8 @@ CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions&) {
   sub->add_flag("--json", options->json, "Print JSON instead of a table");
 
   auto run = [options]() {
+    // A model of a workspace is read while no run can rewrite it.
+    const auto workspaces = HoldEnclosingWorkspaces({options->model});
     const Reconstruction model = ReadColmapModel(options->model);
     const auto ground_truth = ReadGroundTruth(options->ground_truth);
     const EvaluationResult result = EvaluateReconstruction(model, ground_truth);

@@ -8,6 +8,7 @@
 
 #include "cli/commands.h"
 #include "cli/exit_codes.h"
+#include "pipeline/workspace.h"
 #include "plugin/plugin_registry.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
@@ -57,6 +58,9 @@ CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions&) {
     const PluginRegistry registry = PluginRegistry::Discover(PluginSearchPath({}));
     PluginInstance<Exporter> exporter =
         registry.Create<Exporter>("exporter", options->format, plugin_options, "exporter");
+    // The workspaces of the model read and of the folder written are held as a stage
+    // holds them: a run in progress refuses the export with the lock's message.
+    const auto workspaces = HoldEnclosingWorkspaces({options->model, options->output});
     const Reconstruction reconstruction = ReadColmapModel(options->model);
 
     ExportContext context;
@@ -64,9 +68,8 @@ CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions&) {
     context.image_dir = options->images;
     context.model_index = options->model_index;
     CreateFolder(context.output_dir);
-    CallPlugin(exporter.name(), PluginStage::kExport,
-               "model " + std::to_string(context.model_index),
-               [&] { exporter->Export(reconstruction, context); });
+    exporter.Call(PluginStage::kExport, "model " + std::to_string(context.model_index),
+                  [&](auto& plugin) { plugin.Export(reconstruction, context); });
 
     const size_t num_observations = NumObservations(reconstruction);
     spdlog::info(

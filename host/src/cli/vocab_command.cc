@@ -6,6 +6,8 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <map>
 
 #include "cli/commands.h"
@@ -14,6 +16,7 @@
 #include "feature/database_feature_reader.h"
 #include "pipeline/extract_stage.h"
 #include "pipeline/pipeline_context.h"
+#include "pipeline/workspace.h"
 #include "plugin/plugin_call.h"
 #include "util/paths.h"
 #include "util/strings.h"
@@ -100,17 +103,20 @@ CommandRegistration RegisterVocabCommand(CLI::App& app, const GlobalOptions&) {
         manifest.exporters.clear();
         PipelineContext context = PipelineContext::Create(std::move(manifest));
         context.Require("detector", "vocab");
-        context.CheckPairSelectorDescriptors(context.detector->Metric(), 0);
+        const DescriptorMetric metric = context.detector.Call(
+            PluginStage::kOptions, "", [](const Detector& detector) { return detector.Metric(); });
+        context.CheckPairSelectorDescriptors(metric, 0);
 
         const bool temporary = options->workspace.empty();
-        std::filesystem::path workspace = options->workspace;
+        std::filesystem::path folder = options->workspace;
         if (temporary) {
           std::string pattern =
               (std::filesystem::temp_directory_path() / "tessera-vocab-XXXXXX").string();
           if (mkdtemp(pattern.data()) == nullptr) {
-            throw std::runtime_error("cannot create a temporary workspace");
+            throw InputError(std::filesystem::path(pattern).parent_path().string() +
+                             ": cannot create a temporary workspace: " + std::strerror(errno));
           }
-          workspace = pattern;
+          folder = pattern;
         }
         struct Cleanup {
           std::filesystem::path dir;
@@ -118,31 +124,25 @@ CommandRegistration RegisterVocabCommand(CLI::App& app, const GlobalOptions&) {
             std::error_code error;
             if (!dir.empty()) std::filesystem::remove_all(dir, error);
           }
-        } cleanup{temporary ? workspace : std::filesystem::path()};
-        std::error_code error;
-        std::filesystem::create_directories(workspace, error);
-        if (error) {
-          throw InputError(workspace.string() +
-                           ": cannot create the workspace folder: " + error.message());
-        }
-
-        Database database(workspace / "database.db");
+        } cleanup{temporary ? folder : std::filesystem::path()};
+        // Opened as every stage opens it: locked, its crash log kept, its folder left out
+        // of the image scan.
+        const auto workspace = Workspace::Open(folder);
         const ExtractionSummary extraction =
-            ExtractFeatures(options->images, context.manifest, context.detector, &database);
+            ExtractFeatures(*workspace, context.MakeExtractSettings(options->images));
+        const Database& database = workspace->database();
         const int dimension = database.DescriptorDimension().value_or(0);
-        context.CheckPairSelectorDescriptors(context.detector->Metric(), dimension);
+        context.CheckPairSelectorDescriptors(metric, dimension);
 
         std::vector<image_t> image_ids;
         PairSelectionInput input = ReadSelectionInput(database, &image_ids);
         input.num_threads = context.manifest.EffectiveNumThreads();
-        const DatabaseFeatureReader reader(&database, image_ids, context.detector->Metric(),
-                                           dimension);
+        const DatabaseFeatureReader reader(&database, image_ids, metric, dimension);
         input.features = &reader;
         const auto& selector = context.pair_selectors.front();
         try {
-          CallPlugin(selector.name(), PluginStage::kTrain,
-                     std::to_string(input.images.size()) + " images",
-                     [&] { selector->Train(input, options->output); });
+          selector.Call(PluginStage::kTrain, std::to_string(input.images.size()) + " images",
+                        [&](PairSelector& plugin) { plugin.Train(input, options->output); });
         } catch (const PluginError& train_error) {
           if (!train_error.input_error()) throw;
           throw InputError(options->images + ": cannot train a codebook: " + train_error.what());
@@ -150,7 +150,7 @@ CommandRegistration RegisterVocabCommand(CLI::App& app, const GlobalOptions&) {
         spdlog::info(
             "vocab: codebook of {} centres trained on {} images ({} features), written to "
             "{}; {:.2f} s",
-            selector->EffectiveOptions().value("codebook_size", 0), extraction.num_images,
+            selector.EffectiveOptions().value("codebook_size", 0), extraction.num_images,
             extraction.num_features, options->output, timer.ElapsedSeconds());
         return static_cast<int>(kExitSuccess);
       }};

@@ -100,14 +100,15 @@ void CopyDatabase(const std::filesystem::path& from, const std::filesystem::path
   if (std::filesystem::exists(wal)) std::filesystem::copy_file(wal, to.string() + "-wal");
 }
 
-MergeSummary MergeExtraction(const std::filesystem::path& output_dir, int count) {
+MergeSummary MergeExtraction(Workspace& workspace, int count) {
+  const std::filesystem::path& output_dir = workspace.folder();
   MergeSummary summary;
   summary.num_shards = count;
   std::vector<OpenShard> shards = OpenShards(output_dir, kExtractStage, count);
   const nlohmann::json merged_record = MergedExtractionRecord(shards);
-  const std::filesystem::path database_file = output_dir / "database.db";
-  if (std::filesystem::exists(database_file)) {
-    const Database existing(database_file);
+  if (std::filesystem::exists(workspace.DatabaseFile())) {
+    workspace.OpenDatabase();
+    const Database& existing = workspace.database();
     if (existing.ReadStageProvenance(kMergedExtractionKey) == merged_record) {
       summary.already_merged = true;
       summary.num_images = existing.ReadNumKeypointsPerImage().size();
@@ -166,30 +167,23 @@ MergeSummary MergeExtraction(const std::filesystem::path& output_dir, int count)
     transaction.Commit();
     summary.num_images = merged.ReadNumKeypointsPerImage().size();
   }
-  // The old database, if it held anything, is kept beside the new one.
-  if (std::filesystem::exists(database_file)) {
-    const std::filesystem::path kept = output_dir / "database.db.before-merge";
-    spdlog::warn("merge: keeping the previous {} as {}", database_file.string(), kept.string());
-    RemoveDatabaseFiles(kept);
-    for (const char* suffix : {"", "-wal", "-shm"}) {
-      const std::filesystem::path from = database_file.string() + suffix;
-      if (std::filesystem::exists(from)) std::filesystem::rename(from, kept.string() + suffix);
-    }
-  }
-  std::filesystem::rename(merging, database_file);
+  // The old database, if there is one, is kept beside the new one.
+  workspace.ReplaceDatabase(merging);
   return summary;
 }
 
-MergeSummary MergeMatching(const std::filesystem::path& output_dir, int count) {
+MergeSummary MergeMatching(Workspace& workspace, int count) {
+  const std::filesystem::path& output_dir = workspace.folder();
   MergeSummary summary;
   summary.num_shards = count;
   const std::vector<OpenShard> shards = OpenShards(output_dir, kMatchStage, count);
-  const std::filesystem::path database_file = output_dir / "database.db";
+  const std::filesystem::path database_file = workspace.DatabaseFile();
   if (!std::filesystem::exists(database_file)) {
     throw InputError(database_file.string() +
                      ": no workspace database; merge the extraction shards first");
   }
-  Database database(database_file);
+  workspace.OpenDatabase();
+  Database& database = workspace.database();
   const ShardRecord& first = shards.front().record;
   if (FeaturesFingerprint(database) != first.images) {
     throw InputError(Describe(kMatchStage, 0, count, shards.front().path) +
@@ -253,17 +247,16 @@ std::optional<int> FindShardCount(const std::filesystem::path& output_dir,
   return *counts.begin();
 }
 
-MergeSummary MergeShards(const MergeOptions& options) {
-  const auto lock = LockWorkspace(options.output_dir);
+MergeSummary MergeShards(Workspace& workspace, const MergeOptions& options) {
   std::optional<int> count = options.num_shards;
-  if (!count) count = FindShardCount(options.output_dir, options.stage);
+  if (!count) count = FindShardCount(workspace.folder(), options.stage);
   if (!count) {
-    throw InputError((options.output_dir / "shards").string() + ": no " + options.stage +
+    throw InputError((workspace.folder() / "shards").string() + ": no " + options.stage +
                      " shards to merge");
   }
   if (*count < 1) throw InputError("--shards " + std::to_string(*count) + ": must be at least 1");
-  return options.stage == kExtractStage ? MergeExtraction(options.output_dir, *count)
-                                        : MergeMatching(options.output_dir, *count);
+  return options.stage == kExtractStage ? MergeExtraction(workspace, *count)
+                                        : MergeMatching(workspace, *count);
 }
 
 }  // namespace tessera

@@ -15,6 +15,8 @@
 #include <optional>
 #include <string>
 
+#include "pipeline/workspace.h"
+
 namespace tessera {
 
 // database.db's record of the extraction shards it was merged from (tessera_stages):
@@ -22,7 +24,6 @@ namespace tessera {
 inline constexpr const char* kMergedExtractionKey = "tessera_merged_extraction";
 
 struct MergeOptions {
-  std::filesystem::path output_dir;
   std::string stage;              // kExtractStage or kMatchStage
   std::optional<int> num_shards;  // N; nullopt: the N of the shard files found
 };
@@ -34,9 +35,11 @@ struct MergeSummary {
   size_t num_pairs = 0;         // matching: pairs written from the shards
 };
 
+// Merges the shards of `workspace` (opened by its one writer; its database may be
+// closed: extraction opens it only when it exists, then swaps the merged one in).
 // Throws InputError (nothing changed) for missing, unfinished, corrupt or mismatched
 // shards.
-MergeSummary MergeShards(const MergeOptions& options);
+MergeSummary MergeShards(Workspace& workspace, const MergeOptions& options);
 
 // The N of the STAGE-K-of-N.db files in OUTPUT/shards (nullopt: none). Throws
 // InputError when files of several N are there and `num_shards` does not choose.

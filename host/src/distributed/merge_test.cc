@@ -65,9 +65,17 @@ std::string FileBytes(const std::filesystem::path& path) {
   return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
+// `tessera merge --stage STAGE` on `output`.
+MergeSummary Merge(const std::filesystem::path& output, const std::string& stage) {
+  Workspace::Options open;
+  open.open_database = false;
+  const auto workspace = Workspace::Open(output, open);
+  return MergeShards(*workspace, {stage, std::nullopt});
+}
+
 std::string MergeError(const std::filesystem::path& output, const std::string& stage) {
   try {
-    MergeShards({output, stage, std::nullopt});
+    Merge(output, stage);
   } catch (const InputError& error) {
     return error.what();
   }
@@ -84,9 +92,10 @@ class MergeTest : public ::testing::Test {
   RunOptions run() const { return {images(), output()}; }
 
   void Single() {
-    Database database(dir_.path() / "single.db");
-    ExtractFeatures(images(), context_.manifest, context_.detector, &database);
-    MatchFeatures(context_.manifest, context_.pair_selectors, context_.matcher, &database);
+    const auto workspace = Workspace::Open(dir_.path() / "single");
+    const Database& database = workspace->database();
+    ExtractFeatures(*workspace, context_.MakeExtractSettings(images()));
+    MatchFeatures(*workspace, context_.MakeMatchSettings());
     features_ = Rows(database, "features");
     matches_ = Rows(database, "matches");
     geometries_ = Rows(database, "geometries");
@@ -113,7 +122,7 @@ class MergeTest : public ::testing::Test {
 TEST_F(MergeTest, ShardsMergeIntoWhatOneProcessMakes) {
   Single();
   ExtractShards(3);
-  const MergeSummary extraction = MergeShards({output(), kExtractStage, std::nullopt});
+  const MergeSummary extraction = Merge(output(), kExtractStage);
   EXPECT_EQ(extraction.num_shards, 3);
   EXPECT_EQ(extraction.num_images, 4u);
   EXPECT_FALSE(extraction.already_merged);
@@ -123,7 +132,7 @@ TEST_F(MergeTest, ShardsMergeIntoWhatOneProcessMakes) {
     EXPECT_FALSE(ReadShardRecord(database)) << "shard 0's record came along";
   }
   MatchShards(2);
-  const MergeSummary matching = MergeShards({output(), kMatchStage, std::nullopt});
+  const MergeSummary matching = Merge(output(), kMatchStage);
   EXPECT_EQ(matching.num_pairs, 6u);
   const Database database(output() / "database.db");
   EXPECT_EQ(Rows(database, "matches"), matches_);
@@ -154,10 +163,10 @@ TEST_F(MergeTest, ExtractionShardsBuildEachIndexOnceAndMatchingShardsReadIt) {
   ExtractShards(3);
   const auto prepared = CacheFiles(output());
   EXPECT_EQ(prepared.size(), 4u);
-  MergeShards({output(), kExtractStage, std::nullopt});
+  Merge(output(), kExtractStage);
   MatchShards(3);
   EXPECT_EQ(CacheFiles(output()), prepared);
-  MergeShards({output(), kMatchStage, std::nullopt});
+  Merge(output(), kMatchStage);
   const Database database(output() / "database.db");
   EXPECT_EQ(Rows(database, "matches"), matches_);
   EXPECT_EQ(Rows(database, "geometries"), geometries_);
@@ -172,9 +181,9 @@ TEST_F(MergeTest, AnUnwritableCacheCostsOnlyTheIndexFiles) {
   std::filesystem::create_directories(output());
   std::ofstream(output() / "cache") << "not a folder";
   ExtractShards(2);
-  MergeShards({output(), kExtractStage, std::nullopt});
+  Merge(output(), kExtractStage);
   MatchShards(2);
-  MergeShards({output(), kMatchStage, std::nullopt});
+  Merge(output(), kMatchStage);
   const Database database(output() / "database.db");
   EXPECT_EQ(Rows(database, "features"), features_);
   EXPECT_EQ(Rows(database, "matches"), matches_);
@@ -183,12 +192,12 @@ TEST_F(MergeTest, AnUnwritableCacheCostsOnlyTheIndexFiles) {
 
 TEST_F(MergeTest, MergingAgainChangesNothing) {
   ExtractShards(2);
-  MergeShards({output(), kExtractStage, std::nullopt});
+  Merge(output(), kExtractStage);
   MatchShards(2);
-  MergeShards({output(), kMatchStage, std::nullopt});
+  Merge(output(), kMatchStage);
   const std::string before = Rows(Database(output() / "database.db"), "matches");
-  EXPECT_TRUE(MergeShards({output(), kExtractStage, std::nullopt}).already_merged);
-  EXPECT_EQ(MergeShards({output(), kMatchStage, std::nullopt}).num_pairs, 6u);
+  EXPECT_TRUE(Merge(output(), kExtractStage).already_merged);
+  EXPECT_EQ(Merge(output(), kMatchStage).num_pairs, 6u);
   const Database database(output() / "database.db");
   EXPECT_EQ(Rows(database, "matches"), before);
   EXPECT_EQ(database.NumMatchedPairs(), 6u);
@@ -210,7 +219,7 @@ TEST_F(MergeTest, AShardRunAgainSkipsWhatItFinished) {
   const ExtractionSummary second = RunExtractShard(context_, run(), {0, 1});
   EXPECT_EQ(second.num_reused, 1u);
   EXPECT_EQ(second.num_detected, 3u);
-  MergeShards({output(), kExtractStage, std::nullopt});
+  Merge(output(), kExtractStage);
   MatchShards(2);
   const MatchingSummary again = RunMatchShard(context_, run(), {1, 2});
   EXPECT_EQ(again.num_matched, 0u);
@@ -228,7 +237,7 @@ TEST_F(MergeTest, MissingShardsAreNamedByIndex) {
 
 TEST_F(MergeTest, AShardOfAnotherManifestOptionsOrImageListIsRefusedByName) {
   ExtractShards(2);
-  MergeShards({output(), kExtractStage, std::nullopt});
+  Merge(output(), kExtractStage);
   MatchShards(2);
   const std::string database_bytes = FileBytes(output() / "database.db");
   const auto expect_refused = [&](const std::string& stage, const std::string& what,
@@ -249,13 +258,13 @@ TEST_F(MergeTest, AShardOfAnotherManifestOptionsOrImageListIsRefusedByName) {
   expect_refused(kExtractStage, "another manifest", [](ShardRecord* r) { r->manifest = "x"; });
   expect_refused(kExtractStage, "another image list", [](ShardRecord* r) { r->images = "x"; });
   EXPECT_EQ(FileBytes(output() / "database.db"), database_bytes);
-  MergeShards({output(), kMatchStage, std::nullopt});  // restored: merges
+  Merge(output(), kMatchStage);  // restored: merges
   EXPECT_EQ(Database(output() / "database.db").NumMatchedPairs(), 6u);
 }
 
 TEST_F(MergeTest, ACorruptOrTruncatedShardIsNamedAndDatabaseUntouched) {
   ExtractShards(2);
-  MergeShards({output(), kExtractStage, std::nullopt});
+  Merge(output(), kExtractStage);
   MatchShards(2);
   const std::string database_bytes = FileBytes(output() / "database.db");
   const std::filesystem::path shard = ShardDatabasePath(output(), kMatchStage, {1, 2});

@@ -2,8 +2,6 @@
 
 #include <spdlog/spdlog.h>
 
-#include <atomic>
-#include <mutex>
 #include <optional>
 
 #include "database/database.h"
@@ -14,8 +12,6 @@
 #include "pipeline/match_stage.h"
 #include "pipeline/workspace.h"
 #include "tessera/errors.h"
-#include "util/parallel.h"
-#include "util/timer.h"
 
 namespace tessera {
 namespace {
@@ -50,8 +46,10 @@ std::vector<int> UnfinishedShards(const PipelineContext& context, const RunOptio
   std::string images;
   nlohmann::json shard_options = nlohmann::json::object();
   if (stage == kExtractStage) {
-    const ImageScan scan = ScanImageFolder(
-        options.image_dir, WorkspaceScanOptions(options.output_dir, context.manifest));
+    const ImageScan scan =
+        ScanImageFolder(options.image_dir,
+                        WorkspaceScanOptions(options.output_dir, context.manifest.camera.mask_path,
+                                             context.manifest.max_image_pixels));
     std::vector<Database::ImageFile> files;
     for (const ImageEntry& entry : scan.images) {
       files.push_back({entry.name, std::nullopt, entry.file_size, entry.content_hash, ""});
@@ -92,31 +90,37 @@ nlohmann::json ExtractShardOptions(const std::filesystem::path& image_dir) {
 ExtractionSummary RunExtractShard(const PipelineContext& context, const RunOptions& options,
                                   const Shard& shard, const StageControl& control) {
   context.Require("detector", "extract");
+  CheckImageFolderApart(options.image_dir, options.output_dir);
   ShardRecord record;
   record.stage = kExtractStage;
   record.shard = shard;
   record.manifest = ManifestFingerprint(context.manifest);
   record.options = ExtractShardOptions(options.image_dir);
-  const std::unique_ptr<Database> database = OpenShardDatabase(options.output_dir, record);
-  context.UseWorkspaceCaches(options.output_dir);
+  const auto workspace = Workspace::OpenShard(
+      options.output_dir,
+      ShardDatabasePath(options.output_dir, kExtractStage, shard).stem().string(),
+      [&] { return OpenShardDatabase(options.output_dir, record); });
+  context.UseWorkspaceCaches(*workspace);
   spdlog::info("extract {}: detecting images {}, {}, ... (every {}) into {}", ShardName(shard),
-               shard.index, shard.index + shard.count, shard.count, database->path().string());
-  ExtractionSummary summary = ExtractFeatures(
-      options.image_dir, context.manifest, context.detector, database.get(),
-      WorkspaceScanOptions(options.output_dir, context.manifest), control,
-      [&](size_t image_index) { return ImageInShard(image_index, shard); }, &context.matcher);
+               shard.index, shard.index + shard.count, shard.count,
+               workspace->database().path().string());
+  StageScope scope;
+  scope.name = ShardName(shard);
+  scope.images = [&](size_t image_index) { return ImageInShard(image_index, shard); };
+  ExtractionSummary summary =
+      ExtractFeatures(*workspace, context.MakeExtractSettings(options.image_dir), scope, control);
   if (summary.status == StageStatus::kCompleted) {
-    record.images = ImageListFingerprint(database->ReadImageFiles());
+    Database& database = workspace->database();
+    record.images = ImageListFingerprint(database.ReadImageFiles());
     record.complete = true;
-    record.content = ExtractContent(*database);
-    WriteShardRecord(record, database.get());
+    record.content = ExtractContent(database);
+    WriteShardRecord(record, &database);
   }
   return summary;
 }
 
 MatchingSummary RunMatchShard(const PipelineContext& context, const RunOptions& options,
                               const Shard& shard, const StageControl& control) {
-  const Timer timer;
   context.Require("pair_selector", "match");
   context.Require("matcher", "match");
   const std::filesystem::path source_file = options.output_dir / "database.db";
@@ -136,12 +140,11 @@ MatchingSummary RunMatchShard(const PipelineContext& context, const RunOptions& 
                      " has changes a killed writer did not fold in; run `tessera merge --output " +
                      options.output_dir.string() + "` again, then the matching shards");
   }
-  Database source(source_file, Database::Mode::kReadOnly);
+  const Database source(source_file, Database::Mode::kReadOnly);
+  const MatchSettings settings = context.MakeMatchSettings();
   const WorkspaceDescriptors descriptors = ReadWorkspaceDescriptors(source);
-  CheckPairSelectors(context.manifest, context.pair_selectors, descriptors.metric,
-                     descriptors.dimension);
-  const MatchProvenance provenance =
-      MakeMatchProvenance(context.manifest, context.matcher, descriptors);
+  CheckPairSelectors(settings, descriptors.metric, descriptors.dimension);
+  const MatchProvenance provenance = MakeMatchProvenance(settings, descriptors);
 
   ShardRecord record;
   record.stage = kMatchStage;
@@ -150,81 +153,40 @@ MatchingSummary RunMatchShard(const PipelineContext& context, const RunOptions& 
   record.options = nlohmann::json::object();
   record.images = FeaturesFingerprint(source);
   record.provenance = {{"matches", provenance.matches}, {"geometries", provenance.geometries}};
-  const std::unique_ptr<Database> database = OpenShardDatabase(options.output_dir, record);
+  const auto workspace = Workspace::OpenShard(
+      options.output_dir, ShardDatabasePath(options.output_dir, kMatchStage, shard).stem().string(),
+      [&] { return OpenShardDatabase(options.output_dir, record); });
+  context.UseWorkspaceCaches(*workspace);
 
-  const MatchPlan plan =
-      PlanMatching(context.manifest, context.pair_selectors, context.matcher, descriptors, &source);
-  const std::map<image_t, size_t> num_features = source.ReadNumKeypointsPerImage();
-  const auto features_of = [&](const Image& image) {
-    const auto it = num_features.find(image.image_id);
-    return it == num_features.end() ? size_t{0} : it->second;
-  };
-  std::vector<double> pair_costs, image_costs;
-  for (const auto& [i, j] : plan.pairs) {
-    pair_costs.push_back(PairCost(features_of(plan.images[i]), features_of(plan.images[j])));
-  }
-  for (const Image& image : plan.images) image_costs.push_back(ImageCost(features_of(image)));
-  const std::vector<int> shard_of =
-      AssignPairsToShards(plan.pairs, pair_costs, image_costs, shard.count);
-  // Pairs database.db holds with this run's provenance are done; others are redone.
-  const bool source_current =
-      source.ReadStageProvenance(Database::kMatchesStage) == provenance.matches &&
-      source.ReadStageProvenance(Database::kTwoViewGeometriesStage) == provenance.geometries;
-  MatchingSummary summary;
-  summary.pairs_per_selector = plan.pairs_per_selector;
-  std::vector<ImageIndexPair> todo;
-  for (size_t p = 0; p < plan.pairs.size(); ++p) {
-    if (shard_of[p] != shard.index) continue;
-    ++summary.num_pairs;
-    const image_t id1 = plan.images[plan.pairs[p].first].image_id;
-    const image_t id2 = plan.images[plan.pairs[p].second].image_id;
-    const bool in_source =
-        source_current && source.ExistsMatches(id1, id2) && source.ExistsTwoViewGeometry(id1, id2);
-    const bool in_shard =
-        database->ExistsMatches(id1, id2) && database->ExistsTwoViewGeometry(id1, id2);
-    if (in_source || in_shard) {
-      ++summary.num_reused;
-    } else {
-      todo.push_back(plan.pairs[p]);
+  // The pairs of this shard: cut along the Hilbert curve by their cost (shard_plan.h).
+  StageScope scope;
+  scope.name = ShardName(shard);
+  scope.source = &source;
+  scope.pairs = [&](const std::vector<ImageIndexPair>& pairs, const std::vector<Image>& images) {
+    const std::map<image_t, size_t> num_features = source.ReadNumKeypointsPerImage();
+    const auto features_of = [&](const Image& image) {
+      const auto it = num_features.find(image.image_id);
+      return it == num_features.end() ? size_t{0} : it->second;
+    };
+    std::vector<double> pair_costs, image_costs;
+    for (const auto& [i, j] : pairs) {
+      pair_costs.push_back(PairCost(features_of(images[i]), features_of(images[j])));
     }
-  }
-  spdlog::info("match {}: {} of {} pairs, {} to match with '{}' ({} already done) into {}",
-               ShardName(shard), summary.num_pairs, plan.pairs.size(), todo.size(),
-               context.matcher.name(), summary.num_reused, database->path().string());
-
-  context.UseWorkspaceCaches(options.output_dir);
-  PairMatchVerifier verifier(context.manifest, context.matcher, plan, descriptors, &source,
-                             database.get());
-  std::mutex progress_mutex;
-  size_t done = 0;  // under progress_mutex
-  std::atomic<size_t> putative{0}, inliers{0};
-  std::atomic<int64_t> match_micros{0}, verify_micros{0};
-  if (todo.empty()) control.Report("match", 0, 0);
-  ParallelFor(todo.size(), context.manifest.EffectiveNumThreads(), [&](size_t k) {
-    if (control.Cancelled()) return;
-    const PairResult result = verifier.Run(todo[k]);
-    match_micros += static_cast<int64_t>(result.match_seconds * 1e6);
-    verify_micros += static_cast<int64_t>(result.verify_seconds * 1e6);
-    putative += result.num_putative_matches;
-    inliers += result.num_inlier_matches;
-    std::lock_guard<std::mutex> lock(progress_mutex);
-    control.Report("match", ++done, todo.size());
-  });
-  summary.num_matched = done;
-  summary.num_putative_matches = putative;
-  summary.num_inlier_matches = inliers;
-  summary.num_verified = database->NumVerifiedPairs();
-  summary.match_seconds = match_micros / 1e6;
-  summary.verify_seconds = verify_micros / 1e6;
-  if (done < todo.size()) {
-    summary.status = StageStatus::kCancelled;
-  } else {
+    for (const Image& image : images) image_costs.push_back(ImageCost(features_of(image)));
+    const std::vector<int> shard_of =
+        AssignPairsToShards(pairs, pair_costs, image_costs, shard.count);
+    std::vector<bool> mine(pairs.size());
+    for (size_t p = 0; p < pairs.size(); ++p) mine[p] = shard_of[p] == shard.index;
+    return mine;
+  };
+  MatchingSummary summary = MatchFeatures(*workspace, settings, scope, control);
+  if (summary.status == StageStatus::kCompleted) {
+    Database& database = workspace->database();
     record.complete = true;
     // Nothing else can change a finished shard's pairs: its inputs say it all.
-    record.content = HashText(record.ToJson().dump() + std::to_string(database->NumMatchedPairs()));
-    WriteShardRecord(record, database.get());
+    record.content = HashText(record.ToJson().dump() + std::to_string(database.NumMatchedPairs()));
+    WriteShardRecord(record, &database);
   }
-  summary.seconds = timer.ElapsedSeconds();
   return summary;
 }
 

@@ -4,8 +4,10 @@
 #include <sys/wait.h>
 
 #include <array>
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <memory>
 #include <sstream>
 
@@ -131,7 +133,10 @@ std::vector<std::string> SubmitSlurmScripts(const std::filesystem::path& sbatch,
     if (!ids.empty()) command += " --dependency=afterok:" + ids.back();
     command += " " + ShellQuote(script.path.string()) + " 2>&1";
     std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
-    if (!pipe) throw std::runtime_error("cannot run " + sbatch.string());
+    if (!pipe) {
+      throw InputError(sbatch.string() + ": cannot run it to submit " + script.path.string() +
+                       ": " + std::strerror(errno));
+    }
     std::string output;
     std::array<char, 512> buffer{};
     while (fgets(buffer.data(), buffer.size(), pipe.get()) != nullptr) output += buffer.data();

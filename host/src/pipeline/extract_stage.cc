@@ -7,6 +7,7 @@
 #include <map>
 #include <mutex>
 #include <opencv2/core.hpp>
+#include <optional>
 
 #include "image/camera_assignment.h"
 #include "image/image_io.h"
@@ -23,7 +24,7 @@ namespace {
 nlohmann::json FeaturesProvenance(const PluginInstance<Detector>& detector) {
   nlohmann::json provenance = detector.Provenance();
   provenance["metric"] = DescriptorMetricName(
-      CallPlugin(detector.name(), PluginStage::kOptions, "", [&] { return detector->Metric(); }));
+      detector.Call(PluginStage::kOptions, "", [](auto& plugin) { return plugin.Metric(); }));
   return provenance;
 }
 
@@ -164,47 +165,52 @@ void WriteImageMetadata(const ImageScan& scan, const std::vector<Image>& images,
   }
 }
 
-}  // namespace
-
-ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const Manifest& manifest,
-                                  const PluginInstance<Detector>& detector, Database* database,
-                                  const ImageScanOptions& scan_options, const StageControl& control,
-                                  const std::function<bool(size_t)>& select,
-                                  const PluginInstance<Matcher>* matcher) {
-  const Timer timer;
-  ExtractionSummary summary;
-
-  const ImageScan scan = ScanImageFolder(image_dir, scan_options);
+// Step 1: the usable images of the folder; the entries skipped are logged and counted.
+ImageScan ScanImages(const Workspace& workspace, const ExtractSettings& settings,
+                     ExtractionSummary* summary) {
+  ImageScan scan =
+      ScanImageFolder(settings.image_dir,
+                      workspace.ScanOptions(settings.camera.mask_path, settings.max_image_pixels));
   for (const auto& line : scan.skipped_folders) spdlog::info("extract: {}", line);
   for (const auto& warning : scan.warnings) spdlog::warn("{}", warning);
-  summary.num_images = scan.images.size();
-  summary.num_skipped_files = scan.warnings.size();
+  summary->num_images = scan.images.size();
+  summary->num_skipped_files = scan.warnings.size();
   if (scan.images.size() < 2) {
-    throw InputError(image_dir.string() + ": " + std::to_string(scan.images.size()) +
+    throw InputError(settings.image_dir.string() + ": " + std::to_string(scan.images.size()) +
                      " usable image(s); at least 2 are needed");
   }
+  return scan;
+}
 
+// Step 2: the mask of each image, when there is a mask folder, with a warning for each
+// image that has none.
+ImageMasks FindMasks(const std::filesystem::path& mask_folder, const ImageScan& scan) {
   ImageMasks masks;
-  if (!manifest.camera.mask_path.empty()) {
-    std::vector<std::string> names;
-    for (const ImageEntry& entry : scan.images) names.push_back(entry.name);
-    masks = FindImageMasks(manifest.camera.mask_path, names);
-    if (masks.files.empty()) {
-      spdlog::warn(
-          "extract: the mask folder {} matches none of the {} images (the mask of a/b.jpg is "
-          "a/b.jpg.png or a/b.png); every image is used without a mask",
-          masks.folder.string(), scan.images.size());
-    } else {
-      for (const std::string& name : masks.missing) {
-        spdlog::warn("'{}': no mask in {} (looked for {}.png); used without a mask", name,
-                     masks.folder.string(), name);
-      }
-      spdlog::info("extract: {} of {} images have a mask in {}", masks.files.size(),
-                   scan.images.size(), masks.folder.string());
-    }
+  if (mask_folder.empty()) return masks;
+  std::vector<std::string> names;
+  for (const ImageEntry& entry : scan.images) names.push_back(entry.name);
+  masks = FindImageMasks(mask_folder, names);
+  if (masks.files.empty()) {
+    spdlog::warn(
+        "extract: the mask folder {} matches none of the {} images (the mask of a/b.jpg is "
+        "a/b.jpg.png or a/b.png); every image is used without a mask",
+        masks.folder.string(), scan.images.size());
+    return masks;
   }
+  for (const std::string& name : masks.missing) {
+    spdlog::warn("'{}': no mask in {} (looked for {}.png); used without a mask", name,
+                 masks.folder.string(), name);
+  }
+  spdlog::info("extract: {} of {} images have a mask in {}", masks.files.size(), scan.images.size(),
+               masks.folder.string());
+  return masks;
+}
 
-  nlohmann::json provenance = FeaturesProvenance(detector);
+// Step 3: features made by another detector, other options or other masks are
+// discarded with everything made from them; what this run makes is recorded.
+void RecordProvenance(const ExtractSettings& settings, const ImageMasks& masks,
+                      Database* database) {
+  nlohmann::json provenance = FeaturesProvenance(*settings.detector);
   // Only with masks, so that the provenance of workspaces without them is unchanged.
   if (!masks.files.empty()) provenance["masks"] = masks.digest;
   const auto stored = database->ReadStageProvenance(Database::kFeaturesStage);
@@ -222,54 +228,85 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
   database->WriteStageProvenance(Database::kFeaturesStage, provenance);
   database->WriteStageProvenance(
       Database::kImagesStage,
-      {{"folder", std::filesystem::absolute(image_dir).lexically_normal().string()}});
+      {{"folder", std::filesystem::absolute(settings.image_dir).lexically_normal().string()}});
+}
 
-  const std::map<std::string, std::string> skipped_before =
-      ReconcileImages(scan, database, &summary);
-  const std::vector<Image> images = RegisterImages(scan, manifest.camera, skipped_before, database);
-  WriteImageMetadata(scan, images, database);
+// Step 4: the scan indices of the images to detect now: in scope, usable, without
+// features, and not quarantined.
+std::vector<size_t> PlanDetection(const Workspace& workspace, const ExtractSettings& settings,
+                                  const StageScope& scope, const ImageScan& scan,
+                                  const std::vector<Image>& images,
+                                  const std::map<std::string, std::string>& skipped_before,
+                                  ExtractionSummary* summary) {
+  const std::string& detector = settings.detector->name();
   std::vector<size_t> todo;
   for (size_t i = 0; i < images.size(); ++i) {
-    if (select && !select(i)) continue;  // another shard's image
+    if (scope.images && !scope.images(i)) continue;  // another shard's image
     if (images[i].image_id == kInvalidImageId) {
       spdlog::warn("Skipped '{}' (as in an earlier run, the file is unchanged): {}",
                    scan.images[i].name, skipped_before.at(scan.images[i].name));
-      ++summary.num_failed;
-    } else if (database->ExistsKeypoints(images[i].image_id)) {
-      ++summary.num_reused;
-    } else if (IsQuarantined(detector.name(), PluginStage::kDetect, ImageSubject(images[i].name))) {
+      ++summary->num_failed;
+    } else if (workspace.database().ExistsKeypoints(images[i].image_id)) {
+      ++summary->num_reused;
+    } else if (workspace.IsQuarantined(detector, PluginStage::kDetect,
+                                       ImageSubject(images[i].name))) {
       spdlog::warn("extract: skipping {}: it crashed detector '{}' twice", images[i].name,
-                   detector.name());
+                   detector);
     } else {
       todo.push_back(i);
     }
   }
   spdlog::info("extract: {} images, {} to detect with '{}' ({} already done)", images.size(),
-               todo.size(), detector.name(), summary.num_reused);
+               todo.size(), detector, summary->num_reused);
+  return todo;
+}
 
-  std::mutex database_mutex;
-  std::mutex progress_mutex;
-  size_t processed = 0;  // detected or skipped, under progress_mutex
-  const auto report = [&] {
-    std::lock_guard<std::mutex> lock(progress_mutex);
-    control.Report("extract", ++processed, todo.size());
-  };
-  if (todo.empty()) control.Report("extract", 0, 0);
-  std::atomic<size_t> done{0};
-  std::atomic<size_t> num_features{0};
-  std::atomic<size_t> num_failed{0};
-  std::atomic<bool> prepare_failed{false};  // warned once
-  const bool prepare = matcher != nullptr && static_cast<bool>(*matcher);
-  const Timer detect_timer;
-  ParallelFor(todo.size(), manifest.EffectiveNumThreads(), [&](size_t k) {
-    if (control.Cancelled()) return;
-    const ImageEntry& entry = scan.images[todo[k]];
-    const Image& image = images[todo[k]];
-    // Any failure before mapping skips the image, never the run: the reason is
-    // recorded with the file's hash, so the next run skips it too unless it changes.
-    FeatureSet features;
+// Step 5: decodes and detects images, one Run per image, on any thread. Any failure
+// skips the image, never the run: the reason is recorded with the file's hash, so the
+// next run skips it too unless it changes.
+class ImageDetector {
+ public:
+  ImageDetector(const Workspace& workspace, const ExtractSettings& settings,
+                const ImageMasks& masks)
+      : workspace_(workspace), settings_(settings), masks_(masks) {}
+
+  struct Detection {
+    size_t num_features = 0;
     size_t num_masked = 0;  // keypoints removed by the image's mask
-    std::string failure;
+  };
+
+  // Detects the image of `entry` (database image `image`); nullopt when it was skipped
+  // (and recorded as such).
+  std::optional<Detection> Run(const ImageEntry& entry, const Image& image) {
+    size_t num_masked = 0;
+    FeatureSet features;
+    const std::string failure = Detect(entry, &features, &num_masked);
+    Database& database = workspace_.database();
+    if (!failure.empty()) {
+      spdlog::warn("Skipped '{}': {}", entry.name, failure);
+      std::lock_guard<std::mutex> lock(database_mutex_);
+      Database::Transaction transaction(&database);
+      database.DeleteImage(image.image_id);
+      database.WriteImageFile(
+          {entry.name, std::nullopt, entry.file_size, entry.content_hash, failure});
+      transaction.Commit();
+      return std::nullopt;
+    }
+    {
+      std::lock_guard<std::mutex> lock(database_mutex_);
+      Database::Transaction transaction(&database);
+      database.WriteKeypoints(image.image_id, features.keypoints);
+      database.WriteDescriptors(image.image_id, features.descriptors);
+      transaction.Commit();
+    }
+    Prepare(entry, features);
+    return Detection{features.keypoints.size(), num_masked};
+  }
+
+ private:
+  // The image's features, masked; returns why it cannot be used ("" when it can).
+  std::string Detect(const ImageEntry& entry, FeatureSet* features, size_t* num_masked) const {
+    const PluginInstance<Detector>& detector = *settings_.detector;
     std::string stage;  // "" while decoding
     try {
       const cv::Mat gray = ReadGrayImage(entry.path);
@@ -279,71 +316,105 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
       view.height = gray.rows;
       view.stride = gray.step[0];
       view.data = gray.data;
-      features = CallPlugin(detector.name(), PluginStage::kDetect, ImageSubject(entry.name),
-                            [&] { return detector->Detect(view); });
-      if (features.descriptors.size() != static_cast<Eigen::Index>(features.keypoints.size())) {
-        failure = "detector '" + detector.name() + "' returned " +
-                  std::to_string(features.keypoints.size()) + " keypoints but " +
-                  std::to_string(features.descriptors.size()) + " descriptors";
+      *features = detector.Call(PluginStage::kDetect, ImageSubject(entry.name),
+                                [&](auto& plugin) { return plugin.Detect(view); });
+      if (features->descriptors.size() != static_cast<Eigen::Index>(features->keypoints.size())) {
+        return "detector '" + detector.name() + "' returned " +
+               std::to_string(features->keypoints.size()) + " keypoints but " +
+               std::to_string(features->descriptors.size()) + " descriptors";
       }
-      const auto mask_file = masks.files.find(entry.name);
-      if (failure.empty() && mask_file != masks.files.end()) {
+      const auto mask_file = masks_.files.find(entry.name);
+      if (mask_file != masks_.files.end()) {
         std::string problem;
         if (const auto mask = ReadMask(mask_file->second, gray.cols, gray.rows, &problem)) {
-          num_masked = RemoveMaskedFeatures(*mask, &features);
+          *num_masked = RemoveMaskedFeatures(*mask, features);
         } else {
           spdlog::warn("'{}': {}; used without a mask", entry.name, problem);
         }
       }
+      return "";
     } catch (const PluginError& error) {
-      failure = error.what();  // names the plugin, the stage and the image
+      return error.what();  // names the plugin, the stage and the image
     } catch (const std::exception& error) {
-      failure = error.what();
+      std::string failure = error.what();
       // "PATH: why" from the decoder: the warning names the image once.
       const std::string prefix = entry.path.string() + ": ";
       if (failure.rfind(prefix, 0) == 0) failure = failure.substr(prefix.size());
       const std::string::size_type newline = failure.find('\n');
       if (newline != std::string::npos) failure = failure.substr(0, newline);
-      failure = stage + failure;
+      return stage + failure;
     }
-    if (!failure.empty()) {
-      spdlog::warn("Skipped '{}': {}", entry.name, failure);
-      std::lock_guard<std::mutex> lock(database_mutex);
-      Database::Transaction transaction(database);
-      database->DeleteImage(image.image_id);
-      database->WriteImageFile(
-          {entry.name, std::nullopt, entry.file_size, entry.content_hash, failure});
-      transaction.Commit();
-      ++num_failed;
-      report();
+  }
+
+  // Matcher::Prepare on the new descriptors; a failure is warned about once.
+  void Prepare(const ImageEntry& entry, const FeatureSet& features) {
+    const PluginInstance<Matcher>* matcher = settings_.matcher;
+    if (matcher == nullptr || !*matcher ||
+        workspace_.IsQuarantined(matcher->name(), PluginStage::kPrepare,
+                                 ImageSubject(entry.name))) {
       return;
     }
-    {
-      std::lock_guard<std::mutex> lock(database_mutex);
-      Database::Transaction transaction(database);
-      database->WriteKeypoints(image.image_id, features.keypoints);
-      database->WriteDescriptors(image.image_id, features.descriptors);
-      transaction.Commit();
-    }
-    if (prepare &&
-        !IsQuarantined(matcher->name(), PluginStage::kPrepare, ImageSubject(entry.name))) {
-      try {
-        CallPlugin(matcher->name(), PluginStage::kPrepare, ImageSubject(entry.name),
-                   [&] { (*matcher)->Prepare(features.descriptors); });
-      } catch (const PluginError& error) {
-        if (!prepare_failed.exchange(true)) {
-          spdlog::warn("{}; matching builds what it needs (later such failures are not shown)",
-                       error.what());
-        }
+    try {
+      matcher->Call(PluginStage::kPrepare, ImageSubject(entry.name),
+                    [&](auto& plugin) { plugin.Prepare(features.descriptors); });
+    } catch (const PluginError& error) {
+      if (!prepare_failed_.exchange(true)) {
+        spdlog::warn("{}; matching builds what it needs (later such failures are not shown)",
+                     error.what());
       }
     }
-    num_features += features.keypoints.size();
-    const size_t n = ++done;
-    spdlog::info("extract: [{}/{}] {}: {} features{} ({:.2f} images/s)", n, todo.size(), entry.name,
-                 features.keypoints.size(),
-                 num_masked > 0 ? " (" + std::to_string(num_masked) + " masked out)" : "",
-                 n / std::max(1e-9, detect_timer.ElapsedSeconds()));
-    report();
+  }
+
+  const Workspace& workspace_;
+  const ExtractSettings& settings_;
+  const ImageMasks& masks_;
+  std::mutex database_mutex_;
+  std::atomic<bool> prepare_failed_{false};  // warned once
+};
+
+}  // namespace
+
+ExtractionSummary ExtractFeatures(const Workspace& workspace, const ExtractSettings& settings,
+                                  const StageScope& scope, const StageControl& control) {
+  const Timer timer;
+  ExtractionSummary summary;
+  if (settings.detector == nullptr || !*settings.detector) {
+    throw std::logic_error("ExtractFeatures: no detector");
+  }
+  Database* database = &workspace.database();
+  const ImageScan scan = ScanImages(workspace, settings, &summary);
+  const ImageMasks masks = FindMasks(settings.camera.mask_path, scan);
+  RecordProvenance(settings, masks, database);
+  const std::map<std::string, std::string> skipped_before =
+      ReconcileImages(scan, database, &summary);
+  const std::vector<Image> images = RegisterImages(scan, settings.camera, skipped_before, database);
+  WriteImageMetadata(scan, images, database);
+  const std::vector<size_t> todo =
+      PlanDetection(workspace, settings, scope, scan, images, skipped_before, &summary);
+
+  ImageDetector detector(workspace, settings, masks);
+  std::mutex progress_mutex;
+  size_t processed = 0;  // detected or skipped, under progress_mutex
+  if (todo.empty()) control.Report("extract", 0, 0);
+  std::atomic<size_t> done{0}, num_features{0}, num_failed{0};
+  const Timer detect_timer;
+  ParallelFor(todo.size(), settings.num_threads, [&](size_t k) {
+    if (control.Cancelled()) return;
+    const ImageEntry& entry = scan.images[todo[k]];
+    const std::optional<ImageDetector::Detection> detection = detector.Run(entry, images[todo[k]]);
+    if (detection) {
+      num_features += detection->num_features;
+      const size_t n = ++done;
+      const size_t num_masked = detection->num_masked;
+      spdlog::info("extract: [{}/{}] {}: {} features{} ({:.2f} images/s)", n, todo.size(),
+                   entry.name, detection->num_features,
+                   num_masked > 0 ? " (" + std::to_string(num_masked) + " masked out)" : "",
+                   n / std::max(1e-9, detect_timer.ElapsedSeconds()));
+    } else {
+      ++num_failed;
+    }
+    std::lock_guard<std::mutex> lock(progress_mutex);
+    control.Report("extract", ++processed, todo.size());
   });
   summary.num_failed += num_failed;
   summary.num_detected = done;
@@ -355,7 +426,7 @@ ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const 
     return summary;
   }
   if (scan.images.size() - summary.num_failed < 2) {
-    throw InputError(image_dir.string() + ": " +
+    throw InputError(settings.image_dir.string() + ": " +
                      std::to_string(scan.images.size() - summary.num_failed) +
                      " usable image(s) after " + std::to_string(summary.num_failed) +
                      " could not be decoded or detected; at least 2 are needed");

@@ -1,23 +1,38 @@
 #pragma once
 
 #include <filesystem>
-#include <functional>
 #include <string>
 #include <vector>
 
-#include "database/database.h"
-#include "image/image_io.h"
-#include "manifest/manifest.h"
+#include "image/camera_settings.h"
 #include "pipeline/run_summary.h"
 #include "pipeline/stage_control.h"
+#include "pipeline/stage_scope.h"
+#include "pipeline/workspace.h"
 #include "plugin/plugin_registry.h"
 
 namespace tessera {
 
-// Ingests the images of `image_dir` into the database (cameras from EXIF or the
-// manifest, images in natural order) and detects features in every image that has
-// none yet. Features made by another detector or options are discarded first, with
-// everything that depends on them. Each image is its own transaction, so an
+// What the extract stage needs besides the workspace; PipelineContext fills it from the
+// manifest.
+struct ExtractSettings {
+  std::filesystem::path image_dir;
+  const PluginInstance<Detector>* detector = nullptr;  // required
+  // When set, it prepares each image's descriptors for matching as soon as they are
+  // detected (Matcher::Prepare: the flann matcher writes the image's search index into
+  // the workspace's cache), so that this work is done once per image and spread over
+  // the extraction shards. A failure there is a warning: matching then builds what it
+  // needs.
+  const PluginInstance<Matcher>* matcher = nullptr;
+  CameraSettings camera;  // new cameras; camera.mask_path: the image masks
+  int64_t max_image_pixels = kDefaultMaxImagePixels;
+  int num_threads = 1;
+};
+
+// Ingests the images of `settings.image_dir` into the workspace's database (cameras
+// from EXIF or the settings, images in natural order) and detects features in every
+// image that has none yet. Features made by another detector or options are discarded
+// first, with everything that depends on them. Each image is its own transaction, so an
 // interrupted run resumes where it stopped.
 //
 // The workspace knows its inputs: each image's size and content hash are recorded.
@@ -25,28 +40,20 @@ namespace tessera {
 // again (so it is detected again and its pairs matched again); an image no longer in
 // the folder is removed; a new one is added; each with a log line saying why. An image
 // that cannot be decoded or detected is skipped with a warning naming it and the
-// reason, and recorded, so that later runs skip it too until its file changes.
+// reason, and recorded, so that later runs skip it too until its file changes. An image
+// that crashed the detector twice (the workspace's crash log) is skipped.
 // Throws InputError when the folder has fewer than two usable images.
+//
+// `scope.images` (a shard of the images, distributed/): when set, only the images whose
+// index in the scan (natural name order) it accepts are detected; the others are
+// ingested and left without features.
 //
 // `control`: progress ("extract", images decoded and detected or skipped, images to
 // detect) and cancellation, checked before each image. A cancelled run stops starting
 // images, lets those under way finish and returns status kCancelled: the workspace
 // holds every image ingested and the features of every image detected.
-//
-// `select` (a shard of the images, distributed/): when set, only the images whose index
-// in the scan (natural name order) it accepts are detected; the others are ingested
-// and left without features.
-//
-// `matcher`: when set, it prepares each image's descriptors for matching as soon as they
-// are detected (Matcher::Prepare: the flann matcher writes the image's search index into
-// the workspace's cache), so that this work is done once per image and spread over the
-// extraction shards. A failure there is a warning: matching then builds what it needs.
-ExtractionSummary ExtractFeatures(const std::filesystem::path& image_dir, const Manifest& manifest,
-                                  const PluginInstance<Detector>& detector, Database* database,
-                                  const ImageScanOptions& scan_options = {},
-                                  const StageControl& control = {},
-                                  const std::function<bool(size_t)>& select = {},
-                                  const PluginInstance<Matcher>* matcher = nullptr);
+ExtractionSummary ExtractFeatures(const Workspace& workspace, const ExtractSettings& settings,
+                                  const StageScope& scope = {}, const StageControl& control = {});
 
 // The stage's closing log line.
 void LogExtraction(const ExtractionSummary& summary);

@@ -19,7 +19,8 @@ TEST(ExtractStage, CancelledAfterTwoImagesKeepsThemAndARerunDoesTheRest) {
   testing::WriteSampleImages(dir.path() / "images", 4);
   const testing::CheapPlugins plugins;
   const Manifest manifest = testing::CheapManifest(1);
-  Database database(dir.path() / "database.db");
+  const auto workspace = Workspace::Open(dir.path());
+  Database& database = workspace->database();
 
   CancellationToken token;
   StageControl control;
@@ -28,7 +29,7 @@ TEST(ExtractStage, CancelledAfterTwoImagesKeepsThemAndARerunDoesTheRest) {
     if (done == 2) token.Cancel();
   };
   const ExtractionSummary first =
-      ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database, {}, control);
+      ExtractFeatures(*workspace, plugins.Extract(dir.path() / "images", manifest), {}, control);
   EXPECT_EQ(first.status, StageStatus::kCancelled);
   EXPECT_EQ(first.num_detected, 2u);
   EXPECT_EQ(database.NumImages(), 4u);  // every image is ingested before detection
@@ -41,7 +42,7 @@ TEST(ExtractStage, CancelledAfterTwoImagesKeepsThemAndARerunDoesTheRest) {
   }
 
   const ExtractionSummary second =
-      ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database);
+      ExtractFeatures(*workspace, plugins.Extract(dir.path() / "images", manifest));
   EXPECT_EQ(second.status, StageStatus::kCompleted);
   EXPECT_EQ(second.num_reused, 2u);
   EXPECT_EQ(second.num_detected, 2u);
@@ -53,7 +54,7 @@ TEST(ExtractStage, ProgressIsMonotoneAndEndsAtTotal) {
   testing::WriteSampleImages(dir.path() / "images", 4);
   const testing::CheapPlugins plugins;
   const Manifest manifest = testing::CheapManifest(3);
-  Database database(dir.path() / "database.db");
+  const auto workspace = Workspace::Open(dir.path());
   std::vector<std::pair<size_t, size_t>> calls;
   StageControl control;
   control.progress = [&](const std::string& stage, size_t done, size_t total) {
@@ -61,7 +62,7 @@ TEST(ExtractStage, ProgressIsMonotoneAndEndsAtTotal) {
     calls.emplace_back(done, total);
   };
   const ExtractionSummary summary =
-      ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database, {}, control);
+      ExtractFeatures(*workspace, plugins.Extract(dir.path() / "images", manifest), {}, control);
   EXPECT_EQ(summary.status, StageStatus::kCompleted);
   ASSERT_EQ(calls.size(), 4u);
   for (size_t k = 0; k < calls.size(); ++k) {
@@ -71,7 +72,7 @@ TEST(ExtractStage, ProgressIsMonotoneAndEndsAtTotal) {
 
   // Nothing left to do: one call, (0, 0).
   calls.clear();
-  ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database, {}, control);
+  ExtractFeatures(*workspace, plugins.Extract(dir.path() / "images", manifest), {}, control);
   ASSERT_EQ(calls.size(), 1u);
   EXPECT_EQ(calls[0], std::make_pair(size_t{0}, size_t{0}));
 }
@@ -90,8 +91,9 @@ TEST(ExtractStage, NoKeypointLiesUnderTheBlackHalfOfAMask) {
   std::filesystem::create_directories(dir.path() / "masks");
   cv::imwrite((dir.path() / "masks" / "0001.jpg.png").string(), mask);
   cv::imwrite((dir.path() / "masks" / "0000.png").string(), mask(cv::Rect(0, 0, 100, 100)));
-  Database database(dir.path() / "database.db");
-  ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database);
+  const auto workspace = Workspace::Open(dir.path());
+  Database& database = workspace->database();
+  ExtractFeatures(*workspace, plugins.Extract(dir.path() / "images", manifest));
 
   const auto count_right = [&](const std::string& name, size_t* total) {
     const FeatureKeypoints keypoints =
@@ -111,7 +113,7 @@ TEST(ExtractStage, NoKeypointLiesUnderTheBlackHalfOfAMask) {
   mask.setTo(255);
   cv::imwrite((dir.path() / "masks" / "0001.jpg.png").string(), mask);
   const ExtractionSummary again =
-      ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database);
+      ExtractFeatures(*workspace, plugins.Extract(dir.path() / "images", manifest));
   EXPECT_EQ(again.num_detected, 3u);
   EXPECT_GT(count_right("0001.jpg", &total), 200u);
 }

@@ -72,12 +72,15 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
   return summary;
 }
 
-MapStageSummary MapWorkspace(const PipelineContext& context, Database* database,
-                             const std::filesystem::path& output_dir,
-                             const std::filesystem::path& image_dir_option,
-                             const StageControl& control) {
+MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& settings,
+                             const StageScope& scope, const StageControl& control) {
   const Timer timer;
   MapStageSummary summary;
+  if (settings.bundle_adjuster == nullptr || !scope.IsWhole()) {
+    throw std::logic_error("MapWorkspace: no bundle adjuster, or a scope it cannot map");
+  }
+  Database* database = &workspace.database();
+  const std::filesystem::path& output_dir = workspace.folder();
   const MapperInput input = LoadMapperInput(*database);
   if (input.pairs.empty()) {
     if (!database->ReadStageProvenance(Database::kTwoViewGeometriesStage)) {
@@ -101,8 +104,8 @@ MapStageSummary MapWorkspace(const PipelineContext& context, Database* database,
   };
   if (cancelled()) return summary;
   control.Report("map", 0, 1);
-  const BundleAdjusterGuard bundle_adjuster(context.bundle_adjuster);
-  const IncrementalPipeline mapper(context.mapper_options, bundle_adjuster, context.manifest.seed);
+  const BundleAdjusterGuard bundle_adjuster(*settings.bundle_adjuster);
+  const IncrementalPipeline mapper(settings.mapper, bundle_adjuster, settings.seed);
   MapperObserver observer;
   observer.should_stop = [&control] { return control.Cancelled(); };
   observer.on_model_changed = control.model_changed;
@@ -111,7 +114,7 @@ MapStageSummary MapWorkspace(const PipelineContext& context, Database* database,
   if (cancelled()) return summary;
   control.Report("map", 1, 1);
 
-  const std::filesystem::path image_dir = ImageFolder(image_dir_option, *database);
+  const std::filesystem::path image_dir = ImageFolder(settings.image_dir, *database);
   if (image_dir.empty()) {
     spdlog::warn("map: the image folder is unknown (pass --images); points are not coloured");
   } else {
@@ -125,22 +128,22 @@ MapStageSummary MapWorkspace(const PipelineContext& context, Database* database,
   const std::filesystem::path sparse_dir = output_dir / "sparse";
   RemoveStaleModels(sparse_dir, result.models.size());
   MappingSummary mapping =
-      SummarizeMapping(result, input, sparse_dir, context.mapper_options, context.manifest.seed);
+      SummarizeMapping(result, input, sparse_dir, settings.mapper, settings.seed);
   std::optional<PluginError> first_export_error;
   summary.num_models = result.models.size();
   if (result.models.empty()) control.Report("export", 0, 0);
   for (size_t index = 0; index < result.models.size(); ++index) {
     if (cancelled()) return summary;
     const Reconstruction& model = result.models[index];
-    if (context.exporters.empty()) {
+    if (settings.exporters == nullptr || settings.exporters->empty()) {
       WriteColmapModel(model, sparse_dir / std::to_string(index), ColmapModelFormat::kBinary);
     } else {
       // One failing exporter does not stop the others; the first failure is reported
       // once all have run, so that nothing computed is lost.
-      for (const auto& exporter : context.exporters) {
+      for (const auto& exporter : *settings.exporters) {
         try {
-          CallPlugin(exporter.name(), PluginStage::kExport, "model " + std::to_string(index), [&] {
-            exporter->Export(model, {output_dir, image_dir, static_cast<int>(index)});
+          exporter.Call(PluginStage::kExport, "model " + std::to_string(index), [&](auto& plugin) {
+            plugin.Export(model, {output_dir, image_dir, static_cast<int>(index)});
           });
         } catch (const PluginError& error) {
           spdlog::error("map: {}", error.what());

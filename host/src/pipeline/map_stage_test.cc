@@ -6,6 +6,7 @@
 
 #include "pipeline/extract_stage.h"
 #include "pipeline/match_stage.h"
+#include "pipeline/pipeline_context.h"
 #include "pipeline/stage_test_util.h"
 
 namespace tessera {
@@ -35,9 +36,9 @@ TEST(MapStage, CancelledBeforeMappingTouchesNoOutput) {
   testing::WriteSampleImages(dir.path() / "images", 3);
   const testing::CheapPlugins plugins;
   const Manifest manifest = testing::CheapManifest(2);
-  Database database(dir.path() / "database.db");
-  ExtractFeatures(dir.path() / "images", manifest, plugins.detector, &database);
-  MatchFeatures(manifest, plugins.pair_selectors, plugins.matcher, &database);
+  const auto workspace = Workspace::Open(dir.path());
+  ExtractFeatures(*workspace, plugins.Extract(dir.path() / "images", manifest));
+  MatchFeatures(*workspace, plugins.Match(manifest));
   fs::create_directories(dir.path() / "sparse" / "3");
 
   PipelineContext context;  // no plugin: a cancelled stage must not need one
@@ -48,7 +49,7 @@ TEST(MapStage, CancelledBeforeMappingTouchesNoOutput) {
   size_t num_progress_calls = 0;
   control.progress = [&](const std::string&, size_t, size_t) { ++num_progress_calls; };
   const MapStageSummary summary =
-      MapWorkspace(context, &database, dir.path(), dir.path() / "images", control);
+      MapWorkspace(*workspace, context.MakeMapSettings(dir.path() / "images"), {}, control);
   EXPECT_EQ(summary.status, StageStatus::kCancelled);
   EXPECT_EQ(summary.num_models, 0u);
   EXPECT_EQ(summary.num_images, 3u);

@@ -12,7 +12,7 @@
 
 #include "feature/database_feature_reader.h"
 #include "geometry/two_view_geometry_estimation.h"
-#include "plugin/plugin_crash_log.h"
+#include "plugin/plugin_call.h"
 #include "util/parallel.h"
 #include "util/random.h"
 #include "util/strings.h"
@@ -96,38 +96,25 @@ class LruFeatureCache {
 // About 800 images of 8192 SIFT features (1.2 MB each); more are read again.
 constexpr size_t kFeatureCacheBytes = size_t{1} << 30;
 
-std::string SelectorSource(const Manifest& manifest, size_t index) {
-  return manifest.pair_selectors.at(index).json_path;
-}
-
 // Each selector's pairs and their union: pairs first seen first, each once as
 // (min, max). Throws for an index out of range or a self pair: a broken plugin.
-std::vector<ImageIndexPair> SelectPairs(
-    const Manifest& manifest, const std::vector<PluginInstance<PairSelector>>& pair_selectors,
-    const PairSelectionInput& input, std::vector<SelectorPairs>* per_selector) {
+std::vector<ImageIndexPair> SelectPairs(const MatchSettings& settings,
+                                        const PairSelectionInput& input,
+                                        std::vector<SelectorPairs>* per_selector) {
   const size_t n = input.images.size();
   std::vector<ImageIndexPair> united;
   std::unordered_set<uint64_t> seen;
+  const std::vector<PluginInstance<PairSelector>>& pair_selectors = *settings.pair_selectors;
   for (size_t s = 0; s < pair_selectors.size(); ++s) {
     const auto& selector = pair_selectors[s];
-    const std::string json_path = SelectorSource(manifest, s);
+    const std::string& json_path = settings.pair_selector_paths.at(s);
     std::vector<ImageIndexPair> pairs;
-    const std::string subject = std::to_string(n) + " images";
     try {
-      const PluginCallScope scope(selector.name(), PluginStage::kSelectPairs, subject);
-      pairs = selector->SelectPairs(input);
-    } catch (const OptionError& error) {
-      throw InputError(json_path + ".options" + (error.path().empty() ? "" : "." + error.path()) +
-                       ": " + error.message() + " (pair selector '" + selector.name() + "')");
-    } catch (const InputError& error) {
-      throw InputError(json_path + ": pair selector '" + selector.name() + "': " + error.what());
-    } catch (const std::exception& error) {
-      throw PluginError(selector.name(), PluginStage::kSelectPairs, subject, error.what(),
-                        /*input_error=*/false);
-    } catch (...) {
-      throw PluginError(selector.name(), PluginStage::kSelectPairs, subject,
-                        "it threw an exception that is not a std::exception",
-                        /*input_error=*/false);
+      pairs = selector.Call(PluginStage::kSelectPairs, std::to_string(n) + " images",
+                            [&](auto& plugin) { return plugin.SelectPairs(input); });
+    } catch (const PluginError& error) {
+      if (!error.input_error()) throw;
+      throw error.AsSlotError(json_path, "pair selector '" + selector.name() + "'");
     }
     std::unordered_set<uint64_t> own;
     for (const auto& [i, j] : pairs) {
@@ -149,31 +136,21 @@ std::vector<ImageIndexPair> SelectPairs(
 
 }  // namespace
 
-void CheckPairSelectors(const Manifest& manifest,
-                        const std::vector<PluginInstance<PairSelector>>& pair_selectors,
-                        DescriptorMetric metric, int dimension) {
-  const std::string source = manifest.file.empty() ? "manifest" : manifest.file.string();
+void CheckPairSelectors(const MatchSettings& settings, DescriptorMetric metric, int dimension) {
+  const std::vector<PluginInstance<PairSelector>>& pair_selectors = *settings.pair_selectors;
   for (size_t s = 0; s < pair_selectors.size(); ++s) {
-    const std::string json_path = SelectorSource(manifest, s);
     const std::string name = pair_selectors[s].name();
-    const std::string subject = std::string(DescriptorMetricName(metric)) + " descriptors";
+    const std::string descriptors = std::string(DescriptorMetricName(metric)) + " descriptors";
     try {
-      const PluginCallScope scope(name, PluginStage::kOptions, subject);
-      pair_selectors[s]->CheckDescriptors(metric, dimension);
-    } catch (const OptionError& error) {
-      throw InputError(source + ": " + json_path + ".options" +
-                       (error.path().empty() ? "" : "." + error.path()) + ": " + error.message() +
-                       " (pair selector '" + name + "', " + DescriptorMetricName(metric) +
-                       " descriptors)");
-    } catch (const InputError& error) {
-      throw InputError(source + ": " + json_path + ": pair selector '" + name +
-                       "': " + error.what());
-    } catch (const std::exception& error) {
-      throw PluginError(name, PluginStage::kOptions, subject, error.what(), /*input_error=*/false);
-    } catch (...) {
-      throw PluginError(name, PluginStage::kOptions, subject,
-                        "it threw an exception that is not a std::exception",
-                        /*input_error=*/false);
+      pair_selectors[s].Call(PluginStage::kOptions, descriptors,
+                             [&](auto& plugin) { plugin.CheckDescriptors(metric, dimension); });
+    } catch (const PluginError& error) {
+      if (!error.input_error()) throw;
+      const std::string what = "pair selector '" + name + "'";
+      const InputError slot_error =
+          error.AsSlotError(settings.pair_selector_paths.at(s),
+                            error.option_error() ? what + ", " + descriptors : what);
+      throw InputError(settings.source + ": " + slot_error.what());
     }
   }
 }
@@ -202,21 +179,20 @@ WorkspaceDescriptors ReadWorkspaceDescriptors(const Database& database) {
   return descriptors;
 }
 
-MatchProvenance MakeMatchProvenance(const Manifest& manifest,
-                                    const PluginInstance<Matcher>& matcher,
+MatchProvenance MakeMatchProvenance(const MatchSettings& settings,
                                     const WorkspaceDescriptors& descriptors) {
   MatchProvenance provenance;
   provenance.matches = {{"features", descriptors.features_provenance},
-                        {"matcher", matcher.Provenance()}};
-  nlohmann::json verification = manifest.verification.ToJson();
-  verification["seed"] = manifest.seed;
+                        {"matcher", settings.matcher->Provenance()}};
+  nlohmann::json verification = settings.verification.ToJson();
+  verification["seed"] = settings.seed;
   provenance.geometries = {{"matches", provenance.matches}, {"verification", verification}};
   return provenance;
 }
 
-void InvalidateStaleResults(const Manifest& manifest, const PluginInstance<Matcher>& matcher,
-                            const WorkspaceDescriptors& descriptors, Database* database) {
-  const MatchProvenance provenance = MakeMatchProvenance(manifest, matcher, descriptors);
+void InvalidateStaleResults(const MatchSettings& settings, const WorkspaceDescriptors& descriptors,
+                            Database* database) {
+  const MatchProvenance provenance = MakeMatchProvenance(settings, descriptors);
   const nlohmann::json& matches_provenance = provenance.matches;
   const nlohmann::json& geometries_provenance = provenance.geometries;
   const auto stored_matches = database->ReadStageProvenance(Database::kMatchesStage);
@@ -233,22 +209,23 @@ void InvalidateStaleResults(const Manifest& manifest, const PluginInstance<Match
   database->WriteStageProvenance(Database::kTwoViewGeometriesStage, geometries_provenance);
 }
 
-MatchPlan PlanMatching(const Manifest& manifest,
-                       const std::vector<PluginInstance<PairSelector>>& pair_selectors,
-                       const PluginInstance<Matcher>& matcher,
-                       const WorkspaceDescriptors& descriptors, Database* database) {
+MatchPlan PlanMatching(const Workspace& workspace, const MatchSettings& settings,
+                       const WorkspaceDescriptors& descriptors, const MatchProvenance& provenance,
+                       const StageScope& scope) {
+  const Database& results = workspace.database();
+  const Database& source = scope.source != nullptr ? *scope.source : results;
   MatchPlan plan;
   // Images in capture order: pair selectors such as `sequential` rely on it.
-  plan.images = database->ReadAllImages();
+  plan.images = source.ReadAllImages();
   std::vector<Image>& images = plan.images;
   std::sort(images.begin(), images.end(),
             [](const Image& a, const Image& b) { return NaturalLess(a.name, b.name); });
-  for (const Camera& camera : database->ReadAllCameras()) plan.cameras[camera.camera_id] = camera;
+  for (const Camera& camera : source.ReadAllCameras()) plan.cameras[camera.camera_id] = camera;
   // Workspaces made before metadata was stored have none: selectors see empty metadata.
-  const std::map<image_t, ImageMetadata> metadata = database->ReadAllImageMetadata();
+  const std::map<image_t, ImageMetadata> metadata = source.ReadAllImageMetadata();
 
   PairSelectionInput input;
-  input.num_threads = manifest.EffectiveNumThreads();
+  input.num_threads = settings.num_threads;
   std::vector<image_t> image_ids;
   for (const Image& image : images) {
     PairSelectionImage entry;
@@ -259,19 +236,33 @@ MatchPlan PlanMatching(const Manifest& manifest,
     input.images.push_back(std::move(entry));
     image_ids.push_back(image.image_id);
   }
-  const DatabaseFeatureReader feature_reader(database, image_ids, descriptors.metric,
+  const DatabaseFeatureReader feature_reader(&source, image_ids, descriptors.metric,
                                              descriptors.dimension);
   input.features = &feature_reader;
 
-  plan.pairs = SelectPairs(manifest, pair_selectors, input, &plan.pairs_per_selector);
-  for (const auto& [i, j] : plan.pairs) {
+  plan.pairs = SelectPairs(settings, input, &plan.pairs_per_selector);
+  const std::vector<bool> in_scope =
+      scope.pairs ? scope.pairs(plan.pairs, images) : std::vector<bool>(plan.pairs.size(), true);
+  // Pairs the source holds with this run's provenance are done; others are redone.
+  const bool source_current =
+      &source != &results &&
+      source.ReadStageProvenance(Database::kMatchesStage) == provenance.matches &&
+      source.ReadStageProvenance(Database::kTwoViewGeometriesStage) == provenance.geometries;
+  const std::string& matcher = settings.matcher->name();
+  for (size_t p = 0; p < plan.pairs.size(); ++p) {
+    if (!in_scope.at(p)) continue;
+    ++plan.num_in_scope;
+    const auto [i, j] = plan.pairs[p];
     const image_t id1 = images[i].image_id, id2 = images[j].image_id;
-    if (database->ExistsMatches(id1, id2) && database->ExistsTwoViewGeometry(id1, id2)) {
+    const auto done = [&](const Database& database) {
+      return database.ExistsMatches(id1, id2) && database.ExistsTwoViewGeometry(id1, id2);
+    };
+    if (done(results) || (source_current && done(source))) {
       ++plan.num_reused;
-    } else if (IsQuarantined(matcher.name(), PluginStage::kMatch,
-                             PairSubject(images[i].name, images[j].name))) {
+    } else if (workspace.IsQuarantined(matcher, PluginStage::kMatch,
+                                       PairSubject(images[i].name, images[j].name))) {
       spdlog::warn("match: skipping {} and {}: they crashed matcher '{}' twice", images[i].name,
-                   images[j].name, matcher.name());
+                   images[j].name, matcher);
     } else {
       plan.todo.emplace_back(i, j);
     }
@@ -283,15 +274,14 @@ class PairMatchVerifier::FeatureCache : public LruFeatureCache {
   using LruFeatureCache::LruFeatureCache;
 };
 
-PairMatchVerifier::PairMatchVerifier(const Manifest& manifest,
-                                     const PluginInstance<Matcher>& matcher, const MatchPlan& plan,
-                                     const WorkspaceDescriptors& descriptors, Database* database,
-                                     Database* results)
-    : manifest_(manifest),
-      matcher_(matcher),
+PairMatchVerifier::PairMatchVerifier(const MatchSettings& settings, const MatchPlan& plan,
+                                     const WorkspaceDescriptors& descriptors,
+                                     const Database* features, Database* results)
+    : settings_(settings),
+      matcher_(*settings.matcher),
       plan_(plan),
-      database_(results != nullptr ? results : database),
-      feature_cache_(std::make_unique<FeatureCache>(database, descriptors.metric,
+      database_(results),
+      feature_cache_(std::make_unique<FeatureCache>(features, descriptors.metric,
                                                     descriptors.dimension, kFeatureCacheBytes)) {}
 
 PairMatchVerifier::~PairMatchVerifier() = default;
@@ -309,16 +299,16 @@ PairResult PairMatchVerifier::Run(const ImageIndexPair& pair) {
     std::lock_guard<std::mutex> lock(database_mutex_);
     matches = database_->ReadMatches(image1.image_id, image2.image_id);
   } else {
-    matches =
-        CallPlugin(matcher_.name(), PluginStage::kMatch, PairSubject(image1.name, image2.name),
-                   [&] { return matcher_->Match(features1->descriptors, features2->descriptors); });
+    matches = matcher_.Call(
+        PluginStage::kMatch, PairSubject(image1.name, image2.name),
+        [&](auto& plugin) { return plugin.Match(features1->descriptors, features2->descriptors); });
   }
   result.match_seconds = step.ElapsedSeconds();
   step.Restart();
   const TwoViewGeometry geometry = EstimateTwoViewGeometry(
       plan_.cameras.at(image1.camera_id), features1->keypoints, plan_.cameras.at(image2.camera_id),
-      features2->keypoints, matches, manifest_.verification,
-      DeriveSeed(manifest_.seed, ImagePairToPairId(image1.image_id, image2.image_id)));
+      features2->keypoints, matches, settings_.verification,
+      DeriveSeed(settings_.seed, ImagePairToPairId(image1.image_id, image2.image_id)));
   result.verify_seconds = step.ElapsedSeconds();
   {
     std::lock_guard<std::mutex> lock(database_mutex_);
@@ -339,37 +329,52 @@ PairResult PairMatchVerifier::Run(const ImageIndexPair& pair) {
   return result;
 }
 
-MatchingSummary MatchFeatures(const Manifest& manifest,
-                              const std::vector<PluginInstance<PairSelector>>& pair_selectors,
-                              const PluginInstance<Matcher>& matcher, Database* database,
-                              const StageControl& control) {
-  const Timer timer;
-  MatchingSummary summary;
-  if (pair_selectors.size() != manifest.pair_selectors.size()) {
-    throw std::logic_error("MatchFeatures: " + std::to_string(pair_selectors.size()) +
-                           " pair selectors for " + std::to_string(manifest.pair_selectors.size()) +
-                           " manifest slots");
-  }
-  const WorkspaceDescriptors descriptors = ReadWorkspaceDescriptors(*database);
-  CheckPairSelectors(manifest, pair_selectors, descriptors.metric, descriptors.dimension);
-  InvalidateStaleResults(manifest, matcher, descriptors, database);
-  const MatchPlan plan = PlanMatching(manifest, pair_selectors, matcher, descriptors, database);
-  summary.pairs_per_selector = plan.pairs_per_selector;
-  summary.num_pairs = plan.pairs.size();
-  summary.num_reused = plan.num_reused;
-  const std::vector<ImageIndexPair>& todo = plan.todo;
+namespace {
 
-  // "30 pairs from 'spatial'", or "24 pairs from 'spatial' + 10 from 'sequential' = 30".
+// "30 pairs from 'spatial'", or "24 pairs from 'spatial' + 10 from 'sequential' = 30".
+std::string DescribeChosenPairs(const MatchPlan& plan) {
   std::string chosen;
-  for (const SelectorPairs& selector : summary.pairs_per_selector) {
+  for (const SelectorPairs& selector : plan.pairs_per_selector) {
     chosen += (chosen.empty() ? "" : " + ") + std::to_string(selector.num_pairs) +
               (chosen.empty() ? " pairs" : "") + " from '" + selector.plugin + "'";
   }
-  if (summary.pairs_per_selector.size() > 1) chosen += " = " + std::to_string(plan.pairs.size());
-  spdlog::info("match: {}, {} to match with '{}' ({} already done)", chosen, todo.size(),
-               matcher.name(), summary.num_reused);
+  if (plan.pairs_per_selector.size() > 1) chosen += " = " + std::to_string(plan.pairs.size());
+  return chosen;
+}
 
-  PairMatchVerifier verifier(manifest, matcher, plan, descriptors, database);
+}  // namespace
+
+MatchingSummary MatchFeatures(const Workspace& workspace, const MatchSettings& settings,
+                              const StageScope& scope, const StageControl& control) {
+  const Timer timer;
+  MatchingSummary summary;
+  if (settings.pair_selectors == nullptr || settings.matcher == nullptr ||
+      settings.pair_selectors->size() != settings.pair_selector_paths.size()) {
+    throw std::logic_error("MatchFeatures: incomplete settings");
+  }
+  Database* results = &workspace.database();
+  const Database& source = scope.source != nullptr ? *scope.source : *results;
+  const WorkspaceDescriptors descriptors = ReadWorkspaceDescriptors(source);
+  CheckPairSelectors(settings, descriptors.metric, descriptors.dimension);
+  const MatchProvenance provenance = MakeMatchProvenance(settings, descriptors);
+  // A shard's database is made for one provenance (its record); the merge invalidates.
+  if (scope.source == nullptr) InvalidateStaleResults(settings, descriptors, results);
+  const MatchPlan plan = PlanMatching(workspace, settings, descriptors, provenance, scope);
+  summary.pairs_per_selector = plan.pairs_per_selector;
+  summary.num_pairs = plan.num_in_scope;
+  summary.num_reused = plan.num_reused;
+  const std::vector<ImageIndexPair>& todo = plan.todo;
+  const std::string& matcher = settings.matcher->name();
+  if (scope.name.empty()) {
+    spdlog::info("match: {}, {} to match with '{}' ({} already done)", DescribeChosenPairs(plan),
+                 todo.size(), matcher, summary.num_reused);
+  } else {
+    spdlog::info("match {}: {} of {} pairs, {} to match with '{}' ({} already done) into {}",
+                 scope.name, plan.num_in_scope, plan.pairs.size(), todo.size(), matcher,
+                 summary.num_reused, results->path().string());
+  }
+
+  PairMatchVerifier verifier(settings, plan, descriptors, &source, results);
   std::mutex progress_mutex;
   size_t done = 0;  // under progress_mutex
   std::atomic<size_t> putative{0}, inliers{0};
@@ -377,7 +382,7 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
   const Timer stage_timer;
   const size_t report_every = std::max<size_t>(1, todo.size() / 20);
   if (todo.empty()) control.Report("match", 0, 0);
-  ParallelFor(todo.size(), manifest.EffectiveNumThreads(), [&](size_t k) {
+  ParallelFor(todo.size(), settings.num_threads, [&](size_t k) {
     if (control.Cancelled()) return;
     const PairResult result = verifier.Run(todo[k]);
     match_micros += static_cast<int64_t>(result.match_seconds * 1e6);
@@ -396,7 +401,7 @@ MatchingSummary MatchFeatures(const Manifest& manifest,
   summary.num_matched = done;
   summary.num_putative_matches = putative;
   summary.num_inlier_matches = inliers;
-  summary.num_verified = database->NumVerifiedPairs();
+  summary.num_verified = results->NumVerifiedPairs();
   summary.match_seconds = match_micros / 1e6;
   summary.verify_seconds = verify_micros / 1e6;
   summary.seconds = timer.ElapsedSeconds();

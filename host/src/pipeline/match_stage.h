@@ -14,19 +14,31 @@
 #include <vector>
 
 #include "database/database.h"
-#include "manifest/manifest.h"
+#include "geometry/verification_settings.h"
 #include "pipeline/run_summary.h"
 #include "pipeline/stage_control.h"
+#include "pipeline/stage_scope.h"
+#include "pipeline/workspace.h"
 #include "plugin/plugin_registry.h"
 
 namespace tessera {
 
-// Asks each selector (manifest.pair_selectors[i] made pair_selectors[i]) whether it
-// works with these descriptors (PairSelector::CheckDescriptors); `dimension` 0 when not
-// known yet. Throws InputError naming the manifest and the selector's JSON path.
-void CheckPairSelectors(const Manifest& manifest,
-                        const std::vector<PluginInstance<PairSelector>>& pair_selectors,
-                        DescriptorMetric metric, int dimension);
+// What the match stage needs besides the workspace; PipelineContext fills it from the
+// manifest.
+struct MatchSettings {
+  const std::vector<PluginInstance<PairSelector>>* pair_selectors = nullptr;  // one or more
+  std::vector<std::string> pair_selector_paths;  // each selector's JSON path, for messages
+  const PluginInstance<Matcher>* matcher = nullptr;
+  VerificationSettings verification;
+  uint64_t seed = 0;  // seeds verification's RANSAC, per pair
+  int num_threads = 1;
+  std::string source = "manifest";  // the manifest's file, for messages
+};
+
+// Asks each selector whether it works with these descriptors
+// (PairSelector::CheckDescriptors); `dimension` 0 when not known yet. Throws InputError
+// naming the manifest and the selector's JSON path.
+void CheckPairSelectors(const MatchSettings& settings, DescriptorMetric metric, int dimension);
 
 // The workspace's descriptors: their metric and width (bytes per row; 0 when there
 // are none), and the provenance of the features. Throws InputError when the workspace
@@ -45,8 +57,7 @@ struct MatchProvenance {
   nlohmann::json matches;
   nlohmann::json geometries;
 };
-MatchProvenance MakeMatchProvenance(const Manifest& manifest,
-                                    const PluginInstance<Matcher>& matcher,
+MatchProvenance MakeMatchProvenance(const MatchSettings& settings,
                                     const WorkspaceDescriptors& descriptors);
 
 // Step 1. Matches depend on the features and on how pairs were matched; geometries on
@@ -54,27 +65,30 @@ MatchProvenance MakeMatchProvenance(const Manifest& manifest,
 // field added there is covered) and the seed. Stored results made otherwise are
 // discarded; the provenance of what this run makes is recorded. Pair selection itself
 // only decides which pairs exist, so changing it keeps every pair already matched.
-void InvalidateStaleResults(const Manifest& manifest, const PluginInstance<Matcher>& matcher,
-                            const WorkspaceDescriptors& descriptors, Database* database);
+void InvalidateStaleResults(const MatchSettings& settings, const WorkspaceDescriptors& descriptors,
+                            Database* database);
 
 // What step 2 chose: the workspace's images (in capture order), their cameras, every
-// chosen pair (indices into `images`) and those still to match and verify.
+// chosen pair (indices into `images`) and those of the scope still to match and verify.
 struct MatchPlan {
   std::vector<Image> images;
   std::map<camera_t, Camera> cameras;
   std::vector<ImageIndexPair> pairs;  // united over the selectors, each once as (min, max)
-  std::vector<ImageIndexPair> todo;   // pairs neither done already nor quarantined
+  std::vector<ImageIndexPair> todo;   // pairs of the scope neither done already nor quarantined
   std::vector<SelectorPairs> pairs_per_selector;
-  size_t num_reused = 0;  // pairs with matches and a geometry in the workspace
+  size_t num_in_scope = 0;  // pairs of the scope (all of `pairs` for a whole stage)
+  size_t num_reused = 0;    // pairs of the scope with matches and a geometry already
 };
 
 // Step 2. Selectors get every image in capture order with its camera and stored
 // metadata, and the workspace's features on demand; their pairs are united (each pair
-// once, in the order the selectors gave them, first selector first).
-MatchPlan PlanMatching(const Manifest& manifest,
-                       const std::vector<PluginInstance<PairSelector>>& pair_selectors,
-                       const PluginInstance<Matcher>& matcher,
-                       const WorkspaceDescriptors& descriptors, Database* database);
+// once, in the order the selectors gave them, first selector first). A pair is done
+// when the workspace's database holds its matches and geometry, or (scope.source) when
+// the source holds them with `provenance`; a pair that crashed the matcher twice is
+// skipped.
+MatchPlan PlanMatching(const Workspace& workspace, const MatchSettings& settings,
+                       const WorkspaceDescriptors& descriptors, const MatchProvenance& provenance,
+                       const StageScope& scope = {});
 
 // What step 3 did with one pair.
 struct PairResult {
@@ -89,19 +103,18 @@ struct PairResult {
 // read through a bounded cache, so memory does not grow with the number of images.
 class PairMatchVerifier {
  public:
-  // All four must outlive the verifier. `results` (a shard database, distributed/):
-  // where matches and geometries are looked up and written, features still being read
-  // from `database`; nullptr: `database`.
-  PairMatchVerifier(const Manifest& manifest, const PluginInstance<Matcher>& matcher,
-                    const MatchPlan& plan, const WorkspaceDescriptors& descriptors,
-                    Database* database, Database* results = nullptr);
+  // All must outlive the verifier. Features are read from `features`; matches and
+  // geometries are looked up in and written to `results`.
+  PairMatchVerifier(const MatchSettings& settings, const MatchPlan& plan,
+                    const WorkspaceDescriptors& descriptors, const Database* features,
+                    Database* results);
   ~PairMatchVerifier();
 
   PairResult Run(const ImageIndexPair& pair);
 
  private:
   class FeatureCache;
-  const Manifest& manifest_;
+  const MatchSettings& settings_;
   const PluginInstance<Matcher>& matcher_;
   const MatchPlan& plan_;
   Database* database_;  // where results go
@@ -109,17 +122,19 @@ class PairMatchVerifier {
   std::mutex database_mutex_;
 };
 
-// The three steps in order, on manifest.EffectiveNumThreads() threads. The descriptor
-// metric and the features' provenance come from the database, so the detector need
-// not be loaded. Throws InputError when the database has no features.
+// The three steps in order, on settings.num_threads threads. The descriptor metric and
+// the features' provenance come from the database, so the detector need not be loaded.
+// Throws InputError when the database has no features.
+//
+// `scope` (a matching shard, distributed/): the pairs it owns are matched, with images
+// and features read from scope.source (database.db, read only) and results written to
+// the workspace's database (the shard's); step 1 is left to the merge.
 //
 // `control`: progress ("match", pairs done, pairs to do) and cancellation, checked
 // before each pair. A cancelled run stops starting pairs, lets those under way finish
 // and returns status kCancelled: the workspace holds every pair finished.
-MatchingSummary MatchFeatures(const Manifest& manifest,
-                              const std::vector<PluginInstance<PairSelector>>& pair_selectors,
-                              const PluginInstance<Matcher>& matcher, Database* database,
-                              const StageControl& control = {});
+MatchingSummary MatchFeatures(const Workspace& workspace, const MatchSettings& settings,
+                              const StageScope& scope = {}, const StageControl& control = {});
 
 // The stage's closing log line.
 void LogMatching(const MatchingSummary& summary);

@@ -13,18 +13,19 @@ class MatchStageTest : public ::testing::Test {
  protected:
   void SetUp() override {
     testing::WriteSampleImages(dir_.path() / "images", 4);
-    database_ = std::make_unique<Database>(dir_.path() / "database.db");
-    ExtractFeatures(dir_.path() / "images", testing::CheapManifest(2), plugins_.detector,
-                    database_.get());
+    workspace_ = Workspace::Open(dir_.path());
+    database_ = &workspace_->database();
+    ExtractFeatures(*workspace_,
+                    plugins_.Extract(dir_.path() / "images", testing::CheapManifest(2)));
   }
   MatchingSummary Match(const Manifest& manifest, const StageControl& control = {}) {
-    return MatchFeatures(manifest, plugins_.pair_selectors, plugins_.matcher, database_.get(),
-                         control);
+    return MatchFeatures(*workspace_, plugins_.Match(manifest), {}, control);
   }
 
   testing::TemporaryDir dir_;
   testing::CheapPlugins plugins_;
-  std::unique_ptr<Database> database_;
+  std::unique_ptr<Workspace> workspace_;
+  Database* database_ = nullptr;
 };
 
 TEST_F(MatchStageTest, CancelledAfterThreePairsKeepsThemAndARerunDoesTheRest) {
@@ -65,13 +66,13 @@ TEST_F(MatchStageTest, ProgressIsMonotoneAndEndsAtTotal) {
 }
 
 TEST_F(MatchStageTest, TheThreeStepsOneByOne) {
-  const Manifest manifest = testing::CheapManifest(1);
+  const MatchSettings settings = plugins_.Match(testing::CheapManifest(1));
   const WorkspaceDescriptors descriptors = ReadWorkspaceDescriptors(*database_);
   EXPECT_EQ(descriptors.metric, DescriptorMetric::kHamming);
   EXPECT_EQ(descriptors.dimension, 32);  // ORB: 256 bits
-  InvalidateStaleResults(manifest, plugins_.matcher, descriptors, database_.get());
-  const MatchPlan plan = PlanMatching(manifest, plugins_.pair_selectors, plugins_.matcher,
-                                      descriptors, database_.get());
+  InvalidateStaleResults(settings, descriptors, database_);
+  const MatchProvenance provenance = MakeMatchProvenance(settings, descriptors);
+  const MatchPlan plan = PlanMatching(*workspace_, settings, descriptors, provenance);
   ASSERT_EQ(plan.images.size(), 4u);
   EXPECT_EQ(plan.images.front().name, "0000.jpg");
   EXPECT_EQ(plan.pairs.size(), 6u);
@@ -80,15 +81,14 @@ TEST_F(MatchStageTest, TheThreeStepsOneByOne) {
   EXPECT_EQ(plan.pairs_per_selector[0].num_pairs, 6u);
 
   // Neighbouring views of the fountain: many putative matches, a verified geometry.
-  PairMatchVerifier verifier(manifest, plugins_.matcher, plan, descriptors, database_.get());
+  PairMatchVerifier verifier(settings, plan, descriptors, database_, database_);
   const PairResult result = verifier.Run(plan.todo.front());
   EXPECT_GT(result.num_putative_matches, 100u);
   EXPECT_GE(result.num_inlier_matches, 15u);
   EXPECT_LE(result.num_inlier_matches, result.num_putative_matches);
   EXPECT_EQ(database_->NumMatchedPairs(), 1u);
 
-  const MatchPlan again = PlanMatching(manifest, plugins_.pair_selectors, plugins_.matcher,
-                                       descriptors, database_.get());
+  const MatchPlan again = PlanMatching(*workspace_, settings, descriptors, provenance);
   EXPECT_EQ(again.num_reused, 1u);
   EXPECT_EQ(again.todo.size(), 5u);
 }

@@ -69,16 +69,50 @@ void PipelineContext::LimitLibraryThreads() const {
   cv::setNumThreads(manifest.EffectiveNumThreads());
 }
 
-void PipelineContext::UseWorkspaceCaches(const std::filesystem::path& output_dir) const {
+void PipelineContext::UseWorkspaceCaches(const Workspace& workspace) const {
   if (matcher) {
-    const std::filesystem::path folder = output_dir / "cache" / "matcher" / matcher.name();
-    CallPlugin(matcher.name(), PluginStage::kOptions, "",
-               [&] { matcher->SetCacheFolder(std::filesystem::absolute(folder)); });
+    const std::filesystem::path folder = workspace.CacheFolder("matcher", matcher.name());
+    matcher.Call(PluginStage::kOptions, "", [&](auto& plugin) { plugin.SetCacheFolder(folder); });
   }
 }
 
 void PipelineContext::CheckPairSelectorDescriptors(DescriptorMetric metric, int dimension) const {
-  CheckPairSelectors(manifest, pair_selectors, metric, dimension);
+  CheckPairSelectors(MakeMatchSettings(), metric, dimension);
+}
+
+ExtractSettings PipelineContext::MakeExtractSettings(const std::filesystem::path& image_dir) const {
+  ExtractSettings settings;
+  settings.image_dir = image_dir;
+  settings.detector = &detector;
+  settings.matcher = &matcher;
+  settings.camera = manifest.camera;
+  settings.max_image_pixels = manifest.max_image_pixels;
+  settings.num_threads = manifest.EffectiveNumThreads();
+  return settings;
+}
+
+MatchSettings PipelineContext::MakeMatchSettings() const {
+  MatchSettings settings;
+  settings.pair_selectors = &pair_selectors;
+  for (const PluginSlot& slot : manifest.pair_selectors) {
+    settings.pair_selector_paths.push_back(slot.json_path);
+  }
+  settings.matcher = &matcher;
+  settings.verification = manifest.verification;
+  settings.seed = manifest.seed;
+  settings.num_threads = manifest.EffectiveNumThreads();
+  settings.source = manifest.file.empty() ? "manifest" : manifest.file.string();
+  return settings;
+}
+
+MapSettings PipelineContext::MakeMapSettings(const std::filesystem::path& image_dir) const {
+  MapSettings settings;
+  settings.bundle_adjuster = &bundle_adjuster;
+  settings.exporters = &exporters;
+  settings.mapper = mapper_options;
+  settings.seed = manifest.seed;
+  settings.image_dir = image_dir;
+  return settings;
 }
 
 }  // namespace tessera

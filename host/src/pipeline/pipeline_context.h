@@ -5,6 +5,10 @@
 #include <vector>
 
 #include "manifest/manifest.h"
+#include "pipeline/extract_stage.h"
+#include "pipeline/map_stage.h"
+#include "pipeline/match_stage.h"
+#include "pipeline/workspace.h"
 #include "plugin/plugin_registry.h"
 #include "sfm/incremental_mapper_options.h"
 #include "tessera/sdk.h"
@@ -12,9 +16,10 @@
 
 namespace tessera {
 
-// The plugins of one run, made from a manifest. Construction parses the manifest,
-// discovers plugins and instantiates every slot the manifest names (which validates
-// all plugin options) before any image is read.
+// The plugins of one run, made from a manifest, and each stage's settings filled from
+// it: the manifest knows the stages, never the reverse. Construction parses the
+// manifest, discovers plugins and instantiates every slot the manifest names (which
+// validates all plugin options) before any image is read.
 struct PipelineContext {
   Manifest manifest;
   PluginRegistry registry;
@@ -43,8 +48,14 @@ struct PipelineContext {
 
   // Points the plugins that keep caches in the workspace at their folders (the
   // matcher's: OUTPUT/cache/matcher/NAME, Matcher::SetCacheFolder). Every stage that
-  // extracts or matches into `output_dir` calls it first, before any thread starts.
-  void UseWorkspaceCaches(const std::filesystem::path& output_dir) const;
+  // extracts or matches into `workspace` calls it first, before any thread starts.
+  void UseWorkspaceCaches(const Workspace& workspace) const;
+
+  // Each stage's settings, from the manifest and these plugins (which must outlive
+  // them). `image_dir`: the images (map: empty for the folder extract recorded).
+  ExtractSettings MakeExtractSettings(const std::filesystem::path& image_dir) const;
+  MatchSettings MakeMatchSettings() const;
+  MapSettings MakeMapSettings(const std::filesystem::path& image_dir) const;
 
   // Asks every pair selector whether it works with descriptors of this metric and width
   // (PairSelector::CheckDescriptors) before any image is read: `tessera run` calls it

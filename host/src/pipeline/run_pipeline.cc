@@ -7,6 +7,7 @@
 #include "pipeline/map_stage.h"
 #include "pipeline/match_stage.h"
 #include "pipeline/workspace.h"
+#include "plugin/plugin_call.h"
 #include "tessera/io/file_io.h"
 #include "util/timer.h"
 
@@ -27,37 +28,32 @@ std::filesystem::path InputImages(const PipelineContext& context, const RunOptio
 ExtractionSummary RunExtract(const PipelineContext& context, const RunOptions& options,
                              const StageControl& control) {
   context.Require("detector", "extract");
-  const auto lock = LockWorkspace(options.output_dir);
-  Database database(PrepareWorkspace(options.output_dir));
-  context.UseWorkspaceCaches(options.output_dir);
-  return ExtractFeatures(InputImages(context, options), context.manifest, context.detector,
-                         &database, WorkspaceScanOptions(options.output_dir, context.manifest),
-                         control, {}, &context.matcher);
+  CheckImageFolderApart(options.image_dir, options.output_dir);
+  const auto workspace = Workspace::Open(options.output_dir);
+  context.UseWorkspaceCaches(*workspace);
+  return ExtractFeatures(*workspace, context.MakeExtractSettings(InputImages(context, options)), {},
+                         control);
 }
 
 MatchingSummary RunMatch(const PipelineContext& context, const RunOptions& options,
                          const StageControl& control) {
   context.Require("pair_selector", "match");
   context.Require("matcher", "match");
-  const auto lock = LockWorkspace(options.output_dir);
-  Database database(PrepareWorkspace(options.output_dir));
-  context.UseWorkspaceCaches(options.output_dir);
-  return MatchFeatures(context.manifest, context.pair_selectors, context.matcher, &database,
-                       control);
+  const auto workspace = Workspace::Open(options.output_dir);
+  context.UseWorkspaceCaches(*workspace);
+  return MatchFeatures(*workspace, context.MakeMatchSettings(), {}, control);
 }
 
 MapStageSummary RunMap(const PipelineContext& context, const RunOptions& options,
                        const StageControl& control) {
   context.Require("bundle_adjuster", "map");
-  const std::filesystem::path database_file = PrepareWorkspace(options.output_dir);
-  const auto lock = LockWorkspace(options.output_dir);
-  if (!std::filesystem::exists(database_file)) {
-    throw InputError(database_file.string() +
-                     ": no workspace database; run extract and match first");
-  }
-  Database database(database_file);
-  CheckImagesUnchanged(options.image_dir, options.output_dir, context.manifest, database);
-  return MapWorkspace(context, &database, options.output_dir, options.image_dir, control);
+  Workspace::Options open;
+  open.require_database_for = "map";
+  const auto workspace = Workspace::Open(options.output_dir, open);
+  CheckImagesUnchanged(
+      *workspace, options.image_dir,
+      workspace->ScanOptions(context.manifest.camera.mask_path, context.manifest.max_image_pixels));
+  return MapWorkspace(*workspace, context.MakeMapSettings(options.image_dir), {}, control);
 }
 
 RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
@@ -68,30 +64,30 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
   context.Require("matcher", "match");
   context.Require("bundle_adjuster", "map");
   // A selector that cannot use the detector's descriptors fails before extraction.
-  context.CheckPairSelectorDescriptors(context.detector->Metric(), 0);
-  const std::filesystem::path database_file = PrepareWorkspace(options.output_dir);
-  const auto lock = LockWorkspace(options.output_dir);
-  Database database(database_file);
-  context.UseWorkspaceCaches(options.output_dir);
+  context.CheckPairSelectorDescriptors(
+      context.detector.Call(PluginStage::kOptions, "",
+                            [](auto& plugin) { return plugin.Metric(); }),
+      0);
+  CheckImageFolderApart(options.image_dir, options.output_dir);
+  const auto workspace = Workspace::Open(options.output_dir);
+  context.UseWorkspaceCaches(*workspace);
   const std::filesystem::path image_dir = InputImages(context, options);
   RunResult run;
   RunSummary& summary = run.summary;
-  summary.extract = ExtractFeatures(image_dir, context.manifest, context.detector, &database,
-                                    WorkspaceScanOptions(options.output_dir, context.manifest),
-                                    control, {}, &context.matcher);
+  summary.extract =
+      ExtractFeatures(*workspace, context.MakeExtractSettings(image_dir), {}, control);
   if (summary.extract.status == StageStatus::kCancelled) {
     run.status = StageStatus::kCancelled;
     return run;
   }
-  summary.match =
-      MatchFeatures(context.manifest, context.pair_selectors, context.matcher, &database, control);
+  summary.match = MatchFeatures(*workspace, context.MakeMatchSettings(), {}, control);
   LogExtraction(summary.extract);
   LogMatching(summary.match);
   if (summary.match.status == StageStatus::kCancelled) {
     run.status = StageStatus::kCancelled;
     return run;
   }
-  summary.map = MapWorkspace(context, &database, options.output_dir, image_dir, control);
+  summary.map = MapWorkspace(*workspace, context.MakeMapSettings(image_dir), {}, control);
   if (summary.map.status == StageStatus::kCancelled) {
     run.status = StageStatus::kCancelled;
     return run;

@@ -10,6 +10,8 @@
 #include <vector>
 
 #include "manifest/manifest.h"
+#include "pipeline/extract_stage.h"
+#include "pipeline/match_stage.h"
 #include "test_support.h"
 
 namespace tessera::testing {
@@ -50,6 +52,29 @@ struct CheapPlugins {
     return selectors;
   }();
   PluginInstance<Matcher> matcher = LoadBundledPlugin<Matcher>("matcher", "brute_force");
+
+  // The stages' settings for these plugins and `manifest`, as PipelineContext makes them.
+  ExtractSettings Extract(const std::filesystem::path& image_dir, const Manifest& manifest) const {
+    ExtractSettings settings;
+    settings.image_dir = image_dir;
+    settings.detector = &detector;
+    settings.camera = manifest.camera;
+    settings.max_image_pixels = manifest.max_image_pixels;
+    settings.num_threads = manifest.EffectiveNumThreads();
+    return settings;
+  }
+  MatchSettings Match(const Manifest& manifest) const {
+    MatchSettings settings;
+    settings.pair_selectors = &pair_selectors;
+    for (const PluginSlot& slot : manifest.pair_selectors) {
+      settings.pair_selector_paths.push_back(slot.json_path);
+    }
+    settings.matcher = &matcher;
+    settings.verification = manifest.verification;
+    settings.seed = manifest.seed;
+    settings.num_threads = manifest.EffectiveNumThreads();
+    return settings;
+  }
 };
 
 }  // namespace tessera::testing

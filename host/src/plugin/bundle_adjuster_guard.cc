@@ -21,8 +21,8 @@ std::string BundleAdjusterGuard::Subject(const BundleAdjustmentConfig& config,
 
 BundleAdjustmentSummary BundleAdjusterGuard::Adjust(const BundleAdjustmentConfig& config,
                                                     Reconstruction* reconstruction) const {
-  return CallPlugin(plugin_.name(), PluginStage::kAdjust, Subject(config, reconstruction),
-                    [&] { return plugin_->Adjust(config, reconstruction); });
+  return plugin_.Call(PluginStage::kAdjust, Subject(config, reconstruction),
+                      [&](auto& plugin) { return plugin.Adjust(config, reconstruction); });
 }
 
 }  // namespace tessera

@@ -210,6 +210,22 @@ PluginError::PluginError(const std::string& plugin, PluginStage stage, const std
       message_(message),
       input_error_(input_error) {}
 
+PluginError::PluginError(const std::string& plugin, PluginStage stage, const std::string& subject,
+                         const OptionError& error)
+    : PluginError(plugin, stage, subject, error.what(), /*input_error=*/true) {
+  option_message_ = error.message();
+  option_error_ = true;
+  option_path_ = error.path();
+}
+
+InputError PluginError::AsSlotError(const std::string& json_path, const std::string& what) const {
+  if (option_error_) {
+    return InputError(json_path + ".options" + (option_path_.empty() ? "" : "." + option_path_) +
+                      ": " + option_message_ + " (" + what + ")");
+  }
+  return InputError(json_path + ": " + what + ": " + message_);
+}
+
 PluginCallScope::PluginCallScope(const std::string& plugin, PluginStage stage,
                                  const std::string& subject)
     : outermost_(!t_record.active) {

@@ -47,12 +47,24 @@ class PluginError : public std::runtime_error {
  public:
   PluginError(const std::string& plugin, PluginStage stage, const std::string& subject,
               const std::string& message, bool input_error);
+  // The plugin threw an OptionError: `option_path` is its JSON path below the slot's
+  // options ("" for the options as a whole).
+  PluginError(const std::string& plugin, PluginStage stage, const std::string& subject,
+              const OptionError& error);
 
   const std::string& plugin() const { return plugin_; }
   PluginStage stage() const { return stage_; }
   const std::string& subject() const { return subject_; }
   const std::string& message() const { return message_; }
   bool input_error() const { return input_error_; }
+  bool option_error() const { return option_error_; }
+  const std::string& option_path() const { return option_path_; }
+
+  // The input error as the user's configuration names it: "JSON_PATH.options.PATH:
+  // message (WHAT)" for an option, else "JSON_PATH: WHAT: message". `json_path` is the
+  // plugin's slot ("pipeline.pair_selector[1]"), `what` the plugin ("pair selector
+  // 'x'"). Only for input errors.
+  InputError AsSlotError(const std::string& json_path, const std::string& what) const;
 
  private:
   std::string plugin_;
@@ -60,6 +72,9 @@ class PluginError : public std::runtime_error {
   std::string subject_;
   std::string message_;
   bool input_error_;
+  bool option_error_ = false;
+  std::string option_path_;
+  std::string option_message_;  // the OptionError's message, without its path
 };
 
 // Records a plugin call for the crash handler while it lives (one per thread; the
@@ -84,7 +99,9 @@ auto CallPlugin(const std::string& plugin, PluginStage stage, const std::string&
   const PluginCallScope scope(plugin, stage, subject);
   try {
     return fn();
-  } catch (const InputError& error) {  // OptionError too
+  } catch (const OptionError& error) {
+    throw PluginError(plugin, stage, subject, error);
+  } catch (const InputError& error) {
     throw PluginError(plugin, stage, subject, error.what(), /*input_error=*/true);
   } catch (const std::exception& error) {
     throw PluginError(plugin, stage, subject, error.what(), /*input_error=*/false);

@@ -31,11 +31,6 @@ std::string FormatCrash(const PluginCrash& crash) {
   return crash.signal + "\t" + crash.plugin + "\t" + crash.stage + "\t" + crash.subject + "\n";
 }
 
-PluginCrashLog& MutableCurrentLog() {
-  static PluginCrashLog log;
-  return log;
-}
-
 }  // namespace
 
 std::string PluginCrash::Describe() const {
@@ -47,18 +42,35 @@ std::string PluginCrash::Describe() const {
          (subject.empty() ? "" : " " + subject);
 }
 
-std::filesystem::path PluginCrashLog::HistoryFile(const std::filesystem::path& workspace_dir) {
-  return workspace_dir / "plugin_crashes.tsv";
+std::filesystem::path PluginCrashLog::HistoryFile(const std::filesystem::path& folder,
+                                                  const std::string& stem) {
+  return folder / (stem + ".tsv");
 }
 
-std::filesystem::path PluginCrashLog::PendingFile(const std::filesystem::path& workspace_dir) {
-  return workspace_dir / "plugin_crashes.new";
+std::filesystem::path PluginCrashLog::PendingFile(const std::filesystem::path& folder,
+                                                  const std::string& stem) {
+  return folder / (stem + ".new");
 }
 
-PluginCrashLog PluginCrashLog::Open(const std::filesystem::path& workspace_dir) {
+PluginCrashLog PluginCrashLog::ReadHistory(const std::filesystem::path& folder,
+                                           const std::string& stem) {
   PluginCrashLog log;
-  const std::filesystem::path history = HistoryFile(workspace_dir);
-  const std::filesystem::path pending = PendingFile(workspace_dir);
+  const std::filesystem::path history = HistoryFile(folder, stem);
+  std::error_code error;
+  if (std::filesystem::exists(history, error)) {
+    log.history_ = ParseCrashes(ReadFileContents(history));
+  }
+  return log;
+}
+
+void PluginCrashLog::IncludeHistory(const PluginCrashLog& other) {
+  history_.insert(history_.end(), other.history_.begin(), other.history_.end());
+}
+
+PluginCrashLog PluginCrashLog::Open(const std::filesystem::path& folder, const std::string& stem) {
+  PluginCrashLog log;
+  const std::filesystem::path history = HistoryFile(folder, stem);
+  const std::filesystem::path pending = PendingFile(folder, stem);
   std::error_code error;
   std::string history_text;
   if (std::filesystem::exists(history, error)) history_text = ReadFileContents(history);
@@ -110,9 +122,5 @@ size_t PluginCrashLog::NumCrashes(const std::string& plugin, PluginStage stage,
   }
   return count;
 }
-
-const PluginCrashLog& CurrentPluginCrashLog() { return MutableCurrentLog(); }
-
-void SetCurrentPluginCrashLog(PluginCrashLog log) { MutableCurrentLog() = std::move(log); }
 
 }  // namespace tessera

@@ -28,10 +28,20 @@ class PluginCrashLog {
   // A subject that crashed a plugin this often in one stage is skipped from then on.
   static constexpr size_t kQuarantineCrashes = 2;
 
-  // Reads the workspace's history, moves the crashes of the last run (if any) into it,
-  // and points the crash handler at the workspace. Throws InputError when the files
-  // cannot be read or written.
-  static PluginCrashLog Open(const std::filesystem::path& workspace_dir);
+  // Reads the history in `folder` (FOLDER/STEM.tsv), moves the crashes of the last run
+  // (FOLDER/STEM.new) into it, and points the crash handler at FOLDER/STEM.new, so
+  // that this process's crashes are recorded there. A workspace's log is
+  // plugin_crashes in its folder; a shard's is its own, under OUTPUT/shards/, since
+  // shards on many hosts run at once. Throws InputError when the files cannot be read
+  // or written.
+  static PluginCrashLog Open(const std::filesystem::path& folder,
+                             const std::string& stem = kWorkspaceStem);
+  // The history alone, read only (a shard reads its workspace's this way). Throws
+  // InputError when it cannot be read.
+  static PluginCrashLog ReadHistory(const std::filesystem::path& folder,
+                                    const std::string& stem = kWorkspaceStem);
+  // Counts `other`'s history as this log's too (a shard's log includes its workspace's).
+  void IncludeHistory(const PluginCrashLog& other);
 
   // Crashes recorded since the log was last opened: the previous run's.
   const std::vector<PluginCrash>& new_crashes() const { return new_crashes_; }
@@ -48,23 +58,15 @@ class PluginCrashLog {
     return NumCrashes(plugin, stage, subject) >= kQuarantineCrashes;
   }
 
-  static std::filesystem::path HistoryFile(const std::filesystem::path& workspace_dir);
-  static std::filesystem::path PendingFile(const std::filesystem::path& workspace_dir);
+  static constexpr const char* kWorkspaceStem = "plugin_crashes";
+  static std::filesystem::path HistoryFile(const std::filesystem::path& folder,
+                                           const std::string& stem = kWorkspaceStem);
+  static std::filesystem::path PendingFile(const std::filesystem::path& folder,
+                                           const std::string& stem = kWorkspaceStem);
 
  private:
   std::vector<PluginCrash> history_;
   std::vector<PluginCrash> new_crashes_;
 };
-
-// The log of the workspace this process works in, set by the command line once it
-// has opened the workspace; empty (no quarantine) until then.
-const PluginCrashLog& CurrentPluginCrashLog();
-void SetCurrentPluginCrashLog(PluginCrashLog log);
-
-// Whether the current workspace quarantines `subject` for this plugin and stage.
-inline bool IsQuarantined(const std::string& plugin, PluginStage stage,
-                          const std::string& subject) {
-  return CurrentPluginCrashLog().IsQuarantined(plugin, stage, subject);
-}
 
 }  // namespace tessera

@@ -59,17 +59,27 @@ class PluginInstance {
   ~PluginInstance() { object_.reset(); }
 
   explicit operator bool() const { return object_ != nullptr; }
-  Interface* operator->() const { return object_.get(); }
-  Interface& operator*() const { return *object_; }
-  Interface* get() const { return object_.get(); }
   const std::string& name() const { return name_; }
   const std::string& version() const { return version_; }
   const std::filesystem::path& file() const { return file_; }
+
+  // The only way in: calls `fn(plugin)` through CallPlugin, so that whatever it throws
+  // becomes a PluginError naming this plugin, `stage` and `subject` ("image a.jpg"),
+  // and a crash is attributed to them. No pointer to the object leaves this holder.
+  template <typename Fn>
+  decltype(auto) Call(PluginStage stage, const std::string& subject, Fn&& fn) const {
+    Interface& object = *object_;
+    return CallPlugin(name_, stage, subject, [&]() -> decltype(auto) { return fn(object); });
+  }
+
+  // The options in effect, defaults filled in.
+  nlohmann::json EffectiveOptions() const {
+    return Call(PluginStage::kOptions, "",
+                [](const Interface& plugin) { return plugin.EffectiveOptions(); });
+  }
   // Name, version and effective options: what produced a result.
   nlohmann::json Provenance() const {
-    nlohmann::json options =
-        CallPlugin(name_, PluginStage::kOptions, "", [&] { return object_->EffectiveOptions(); });
-    return {{"plugin", name_}, {"version", version_}, {"options", std::move(options)}};
+    return {{"plugin", name_}, {"version", version_}, {"options", EffectiveOptions()}};
   }
 
  private:

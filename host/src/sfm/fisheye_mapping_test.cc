@@ -24,7 +24,8 @@ TEST(FisheyeMapping, RecoversAWideAngleFisheyeSceneAndItsDistortion) {
   ASSERT_EQ(scene.input.cameras.at(1).model_id, CameraModelId::kOpenCVFisheye);
   const auto adjuster =
       testing::LoadBundledPlugin<BundleAdjuster>("bundle_adjuster", "ceres", {{"num_threads", 1}});
-  const MapperResult result = IncrementalPipeline({}, *adjuster, 0).Reconstruct(scene.input);
+  const MapperResult result =
+      IncrementalPipeline({}, testing::Unguarded(adjuster), 0).Reconstruct(scene.input);
   ASSERT_EQ(result.models.size(), 1u);
   const Reconstruction& model = result.models[0];
   EXPECT_EQ(model.images.size(), scene.input.images.size());

@@ -30,7 +30,7 @@ namespace {
 const BundleAdjuster& Adjuster() {
   static const auto adjuster =
       testing::LoadBundledPlugin<BundleAdjuster>("bundle_adjuster", "ceres", {{"num_threads", 1}});
-  return *adjuster;
+  return testing::Unguarded(adjuster);
 }
 
 testing::SyntheticScene MakePathScene(int num_images) {

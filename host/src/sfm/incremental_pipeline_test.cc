@@ -19,7 +19,7 @@ using testing::SyntheticSceneOptions;
 const BundleAdjuster& Adjuster() {
   static const auto adjuster =
       testing::LoadBundledPlugin<BundleAdjuster>("bundle_adjuster", "ceres", {{"num_threads", 1}});
-  return *adjuster;
+  return testing::Unguarded(adjuster);
 }
 
 MapperResult Map(const SyntheticScene& scene, IncrementalMapperOptions options = {},

@@ -62,7 +62,8 @@ WorkspaceLock::WorkspaceLock(const std::filesystem::path& workspace, std::string
   if (error) {
     throw InputError(workspace.string() + ": cannot create the output folder: " + error.message());
   }
-  fd_ = open(file_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  // Never through a symbolic link: the file is truncated, and a link could point anywhere.
+  fd_ = open(file_.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
   if (fd_ < 0) {
     throw InputError(file_.string() +
                      ": cannot open the workspace lock file: " + std::strerror(errno));

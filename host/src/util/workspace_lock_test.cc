@@ -67,5 +67,27 @@ TEST(WorkspaceLock, ALockOfAKilledProcessIsTakenOver) {
   EXPECT_EQ(stale.rfind("process " + std::to_string(child) + " (since ", 0), 0u) << stale;
 }
 
+// A lock file that is a symbolic link is refused: the lock file is truncated, and a
+// link could point at any file of the user's.
+TEST(WorkspaceLock, ALockFileThatIsASymbolicLinkIsRefusedAndItsTargetKept) {
+  testing::TemporaryDir dir;
+  const auto workspace = dir.path() / "out";
+  std::filesystem::create_directories(workspace);
+  const auto target = dir.path() / "precious.txt";
+  WriteFileAtomically(target, "keep me\n");
+  std::filesystem::create_symlink(target, WorkspaceLock::LockFile(workspace));
+  try {
+    WorkspaceLock lock(workspace);
+    FAIL() << "a lock file that is a symbolic link was taken";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find(WorkspaceLock::LockFile(workspace).string() +
+                        ": cannot open the workspace lock file"),
+              std::string::npos)
+        << error.what();
+  }
+  EXPECT_EQ(ReadFileContents(target), "keep me\n");
+}
+
 }  // namespace
 }  // namespace tessera

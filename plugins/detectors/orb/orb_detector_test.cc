@@ -85,7 +85,8 @@ double Median(std::vector<double> values) {
 }
 
 FeatureSet Detect(const nlohmann::json& options, const cv::Mat& image) {
-  return testing::LoadBundledPlugin<Detector>("detector", "orb", options)->Detect(View(image));
+  return testing::Unguarded(testing::LoadBundledPlugin<Detector>("detector", "orb", options))
+      .Detect(View(image));
 }
 
 TEST(OrbDetector, MatchesUnderKnownRotationAndShift) {
@@ -226,8 +227,8 @@ TEST(OrbDetector, HonoursMaxNumFeatures) {
 
 TEST(OrbDetector, DescriptorsAre32BytesComparedByHamming) {
   const auto detector = testing::LoadBundledPlugin<Detector>("detector", "orb");
-  EXPECT_EQ(detector->Metric(), DescriptorMetric::kHamming);
-  const FeatureSet features = detector->Detect(View(MakeTexturedImage()));
+  EXPECT_EQ(testing::Unguarded(detector).Metric(), DescriptorMetric::kHamming);
+  const FeatureSet features = testing::Unguarded(detector).Detect(View(MakeTexturedImage()));
   EXPECT_EQ(features.descriptors.dimension(), 32);
   EXPECT_EQ(features.descriptors.size(), static_cast<Eigen::Index>(features.keypoints.size()));
   EXPECT_EQ(features.descriptors.metric, DescriptorMetric::kHamming);
@@ -243,11 +244,11 @@ TEST(OrbDetector, DescriptorsAre32BytesComparedByHamming) {
 TEST(OrbDetector, IsDeterministicAndThreadSafe) {
   const cv::Mat image = MakeTexturedImage();
   const auto detector = testing::LoadBundledPlugin<Detector>("detector", "orb");
-  const FeatureSet expected = detector->Detect(View(image));
+  const FeatureSet expected = testing::Unguarded(detector).Detect(View(image));
   std::vector<FeatureSet> results(4);
   std::vector<std::thread> threads;
   for (FeatureSet& result : results) {
-    threads.emplace_back([&] { result = detector->Detect(View(image)); });
+    threads.emplace_back([&] { result = testing::Unguarded(detector).Detect(View(image)); });
   }
   for (std::thread& thread : threads) thread.join();
   for (const FeatureSet& result : results) {
@@ -268,7 +269,7 @@ TEST(OrbDetector, ReportsEffectiveOptions) {
   const nlohmann::json expected = {{"max_num_features", 8192}, {"max_image_size", 3200},
                                    {"scale_factor", 1.2},      {"num_levels", 8},
                                    {"fast_threshold", 10},     {"edge_threshold", 31}};
-  EXPECT_EQ(detector->EffectiveOptions(), expected);
+  EXPECT_EQ(testing::Unguarded(detector).EffectiveOptions(), expected);
 }
 
 std::string OptionErrorText(const nlohmann::json& options) {
@@ -307,7 +308,7 @@ TEST(OrbDetector, RejectsInvalidOptions) {
 
 TEST(OrbDetector, RejectsAnEmptyImage) {
   const auto detector = testing::LoadBundledPlugin<Detector>("detector", "orb");
-  EXPECT_THROW(detector->Detect(ImageView()), InputError);
+  EXPECT_THROW(testing::Unguarded(detector).Detect(ImageView()), InputError);
 }
 
 }  // namespace

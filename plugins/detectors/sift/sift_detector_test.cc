@@ -84,7 +84,8 @@ double Median(std::vector<double> values) {
 }
 
 FeatureSet Detect(const nlohmann::json& options, const cv::Mat& image) {
-  return testing::LoadBundledPlugin<Detector>("detector", "sift", options)->Detect(View(image));
+  return testing::Unguarded(testing::LoadBundledPlugin<Detector>("detector", "sift", options))
+      .Detect(View(image));
 }
 
 void ExpectSameFeatures(const FeatureSet& a, const FeatureSet& b) {
@@ -241,11 +242,11 @@ TEST(SiftDetector, DescriptorsAreCompatibleWithColmap) {
 TEST(SiftDetector, IsDeterministicAndThreadSafe) {
   const cv::Mat image = MakeTexturedImage();
   const auto detector = testing::LoadBundledPlugin<Detector>("detector", "sift");
-  const FeatureSet expected = detector->Detect(View(image));
+  const FeatureSet expected = testing::Unguarded(detector).Detect(View(image));
   std::vector<FeatureSet> results(4);
   std::vector<std::thread> threads;
   for (FeatureSet& result : results) {
-    threads.emplace_back([&] { result = detector->Detect(View(image)); });
+    threads.emplace_back([&] { result = testing::Unguarded(detector).Detect(View(image)); });
   }
   for (std::thread& thread : threads) thread.join();
   for (const FeatureSet& result : results) ExpectSameFeatures(result, expected);
@@ -258,8 +259,8 @@ TEST(SiftDetector, ReportsEffectiveOptions) {
                                    {"contrast_threshold", 0.02}, {"edge_threshold", 10.0},
                                    {"num_octave_layers", 3},     {"sigma", 1.6},
                                    {"root_sift", true}};
-  EXPECT_EQ(detector->EffectiveOptions(), expected);
-  EXPECT_EQ(detector->Metric(), DescriptorMetric::kL2);
+  EXPECT_EQ(testing::Unguarded(detector).EffectiveOptions(), expected);
+  EXPECT_EQ(testing::Unguarded(detector).Metric(), DescriptorMetric::kL2);
 }
 
 std::string OptionErrorText(const nlohmann::json& options) {
@@ -307,7 +308,7 @@ TEST(SiftDetector, RejectsInvalidOptions) {
 
 TEST(SiftDetector, RejectsAnEmptyImage) {
   const auto detector = testing::LoadBundledPlugin<Detector>("detector", "sift");
-  EXPECT_THROW(detector->Detect(ImageView()), InputError);
+  EXPECT_THROW(testing::Unguarded(detector).Detect(ImageView()), InputError);
 }
 
 TEST(SiftDetector, FindsManyFeaturesInAPhotograph) {

@@ -47,7 +47,7 @@ TEST(GaussianSplattingExporter, UndistortsASimpleRadialCameraToPinhole) {
   ExportContext context;
   context.output_dir = output.path();
   context.image_dir = images.path();
-  exporter->Export(model, context);
+  testing::Unguarded(exporter).Export(model, context);
 
   const fs::path root = output.path() / "gaussian_splatting";
   const Reconstruction undistorted = ReadColmapModel(root / "sparse" / "0");
@@ -107,7 +107,7 @@ TEST(GaussianSplattingExporter, UndistortsAnOpenCVFisheyeCameraToPinholeWithItsM
   ExportContext context;
   context.output_dir = output.path();
   context.image_dir = images.path();
-  exporter->Export(model, context);
+  testing::Unguarded(exporter).Export(model, context);
 
   const fs::path root = output.path() / "gaussian_splatting";
   const Reconstruction undistorted = ReadColmapModel(root / "sparse" / "0");
@@ -161,7 +161,7 @@ TEST(GaussianSplattingExporter, FolderOptionAndErrorsNameTheFile) {
   context.output_dir = output.path();
   context.model_index = 1;
   try {
-    exporter->Export(model, context);
+    testing::Unguarded(exporter).Export(model, context);
     FAIL() << "expected InputError";
   } catch (const InputError& error) {
     EXPECT_EQ(std::string(error.what()),
@@ -171,7 +171,7 @@ TEST(GaussianSplattingExporter, FolderOptionAndErrorsNameTheFile) {
   }
   context.image_dir = images.path();
   try {
-    exporter->Export(model, context);
+    testing::Unguarded(exporter).Export(model, context);
     FAIL() << "expected InputError";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find((images.path() / "img_1.png").string()),
@@ -181,7 +181,7 @@ TEST(GaussianSplattingExporter, FolderOptionAndErrorsNameTheFile) {
   for (const auto& [image_id, image] : model.images) {
     cv::imwrite((images.path() / image.name).string(), cv::Mat(30, 40, CV_8UC3, cv::Scalar(9)));
   }
-  exporter->Export(model, context);
+  testing::Unguarded(exporter).Export(model, context);
   EXPECT_TRUE(fs::is_regular_file(output.path() / "3dgs_1" / "images" / "img_2.png"));
   EXPECT_EQ(ReadColmapModel(output.path() / "3dgs_1" / "sparse" / "0").cameras.at(1).params,
             (std::vector<double>{50, 50, 20, 15}));
@@ -201,7 +201,7 @@ TEST(GaussianSplattingExporter, FountainImagesKeepTheirSizeAndPointsReproject) {
   ExportContext context;
   context.output_dir = output.path();
   context.image_dir = image_dir;
-  exporter->Export(model, context);
+  testing::Unguarded(exporter).Export(model, context);
 
   const fs::path root = output.path() / "gaussian_splatting";
   const Reconstruction undistorted = ReadColmapModel(root / "sparse" / "0");

@@ -34,7 +34,8 @@ TEST(FlannMatcher, FindsTheTrueMatchesOfSiftLikeDescriptors) {
   const SyntheticPair pair = MakeL2Pair(500, 200, 10, 1);
   for (const char* index : {"kmeans", "kdtree"}) {
     const Quality quality = Evaluate(
-        Load({{"l2_index", index}})->Match(pair.descriptors1, pair.descriptors2), pair.truth);
+        testing::Unguarded(Load({{"l2_index", index}})).Match(pair.descriptors1, pair.descriptors2),
+        pair.truth);
     EXPECT_GE(quality.recall, 0.90) << index;
     EXPECT_GE(quality.precision, 0.99) << index;
   }
@@ -43,8 +44,9 @@ TEST(FlannMatcher, FindsTheTrueMatchesOfSiftLikeDescriptors) {
 TEST(FlannMatcher, FindsTheTrueMatchesOfBinaryDescriptors) {
   const SyntheticPair pair = MakeHammingPair(500, 200, 20, 2);
   for (const char* index : {"hierarchical", "lsh"}) {
-    const Quality quality = Evaluate(
-        Load({{"hamming_index", index}})->Match(pair.descriptors1, pair.descriptors2), pair.truth);
+    const Quality quality = Evaluate(testing::Unguarded(Load({{"hamming_index", index}}))
+                                         .Match(pair.descriptors1, pair.descriptors2),
+                                     pair.truth);
     EXPECT_GE(quality.recall, 0.90) << index;
     EXPECT_GE(quality.precision, 0.99) << index;
   }
@@ -55,13 +57,14 @@ TEST(FlannMatcher, AgreesWithBruteForce) {
       LoadBundledPlugin<Matcher>("matcher", "brute_force", nlohmann::json::object());
   const auto flann = Load();
   const SyntheticPair l2 = MakeL2Pair(500, 200, 10, 3);
-  EXPECT_GE(Agreement(flann->Match(l2.descriptors1, l2.descriptors2),
-                      brute_force->Match(l2.descriptors1, l2.descriptors2)),
+  EXPECT_GE(Agreement(testing::Unguarded(flann).Match(l2.descriptors1, l2.descriptors2),
+                      testing::Unguarded(brute_force).Match(l2.descriptors1, l2.descriptors2)),
             0.95);
   const SyntheticPair binary = MakeHammingPair(500, 200, 20, 4);
-  EXPECT_GE(Agreement(flann->Match(binary.descriptors1, binary.descriptors2),
-                      brute_force->Match(binary.descriptors1, binary.descriptors2)),
-            0.95);
+  EXPECT_GE(
+      Agreement(testing::Unguarded(flann).Match(binary.descriptors1, binary.descriptors2),
+                testing::Unguarded(brute_force).Match(binary.descriptors1, binary.descriptors2)),
+      0.95);
 }
 
 // With more checks than rows the k-means tree visits every leaf: the search is exact,
@@ -73,10 +76,11 @@ TEST(FlannMatcher, ExhaustiveSearchGivesBruteForceMatchesExactly) {
   for (const bool cross_check : {true, false}) {
     const nlohmann::json options = {{"cross_check", cross_check}};
     const auto brute_force = LoadBundledPlugin<Matcher>("matcher", "brute_force", options);
-    const FeatureMatches expected = brute_force->Match(pair.descriptors1, pair.descriptors2);
+    const FeatureMatches expected =
+        testing::Unguarded(brute_force).Match(pair.descriptors1, pair.descriptors2);
     ASSERT_GT(expected.size(), 100u);
-    EXPECT_EQ(Load({{"cross_check", cross_check}, {"checks", 100000}})
-                  ->Match(pair.descriptors1, pair.descriptors2),
+    EXPECT_EQ(testing::Unguarded(Load({{"cross_check", cross_check}, {"checks", 100000}}))
+                  .Match(pair.descriptors1, pair.descriptors2),
               expected)
         << "cross_check " << cross_check;
   }
@@ -88,45 +92,56 @@ TEST(FlannMatcher, RatioTestDropsAmbiguousMatches) {
   const FeatureDescriptors descriptors1 = L2Rows({Row(100), Row(30)});
   const FeatureDescriptors descriptors2 =
       L2Rows({Row(100, 0, 5), Row(100, 0, -5), Row(30, 1, 10), Row(30, 1, -20)});
-  EXPECT_EQ(Load()->Match(descriptors1, descriptors2), MatchesOf({{1, 2}}));
-  EXPECT_EQ(Load({{"ratio", 0.51}})->Match(descriptors1, descriptors2), MatchesOf({{1, 2}}));
-  EXPECT_TRUE(Load({{"ratio", 0.49}})->Match(descriptors1, descriptors2).empty());
-  EXPECT_EQ(Load({{"ratio", 1.0}})->Match(descriptors1, descriptors2), MatchesOf({{1, 2}}));
+  EXPECT_EQ(testing::Unguarded(Load()).Match(descriptors1, descriptors2), MatchesOf({{1, 2}}));
+  EXPECT_EQ(testing::Unguarded(Load({{"ratio", 0.51}})).Match(descriptors1, descriptors2),
+            MatchesOf({{1, 2}}));
+  EXPECT_TRUE(
+      testing::Unguarded(Load({{"ratio", 0.49}})).Match(descriptors1, descriptors2).empty());
+  EXPECT_EQ(testing::Unguarded(Load({{"ratio", 1.0}})).Match(descriptors1, descriptors2),
+            MatchesOf({{1, 2}}));
 }
 
 TEST(FlannMatcher, CrossCheckDropsNonMutualMatches) {
   const FeatureDescriptors descriptors1 = L2Rows({Row(100, 0, 3), Row(100, 0, 10)});
   const FeatureDescriptors descriptors2 = L2Rows({Row(100), Row(200)});
-  EXPECT_EQ(Load()->Match(descriptors1, descriptors2), MatchesOf({{0, 0}}));
-  EXPECT_EQ(Load({{"cross_check", false}})->Match(descriptors1, descriptors2),
+  EXPECT_EQ(testing::Unguarded(Load()).Match(descriptors1, descriptors2), MatchesOf({{0, 0}}));
+  EXPECT_EQ(testing::Unguarded(Load({{"cross_check", false}})).Match(descriptors1, descriptors2),
             MatchesOf({{0, 0}, {1, 0}}));
 }
 
 TEST(FlannMatcher, MaxDistanceIsInDescriptorUnits) {
   const FeatureDescriptors descriptors1 = L2Rows({Row(100), Row(30)});
   const FeatureDescriptors descriptors2 = L2Rows({Row(100, 0, 30), Row(30, 5, 3)});
-  EXPECT_EQ(Load({{"max_distance", 31}})->Match(descriptors1, descriptors2),
+  EXPECT_EQ(testing::Unguarded(Load({{"max_distance", 31}})).Match(descriptors1, descriptors2),
             MatchesOf({{0, 0}, {1, 1}}));
-  EXPECT_EQ(Load({{"max_distance", 29}})->Match(descriptors1, descriptors2), MatchesOf({{1, 1}}));
+  EXPECT_EQ(testing::Unguarded(Load({{"max_distance", 29}})).Match(descriptors1, descriptors2),
+            MatchesOf({{1, 1}}));
   const SyntheticPair binary = MakeHammingPair(300, 0, 12, 5);
-  const FeatureMatches all = Load()->Match(binary.descriptors1, binary.descriptors2);
+  const FeatureMatches all =
+      testing::Unguarded(Load()).Match(binary.descriptors1, binary.descriptors2);
   EXPECT_GE(all.size(), 270u);
-  EXPECT_TRUE(
-      Load({{"max_distance", 11}})->Match(binary.descriptors1, binary.descriptors2).empty());
-  EXPECT_EQ(Load({{"max_distance", 12}})->Match(binary.descriptors1, binary.descriptors2), all);
+  EXPECT_TRUE(testing::Unguarded(Load({{"max_distance", 11}}))
+                  .Match(binary.descriptors1, binary.descriptors2)
+                  .empty());
+  EXPECT_EQ(testing::Unguarded(Load({{"max_distance", 12}}))
+                .Match(binary.descriptors1, binary.descriptors2),
+            all);
 }
 
 TEST(FlannMatcher, SmallAndEmptySets) {
   const auto matcher = Load();
-  EXPECT_EQ(matcher->Match(L2Rows({Row(10), Row(200)}), L2Rows({Row(12)})), MatchesOf({{0, 0}}));
-  EXPECT_EQ(matcher->Match(L2Rows({Row(12)}), L2Rows({Row(10), Row(200)})), MatchesOf({{0, 0}}));
-  EXPECT_TRUE(matcher->Match(L2Rows({}), L2Rows({Row(1), Row(2)})).empty());
-  EXPECT_TRUE(matcher->Match(L2Rows({Row(1)}), L2Rows({})).empty());
+  EXPECT_EQ(testing::Unguarded(matcher).Match(L2Rows({Row(10), Row(200)}), L2Rows({Row(12)})),
+            MatchesOf({{0, 0}}));
+  EXPECT_EQ(testing::Unguarded(matcher).Match(L2Rows({Row(12)}), L2Rows({Row(10), Row(200)})),
+            MatchesOf({{0, 0}}));
+  EXPECT_TRUE(testing::Unguarded(matcher).Match(L2Rows({}), L2Rows({Row(1), Row(2)})).empty());
+  EXPECT_TRUE(testing::Unguarded(matcher).Match(L2Rows({Row(1)}), L2Rows({})).empty());
   FeatureDescriptors empty;
   empty.metric = DescriptorMetric::kHamming;
-  EXPECT_TRUE(matcher->Match(empty, L2Rows({Row(1)})).empty());
+  EXPECT_TRUE(testing::Unguarded(matcher).Match(empty, L2Rows({Row(1)})).empty());
   const SyntheticPair single = MakeHammingPair(1, 0, 3, 6);
-  EXPECT_EQ(matcher->Match(single.descriptors1, single.descriptors2), MatchesOf({{0, 0}}));
+  EXPECT_EQ(testing::Unguarded(matcher).Match(single.descriptors1, single.descriptors2),
+            MatchesOf({{0, 0}}));
 }
 
 TEST(FlannMatcher, RejectsIncompatibleDescriptors) {
@@ -135,7 +150,7 @@ TEST(FlannMatcher, RejectsIncompatibleDescriptors) {
   binary.metric = DescriptorMetric::kHamming;
   binary.data.setZero(3, 32);
   try {
-    matcher->Match(binary, L2Rows({Row(1)}));
+    testing::Unguarded(matcher).Match(binary, L2Rows({Row(1)}));
     FAIL() << "expected an error";
   } catch (const InputError& error) {
     EXPECT_STREQ(error.what(),
@@ -145,7 +160,7 @@ TEST(FlannMatcher, RejectsIncompatibleDescriptors) {
   FeatureDescriptors short_rows;
   short_rows.data.setZero(2, 64);
   try {
-    matcher->Match(L2Rows({Row(1)}), short_rows);
+    testing::Unguarded(matcher).Match(L2Rows({Row(1)}), short_rows);
     FAIL() << "expected an error";
   } catch (const InputError& error) {
     EXPECT_STREQ(error.what(),
@@ -156,7 +171,7 @@ TEST(FlannMatcher, RejectsIncompatibleDescriptors) {
   tiny.metric = DescriptorMetric::kHamming;
   tiny.data.setZero(2, 1);
   try {
-    Load({{"hamming_index", "lsh"}})->Match(tiny, tiny);
+    testing::Unguarded(Load({{"hamming_index", "lsh"}})).Match(tiny, tiny);
     FAIL() << "expected an error";
   } catch (const InputError& error) {
     EXPECT_STREQ(error.what(),
@@ -176,18 +191,21 @@ TEST(FlannMatcher, DeterministicAcrossCallsInstancesAndThreads) {
   const auto matcher = Load({{"cross_check", false}, {"ratio", 1.0}, {"checks", 16}});
   std::vector<FeatureMatches> serial;
   for (const SyntheticPair& pair : pairs) {
-    serial.push_back(matcher->Match(pair.descriptors1, pair.descriptors2));
-    EXPECT_EQ(matcher->Match(pair.descriptors1, pair.descriptors2), serial.back());
+    serial.push_back(testing::Unguarded(matcher).Match(pair.descriptors1, pair.descriptors2));
+    EXPECT_EQ(testing::Unguarded(matcher).Match(pair.descriptors1, pair.descriptors2),
+              serial.back());
   }
   const auto other = Load({{"cross_check", false}, {"ratio", 1.0}, {"checks", 16}});
-  EXPECT_EQ(other->Match(pairs[0].descriptors1, pairs[0].descriptors2), serial[0]);
+  EXPECT_EQ(testing::Unguarded(other).Match(pairs[0].descriptors1, pairs[0].descriptors2),
+            serial[0]);
 
   std::vector<FeatureMatches> parallel(pairs.size());
   std::vector<std::thread> threads;
   for (size_t k = 0; k < pairs.size(); ++k) {
     threads.emplace_back([&, k] {
       for (int repeat = 0; repeat < 3; ++repeat) {
-        parallel[k] = matcher->Match(pairs[k].descriptors1, pairs[k].descriptors2);
+        parallel[k] =
+            testing::Unguarded(matcher).Match(pairs[k].descriptors1, pairs[k].descriptors2);
       }
     });
   }
@@ -199,7 +217,8 @@ TEST(FlannMatcher, DeterministicAcrossCallsInstancesAndThreads) {
       Load({{"cross_check", false}, {"ratio", 1.0}, {"checks", 16}, {"random_seed", 7}});
   bool any_difference = false;
   for (size_t k = 0; k < pairs.size(); ++k) {
-    any_difference |= reseeded->Match(pairs[k].descriptors1, pairs[k].descriptors2) != serial[k];
+    any_difference |= testing::Unguarded(reseeded).Match(pairs[k].descriptors1,
+                                                         pairs[k].descriptors2) != serial[k];
   }
   EXPECT_TRUE(any_difference);
 }
@@ -210,7 +229,7 @@ using MatchJobs = std::vector<std::pair<const FeatureDescriptors*, const Feature
 std::vector<FeatureMatches> MatchInTurn(const PluginInstance<Matcher>& matcher,
                                         const MatchJobs& jobs) {
   std::vector<FeatureMatches> matches;
-  for (const auto& [d1, d2] : jobs) matches.push_back(matcher->Match(*d1, *d2));
+  for (const auto& [d1, d2] : jobs) matches.push_back(testing::Unguarded(matcher).Match(*d1, *d2));
   return matches;
 }
 
@@ -222,7 +241,7 @@ std::vector<FeatureMatches> MatchInThreads(const PluginInstance<Matcher>& matche
   for (size_t t = 0; t < num_threads; ++t) {
     threads.emplace_back([&, t] {
       for (size_t k = t; k < jobs.size(); k += num_threads)
-        matches[k] = matcher->Match(*jobs[k].first, *jobs[k].second);
+        matches[k] = testing::Unguarded(matcher).Match(*jobs[k].first, *jobs[k].second);
     });
   }
   for (std::thread& thread : threads) thread.join();
@@ -261,7 +280,7 @@ TEST(FlannMatcher, AMemoryBoundCacheGivesTheSameMatchesAsFreshIndexes) {
   for (uint32_t seed = 40; seed < 44; ++seed) pairs.push_back(MakeL2Pair(1500, 100, 10, seed));
   const auto fresh = Load({{"checks", 16}, {"index_cache_size", 0}});
   const auto bounded = Load({{"checks", 16}, {"index_cache_mb", 1}});
-  EXPECT_EQ(bounded->EffectiveOptions().at("index_cache_mb"), 1);
+  EXPECT_EQ(testing::Unguarded(bounded).EffectiveOptions().at("index_cache_mb"), 1);
   MatchJobs jobs;
   for (const auto& a : pairs) {
     for (const auto& b : pairs) jobs.emplace_back(&a.descriptors1, &b.descriptors2);
@@ -292,10 +311,10 @@ TEST(FlannMatcher, PreparedIndexFilesGiveTheMatchesOfFreshIndexes) {
   const auto fresh = Load({{"index_cache_size", 0}});
   {
     auto preparing = Load();
-    preparing->SetCacheFolder(folder.path() / "flann");
+    testing::Unguarded(preparing).SetCacheFolder(folder.path() / "flann");
     for (const SyntheticPair* pair : {&l2, &binary}) {
-      preparing->Prepare(pair->descriptors1);
-      preparing->Prepare(pair->descriptors2);
+      testing::Unguarded(preparing).Prepare(pair->descriptors1);
+      testing::Unguarded(preparing).Prepare(pair->descriptors2);
     }
   }
   const auto written = IndexFiles(folder.path() / "flann");
@@ -303,13 +322,15 @@ TEST(FlannMatcher, PreparedIndexFilesGiveTheMatchesOfFreshIndexes) {
   for (const auto& [file, inode] : written) EXPECT_EQ(file.extension(), ".flann");
   for (const auto& options : {nlohmann::json::object(), nlohmann::json{{"index_cache_size", 0}}}) {
     auto reading = Load(options);
-    reading->SetCacheFolder(folder.path() / "flann");
+    testing::Unguarded(reading).SetCacheFolder(folder.path() / "flann");
     for (const SyntheticPair* pair : {&l2, &binary}) {
-      const FeatureMatches expected = fresh->Match(pair->descriptors1, pair->descriptors2);
+      const FeatureMatches expected =
+          testing::Unguarded(fresh).Match(pair->descriptors1, pair->descriptors2);
       EXPECT_GT(expected.size(), 150u);
-      EXPECT_EQ(reading->Match(pair->descriptors1, pair->descriptors2), expected);
-      EXPECT_EQ(reading->Match(pair->descriptors2, pair->descriptors1),
-                fresh->Match(pair->descriptors2, pair->descriptors1));
+      EXPECT_EQ(testing::Unguarded(reading).Match(pair->descriptors1, pair->descriptors2),
+                expected);
+      EXPECT_EQ(testing::Unguarded(reading).Match(pair->descriptors2, pair->descriptors1),
+                testing::Unguarded(fresh).Match(pair->descriptors2, pair->descriptors1));
     }
   }
   EXPECT_EQ(IndexFiles(folder.path() / "flann"), written) << "a whole file was written again";
@@ -319,21 +340,23 @@ TEST(FlannMatcher, MatchWritesTheIndexFilesPrepareDidNot) {
   const TemporaryDir folder;
   const SyntheticPair pair = MakeL2Pair(500, 100, 10, 52);
   auto matcher = Load();
-  matcher->SetCacheFolder(folder.path());
-  const FeatureMatches matches = matcher->Match(pair.descriptors1, pair.descriptors2);
+  testing::Unguarded(matcher).SetCacheFolder(folder.path());
+  const FeatureMatches matches =
+      testing::Unguarded(matcher).Match(pair.descriptors1, pair.descriptors2);
   EXPECT_EQ(IndexFiles(folder.path()).size(), 2u);  // image 2's, and image 1's (cross check)
-  EXPECT_EQ(matches, Load({{"index_cache_size", 0}})->Match(pair.descriptors1, pair.descriptors2));
+  EXPECT_EQ(matches, testing::Unguarded(Load({{"index_cache_size", 0}}))
+                         .Match(pair.descriptors1, pair.descriptors2));
 }
 
 TEST(FlannMatcher, ACorruptOrTruncatedIndexFileIsBuiltAgain) {
   const TemporaryDir folder;
   const SyntheticPair pair = MakeL2Pair(600, 200, 10, 53);
-  const FeatureMatches expected =
-      Load({{"index_cache_size", 0}})->Match(pair.descriptors1, pair.descriptors2);
+  const FeatureMatches expected = testing::Unguarded(Load({{"index_cache_size", 0}}))
+                                      .Match(pair.descriptors1, pair.descriptors2);
   auto preparing = Load();
-  preparing->SetCacheFolder(folder.path());
-  preparing->Prepare(pair.descriptors1);
-  preparing->Prepare(pair.descriptors2);
+  testing::Unguarded(preparing).SetCacheFolder(folder.path());
+  testing::Unguarded(preparing).Prepare(pair.descriptors1);
+  testing::Unguarded(preparing).Prepare(pair.descriptors2);
   auto files = IndexFiles(folder.path());
   ASSERT_EQ(files.size(), 2u);
   const std::filesystem::path flipped = files.begin()->first;
@@ -346,8 +369,8 @@ TEST(FlannMatcher, ACorruptOrTruncatedIndexFileIsBuiltAgain) {
   }
   std::filesystem::resize_file(truncated, std::filesystem::file_size(truncated) / 3);
   auto reading = Load();
-  reading->SetCacheFolder(folder.path());
-  EXPECT_EQ(reading->Match(pair.descriptors1, pair.descriptors2), expected);
+  testing::Unguarded(reading).SetCacheFolder(folder.path());
+  EXPECT_EQ(testing::Unguarded(reading).Match(pair.descriptors1, pair.descriptors2), expected);
   const auto rewritten = IndexFiles(folder.path());
   ASSERT_EQ(rewritten.size(), 2u);
   EXPECT_NE(rewritten.at(flipped), files.at(flipped));
@@ -355,8 +378,8 @@ TEST(FlannMatcher, ACorruptOrTruncatedIndexFileIsBuiltAgain) {
   EXPECT_EQ(std::filesystem::file_size(flipped), flipped_size);
   // The rewritten files are whole: a third matcher reads them without writing.
   auto third = Load();
-  third->SetCacheFolder(folder.path());
-  EXPECT_EQ(third->Match(pair.descriptors1, pair.descriptors2), expected);
+  testing::Unguarded(third).SetCacheFolder(folder.path());
+  EXPECT_EQ(testing::Unguarded(third).Match(pair.descriptors1, pair.descriptors2), expected);
   EXPECT_EQ(IndexFiles(folder.path()), rewritten);
 }
 
@@ -368,8 +391,8 @@ TEST(FlannMatcher, IndexFilesDependOnTheIndexOptions) {
        {nlohmann::json::object(), nlohmann::json{{"branching", 16}},
         nlohmann::json{{"kmeans_iterations", 3}}, nlohmann::json{{"random_seed", 7}}}) {
     auto matcher = Load(options);
-    matcher->SetCacheFolder(folder.path());
-    matcher->Prepare(pair.descriptors2);
+    testing::Unguarded(matcher).SetCacheFolder(folder.path());
+    testing::Unguarded(matcher).Prepare(pair.descriptors2);
   }
   EXPECT_EQ(IndexFiles(folder.path()).size(), 4u);
 }
@@ -377,11 +400,12 @@ TEST(FlannMatcher, IndexFilesDependOnTheIndexOptions) {
 TEST(FlannMatcher, PrepareKeepsNothingWithoutAFolderOrForRandomIndexes) {
   const TemporaryDir folder;
   const SyntheticPair pair = MakeL2Pair(300, 100, 10, 55);
-  Load()->Prepare(pair.descriptors1);  // no folder: nothing to do, nowhere to write
+  testing::Unguarded(Load()).Prepare(
+      pair.descriptors1);  // no folder: nothing to do, nowhere to write
   auto kdtree = Load({{"l2_index", "kdtree"}});
-  kdtree->SetCacheFolder(folder.path());
-  kdtree->Prepare(pair.descriptors1);
-  kdtree->Match(pair.descriptors1, pair.descriptors2);
+  testing::Unguarded(kdtree).SetCacheFolder(folder.path());
+  testing::Unguarded(kdtree).Prepare(pair.descriptors1);
+  testing::Unguarded(kdtree).Match(pair.descriptors1, pair.descriptors2);
   EXPECT_TRUE(IndexFiles(folder.path()).empty());
 }
 
@@ -391,16 +415,17 @@ TEST(FlannMatcher, PrepareNamesTheFileItCannotWrite) {
   std::ofstream(blocked) << "a file where the cache folder should be";
   const SyntheticPair pair = MakeL2Pair(300, 100, 10, 56);
   auto matcher = Load();
-  matcher->SetCacheFolder(blocked);
+  testing::Unguarded(matcher).SetCacheFolder(blocked);
   try {
-    matcher->Prepare(pair.descriptors1);
+    testing::Unguarded(matcher).Prepare(pair.descriptors1);
     FAIL() << "expected an error";
   } catch (const std::exception& error) {
     EXPECT_NE(std::string(error.what()).find(blocked.string()), std::string::npos) << error.what();
   }
   // Matching still works, without the files.
-  EXPECT_EQ(matcher->Match(pair.descriptors1, pair.descriptors2),
-            Load({{"index_cache_size", 0}})->Match(pair.descriptors1, pair.descriptors2));
+  EXPECT_EQ(testing::Unguarded(matcher).Match(pair.descriptors1, pair.descriptors2),
+            testing::Unguarded(Load({{"index_cache_size", 0}}))
+                .Match(pair.descriptors1, pair.descriptors2));
 }
 
 TEST(FlannMatcher, ValidatesOptions) {
@@ -424,7 +449,7 @@ TEST(FlannMatcher, ValidatesOptions) {
         std::string::npos)
         << error.what();
   }
-  const nlohmann::json effective = Load()->EffectiveOptions();
+  const nlohmann::json effective = testing::Unguarded(Load()).EffectiveOptions();
   EXPECT_EQ(effective.size(), 16u);
   EXPECT_EQ(effective.at("index_cache_size"), 100000);
   EXPECT_EQ(effective.at("index_cache_mb"), 1024);

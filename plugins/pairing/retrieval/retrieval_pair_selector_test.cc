@@ -102,24 +102,25 @@ TEST(RetrievalPairSelector, PairsEachImageWithItsSceneTrainedOnTheRun) {
   const InMemoryFeatureReader reader(SyntheticScenes(3, 5, 11));
   auto selector = testing::LoadBundledPlugin<PairSelector>(
       "pair_selector", "retrieval", {{"num_neighbors", 4}, {"codebook_size", 16}});
-  const auto pairs = selector->SelectPairs(Input(15, &reader));
+  const auto pairs = testing::Unguarded(selector).SelectPairs(Input(15, &reader));
   EXPECT_EQ(pairs, SameScenePairs(15, 3));
   EXPECT_EQ(pairs.size(), 30u);
   // Two passes (training sample, then VLAD), keypoints and descriptors each.
   EXPECT_EQ(reader.reads(), 4u * 15);
-  EXPECT_EQ(selector->EffectiveOptions(), (nlohmann::json{{"num_neighbors", 4},
-                                                          {"codebook", ""},
-                                                          {"codebook_size", 16},
-                                                          {"max_features_per_image", 2000},
-                                                          {"training_descriptors", 100000},
-                                                          {"seed", 1}}));
+  EXPECT_EQ(testing::Unguarded(selector).EffectiveOptions(),
+            (nlohmann::json{{"num_neighbors", 4},
+                            {"codebook", ""},
+                            {"codebook_size", 16},
+                            {"max_features_per_image", 2000},
+                            {"training_descriptors", 100000},
+                            {"seed", 1}}));
 }
 
 TEST(RetrievalPairSelector, FewNeighboursGiveSymmetricUniqueOrderedPairs) {
   const InMemoryFeatureReader reader(SyntheticScenes(4, 6, 12));
   auto selector = testing::LoadBundledPlugin<PairSelector>(
       "pair_selector", "retrieval", {{"num_neighbors", 1}, {"codebook_size", 8}});
-  const auto pairs = selector->SelectPairs(Input(24, &reader));
+  const auto pairs = testing::Unguarded(selector).SelectPairs(Input(24, &reader));
   // Each image adds one pair; mutual nearest neighbours share one.
   EXPECT_GE(pairs.size(), 12u);
   EXPECT_LE(pairs.size(), 24u);
@@ -157,16 +158,16 @@ TEST(RetrievalPairSelector, EnoughNeighboursGiveAllPairsWithoutReading) {
   const InMemoryFeatureReader reader(SyntheticScenes(2, 3, 14));
   auto selector = testing::LoadBundledPlugin<PairSelector>("pair_selector", "retrieval",
                                                            {{"num_neighbors", 5}});
-  const auto pairs = selector->SelectPairs(Input(6, &reader));
+  const auto pairs = testing::Unguarded(selector).SelectPairs(Input(6, &reader));
   EXPECT_EQ(pairs.size(), 15u);
   EXPECT_EQ(pairs.front(), ImageIndexPair(0, 1));
   EXPECT_EQ(pairs.back(), ImageIndexPair(4, 5));
   EXPECT_EQ(reader.reads(), 0u);
   auto large = testing::LoadBundledPlugin<PairSelector>("pair_selector", "retrieval",
                                                         {{"num_neighbors", 1000}});
-  EXPECT_EQ(large->SelectPairs(Input(6, nullptr)).size(), 15u);
-  EXPECT_TRUE(large->SelectPairs(Input(1, nullptr)).empty());
-  EXPECT_TRUE(large->SelectPairs(Input(0, nullptr)).empty());
+  EXPECT_EQ(testing::Unguarded(large).SelectPairs(Input(6, nullptr)).size(), 15u);
+  EXPECT_TRUE(testing::Unguarded(large).SelectPairs(Input(1, nullptr)).empty());
+  EXPECT_TRUE(testing::Unguarded(large).SelectPairs(Input(0, nullptr)).empty());
 }
 
 TEST(RetrievalPairSelector, TrainedCodebookFileIsReadBackAndChecked) {
@@ -175,21 +176,21 @@ TEST(RetrievalPairSelector, TrainedCodebookFileIsReadBackAndChecked) {
   const auto file = dir.path() / "vocab.bin";
   auto trainer = testing::LoadBundledPlugin<PairSelector>("pair_selector", "retrieval",
                                                           {{"codebook_size", 24}, {"seed", 4}});
-  trainer->Train(Input(15, &reader), file);
+  testing::Unguarded(trainer).Train(Input(15, &reader), file);
   const Codebook codebook = ReadCodebook(file);
   EXPECT_EQ(codebook.num_centers, 24);
   EXPECT_EQ(codebook.descriptor_dimension, 128);
   // Deterministic: training again writes the same bytes.
-  trainer->Train(Input(15, &reader, 2), dir.path() / "again.bin");
+  testing::Unguarded(trainer).Train(Input(15, &reader, 2), dir.path() / "again.bin");
   EXPECT_EQ(ReadCodebook(dir.path() / "again.bin").centers, codebook.centers);
 
   auto user = testing::LoadBundledPlugin<PairSelector>(
       "pair_selector", "retrieval", {{"num_neighbors", 4}, {"codebook", file.string()}});
-  user->CheckDescriptors(DescriptorMetric::kL2, 128);
-  user->CheckDescriptors(DescriptorMetric::kL2, 0);  // width not known yet
-  EXPECT_EQ(user->SelectPairs(Input(15, &reader)), SameScenePairs(15, 3));
+  testing::Unguarded(user).CheckDescriptors(DescriptorMetric::kL2, 128);
+  testing::Unguarded(user).CheckDescriptors(DescriptorMetric::kL2, 0);  // width not known yet
+  EXPECT_EQ(testing::Unguarded(user).SelectPairs(Input(15, &reader)), SameScenePairs(15, 3));
   try {
-    user->CheckDescriptors(DescriptorMetric::kL2, 64);
+    testing::Unguarded(user).CheckDescriptors(DescriptorMetric::kL2, 64);
     FAIL() << "expected an error";
   } catch (const InputError& error) {
     EXPECT_EQ(std::string(error.what()),
@@ -200,7 +201,8 @@ TEST(RetrievalPairSelector, TrainedCodebookFileIsReadBackAndChecked) {
   // Too few descriptors for the centres asked for.
   auto greedy = testing::LoadBundledPlugin<PairSelector>("pair_selector", "retrieval",
                                                          {{"codebook_size", 5000}});
-  EXPECT_THROW(greedy->Train(Input(15, &reader), dir.path() / "x.bin"), InputError);
+  EXPECT_THROW(testing::Unguarded(greedy).Train(Input(15, &reader), dir.path() / "x.bin"),
+               InputError);
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "x.bin"));
 }
 
@@ -256,7 +258,7 @@ TEST(RetrievalPairSelector, RefusesBinaryDescriptorsAndMissingFeatures) {
   auto selector = testing::LoadBundledPlugin<PairSelector>("pair_selector", "retrieval",
                                                            {{"num_neighbors", 2}});
   try {
-    selector->CheckDescriptors(DescriptorMetric::kHamming, 32);
+    testing::Unguarded(selector).CheckDescriptors(DescriptorMetric::kHamming, 32);
     FAIL() << "expected an error";
   } catch (const OptionError& error) {
     EXPECT_EQ(std::string(error.what()),
@@ -265,9 +267,9 @@ TEST(RetrievalPairSelector, RefusesBinaryDescriptorsAndMissingFeatures) {
               "selector");
   }
   const InMemoryFeatureReader binary(SyntheticScenes(2, 3, 16), DescriptorMetric::kHamming);
-  EXPECT_THROW(selector->SelectPairs(Input(6, &binary)), OptionError);
+  EXPECT_THROW(testing::Unguarded(selector).SelectPairs(Input(6, &binary)), OptionError);
   EXPECT_EQ(binary.reads(), 0u);
-  EXPECT_THROW(selector->SelectPairs(Input(6, nullptr)), InputError);
+  EXPECT_THROW(testing::Unguarded(selector).SelectPairs(Input(6, nullptr)), InputError);
 }
 
 }  // namespace

@@ -92,12 +92,12 @@ TEST(SpatialPairSelector, NearestNeighboursWithinTheDistance) {
   const PairSelectionInput input = Images(AllTagged(local));
   auto selector = testing::LoadBundledPlugin<PairSelector>(
       "pair_selector", "spatial", {{"num_neighbors", 3}, {"max_distance", 1000}});
-  const auto pairs = selector->SelectPairs(input);
+  const auto pairs = testing::Unguarded(selector).SelectPairs(input);
   EXPECT_EQ(pairs, Reference(local, 3, 1000, true));
   // Each image has its 3 nearest, so at least 30 * 3 / 2 pairs and at most 30 * 3.
   EXPECT_GE(pairs.size(), 45u);
   EXPECT_LE(pairs.size(), 90u);
-  EXPECT_EQ(selector->SelectPairs(input), pairs);  // deterministic
+  EXPECT_EQ(testing::Unguarded(selector).SelectPairs(input), pairs);  // deterministic
 }
 
 TEST(SpatialPairSelector, DistanceCutOff) {
@@ -105,7 +105,7 @@ TEST(SpatialPairSelector, DistanceCutOff) {
   const PairSelectionInput input = Images(AllTagged(local));
   auto selector = testing::LoadBundledPlugin<PairSelector>(
       "pair_selector", "spatial", {{"num_neighbors", 1000}, {"max_distance", 40}});
-  const auto pairs = selector->SelectPairs(input);
+  const auto pairs = testing::Unguarded(selector).SelectPairs(input);
   // num_neighbors >= n: every pair within 40 m, and no other.
   const auto expected = Reference(local, 1000, 40, true);
   EXPECT_EQ(pairs, expected);
@@ -114,7 +114,7 @@ TEST(SpatialPairSelector, DistanceCutOff) {
   // A far-away image (5 km east) pairs with nobody.
   std::vector<std::optional<Local>> with_far = AllTagged(local);
   with_far.push_back(Local{5000, 0, 0});
-  const auto far_pairs = selector->SelectPairs(Images(with_far));
+  const auto far_pairs = testing::Unguarded(selector).SelectPairs(Images(with_far));
   EXPECT_EQ(far_pairs, expected);
 }
 
@@ -128,7 +128,7 @@ TEST(SpatialPairSelector, GridNeighbours) {
   }
   auto selector =
       testing::LoadBundledPlugin<PairSelector>("pair_selector", "spatial", {{"num_neighbors", 2}});
-  const auto pairs = selector->SelectPairs(Images(AllTagged(local)));
+  const auto pairs = testing::Unguarded(selector).SelectPairs(Images(AllTagged(local)));
   const std::vector<ImageIndexPair> expected = {{0, 1},  {0, 4},   {1, 2}, {2, 3}, {3, 7},
                                                 {4, 5},  {5, 6},   {6, 7}, {8, 9}, {8, 4},
                                                 {9, 10}, {10, 11}, {11, 7}};
@@ -143,16 +143,19 @@ TEST(SpatialPairSelector, AltitudeCountsUnlessIgnoredOrMissing) {
   const std::vector<Local> local = {{0, 0, 0.0}, {30, 0, 50.0}};
   const nlohmann::json options = {{"max_distance", 40}};
   auto selector = testing::LoadBundledPlugin<PairSelector>("pair_selector", "spatial", options);
-  EXPECT_TRUE(selector->SelectPairs(Images(AllTagged(local))).empty());  // 58 m apart
+  EXPECT_TRUE(
+      testing::Unguarded(selector).SelectPairs(Images(AllTagged(local))).empty());  // 58 m apart
 
   nlohmann::json ignore = options;
   ignore["ignore_altitude"] = true;
   auto flat = testing::LoadBundledPlugin<PairSelector>("pair_selector", "spatial", ignore);
-  EXPECT_EQ(flat->SelectPairs(Images(AllTagged(local))), (std::vector<ImageIndexPair>{{0, 1}}));
+  EXPECT_EQ(testing::Unguarded(flat).SelectPairs(Images(AllTagged(local))),
+            (std::vector<ImageIndexPair>{{0, 1}}));
 
   // One image without an altitude: altitudes are ignored for all.
   const std::vector<std::optional<Local>> partial = {Local{0, 0, 0.0}, Local{30, 0, std::nullopt}};
-  EXPECT_EQ(selector->SelectPairs(Images(partial)), (std::vector<ImageIndexPair>{{0, 1}}));
+  EXPECT_EQ(testing::Unguarded(selector).SelectPairs(Images(partial)),
+            (std::vector<ImageIndexPair>{{0, 1}}));
 }
 
 TEST(SpatialPairSelector, ImagesWithoutGpsFallBackToAWindow) {
@@ -163,43 +166,45 @@ TEST(SpatialPairSelector, ImagesWithoutGpsFallBackToAWindow) {
   positions[7].reset();
   auto selector = testing::LoadBundledPlugin<PairSelector>(
       "pair_selector", "spatial", {{"max_distance", 50}, {"fallback_window", 1}});
-  EXPECT_EQ(selector->SelectPairs(Images(positions)),
+  EXPECT_EQ(testing::Unguarded(selector).SelectPairs(Images(positions)),
             (std::vector<ImageIndexPair>{{2, 3}, {3, 4}, {6, 7}, {7, 8}}));
   auto wider = testing::LoadBundledPlugin<PairSelector>(
       "pair_selector", "spatial", {{"max_distance", 150}, {"fallback_window", 2}});
   // Neighbours at 100 m where both have GPS (not across a missing image: 200 m), and
   // the missing images' windows.
-  EXPECT_EQ(wider->SelectPairs(Images(positions)), (std::vector<ImageIndexPair>{{0, 1},
-                                                                                {1, 2},
-                                                                                {1, 3},
-                                                                                {2, 3},
-                                                                                {3, 4},
-                                                                                {3, 5},
-                                                                                {4, 5},
-                                                                                {5, 6},
-                                                                                {5, 7},
-                                                                                {6, 7},
-                                                                                {7, 8},
-                                                                                {7, 9},
-                                                                                {8, 9}}));
+  EXPECT_EQ(testing::Unguarded(wider).SelectPairs(Images(positions)),
+            (std::vector<ImageIndexPair>{{0, 1},
+                                         {1, 2},
+                                         {1, 3},
+                                         {2, 3},
+                                         {3, 4},
+                                         {3, 5},
+                                         {4, 5},
+                                         {5, 6},
+                                         {5, 7},
+                                         {6, 7},
+                                         {7, 8},
+                                         {7, 9},
+                                         {8, 9}}));
   auto none = testing::LoadBundledPlugin<PairSelector>(
       "pair_selector", "spatial", {{"max_distance", 50}, {"fallback_window", 0}});
-  EXPECT_TRUE(none->SelectPairs(Images(positions)).empty());
+  EXPECT_TRUE(testing::Unguarded(none).SelectPairs(Images(positions)).empty());
 
   // No image has GPS: a plain window.
   const std::vector<std::optional<Local>> untagged(4);
-  EXPECT_EQ(selector->SelectPairs(Images(untagged)),
+  EXPECT_EQ(testing::Unguarded(selector).SelectPairs(Images(untagged)),
             (std::vector<ImageIndexPair>{{0, 1}, {1, 2}, {2, 3}}));
-  EXPECT_TRUE(selector->SelectPairs(Images({})).empty());
-  EXPECT_TRUE(selector->SelectPairs(Images({Local{0, 0, 0.0}})).empty());
+  EXPECT_TRUE(testing::Unguarded(selector).SelectPairs(Images({})).empty());
+  EXPECT_TRUE(testing::Unguarded(selector).SelectPairs(Images({Local{0, 0, 0.0}})).empty());
 }
 
 TEST(SpatialPairSelector, OptionsAndErrors) {
   auto selector = testing::LoadBundledPlugin<PairSelector>("pair_selector", "spatial");
-  EXPECT_EQ(selector->EffectiveOptions(), (nlohmann::json{{"num_neighbors", 50},
-                                                          {"max_distance", 100.0},
-                                                          {"ignore_altitude", false},
-                                                          {"fallback_window", 5}}));
+  EXPECT_EQ(testing::Unguarded(selector).EffectiveOptions(),
+            (nlohmann::json{{"num_neighbors", 50},
+                            {"max_distance", 100.0},
+                            {"ignore_altitude", false},
+                            {"fallback_window", 5}}));
   try {
     testing::LoadBundledPlugin<PairSelector>("pair_selector", "spatial", {{"max_distance", -1}},
                                              "pipeline.pair_selector[1]");

@@ -259,7 +259,7 @@ TEST(CeresBundleAdjuster, RecoversPerturbedSceneUpToScale) {
   const double initial_error = MeanReprojectionError(rec);
 
   const auto adjuster = LoadAdjuster();
-  const BundleAdjustmentSummary summary = adjuster->Adjust({}, &rec);
+  const BundleAdjustmentSummary summary = testing::Unguarded(adjuster).Adjust({}, &rec);
   ASSERT_TRUE(summary.usable) << summary.message;
   EXPECT_EQ(summary.num_residuals, NumObservations(rec, AllImageIds(rec)));
   EXPECT_GT(summary.num_iterations, 0);
@@ -279,7 +279,7 @@ TEST(CeresBundleAdjuster, RecoversPerturbedSceneUpToScale) {
 
   // The same minimum as a solve that starts at the truth: converged, not stopped early.
   Reconstruction from_truth = scene.truth;
-  ASSERT_TRUE(adjuster->Adjust({}, &from_truth).usable);
+  ASSERT_TRUE(testing::Unguarded(adjuster).Adjust({}, &from_truth).usable);
   EXPECT_LT(MaxCenterDifference(rec, from_truth, scene.truth), 1e-4 * scene.baseline);
   EXPECT_NEAR(rec.cameras.at(1).params[0], from_truth.cameras.at(1).params[0], 0.05);
   EXPECT_NEAR(rec.cameras.at(1).params[3], from_truth.cameras.at(1).params[3], 1e-4);
@@ -298,7 +298,7 @@ TEST(CeresBundleAdjuster, FixesGaugeOnFirstPoseAndOneCoordinateOfSecond) {
   const SyntheticScene scene = MakeScene(SmallScene());
   Reconstruction rec = Perturb(scene, AllImageIds(scene.truth));
   const Reconstruction before = rec;
-  ASSERT_TRUE(LoadAdjuster()->Adjust({}, &rec).usable);
+  ASSERT_TRUE(testing::Unguarded(LoadAdjuster()).Adjust({}, &rec).usable);
 
   ExpectSamePose(rec.images.at(1).cam_from_world, before.images.at(1).cam_from_world, 1);
   const Eigen::Vector3d t2_before = before.images.at(2).cam_from_world.translation;
@@ -319,11 +319,11 @@ TEST(CeresBundleAdjuster, HuberLossResistsOutliersBetterThanTrivial) {
   const Reconstruction initial = Perturb(scene, perturbed);
 
   Reconstruction huber = initial;
-  ASSERT_TRUE(LoadAdjuster({{"loss", "huber"}})->Adjust({}, &huber).usable);
+  ASSERT_TRUE(testing::Unguarded(LoadAdjuster({{"loss", "huber"}})).Adjust({}, &huber).usable);
   Reconstruction trivial = initial;
-  ASSERT_TRUE(LoadAdjuster({{"loss", "trivial"}})->Adjust({}, &trivial).usable);
+  ASSERT_TRUE(testing::Unguarded(LoadAdjuster({{"loss", "trivial"}})).Adjust({}, &trivial).usable);
   Reconstruction cauchy = initial;
-  ASSERT_TRUE(LoadAdjuster({{"loss", "cauchy"}})->Adjust({}, &cauchy).usable);
+  ASSERT_TRUE(testing::Unguarded(LoadAdjuster({{"loss", "cauchy"}})).Adjust({}, &cauchy).usable);
 
   const double huber_error = MeanReprojectionError(huber, scene.outliers);
   const double trivial_error = MeanReprojectionError(trivial, scene.outliers);
@@ -348,7 +348,7 @@ TEST(CeresBundleAdjuster, RefineFlagsHoldIntrinsics) {
   Reconstruction rec = initial;
   BundleAdjustmentConfig config;
   config.refine_focal_length = false;
-  ASSERT_TRUE(adjuster->Adjust(config, &rec).usable);
+  ASSERT_TRUE(testing::Unguarded(adjuster).Adjust(config, &rec).usable);
   EXPECT_EQ(rec.cameras.at(1).params[0], params[0]);
   EXPECT_EQ(rec.cameras.at(1).params[1], params[1]);
   EXPECT_EQ(rec.cameras.at(1).params[2], params[2]);
@@ -358,7 +358,7 @@ TEST(CeresBundleAdjuster, RefineFlagsHoldIntrinsics) {
   rec = initial;
   config = BundleAdjustmentConfig();
   config.refine_principal_point = true;
-  ASSERT_TRUE(adjuster->Adjust(config, &rec).usable);
+  ASSERT_TRUE(testing::Unguarded(adjuster).Adjust(config, &rec).usable);
   EXPECT_NE(rec.cameras.at(1).params[1], params[1]);
   EXPECT_NE(rec.cameras.at(1).params[2], params[2]);
 
@@ -367,7 +367,7 @@ TEST(CeresBundleAdjuster, RefineFlagsHoldIntrinsics) {
   config = BundleAdjustmentConfig();
   config.refine_focal_length = false;
   config.refine_extra_params = false;
-  ASSERT_TRUE(adjuster->Adjust(config, &rec).usable);
+  ASSERT_TRUE(testing::Unguarded(adjuster).Adjust(config, &rec).usable);
   EXPECT_EQ(rec.cameras.at(1).params, params);
   EXPECT_NE(rec.points3D.at(1).xyz, initial.points3D.at(1).xyz);
 }
@@ -379,7 +379,7 @@ TEST(CeresBundleAdjuster, ConstantPosesAndPointsStayExactlyUnchanged) {
   config.constant_poses = {1, 4, 7};
   config.constant_points = {5, 6};
   Reconstruction rec = initial;
-  ASSERT_TRUE(LoadAdjuster()->Adjust(config, &rec).usable);
+  ASSERT_TRUE(testing::Unguarded(LoadAdjuster()).Adjust(config, &rec).usable);
   for (const image_t image_id : AllImageIds(rec)) {
     if (config.constant_poses.count(image_id) > 0) {
       ExpectSamePose(rec.images.at(image_id).cam_from_world,
@@ -413,7 +413,7 @@ TEST(CeresBundleAdjuster, PointsSeenOnceInTheProblemStayConstant) {
   BundleAdjustmentConfig config;
   config.images = {1, 2};
   config.constant_poses = {1};
-  const BundleAdjustmentSummary summary = LoadAdjuster()->Adjust(config, &rec);
+  const BundleAdjustmentSummary summary = testing::Unguarded(LoadAdjuster()).Adjust(config, &rec);
   ASSERT_TRUE(summary.usable) << summary.message;
   int expected_residuals = 0;
   for (const auto& [point3D_id, point] : rec.points3D) {
@@ -446,7 +446,7 @@ TEST(CeresBundleAdjuster, LocalBundleAdjustmentMovesOnlyItsImages) {
   config.constant_poses = {1, 2, 3, 4};
   config.refine_focal_length = false;
   config.refine_extra_params = false;
-  const BundleAdjustmentSummary summary = LoadAdjuster()->Adjust(config, &rec);
+  const BundleAdjustmentSummary summary = testing::Unguarded(LoadAdjuster()).Adjust(config, &rec);
   ASSERT_TRUE(summary.usable) << summary.message;
   EXPECT_EQ(summary.num_residuals, NumObservations(rec, config.images));
 
@@ -477,12 +477,14 @@ TEST(CeresBundleAdjuster, EveryLinearSolverReachesTheSameMinimum) {
   perturbed.erase(perturbed.begin());
   const Reconstruction initial = Perturb(scene, perturbed);
   Reconstruction reference = initial;
-  ASSERT_TRUE(LoadAdjuster({{"linear_solver", "dense_schur"}})->Adjust({}, &reference).usable);
+  ASSERT_TRUE(testing::Unguarded(LoadAdjuster({{"linear_solver", "dense_schur"}}))
+                  .Adjust({}, &reference)
+                  .usable);
   EXPECT_LT(MaxCenterErrorAfterScaleAlignment(reference, scene.truth), 0.01 * scene.baseline);
   for (const std::string solver : {"auto", "sparse_schur", "iterative_schur"}) {
     Reconstruction rec = initial;
     const BundleAdjustmentSummary summary =
-        LoadAdjuster({{"linear_solver", solver}})->Adjust({}, &rec);
+        testing::Unguarded(LoadAdjuster({{"linear_solver", solver}})).Adjust({}, &rec);
     ASSERT_TRUE(summary.usable) << solver << ": " << summary.message;
     EXPECT_LT(MeanReprojectionError(rec), 0.8) << solver;
     EXPECT_LT(MaxCenterDifference(rec, reference, scene.truth), 1e-4 * scene.baseline) << solver;
@@ -495,7 +497,7 @@ TEST(CeresBundleAdjuster, EveryCameraModelConverges) {
     std::set<image_t> perturbed = AllImageIds(scene.truth);
     perturbed.erase(perturbed.begin());
     Reconstruction rec = Perturb(scene, perturbed);
-    const BundleAdjustmentSummary summary = LoadAdjuster()->Adjust({}, &rec);
+    const BundleAdjustmentSummary summary = testing::Unguarded(LoadAdjuster()).Adjust({}, &rec);
     const std::string name = CameraModelIdToName(model_id);
     ASSERT_TRUE(summary.usable) << name << ": " << summary.message;
     EXPECT_LT(MeanReprojectionError(rec), 0.8) << name;
@@ -528,7 +530,7 @@ TEST(CeresBundleAdjuster, RejectsInvalidOptions) {
 
 TEST(CeresBundleAdjuster, EffectiveOptionsHaveDefaults) {
   const auto adjuster = LoadAdjuster({{"loss", "cauchy"}});
-  const nlohmann::json& options = adjuster->EffectiveOptions();
+  const nlohmann::json& options = testing::Unguarded(adjuster).EffectiveOptions();
   EXPECT_EQ(options.at("loss"), "cauchy");
   EXPECT_EQ(options.at("loss_scale"), 1.0);
   EXPECT_EQ(options.at("max_num_iterations"), 100);
@@ -543,7 +545,7 @@ TEST(CeresBundleAdjuster, EffectiveOptionsHaveDefaults) {
 TEST(CeresBundleAdjuster, InvalidProblemsAreNotUsable) {
   const auto adjuster = LoadAdjuster();
   Reconstruction empty;
-  BundleAdjustmentSummary summary = adjuster->Adjust({}, &empty);
+  BundleAdjustmentSummary summary = testing::Unguarded(adjuster).Adjust({}, &empty);
   EXPECT_FALSE(summary.usable);
   EXPECT_EQ(summary.message, "no registered images to adjust");
   EXPECT_EQ(summary.num_residuals, 0);
@@ -552,14 +554,14 @@ TEST(CeresBundleAdjuster, InvalidProblemsAreNotUsable) {
   Reconstruction rec = scene.truth;
   BundleAdjustmentConfig config;
   config.images = {1, 99};
-  summary = adjuster->Adjust(config, &rec);
+  summary = testing::Unguarded(adjuster).Adjust(config, &rec);
   EXPECT_FALSE(summary.usable);
   EXPECT_EQ(summary.message, "image 99 of the configuration is not in the reconstruction");
 
   // Registered images without any 3D points.
   Reconstruction no_points = scene.truth;
   no_points.points3D.clear();
-  summary = adjuster->Adjust({}, &no_points);
+  summary = testing::Unguarded(adjuster).Adjust({}, &no_points);
   EXPECT_FALSE(summary.usable);
   EXPECT_EQ(summary.message, "none of the 8 images observes a 3D point");
 
@@ -569,21 +571,21 @@ TEST(CeresBundleAdjuster, InvalidProblemsAreNotUsable) {
   for (const auto& [point3D_id, point3D] : rec.points3D) config.constant_points.insert(point3D_id);
   config.refine_focal_length = false;
   config.refine_extra_params = false;
-  summary = adjuster->Adjust(config, &rec);
+  summary = testing::Unguarded(adjuster).Adjust(config, &rec);
   EXPECT_FALSE(summary.usable);
   EXPECT_NE(summary.message.find("nothing to optimise"), std::string::npos) << summary.message;
 
   // A track that points past an image's keypoints.
   Reconstruction broken = scene.truth;
   broken.points3D.at(1).track.push_back({2, 100000});
-  summary = adjuster->Adjust({}, &broken);
+  summary = testing::Unguarded(adjuster).Adjust({}, &broken);
   EXPECT_FALSE(summary.usable);
   EXPECT_NE(summary.message.find("the track of point 1 refers to keypoint 100000 of image 2"),
             std::string::npos)
       << summary.message;
   EXPECT_EQ(broken.points3D.at(2).xyz, scene.truth.points3D.at(2).xyz);
 
-  EXPECT_FALSE(adjuster->Adjust({}, nullptr).usable);
+  EXPECT_FALSE(testing::Unguarded(adjuster).Adjust({}, nullptr).usable);
 }
 
 TEST(CeresBundleAdjuster, SingleThreadedRunsAreIdentical) {
@@ -592,8 +594,8 @@ TEST(CeresBundleAdjuster, SingleThreadedRunsAreIdentical) {
   const auto adjuster = LoadAdjuster({{"num_threads", 1}});
   Reconstruction first = initial;
   Reconstruction second = initial;
-  const BundleAdjustmentSummary first_summary = adjuster->Adjust({}, &first);
-  const BundleAdjustmentSummary second_summary = adjuster->Adjust({}, &second);
+  const BundleAdjustmentSummary first_summary = testing::Unguarded(adjuster).Adjust({}, &first);
+  const BundleAdjustmentSummary second_summary = testing::Unguarded(adjuster).Adjust({}, &second);
   ASSERT_TRUE(first_summary.usable);
   EXPECT_EQ(first_summary.final_cost, second_summary.final_cost);
   EXPECT_EQ(first_summary.num_iterations, second_summary.num_iterations);
