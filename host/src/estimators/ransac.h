@@ -175,6 +175,83 @@ class LORANSAC {
 
 namespace ransac_internal {
 
+// The best model of a run so far, and the buffers its trials reuse.
+template <typename Estimator, typename LocalEstimator>
+struct RunState {
+  std::vector<typename Estimator::X_t> X_sample;
+  std::vector<typename Estimator::Y_t> Y_sample;
+  std::vector<typename LocalEstimator::X_t> X_inlier;
+  std::vector<typename LocalEstimator::Y_t> Y_inlier;
+  // Residuals of the model last evaluated.
+  std::vector<double> residuals;
+  // Residuals of the best locally optimised model.
+  std::vector<double> best_local_residuals;
+
+  RANSACSupport best_support;
+  std::optional<typename Estimator::M_t> best_model;
+  bool best_model_is_local = false;
+};
+
+// Re-estimates the new best model (whose residuals are in state->residuals) on its
+// inliers while that keeps enlarging the inlier set.
+template <typename Estimator, typename LocalEstimator>
+void OptimizeLocally(const std::vector<typename Estimator::X_t>& X,
+                     const std::vector<typename Estimator::Y_t>& Y, double max_residual,
+                     RunState<Estimator, LocalEstimator>* state) {
+  using M_t = typename Estimator::M_t;
+  constexpr int kMaxNumLocalTrials = 10;
+  for (int local_trial = 0; local_trial < kMaxNumLocalTrials; ++local_trial) {
+    state->X_inlier.clear();
+    state->Y_inlier.clear();
+    for (size_t i = 0; i < X.size(); ++i) {
+      if (state->residuals[i] <= max_residual) {
+        state->X_inlier.push_back(X[i]);
+        state->Y_inlier.push_back(Y[i]);
+      }
+    }
+    const size_t prev_best_num_inliers = state->best_support.num_inliers;
+    for (const M_t& local_model : LocalEstimator::Estimate(state->X_inlier, state->Y_inlier)) {
+      LocalEstimator::Residuals(X, Y, local_model, &state->residuals);
+      const RANSACSupport local_support = EvaluateSupport(state->residuals, max_residual);
+      if (local_support.IsBetterThan(state->best_support)) {
+        state->best_support = local_support;
+        state->best_model = local_model;
+        state->best_model_is_local = true;
+        std::swap(state->residuals, state->best_local_residuals);
+      }
+    }
+    if (state->best_support.num_inliers <= prev_best_num_inliers) break;
+    // The best model's residuals select the inliers of the next round.
+    std::swap(state->residuals, state->best_local_residuals);
+  }
+}
+
+// Fills the report from the run's best model, if it has enough inliers.
+template <typename Estimator, typename LocalEstimator>
+void FinishReport(const std::vector<typename Estimator::X_t>& X,
+                  const std::vector<typename Estimator::Y_t>& Y, double max_residual,
+                  RunState<Estimator, LocalEstimator>* state,
+                  RANSACReport<typename Estimator::M_t>* report) {
+  if (!state->best_model ||
+      state->best_support.num_inliers < static_cast<size_t>(Estimator::kMinNumSamples)) {
+    return;
+  }
+  report->success = true;
+  report->support = state->best_support;
+  report->model = *state->best_model;
+
+  // Recomputing the winner's residuals once is cheaper than keeping a mask per model.
+  if (state->best_model_is_local) {
+    LocalEstimator::Residuals(X, Y, report->model, &state->residuals);
+  } else {
+    Estimator::Residuals(X, Y, report->model, &state->residuals);
+  }
+  report->inlier_mask.resize(X.size());
+  for (size_t i = 0; i < X.size(); ++i) {
+    report->inlier_mask[i] = state->residuals[i] <= max_residual ? 1 : 0;
+  }
+}
+
 // The RANSAC loop; with kLocalOptimization, a new best model is refined on its inliers.
 template <typename Estimator, typename LocalEstimator, bool kLocalOptimization>
 RANSACReport<typename Estimator::M_t> Run(const RANSACOptions& options, uint64_t seed,
@@ -203,65 +280,29 @@ RANSACReport<typename Estimator::M_t> Run(const RANSACOptions& options, uint64_t
       HopelessNumTrials(options, num_samples, Estimator::kMinNumSamples);
 
   RandomSampler sampler(num_samples, seed);
-  std::vector<typename Estimator::X_t> X_sample;
-  std::vector<typename Estimator::Y_t> Y_sample;
-  std::vector<typename LocalEstimator::X_t> X_inlier;
-  std::vector<typename LocalEstimator::Y_t> Y_inlier;
-  std::vector<double> residuals;
-  std::vector<double> best_local_residuals;
-
-  RANSACSupport best_support;
-  std::optional<M_t> best_model;
-  bool best_model_is_local = false;
+  RunState<Estimator, LocalEstimator> state;
   bool abort = false;
 
   for (report.num_trials = 0; report.num_trials < max_num_trials; ++report.num_trials) {
     const std::vector<size_t>& sample = sampler.Sample(Estimator::kMinNumSamples);
-    Gather(X, sample, &X_sample);
-    Gather(Y, sample, &Y_sample);
+    Gather(X, sample, &state.X_sample);
+    Gather(Y, sample, &state.Y_sample);
 
-    for (const M_t& sample_model : Estimator::Estimate(X_sample, Y_sample)) {
-      Estimator::Residuals(X, Y, sample_model, &residuals);
-      const RANSACSupport support = EvaluateSupport(residuals, max_residual);
-      if (support.IsBetterThan(best_support)) {
-        best_support = support;
-        best_model = sample_model;
-        best_model_is_local = false;
-
+    for (const M_t& sample_model : Estimator::Estimate(state.X_sample, state.Y_sample)) {
+      Estimator::Residuals(X, Y, sample_model, &state.residuals);
+      const RANSACSupport support = EvaluateSupport(state.residuals, max_residual);
+      if (support.IsBetterThan(state.best_support)) {
+        state.best_support = support;
+        state.best_model = sample_model;
+        state.best_model_is_local = false;
         if constexpr (kLocalOptimization) {
           if (support.num_inliers > static_cast<size_t>(Estimator::kMinNumSamples) &&
               support.num_inliers >= static_cast<size_t>(LocalEstimator::kMinNumSamples)) {
-            // Re-estimate on the inliers while that keeps enlarging the inlier set.
-            constexpr int kMaxNumLocalTrials = 10;
-            for (int local_trial = 0; local_trial < kMaxNumLocalTrials; ++local_trial) {
-              X_inlier.clear();
-              Y_inlier.clear();
-              for (size_t i = 0; i < num_samples; ++i) {
-                if (residuals[i] <= max_residual) {
-                  X_inlier.push_back(X[i]);
-                  Y_inlier.push_back(Y[i]);
-                }
-              }
-              const size_t prev_best_num_inliers = best_support.num_inliers;
-              for (const M_t& local_model : LocalEstimator::Estimate(X_inlier, Y_inlier)) {
-                LocalEstimator::Residuals(X, Y, local_model, &residuals);
-                const RANSACSupport local_support = EvaluateSupport(residuals, max_residual);
-                if (local_support.IsBetterThan(best_support)) {
-                  best_support = local_support;
-                  best_model = local_model;
-                  best_model_is_local = true;
-                  std::swap(residuals, best_local_residuals);
-                }
-              }
-              if (best_support.num_inliers <= prev_best_num_inliers) break;
-              // The best model's residuals select the inliers of the next round.
-              std::swap(residuals, best_local_residuals);
-            }
+            OptimizeLocally(X, Y, max_residual, &state);
           }
         }
-
         dyn_max_num_trials =
-            ComputeNumTrials(best_support.num_inliers, num_samples, Estimator::kMinNumSamples,
+            ComputeNumTrials(state.best_support.num_inliers, num_samples, Estimator::kMinNumSamples,
                              options.confidence, options.dyn_num_trials_multiplier);
       }
 
@@ -278,30 +319,13 @@ RANSACReport<typename Estimator::M_t> Run(const RANSACOptions& options, uint64_t
     }
     // Give up once a model with min_num_inliers inliers would have been found.
     if (report.num_trials + 1 >= hopeless_num_trials && report.num_trials + 1 >= min_num_trials &&
-        best_support.num_inliers < min_num_inliers) {
+        state.best_support.num_inliers < min_num_inliers) {
       report.hopeless = true;
       report.num_trials += 1;
       break;
     }
   }
-
-  if (!best_model || best_support.num_inliers < static_cast<size_t>(Estimator::kMinNumSamples)) {
-    return report;
-  }
-  report.success = true;
-  report.support = best_support;
-  report.model = *best_model;
-
-  // Recomputing the winner's residuals once is cheaper than keeping a mask per model.
-  if (best_model_is_local) {
-    LocalEstimator::Residuals(X, Y, report.model, &residuals);
-  } else {
-    Estimator::Residuals(X, Y, report.model, &residuals);
-  }
-  report.inlier_mask.resize(num_samples);
-  for (size_t i = 0; i < num_samples; ++i) {
-    report.inlier_mask[i] = residuals[i] <= max_residual ? 1 : 0;
-  }
+  FinishReport(X, Y, max_residual, &state, &report);
   return report;
 }
 

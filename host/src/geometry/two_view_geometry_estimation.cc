@@ -168,6 +168,141 @@ TwoViewGeometry EstimateUncalibrated(const std::vector<Eigen::Vector2d>& points1
   return geometry;
 }
 
+// The three models of a pair with known intrinsics: E in normalised coordinates, F and
+// H in pixels.
+struct CalibratedReports {
+  RANSACReport<Eigen::Matrix3d> E;
+  RANSACReport<Eigen::Matrix3d> F;
+  RANSACReport<Eigen::Matrix3d> H;
+};
+
+CalibratedReports EstimateCalibratedModels(const Camera& camera1, const Camera& camera2,
+                                           const std::vector<Eigen::Vector2d>& points1,
+                                           const std::vector<Eigen::Vector2d>& points2,
+                                           const std::vector<Eigen::Vector2d>& normalized1,
+                                           const std::vector<Eigen::Vector2d>& normalized2,
+                                           const VerificationSettings& settings, uint64_t seed) {
+  const RANSACOptions pixel_options = MakeRansacOptions(settings, settings.max_error_px);
+  const RANSACOptions E_options =
+      MakeRansacOptions(settings, (camera1.CamFromImgThreshold(settings.max_error_px) +
+                                   camera2.CamFromImgThreshold(settings.max_error_px)) /
+                                      2);
+
+  CalibratedReports reports;
+  reports.E = LORANSAC<EssentialMatrixFivePointEstimator, EssentialMatrixFivePointEstimator>(
+                  E_options, DeriveSeed(seed, kEssentialStream))
+                  .Estimate(normalized1, normalized2);
+  // F only decides the configuration when it beats E by the 1 / kMinEFInlierRatio
+  // margin; RANSAC may assume that inlier ratio, which saves a third of the 7-point
+  // trials at high outlier ratios without changing the decision.
+  RANSACOptions F_options = pixel_options;
+  if (reports.E.success) {
+    F_options.min_inlier_ratio =
+        std::clamp(static_cast<double>(reports.E.support.num_inliers) /
+                       (kMinEFInlierRatio * static_cast<double>(points1.size())),
+                   pixel_options.min_inlier_ratio, 1.0);
+  }
+  reports.F = LORANSAC<FundamentalMatrixSevenPointEstimator, FundamentalMatrixEightPointEstimator>(
+                  F_options, DeriveSeed(seed, kFundamentalStream))
+                  .Estimate(points1, points2);
+  const size_t min_num_inliers = static_cast<size_t>(std::max(settings.min_num_inliers, 0));
+
+  // The H test compares against E's or F's inliers: the smaller of those that can
+  // be chosen bounds what H must reach. Without either, H is the only candidate
+  // and gets the full search.
+  size_t min_num_epipolar_inliers = 0;
+  for (const size_t n : {reports.E.support.num_inliers, reports.F.support.num_inliers}) {
+    if (n >= std::max<size_t>(min_num_inliers, 1)) {
+      min_num_epipolar_inliers =
+          min_num_epipolar_inliers == 0 ? n : std::min(min_num_epipolar_inliers, n);
+    }
+  }
+  reports.H = LORANSAC<HomographyMatrixEstimator, HomographyMatrixEstimator>(
+                  HomographyRansacOptions(settings, min_num_epipolar_inliers, points1.size()),
+                  DeriveSeed(seed, kHomographyStream))
+                  .Estimate(points1, points2);
+  return reports;
+}
+
+// Sets geometry->config from the three models and returns the inlier mask of the one
+// chosen, or nullptr when none holds. *calibrated: E was chosen (so a pose follows).
+const std::vector<char>* ChooseCalibratedModel(const CalibratedReports& reports,
+                                               const VerificationSettings& settings,
+                                               TwoViewGeometry* geometry, bool* calibrated) {
+  const RANSACReport<Eigen::Matrix3d>& E_report = reports.E;
+  const RANSACReport<Eigen::Matrix3d>& F_report = reports.F;
+  const RANSACReport<Eigen::Matrix3d>& H_report = reports.H;
+  const size_t min_num_inliers = static_cast<size_t>(std::max(settings.min_num_inliers, 0));
+  const size_t num_E_inliers = E_report.support.num_inliers;
+  const size_t num_F_inliers = F_report.support.num_inliers;
+  const size_t num_H_inliers = H_report.support.num_inliers;
+
+  const std::vector<char>* inlier_mask = nullptr;
+  size_t num_inliers = 0;
+  // Inlier count of the epipolar model (E or F) the H test compares against.
+  size_t num_epipolar_inliers = 0;
+  *calibrated = false;
+  if (E_report.success && num_E_inliers >= min_num_inliers &&
+      static_cast<double>(num_E_inliers) >=
+          kMinEFInlierRatio * static_cast<double>(num_F_inliers)) {
+    *calibrated = true;
+    num_epipolar_inliers = num_E_inliers;
+    // Keep the larger inlier set of the two epipolar models.
+    if (num_E_inliers >= num_F_inliers || !F_report.success) {
+      inlier_mask = &E_report.inlier_mask;
+      num_inliers = num_E_inliers;
+    } else {
+      inlier_mask = &F_report.inlier_mask;
+      num_inliers = num_F_inliers;
+    }
+    geometry->config = TwoViewGeometry::CALIBRATED;
+  } else if (F_report.success && num_F_inliers >= min_num_inliers) {
+    num_epipolar_inliers = num_F_inliers;
+    inlier_mask = &F_report.inlier_mask;
+    num_inliers = num_F_inliers;
+    geometry->config = TwoViewGeometry::UNCALIBRATED;
+  } else if (H_report.success && num_H_inliers >= min_num_inliers) {
+    // Neither epipolar model holds, but a homography does: typically a pure rotation
+    // with too few matches for E or F to be tested reliably.
+    inlier_mask = &H_report.inlier_mask;
+    num_inliers = num_H_inliers;
+    geometry->config = TwoViewGeometry::PLANAR_OR_PANORAMIC;
+  } else {
+    return nullptr;
+  }
+
+  if (num_epipolar_inliers > 0 && H_report.success &&
+      static_cast<double>(num_H_inliers) / static_cast<double>(num_epipolar_inliers) >
+          settings.max_H_inlier_ratio) {
+    geometry->config = TwoViewGeometry::PLANAR_OR_PANORAMIC;
+    if (num_H_inliers > num_inliers) inlier_mask = &H_report.inlier_mask;
+  }
+  return inlier_mask;
+}
+
+// For a planar or panoramic pair: refits H on its inliers in normalised coordinates
+// (undistorted, focal removed) to tell a pure rotation (PANORAMIC, with that rotation;
+// returns true) from a plane seen with baseline (PLANAR when calibrated).
+bool ClassifyHomography(const RANSACReport<Eigen::Matrix3d>& H_report,
+                        const std::vector<Eigen::Vector2d>& normalized1,
+                        const std::vector<Eigen::Vector2d>& normalized2, bool calibrated,
+                        TwoViewGeometry* geometry) {
+  if (geometry->config != TwoViewGeometry::PLANAR_OR_PANORAMIC || !H_report.success) {
+    return false;
+  }
+  const auto H_normalized =
+      HomographyMatrixEstimator::Estimate(ExtractInliers(normalized1, H_report.inlier_mask),
+                                          ExtractInliers(normalized2, H_report.inlier_mask));
+  Eigen::Matrix3d R;
+  if (!H_normalized.empty() && RotationFromHomography(H_normalized[0], &R)) {
+    geometry->config = TwoViewGeometry::PANORAMIC;
+    geometry->cam2_from_cam1 = Rigid3d(Eigen::Quaterniond(R).normalized(), Eigen::Vector3d::Zero());
+    return true;
+  }
+  if (calibrated) geometry->config = TwoViewGeometry::PLANAR;
+  return false;
+}
+
 TwoViewGeometry EstimateCalibrated(const Camera& camera1, const Camera& camera2,
                                    const std::vector<Eigen::Vector2d>& points1,
                                    const std::vector<Eigen::Vector2d>& points2,
@@ -178,123 +313,26 @@ TwoViewGeometry EstimateCalibrated(const Camera& camera1, const Camera& camera2,
     normalized1[i] = camera1.CamFromImg(points1[i]);
     normalized2[i] = camera2.CamFromImg(points2[i]);
   }
-
-  const RANSACOptions pixel_options = MakeRansacOptions(settings, settings.max_error_px);
-  const RANSACOptions E_options =
-      MakeRansacOptions(settings, (camera1.CamFromImgThreshold(settings.max_error_px) +
-                                   camera2.CamFromImgThreshold(settings.max_error_px)) /
-                                      2);
-
-  const auto E_report =
-      LORANSAC<EssentialMatrixFivePointEstimator, EssentialMatrixFivePointEstimator>(
-          E_options, DeriveSeed(seed, kEssentialStream))
-          .Estimate(normalized1, normalized2);
-  // F only decides the configuration when it beats E by the 1 / kMinEFInlierRatio
-  // margin; RANSAC may assume that inlier ratio, which saves a third of the 7-point
-  // trials at high outlier ratios without changing the decision.
-  RANSACOptions F_options = pixel_options;
-  if (E_report.success) {
-    F_options.min_inlier_ratio =
-        std::clamp(static_cast<double>(E_report.support.num_inliers) /
-                       (kMinEFInlierRatio * static_cast<double>(points1.size())),
-                   pixel_options.min_inlier_ratio, 1.0);
-  }
-  const auto F_report =
-      LORANSAC<FundamentalMatrixSevenPointEstimator, FundamentalMatrixEightPointEstimator>(
-          F_options, DeriveSeed(seed, kFundamentalStream))
-          .Estimate(points1, points2);
-  const size_t min_num_inliers = static_cast<size_t>(std::max(settings.min_num_inliers, 0));
-  const size_t num_E_inliers = E_report.support.num_inliers;
-  const size_t num_F_inliers = F_report.support.num_inliers;
-
-  // The H test compares against E's or F's inliers: the smaller of those that can
-  // be chosen bounds what H must reach. Without either, H is the only candidate
-  // and gets the full search.
-  size_t min_num_epipolar_inliers = 0;
-  for (const size_t n : {num_E_inliers, num_F_inliers}) {
-    if (n >= std::max<size_t>(min_num_inliers, 1)) {
-      min_num_epipolar_inliers =
-          min_num_epipolar_inliers == 0 ? n : std::min(min_num_epipolar_inliers, n);
-    }
-  }
-  const auto H_report =
-      LORANSAC<HomographyMatrixEstimator, HomographyMatrixEstimator>(
-          HomographyRansacOptions(settings, min_num_epipolar_inliers, points1.size()),
-          DeriveSeed(seed, kHomographyStream))
-          .Estimate(points1, points2);
-  const size_t num_H_inliers = H_report.support.num_inliers;
+  const CalibratedReports reports = EstimateCalibratedModels(
+      camera1, camera2, points1, points2, normalized1, normalized2, settings, seed);
 
   TwoViewGeometry geometry;
-  if (E_report.success) geometry.E = E_report.model;
-  if (F_report.success) geometry.F = F_report.model;
-  if (H_report.success) geometry.H = H_report.model;
-
-  const std::vector<char>* inlier_mask = nullptr;
-  size_t num_inliers = 0;
-  // Inlier count of the epipolar model (E or F) the H test compares against.
-  size_t num_epipolar_inliers = 0;
+  if (reports.E.success) geometry.E = reports.E.model;
+  if (reports.F.success) geometry.F = reports.F.model;
+  if (reports.H.success) geometry.H = reports.H.model;
   bool calibrated = false;
-  if (E_report.success && num_E_inliers >= min_num_inliers &&
-      static_cast<double>(num_E_inliers) >=
-          kMinEFInlierRatio * static_cast<double>(num_F_inliers)) {
-    calibrated = true;
-    num_epipolar_inliers = num_E_inliers;
-    // Keep the larger inlier set of the two epipolar models.
-    if (num_E_inliers >= num_F_inliers || !F_report.success) {
-      inlier_mask = &E_report.inlier_mask;
-      num_inliers = num_E_inliers;
-    } else {
-      inlier_mask = &F_report.inlier_mask;
-      num_inliers = num_F_inliers;
-    }
-    geometry.config = TwoViewGeometry::CALIBRATED;
-  } else if (F_report.success && num_F_inliers >= min_num_inliers) {
-    num_epipolar_inliers = num_F_inliers;
-    inlier_mask = &F_report.inlier_mask;
-    num_inliers = num_F_inliers;
-    geometry.config = TwoViewGeometry::UNCALIBRATED;
-  } else if (H_report.success && num_H_inliers >= min_num_inliers) {
-    // Neither epipolar model holds, but a homography does: typically a pure rotation
-    // with too few matches for E or F to be tested reliably.
-    inlier_mask = &H_report.inlier_mask;
-    num_inliers = num_H_inliers;
-    geometry.config = TwoViewGeometry::PLANAR_OR_PANORAMIC;
-  } else {
-    return Degenerate();
-  }
-
-  if (num_epipolar_inliers > 0 && H_report.success &&
-      static_cast<double>(num_H_inliers) / static_cast<double>(num_epipolar_inliers) >
-          settings.max_H_inlier_ratio) {
-    geometry.config = TwoViewGeometry::PLANAR_OR_PANORAMIC;
-    if (num_H_inliers > num_inliers) {
-      inlier_mask = &H_report.inlier_mask;
-      num_inliers = num_H_inliers;
-    }
-  }
+  const std::vector<char>* inlier_mask =
+      ChooseCalibratedModel(reports, settings, &geometry, &calibrated);
+  if (inlier_mask == nullptr) return Degenerate();
   geometry.inlier_matches = ExtractInlierMatches(matches, *inlier_mask);
-
-  const bool planar_or_panoramic = geometry.config == TwoViewGeometry::PLANAR_OR_PANORAMIC;
-  if (planar_or_panoramic && H_report.success) {
-    // Refit H on its inliers in normalised coordinates (undistorted, focal removed)
-    // to tell a pure rotation from a plane seen with baseline.
-    const auto H_normalized =
-        HomographyMatrixEstimator::Estimate(ExtractInliers(normalized1, H_report.inlier_mask),
-                                            ExtractInliers(normalized2, H_report.inlier_mask));
-    Eigen::Matrix3d R;
-    if (!H_normalized.empty() && RotationFromHomography(H_normalized[0], &R)) {
-      geometry.config = TwoViewGeometry::PANORAMIC;
-      geometry.cam2_from_cam1 =
-          Rigid3d(Eigen::Quaterniond(R).normalized(), Eigen::Vector3d::Zero());
-      return geometry;
-    }
-    if (calibrated) geometry.config = TwoViewGeometry::PLANAR;
+  if (ClassifyHomography(reports.H, normalized1, normalized2, calibrated, &geometry)) {
+    return geometry;
   }
 
   if (calibrated) {
     std::vector<Eigen::Vector3d> points3D;
     Rigid3d cam2_from_cam1;
-    if (PoseFromEssentialMatrix(E_report.model, ExtractInliers(normalized1, *inlier_mask),
+    if (PoseFromEssentialMatrix(reports.E.model, ExtractInliers(normalized1, *inlier_mask),
                                 ExtractInliers(normalized2, *inlier_mask), &cam2_from_cam1,
                                 &points3D)) {
       geometry.cam2_from_cam1 = cam2_from_cam1;

@@ -342,6 +342,83 @@ void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
   }
 }
 
+// The pairs that map: verified, with min_num_matches inliers, between input images.
+std::vector<const MapperInput::Pair*> SelectVerifiedPairs(const IncrementalMapperOptions& options,
+                                                          const MapperInput& input) {
+  std::vector<const MapperInput::Pair*> verified_pairs;
+  for (const MapperInput::Pair& pair : input.pairs) {
+    if (!IsVerified(pair.geometry) ||
+        pair.geometry.inlier_matches.size() < static_cast<size_t>(options.min_num_matches) ||
+        input.images.count(pair.image_id1) == 0 || input.images.count(pair.image_id2) == 0) {
+      continue;
+    }
+    verified_pairs.push_back(&pair);
+  }
+  return verified_pairs;
+}
+
+// Checks each model against the view graph and logs the result, with a warning that
+// names the disagreeing images of a model that may be folded.
+std::vector<ModelSelfCheck> SelfCheckModels(const IncrementalMapperOptions& options,
+                                            const MapperInput& input, const ViewGraph& view_graph,
+                                            const std::vector<Reconstruction>& models) {
+  std::vector<ModelSelfCheck> checks;
+  for (size_t m = 0; m < models.size(); ++m) {
+    ModelSelfCheck check = SelfCheck(view_graph, models[m], options);
+    if (check.possibly_folded) {
+      std::string names;
+      for (size_t i = 0; i < check.disagreeing_images.size() && i < 10; ++i) {
+        names += (i > 0 ? ", " : "") + input.images.at(check.disagreeing_images[i]).name;
+      }
+      if (check.disagreeing_images.size() > 10) names += ", ...";
+      spdlog::warn(
+          "map: model {} may be folded by symmetric or repeated structure: its poses agree "
+          "within {:g} deg with {} of its {} verified pairs, which hold only {:.0f}% of their "
+          "inliers (min_model_agreement {:.0f}%); images whose pairs mostly disagree: {}",
+          m, options.reg_max_rotation_error, check.num_agreeing, check.num_pairs,
+          100 * check.agreement, 100 * options.min_model_agreement, names.empty() ? "none" : names);
+    } else {
+      spdlog::info(
+          "map: model {}: its poses agree with {} of its {} verified pairs, {:.1f}% of their "
+          "inliers",
+          m, check.num_agreeing, check.num_pairs, 100 * check.agreement);
+    }
+    checks.push_back(std::move(check));
+  }
+  return checks;
+}
+
+// Why each input image is in no model.
+std::map<image_t, std::string> UnregisteredReasons(const IncrementalMapperOptions& options,
+                                                   const MapperInput& input,
+                                                   const MapperRunState& run,
+                                                   const std::vector<Reconstruction>& models) {
+  std::set<image_t> in_verified_pair;
+  for (const MapperInput::Pair* pair : run.verified_pairs) {
+    in_verified_pair.insert(pair->image_id1);
+    in_verified_pair.insert(pair->image_id2);
+  }
+  std::set<image_t> in_model;
+  for (const Reconstruction& model : models) {
+    for (const auto& [image_id, image] : model.images) in_model.insert(image_id);
+  }
+  std::map<image_t, std::string> reasons;
+  for (const auto& [image_id, image] : input.images) {
+    if (in_model.count(image_id) > 0) continue;
+    std::string reason;
+    if (in_verified_pair.count(image_id) == 0) {
+      reason = "no verified pair with at least " + std::to_string(options.min_num_matches) +
+               " inlier matches";
+    } else if (run.failure_reasons.count(image_id) > 0) {
+      reason = run.failure_reasons.at(image_id);
+    } else {
+      reason = "it shares no 3D point with any model and no initial pair with another image";
+    }
+    reasons[image_id] = reason;
+  }
+  return reasons;
+}
+
 }  // namespace
 
 IncrementalPipeline::IncrementalPipeline(const IncrementalMapperOptions& options,
@@ -362,16 +439,7 @@ MapperResult IncrementalPipeline::Reconstruct(const MapperInput& input,
   const auto should_stop = [&control] { return control.ShouldStop(); };
   MapperResult result;
 
-  std::vector<const MapperInput::Pair*> verified_pairs;
-  for (const MapperInput::Pair& pair : input.pairs) {
-    if (!IsVerified(pair.geometry) ||
-        pair.geometry.inlier_matches.size() < static_cast<size_t>(options_.min_num_matches) ||
-        input.images.count(pair.image_id1) == 0 || input.images.count(pair.image_id2) == 0) {
-      continue;
-    }
-    verified_pairs.push_back(&pair);
-  }
-
+  const std::vector<const MapperInput::Pair*> verified_pairs = SelectVerifiedPairs(options_, input);
   if (options_.estimate_focal_length) {
     EstimateFocalLengthsWithoutPrior(options_, run, verified_pairs, &run.cameras,
                                      &result.focal_lengths);
@@ -426,53 +494,9 @@ MapperResult IncrementalPipeline::Reconstruct(const MapperInput& input,
   } else {
     SortModels(&result.models);
   }
-  for (size_t m = 0; m < result.models.size(); ++m) {
-    ModelSelfCheck check = SelfCheck(run.view_graph, result.models[m], options_);
-    if (check.possibly_folded) {
-      std::string names;
-      for (size_t i = 0; i < check.disagreeing_images.size() && i < 10; ++i) {
-        names += (i > 0 ? ", " : "") + input.images.at(check.disagreeing_images[i]).name;
-      }
-      if (check.disagreeing_images.size() > 10) names += ", ...";
-      spdlog::warn(
-          "map: model {} may be folded by symmetric or repeated structure: its poses agree "
-          "within {:g} deg with {} of its {} verified pairs, which hold only {:.0f}% of their "
-          "inliers (min_model_agreement {:.0f}%); images whose pairs mostly disagree: {}",
-          m, options_.reg_max_rotation_error, check.num_agreeing, check.num_pairs,
-          100 * check.agreement, 100 * options_.min_model_agreement,
-          names.empty() ? "none" : names);
-    } else {
-      spdlog::info(
-          "map: model {}: its poses agree with {} of its {} verified pairs, {:.1f}% of their "
-          "inliers",
-          m, check.num_agreeing, check.num_pairs, 100 * check.agreement);
-    }
-    result.self_checks.push_back(std::move(check));
-  }
+  result.self_checks = SelfCheckModels(options_, input, run.view_graph, result.models);
   result.num_registrations_refused = run.num_registrations_refused;
-
-  std::set<image_t> in_verified_pair;
-  for (const MapperInput::Pair* pair : run.verified_pairs) {
-    in_verified_pair.insert(pair->image_id1);
-    in_verified_pair.insert(pair->image_id2);
-  }
-  std::set<image_t> in_model;
-  for (const Reconstruction& model : result.models) {
-    for (const auto& [image_id, image] : model.images) in_model.insert(image_id);
-  }
-  for (const auto& [image_id, image] : input.images) {
-    if (in_model.count(image_id) > 0) continue;
-    std::string reason;
-    if (in_verified_pair.count(image_id) == 0) {
-      reason = "no verified pair with at least " + std::to_string(options_.min_num_matches) +
-               " inlier matches";
-    } else if (run.failure_reasons.count(image_id) > 0) {
-      reason = run.failure_reasons.at(image_id);
-    } else {
-      reason = "it shares no 3D point with any model and no initial pair with another image";
-    }
-    result.unregistered_reasons[image_id] = reason;
-  }
+  result.unregistered_reasons = UnregisteredReasons(options_, input, run, result.models);
   result.num_global_ba = run.num_global_ba;
   result.num_local_ba = run.num_local_ba;
   result.seconds =
