@@ -3,11 +3,14 @@
 // and while the pipeline runs on the worker thread (8 images of the sample at 400 px,
 // ORB, every pair, 1 thread; restarted into a fresh workspace whenever it ends). Each
 // iteration draws one frame (Frame(), as after an input event) and waits for it to finish.
+// Also the time from Cancel, pressed while the matcher runs, to the worker's end.
 
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <fstream>
 #include <random>
+#include <thread>
 
 #include "gui/gl.h"
 #include "gui/gui_app.h"
@@ -83,12 +86,48 @@ void FrameTime(benchmark::State& state, bool while_running) {
 void BM_FrameIdle(benchmark::State& state) { FrameTime(state, false); }
 void BM_FrameWhileRunning(benchmark::State& state) { FrameTime(state, true); }
 
+// Seconds from Cancel to the end of the worker, cancelled once the matcher has finished a
+// pair (the run of the GUI test; a fresh workspace each iteration). No window: the worker never
+// waits on the UI.
+void BM_CancelDuringMatching(benchmark::State& state) {
+  tessera::testing::TemporaryDir dir;
+  tessera::testing::WriteSampleImages(dir.path() / "images", 8);
+  std::ofstream(dir.path() / "manifest.json") << R"({"pipeline": {
+      "detector": {"plugin": "orb", "options": {"max_num_features": 2000}},
+      "pair_selector": {"plugin": "exhaustive"}, "matcher": {"plugin": "brute_force"},
+      "bundle_adjuster": {"plugin": "ceres"}}, "threads": 2})";
+  RunController controller;
+  int runs = 0;
+  auto matching = [&] {
+    const RunStatus status = controller.Status();
+    return !status.stages.empty() && status.stages.back().stage == "match" &&
+           status.stages.back().done >= 1;
+  };
+  for (auto _ : state) {
+    controller.Start({dir.path() / "images", dir.path() / ("out" + std::to_string(runs++)),
+                      dir.path() / "manifest.json"});
+    while (controller.Running() && !matching()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    const auto cancelled_at = std::chrono::steady_clock::now();
+    controller.Cancel();
+    controller.Join();
+    state.SetIterationTime(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - cancelled_at).count());
+    if (controller.Status().state != RunState::kCancelled) {
+      state.SkipWithError("the run ended before it was cancelled during matching");
+      break;
+    }
+  }
+}
+
 BENCHMARK(BM_FrameIdle)->Arg(1000000)->Arg(5000000)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_FrameWhileRunning)
     ->Arg(1000000)
     ->Arg(5000000)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK(BM_CancelDuringMatching)->Iterations(5)->UseManualTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace tessera::gui

@@ -1,0 +1,55 @@
+#pragma once
+
+// The manifest editor, a collapsing section of the set-up window: the manifest's JSON in
+// a text box (loaded from the manifest field's file, or the default manifest), one plugin
+// per slot chosen from the plugins found on the plugin path, Check (as `tessera run`
+// does: parsed, every plugin created with its options), Reload, and Save as, which makes
+// the saved file the run's manifest.
+
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "gui/panel_widgets.h"
+#include "gui/widget_rects.h"
+
+namespace tessera::gui {
+
+class ManifestEditorPanel {
+ public:
+  // manifest_field: the set-up window's manifest field, read by Load and Check and
+  // written by Save; it must outlive the editor.
+  explicit ManifestEditorPanel(PathField* manifest_field);
+
+  // Each is false with the message in Error().
+  // Loads the manifest field's file (empty: the default manifest) into the editor.
+  bool Load();
+  // Checks the editor's JSON as `tessera run` does.
+  bool Check();
+  // Saves the editor's JSON to `file` (after checking) and makes it the run's manifest.
+  bool Save(const std::filesystem::path& file);
+  // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "bundle_adjuster")
+  // in the editor's JSON, with no options.
+  bool SetPlugin(const std::string& slot, const std::string& plugin);
+
+  void SetText(const std::string& text);
+  std::string Text() const { return text_.data(); }
+  const std::string& Error() const { return error_; }
+
+  // The section (its header records "manifest editor"); loads the manifest and finds the
+  // plugins when first opened.
+  void Draw(WidgetRects* widgets);
+
+ private:
+  // The plugins of each slot's kind on the plugin path, found once.
+  void FindPlugins();
+
+  PathField* manifest_field_;
+  std::vector<char> text_ = std::vector<char>(1 << 16, '\0');
+  PathField save_path_{};
+  std::string error_, status_;
+  std::map<std::string, std::vector<std::string>> plugins_by_kind_;
+};
+
+}  // namespace tessera::gui

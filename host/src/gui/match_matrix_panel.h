@@ -1,0 +1,54 @@
+#pragma once
+
+// The match matrix window of a workspace: images by images, each cell coloured by the
+// pair's verified inliers (dark blue: none, to yellow: the most); a click on a cell shows
+// the pair's two photographs side by side with their inlier matches drawn between them.
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+
+#include "gui/image_texture.h"
+#include "gui/match_matrix.h"
+#include "gui/widget_rects.h"
+
+namespace tessera::gui {
+
+class MatchMatrixPanel {
+ public:
+  // Opens the match matrix of the workspace `path` (its database.db); false with the
+  // message in Error() (also logged) when it cannot.
+  bool Open(const std::filesystem::path& path);
+
+  // The "Match matrix" button of the set-up window (opens the matrix of `workspace`),
+  // recorded as "match matrix", and the message of the last failure.
+  void DrawOpenButton(const std::filesystem::path& workspace, WidgetRects* widgets);
+  // The window, while open, at the top left of `view_rect`; the photographs of a pair are
+  // read from `image_dir`. Records "match cells".
+  void Draw(const WidgetRect& view_rect, const std::filesystem::path& image_dir,
+            WidgetRects* widgets);
+
+  const std::string& Error() const { return error_; }
+  // The pair (row, column) clicked and its inlier matches; (-1, -1) when none.
+  std::pair<int, int> SelectedPair() const { return {pair_row_, pair_column_}; }
+  const PairInliers& SelectedPairInliers() const { return pair_inliers_; }
+
+ private:
+  // The cells, `cell` pixels square, as one item recorded as "match cells"; hovering
+  // shows a pair's count, a click selects it.
+  void DrawCells(float cell, const std::filesystem::path& image_dir, WidgetRects* widgets);
+  // Reads the inlier matches of (row, column) and loads its photographs.
+  void SelectPair(int row, int column, const std::filesystem::path& image_dir);
+  // The selected pair's photographs and matches.
+  void DrawPair();
+
+  bool show_ = false;
+  std::optional<MatchMatrix> matrix_;
+  std::string error_;
+  int pair_row_ = -1, pair_column_ = -1;
+  PairInliers pair_inliers_;
+  ImageTexture pair_photos_[2];
+};
+
+}  // namespace tessera::gui

@@ -1,0 +1,168 @@
+#include "gui/picking.h"
+
+#include <imgui.h>
+
+#include <cmath>
+
+#include "tessera/io/model_statistics.h"
+
+namespace tessera::gui {
+namespace fs = std::filesystem;
+
+Picking::Picking(SceneView* view) : view_(view) {}
+
+void Picking::HandleMouse(const WidgetRect& view_rect) {
+  ImGuiIO& io = ImGui::GetIO();
+  OrbitCamera& camera = view_->camera();
+  const float height = view_rect.max_y - view_rect.min_y;
+  const bool in_view = !io.WantCaptureMouse && io.MousePos.x >= view_rect.min_x &&
+                       io.MousePos.x < view_rect.max_x && io.MousePos.y >= view_rect.min_y &&
+                       io.MousePos.y < view_rect.max_y;
+  if (in_view && ImGui::IsMouseClicked(ImGuiMouseButton_Left)) {
+    dragging_ = true;
+    drag_distance_ = 0;
+  }
+  if (dragging_ && ImGui::IsMouseDown(ImGuiMouseButton_Left)) {
+    const ImVec2 delta = io.MouseDelta;
+    drag_distance_ += std::abs(delta.x) + std::abs(delta.y);
+    if (delta.x != 0 || delta.y != 0) {
+      if (io.KeyShift || io.KeyCtrl) {
+        camera.Pan(delta.x, delta.y, height);
+      } else {
+        camera.Orbit(delta.x, delta.y);
+      }
+      view_->user_moved_camera = true;
+    }
+  }
+  if (dragging_ && ImGui::IsMouseReleased(ImGuiMouseButton_Left)) {
+    dragging_ = false;
+    if (drag_distance_ < 3) Pick(io.MousePos.x, io.MousePos.y, view_rect);
+  }
+  if (in_view && ImGui::IsMouseDown(ImGuiMouseButton_Right)) {
+    camera.Pan(io.MouseDelta.x, io.MouseDelta.y, height);
+    view_->user_moved_camera = true;
+  }
+  if (in_view && io.MouseWheel != 0) {
+    camera.Zoom(io.MouseWheel);
+    view_->user_moved_camera = true;
+  }
+}
+
+void Picking::Pick(float x, float y, const WidgetRect& view_rect) {
+  const Scene* scene = view_->scene();
+  if (scene == nullptr) return;
+  auto distance_to_click = [&](const Eigen::Vector3f& world) {
+    const auto pixel = view_->ProjectToWindow(world, view_rect);
+    return pixel ? std::hypot((*pixel)[0] - x, (*pixel)[1] - y) : 1e9f;
+  };
+  float best = 10;
+  image_t best_image = kInvalidImageId;
+  for (const SceneCamera& camera : scene->cameras) {
+    const float distance = distance_to_click(camera.center_in_world);
+    if (distance < best) {
+      best = distance;
+      best_image = camera.image_id;
+    }
+  }
+  if (best_image != kInvalidImageId) {
+    view_->selected_image = best_image;
+    return;
+  }
+  best = 6;
+  point3D_t best_point = kInvalidPoint3DId;
+  for (size_t i = 0; i < scene->point_ids.size(); ++i) {
+    const float distance = distance_to_click(Eigen::Vector3f(
+        scene->positions[3 * i], scene->positions[3 * i + 1], scene->positions[3 * i + 2]));
+    if (distance < best) {
+      best = distance;
+      best_point = scene->point_ids[i];
+    }
+  }
+  view_->selected_point = best_point;
+}
+
+void Picking::DrawDetails(const WidgetRect& view_rect, const fs::path& image_dir,
+                          WidgetRects* widgets) {
+  if (view_->scene() == nullptr) return;
+  DrawCameraDetails(view_rect, image_dir, widgets);
+  DrawPointDetails(view_rect, widgets);
+}
+
+void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& image_dir,
+                                WidgetRects* widgets) {
+  const Reconstruction& model = *view_->scene()->model;
+  const image_t image_id = view_->selected_image;
+  if (image_id == kInvalidImageId || model.images.count(image_id) == 0) return;
+  const Image& image = model.images.at(image_id);
+  ImGui::SetNextWindowPos(ImVec2(view_rect.max_x - 10, 10), ImGuiCond_Appearing, ImVec2(1, 0));
+  bool open = true;
+  ImGui::Begin("Camera", &open, ImGuiWindowFlags_AlwaysAutoResize);
+  size_t observations = 0, usable = 0;
+  double error_sum = 0;
+  for (size_t i = 0; i < image.points2D.size(); ++i) {
+    const auto point = model.points3D.find(image.points2D[i].point3D_id);
+    if (point == model.points3D.end()) continue;
+    ++observations;
+    const ObservationError error =
+        ComputeObservationError(model, point->second, {image.image_id, static_cast<point2D_t>(i)});
+    if (error.usable) {
+      ++usable;
+      error_sum += error.error_px;
+    }
+  }
+  ImGui::Text("%s  (image %u, camera %u)", image.name.c_str(), image.image_id, image.camera_id);
+  ImGui::Text("%zu observations, mean reprojection error %.3f px", observations,
+              usable > 0 ? error_sum / static_cast<double>(usable) : 0.0);
+  widgets->RecordLastItem("camera details");
+  const ImVec2 position = ImGui::GetWindowPos();
+  const ImVec2 size = ImGui::GetWindowSize();
+  widgets->Set("camera window", {position.x, position.y, position.x + size.x, position.y + size.y});
+  // The photograph with its observations, when the image folder has it.
+  if (photo_image_ != image_id) {
+    photo_image_ = image_id;
+    photo_.Load(image_dir / image.name, 480);
+  }
+  if (!photo_.empty()) {
+    const ImVec2 origin = ImGui::GetCursorScreenPos();
+    photo_.Draw();
+    ImDrawList* draw = ImGui::GetWindowDrawList();
+    for (const Point2D& point : image.points2D) {
+      if (!point.HasPoint3D() || model.points3D.count(point.point3D_id) == 0) continue;
+      draw->AddCircle(ImVec2(origin.x + static_cast<float>(point.xy.x()) * photo_.scale(),
+                             origin.y + static_cast<float>(point.xy.y()) * photo_.scale()),
+                      2.5f, IM_COL32(60, 255, 90, 255));
+    }
+  } else {
+    ImGui::TextDisabled("(the photograph is not in the image folder)");
+  }
+  ImGui::End();
+  if (!open) view_->selected_image = kInvalidImageId;
+}
+
+void Picking::DrawPointDetails(const WidgetRect& view_rect, WidgetRects* widgets) {
+  const Reconstruction& model = *view_->scene()->model;
+  const point3D_t point_id = view_->selected_point;
+  if (point_id == kInvalidPoint3DId || model.points3D.count(point_id) == 0) return;
+  const Point3D& point = model.points3D.at(point_id);
+  ImGui::SetNextWindowPos(ImVec2(view_rect.max_x - 10, view_rect.max_y - 10), ImGuiCond_Appearing,
+                          ImVec2(1, 1));
+  bool open = true;
+  ImGui::Begin("Point", &open, ImGuiWindowFlags_AlwaysAutoResize);
+  ImGui::Text("point %llu at (%.3f, %.3f, %.3f), error %.3f px",
+              static_cast<unsigned long long>(point_id), point.xyz.x(), point.xyz.y(),
+              point.xyz.z(), point.error);
+  ImGui::Text("track of %zu observations:", point.track.size());
+  widgets->RecordLastItem("point details");
+  for (const TrackElement& element : point.track) {
+    const auto image = model.images.find(element.image_id);
+    if (image == model.images.end() || element.point2D_idx >= image->second.points2D.size()) {
+      continue;
+    }
+    const Eigen::Vector2d& xy = image->second.points2D[element.point2D_idx].xy;
+    ImGui::BulletText("%s  (%.1f, %.1f)", image->second.name.c_str(), xy.x(), xy.y());
+  }
+  ImGui::End();
+  if (!open) view_->selected_point = kInvalidPoint3DId;
+}
+
+}  // namespace tessera::gui

@@ -1,0 +1,44 @@
+#pragma once
+
+// The mouse in the 3D view and what it picks: a drag orbits (with shift or ctrl, pans),
+// the right button pans, the wheel zooms, and a click (a drag of under 3 pixels) picks
+// the camera or point under it; then a window shows the picked camera (its photograph
+// with its observations, their mean reprojection error) or point (its track).
+
+#include <filesystem>
+
+#include "gui/image_texture.h"
+#include "gui/scene_view.h"
+#include "gui/widget_rects.h"
+
+namespace tessera::gui {
+
+class Picking {
+ public:
+  // The view must outlive the picking.
+  explicit Picking(SceneView* view);
+
+  // The mouse of this frame in `view_rect` (window pixels); after the panels are drawn,
+  // which take the mouse first.
+  void HandleMouse(const WidgetRect& view_rect);
+  // Picks at window pixel (x, y): the nearest camera centre within 10 pixels, else the
+  // nearest point within 6 pixels (none when there is none).
+  void Pick(float x, float y, const WidgetRect& view_rect);
+  // The windows of the picked camera and point; the camera's photograph is read from
+  // `image_dir`. Records "camera details", "camera window" and "point details".
+  void DrawDetails(const WidgetRect& view_rect, const std::filesystem::path& image_dir,
+                   WidgetRects* widgets);
+
+ private:
+  void DrawCameraDetails(const WidgetRect& view_rect, const std::filesystem::path& image_dir,
+                         WidgetRects* widgets);
+  void DrawPointDetails(const WidgetRect& view_rect, WidgetRects* widgets);
+
+  SceneView* view_;
+  bool dragging_ = false;
+  float drag_distance_ = 0;  // pixels the mouse moved since the press
+  ImageTexture photo_;       // the picked camera's photograph
+  image_t photo_image_ = kInvalidImageId;
+};
+
+}  // namespace tessera::gui

@@ -1,0 +1,158 @@
+#include "gui/setup_panel.h"
+
+#include <imgui.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+
+#include "manifest/manifest.h"
+#include "tessera/errors.h"
+
+namespace tessera::gui {
+namespace fs = std::filesystem;
+namespace {
+
+// Whether the folder (or a sub-folder) has a file with an image extension; stops at the
+// first one, so that a large folder costs nothing on the UI thread.
+bool HasImageFile(const fs::path& dir) {
+  std::error_code error;
+  for (fs::recursive_directory_iterator
+           it(dir, fs::directory_options::skip_permission_denied, error),
+       end;
+       !error && it != end; it.increment(error)) {
+    std::string extension = it->path().extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(), ::tolower);
+    for (const char* known : {".jpg", ".jpeg", ".png", ".tif", ".tiff", ".bmp", ".webp"}) {
+      if (extension == known) return true;
+    }
+  }
+  return false;
+}
+
+std::string FormatSeconds(double seconds) {
+  if (seconds < 0) return "?";
+  if (seconds < 60) return std::to_string(static_cast<int>(std::lround(seconds))) + " s";
+  const long minutes = std::lround(seconds) / 60;
+  return std::to_string(minutes) + " min " + std::to_string(std::lround(seconds) % 60) + " s";
+}
+
+// A bar per stage: done/total, and once known the rate and the time left.
+void DrawStageProgress(const std::vector<StageProgress>& stages) {
+  for (const StageProgress& stage : stages) {
+    const float fraction =
+        stage.total == 0 ? 1.0f : static_cast<float>(stage.done) / static_cast<float>(stage.total);
+    std::string overlay = std::to_string(stage.done) + "/" + std::to_string(stage.total);
+    if (stage.rate_per_s > 0) {
+      char rate[64];
+      std::snprintf(rate, sizeof(rate), "  %.2f/s", stage.rate_per_s);
+      overlay += rate;
+      if (stage.done < stage.total) overlay += ", " + FormatSeconds(stage.remaining_s) + " left";
+    }
+    ImGui::ProgressBar(fraction, ImVec2(-80, 0), overlay.c_str());
+    ImGui::SameLine();
+    ImGui::TextUnformatted(stage.stage.c_str());
+  }
+}
+
+}  // namespace
+
+SetupPanel::SetupPanel(const RunRequest& fields, bool follow_run, RunController* controller,
+                       std::function<void()> before_start)
+    : controller_(controller), before_start_(std::move(before_start)), follow_run_(follow_run) {
+  SetPathField(fields.image_dir, &images_);
+  SetPathField(fields.output_dir, &output_);
+  SetPathField(fields.manifest_file, &manifest_);
+}
+
+bool SetupPanel::CheckFields() {
+  error_.clear();
+  images_error_.clear();
+  manifest_error_.clear();
+  const fs::path images(images_.data());
+  const fs::path manifest(manifest_.data());
+  std::error_code error;
+  if (images.empty()) {
+    images_error_ = "choose the folder of images";
+  } else if (!fs::is_directory(images, error)) {
+    images_error_ = images.string() + ": no such folder";
+  } else if (!HasImageFile(images)) {
+    images_error_ = images.string() + ": no images in this folder (JPEG, PNG, TIFF, BMP, WebP)";
+  }
+  if (output_[0] == '\0') error_ = "choose an output folder (the workspace)";
+  if (!manifest.empty()) {
+    try {
+      Manifest::Load(manifest);
+    } catch (const InputError& exception) {
+      manifest_error_ = exception.what();
+    }
+  }
+  return images_error_.empty() && manifest_error_.empty() && error_.empty();
+}
+
+bool SetupPanel::Run() {
+  if (!CheckFields()) {
+    // The first field's message, unless the output folder is missing.
+    for (const std::string* message : {&images_error_, &manifest_error_}) {
+      if (!message->empty() && error_.empty()) error_ = *message;
+    }
+    spdlog::error("{}", error_);
+    return false;
+  }
+  before_start_();
+  if (!controller_->Start(
+          {fs::path(images_.data()), fs::path(output_.data()), fs::path(manifest_.data())})) {
+    error_ = "a run is going on";
+    return false;
+  }
+  return true;
+}
+
+void SetupPanel::Draw(const RunStatus& status, WidgetRects* widgets) {
+  const bool running = controller_->Running();
+  ImGui::TextUnformatted("Reconstruct");
+  DrawFields(widgets);
+  editor_.Draw(widgets);
+  DrawRunButtons(status, running, widgets);
+  DrawStageProgress(status.stages);
+}
+
+void SetupPanel::DrawFields(WidgetRects* widgets) {
+  ImGui::PushItemWidth(-110);
+  ImGui::InputTextWithHint("Images", "folder of photographs", images_.data(), images_.size());
+  widgets->RecordLastItem("images");
+  ImGui::SameLine();
+  browser_.Draw("images", &images_, widgets);
+  ErrorText(images_error_);
+  ImGui::InputTextWithHint("Output", "workspace folder", output_.data(), output_.size());
+  widgets->RecordLastItem("output");
+  ImGui::SameLine();
+  browser_.Draw("output", &output_, widgets);
+  ImGui::InputTextWithHint("Manifest", "default manifest", manifest_.data(), manifest_.size());
+  widgets->RecordLastItem("manifest");
+  ErrorText(manifest_error_);
+  ImGui::PopItemWidth();
+}
+
+void SetupPanel::DrawRunButtons(const RunStatus& status, bool running, WidgetRects* widgets) {
+  ImGui::BeginDisabled(running);
+  if (ImGui::Button("Run")) Run();
+  ImGui::EndDisabled();
+  widgets->RecordLastItem("run");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(!running);
+  if (ImGui::Button("Cancel")) controller_->Cancel();
+  ImGui::EndDisabled();
+  widgets->RecordLastItem("cancel");
+  ImGui::SameLine();
+  ImGui::Text("%s", RunStateName(status.state));
+  ImGui::SameLine();
+  ImGui::Checkbox("show the model growing", &follow_run_);
+  if (status.state == RunState::kFailed || !error_.empty()) {
+    ErrorText(error_.empty() ? status.error : error_);
+  }
+}
+
+}  // namespace tessera::gui

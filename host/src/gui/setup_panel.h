@@ -1,0 +1,60 @@
+#pragma once
+
+// The "Reconstruct" section of the set-up window: the image and output folders (typed, or
+// chosen in a folder browser), the manifest file and its editor, Run (the fields checked
+// first, each wrong one with its message beside it) and Cancel, the run's state, whether
+// the view follows the growing model, and a progress bar per stage with its rate and
+// the time left.
+
+#include <functional>
+#include <string>
+
+#include "gui/folder_browser.h"
+#include "gui/manifest_editor_panel.h"
+#include "gui/panel_widgets.h"
+#include "gui/run_controller.h"
+#include "gui/widget_rects.h"
+
+namespace tessera::gui {
+
+class SetupPanel {
+ public:
+  // `fields`: the fields' first values. before_start: called once the fields are valid,
+  // just before the run starts. The controller must outlive the panel.
+  SetupPanel(const RunRequest& fields, bool follow_run, RunController* controller,
+             std::function<void()> before_start);
+  SetupPanel(const SetupPanel&) = delete;  // the editor points at manifest_
+  SetupPanel& operator=(const SetupPanel&) = delete;
+
+  // Starts a run of the fields (as the Run button does); false with the message in
+  // Error() (also logged) when a field is wrong or a run is going on.
+  bool Run();
+  // A failed run's message, shown in place of a field's.
+  void ShowRunError(const std::string& message) { error_ = message; }
+
+  // The section; `status` is the run's, read once for the frame.
+  void Draw(const RunStatus& status, WidgetRects* widgets);
+
+  const std::string& Error() const { return error_; }
+  std::string ImagesField() const { return images_.data(); }
+  std::string OutputField() const { return output_.data(); }
+  bool follow_run() const { return follow_run_; }
+  ManifestEditorPanel& editor() { return editor_; }
+
+ private:
+  // Sets the fields' messages; true when all are empty.
+  bool CheckFields();
+  void DrawFields(WidgetRects* widgets);
+  // Run and Cancel (one of them enabled, by `running`), the state and the message.
+  void DrawRunButtons(const RunStatus& status, bool running, WidgetRects* widgets);
+
+  RunController* controller_;
+  std::function<void()> before_start_;
+  PathField images_{}, output_{}, manifest_{};
+  std::string error_, images_error_, manifest_error_;
+  bool follow_run_ = true;
+  FolderBrowser browser_;
+  ManifestEditorPanel editor_{&manifest_};
+};
+
+}  // namespace tessera::gui

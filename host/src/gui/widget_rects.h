@@ -1,0 +1,32 @@
+#pragma once
+
+// Where the named widgets were drawn in the last frame, in window pixels: tests click
+// them by name (ImGui 1.86 has no test engine).
+
+#include <map>
+#include <optional>
+#include <string>
+
+namespace tessera::gui {
+
+// A widget's rectangle in window pixels, recorded as it was last drawn.
+struct WidgetRect {
+  float min_x = 0, min_y = 0, max_x = 0, max_y = 0;
+  float CenterX() const { return (min_x + max_x) / 2; }
+  float CenterY() const { return (min_y + max_y) / 2; }
+};
+
+class WidgetRects {
+ public:
+  // Forgets every rectangle (a new frame records them again).
+  void Clear() { rects_.clear(); }
+  // Records ImGui's last item under `name`.
+  void RecordLastItem(const std::string& name);
+  void Set(const std::string& name, const WidgetRect& rect) { rects_[name] = rect; }
+  std::optional<WidgetRect> Find(const std::string& name) const;
+
+ private:
+  std::map<std::string, WidgetRect> rects_;
+};
+
+}  // namespace tessera::gui
