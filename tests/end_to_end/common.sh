@@ -1,17 +1,46 @@
-# Shared by the end-to-end scripts (sourced): failing, the dataset check and the scores
-# of a model by `tessera eval`.
+# Shared by the end-to-end and interoperability scripts (sourced): failing, skipping for
+# missing shared data or colmap (a failure in CI), the dataset check and the scores of a
+# model by `tessera eval`. The scripts take the shared data folder (../shared) as an
+# argument; TESSERA_SHARED_DIR, when set, replaces it.
 
 fail() {
   echo "FAIL: $*"
   exit 1
 }
 
-# Exits with 77 (CTest's skip) when DATASET has no images folder.
-require_dataset() {
-  if [ ! -d "$1/images" ]; then
-    echo "SKIP: $1 not found"
-    exit 77
+# CI=true: set by GitHub Actions, GitLab CI and most others, and by hand to try it. The
+# shared data and colmap are always there in CI, so a skip for their absence would hide a
+# broken path.
+in_ci() { [ "${CI:-}" = true ]; }
+
+# skip_or_fail REASON: CTest's skip (exit 77) with the reason, or exit 1 in CI. Only for
+# missing shared data or colmap; what a machine may lack for good (a display, Slurm,
+# Open3D) skips with a plain `echo "SKIP: reason"; exit 77`.
+skip_or_fail() {
+  if in_ci; then
+    echo "FAIL: CI: $*; this test must not skip in CI"
+    exit 1
   fi
+  echo "SKIP: $*"
+  exit 77
+}
+
+# skip_part_or_fail REASON: for one check that cannot run while the rest of the test can:
+# a line saying so, or exit 1 in CI.
+skip_part_or_fail() {
+  if in_ci; then
+    echo "FAIL: CI: $*; this test must not skip in CI"
+    exit 1
+  fi
+  echo "SKIPPED (visible): $*"
+}
+
+# True when colmap runs (not merely when a file of that name is on the PATH).
+have_colmap() { colmap help > /dev/null 2>&1; }
+
+# Skips (skip_or_fail) when DATASET has no images folder.
+require_dataset() {
+  [ -d "$1/images" ] || skip_or_fail "$1 not found"
 }
 
 # TESSERA MODEL GT: prints "registered pos_mean_rel mean_reprojection_error_px".

@@ -6,7 +6,7 @@
 # usage: gui_test.sh TESSERA SHARED_DIR
 set -uo pipefail
 tessera=$1
-shared=$2
+shared=${TESSERA_SHARED_DIR:-$2}
 source "$(dirname "$0")/common.sh"
 work=$(mktemp -d)
 xvfb_pid=""
@@ -40,7 +40,7 @@ grep -q "not a model" "$work/err.txt" || fail "message: $(cat "$work/err.txt")"
 [ ! -e "$work/x.png" ] || fail "a screenshot was written for a folder that is not a model"
 
 model="$shared/anchors/colmap-3.8/fountain-P11/sparse/0"
-[ -f "$model/points3D.bin" ] || { echo "SKIP: $model not found"; exit 77; }
+[ -f "$model/points3D.bin" ] || skip_or_fail "$model not found"
 "$tessera" -q gui --model "$model" --screenshot "$work/shot.png" --width 640 --height 400 ||
   fail "screenshot of $model"
 # PNG signature, then the IHDR chunk: width and height as big-endian 32-bit integers.

@@ -15,12 +15,12 @@ set -uo pipefail
 tessera=$1
 downscale=$2
 geotag=$3
-shared=$4
+shared=${TESSERA_SHARED_DIR:-$4}
 source_dir=$5
 dataset="$shared/datasets/fountain-P11"
 source "$(dirname "$0")/common.sh"
 require_dataset "$dataset"
-[ -d "$dataset/gt" ] || { echo "SKIP: $dataset/gt not found"; exit 77; }
+[ -d "$dataset/gt" ] || skip_or_fail "$dataset/gt not found"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 

@@ -9,7 +9,7 @@
 set -uo pipefail
 tessera=$1
 make_video=$2
-shared=$3
+shared=${TESSERA_SHARED_DIR:-$3}
 dataset="$shared/datasets/fox"
 source "$(dirname "$0")/common.sh"
 require_dataset "$dataset"

@@ -8,7 +8,7 @@
 set -uo pipefail
 tessera=$1
 downscale=$2
-shared=$3
+shared=${TESSERA_SHARED_DIR:-$3}
 dataset="$shared/datasets/fountain-P11"
 source "$(dirname "$0")/common.sh"
 require_dataset "$dataset"

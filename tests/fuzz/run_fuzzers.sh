@@ -6,7 +6,8 @@
 #
 # Usage: run_fuzzers.sh SOURCE_DIR BUILD_DIR [SECONDS] [SHARED_DIR] [TARGET...]
 #   SECONDS     per target (default 30); 0 replays the regression inputs only.
-#   SHARED_DIR  folder with datasets/ for more seeds (optional).
+#   SHARED_DIR  folder with datasets/ for more seeds (optional; TESSERA_SHARED_DIR replaces
+#               it; its absence is a failure under CI=true, where it is always there).
 #   TARGET      manifest exif image_header colmap_binary colmap_text ground_truth database
 #               (default: all).
 # Environment: TESSERA_FUZZ_CORPUS_DIR keeps the corpus there between runs (default: a
@@ -18,7 +19,7 @@ set -euo pipefail
 source_dir=$(cd "$1" && pwd)
 build_dir=$2
 seconds=${3:-30}
-shared_dir=${4:-}
+shared_dir=${TESSERA_SHARED_DIR:-${4:-}}
 shift $(($# < 4 ? $# : 4))
 all_targets=(manifest exif image_header colmap_binary colmap_text ground_truth database)
 targets=("$@")
@@ -120,8 +121,9 @@ if [ -n "$datasets" ] && [ -d "$datasets" ]; then
     if [ -n "$first_image" ]; then head -c 16384 "$first_image" > "$seeds/exif/dataset_$name"; fi
   done
 else
-  echo "run_fuzzers: no shared datasets at '${datasets:-}': ground-truth seeds from the" \
-       "committed ones only"
+  source "$source_dir/tests/end_to_end/common.sh"
+  skip_part_or_fail "run_fuzzers: no shared datasets at '${datasets:-}': ground-truth seeds" \
+    "from the committed ones only"
 fi
 for target in "${targets[@]}"; do
   for extra in seeds regressions; do

@@ -6,25 +6,20 @@
 #  2. `colmap model_converter` turns both into text, with identical results, and the
 #     text export into binary, which the analyzer reads with the same counts;
 #  3. with record_order_from, the binary export is COLMAP's own files byte for byte.
-# Skipped (exit 77, with a message) when colmap or the shared anchors are absent.
+# Skipped (exit 77, with a message) when colmap or the shared anchors are absent; under
+# CI=true that is a failure instead (common.sh's skip_or_fail).
 # usage: colmap_interop_test.sh TESSERA SHARED_DIR
 set -uo pipefail
 tessera=$1
-shared=$2
+shared=${TESSERA_SHARED_DIR:-$2}
+source "$(dirname "$0")/../end_to_end/common.sh"
 anchor="$shared/anchors/colmap-3.8/fountain-P11/sparse/0"
-if [ ! -d "$anchor" ]; then
-  echo "SKIP: COLMAP's fountain-P11 model not found at $anchor"
-  exit 77
-fi
-if ! command -v colmap > /dev/null; then
-  echo "SKIP: colmap is not installed (scripts/install_dependencies.sh installs it); the" \
-       "COLMAP interoperability test did not run"
-  exit 77
-fi
+[ -d "$anchor" ] || skip_or_fail "COLMAP's fountain-P11 model not found at $anchor"
+have_colmap || skip_or_fail "colmap is not installed (scripts/install_dependencies.sh" \
+  "installs it); the COLMAP interoperability test did not run"
 export QT_QPA_PLATFORM=offscreen
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
 
 # export_model FORMAT NAME [OPTIONS]: writes $work/NAME/sparse/0; prints Tessera's counts.
 export_model() {

@@ -3,16 +3,15 @@
 # model exported with `tessera export --format ply` and camera centres must read back
 # with every point, in id order, with the model's colours, and the camera centres after
 # them in their colour. Skipped (exit 77, with a message) when no python3 with open3d
-# (Debian: python3-open3d) or the shared anchors are found.
+# (Debian: python3-open3d) or the shared anchors are found; missing anchors are a failure
+# under CI=true (common.sh's skip_or_fail).
 # usage: ply_open3d_test.sh TESSERA SHARED_DIR
 set -uo pipefail
 tessera=$1
-shared=$2
+shared=${TESSERA_SHARED_DIR:-$2}
+source "$(dirname "$0")/../end_to_end/common.sh"
 anchor="$shared/anchors/colmap-3.8/fountain-P11"
-if [ ! -d "$anchor/sparse-txt" ]; then
-  echo "SKIP: COLMAP's fountain-P11 model not found at $anchor"
-  exit 77
-fi
+[ -d "$anchor/sparse-txt" ] || skip_or_fail "COLMAP's fountain-P11 model not found at $anchor"
 python=""
 for candidate in python3 /usr/bin/python3; do
   if "$candidate" -c "import open3d" > /dev/null 2>&1; then

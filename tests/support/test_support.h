@@ -13,6 +13,7 @@
 #include <string>
 
 #include "plugin/plugin_registry.h"
+#include "skip_or_fail.h"  // the skip for shared data or colmap that is absent
 
 namespace tessera::testing {
 
@@ -33,6 +34,7 @@ inline std::filesystem::path BinaryDir() {
 }
 
 // ../shared beside the repository (datasets and COLMAP anchors), or TESSERA_SHARED_DIR.
+// A test that needs it skips with TESSERA_SKIP_OR_FAIL_IN_CI when it is absent.
 inline std::filesystem::path SharedDir() {
   if (const char* dir = std::getenv("TESSERA_SHARED_DIR")) return dir;
   return (SourceDir() / ".." / "shared").lexically_normal();

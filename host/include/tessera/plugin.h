@@ -18,6 +18,9 @@
 // boundary or the API of Tessera::io (tessera/io/) changes; the host refuses a plugin
 // built against another version. libtessera_io's SONAME carries this number
 // (libtessera_io.so.4), so a plugin linked against another Tessera::io does not load.
+// abi_headers.sha256 records it with a hash of every header here, comments and whitespace
+// excluded: the test sdk_abi_check fails when a header changes without a bump (bump it,
+// then run scripts/sdk_abi_check.py --update).
 #define TESSERA_PLUGIN_ABI_VERSION 4
 
 extern "C" {

@@ -204,7 +204,9 @@ TEST(EvaluateReconstruction, RotationNoiseIsMeasuredExactly) {
 TEST(EvaluateReconstruction, NoisyModelAgreesWithReferenceScript) {
   const std::string python = PythonWithNumpy();
   if (python.empty()) GTEST_SKIP() << "python3 with numpy not found; eval_gt.py cannot run";
-  if (!fs::exists(SharedPath("anchors/eval_gt.py"))) GTEST_SKIP() << "eval_gt.py not found";
+  if (!fs::exists(SharedPath("anchors/eval_gt.py"))) {
+    TESSERA_SKIP_OR_FAIL_IN_CI(SharedPath("anchors/eval_gt.py") << " not found");
+  }
   const auto ground_truth = RingGroundTruth(12);
   Reconstruction model = ModelFromGroundTruth(ground_truth, KnownSimilarity());
   model.images.erase(5);                  // 0004.jpg is not registered
@@ -329,7 +331,9 @@ TEST(ReadGroundTruth, UnrecognisedPathThrows) {
 
 TEST(ReadGroundTruth, StrechaCamerasOfFountain) {
   const fs::path gt = SharedPath("datasets/fountain-P11/gt");
-  if (!fs::is_directory(gt)) GTEST_SKIP() << gt << " not found (set TESSERA_SHARED_DIR)";
+  if (!fs::is_directory(gt)) {
+    TESSERA_SKIP_OR_FAIL_IN_CI(gt << " not found (set TESSERA_SHARED_DIR)");
+  }
   const auto poses = ReadGroundTruth(gt);
   ASSERT_EQ(poses.size(), 11u);
   // 0000.jpg.camera: R (camera-to-world) rows 5-7, C row 8.
@@ -341,7 +345,9 @@ TEST(ReadGroundTruth, StrechaCamerasOfFountain) {
 // The fox's transforms.json: 67 frames; frame 0 is images/0001.jpg.
 TEST(ReadGroundTruth, TransformsJsonOfFox) {
   const fs::path transforms = SharedPath("datasets/fox/transforms.json");
-  if (!fs::exists(transforms)) GTEST_SKIP() << transforms << " not found (set TESSERA_SHARED_DIR)";
+  if (!fs::exists(transforms)) {
+    TESSERA_SKIP_OR_FAIL_IN_CI(transforms << " not found (set TESSERA_SHARED_DIR)");
+  }
   const auto poses = ReadGroundTruth(transforms);
   EXPECT_EQ(poses.size(), 67u);
   EXPECT_EQ(ReadGroundTruth(transforms.parent_path()).size(), 67u);
@@ -385,7 +391,7 @@ TEST_P(ColmapAnchorEvaluation, AgreesWithReferenceScript) {
   const fs::path model_dir = SharedPath("anchors/colmap-3.8/" + GetParam() + "/sparse/0");
   const fs::path gt = SharedPath("datasets/" + GetParam() + "/gt");
   if (!fs::is_directory(model_dir) || !fs::is_directory(gt)) {
-    GTEST_SKIP() << model_dir << " or " << gt << " not found (set TESSERA_SHARED_DIR)";
+    TESSERA_SKIP_OR_FAIL_IN_CI(model_dir << " or " << gt << " not found (set TESSERA_SHARED_DIR)");
   }
   const Reconstruction model = ReadColmapModel(model_dir);
   const EvaluationResult result = EvaluateReconstruction(model, ReadGroundTruth(gt));

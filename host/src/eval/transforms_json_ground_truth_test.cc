@@ -43,7 +43,7 @@ ExportContext ContextFor(const fs::path& output, const fs::path& images) {
 }
 TEST(TransformsJsonGroundTruth, FountainReadsBackWithTheSameCameraCentres) {
   const fs::path anchor = testing::SharedDir() / "anchors" / "colmap-3.8" / "fountain-P11";
-  if (!fs::is_directory(anchor)) GTEST_SKIP() << "COLMAP's fountain-P11 model not found";
+  if (!fs::is_directory(anchor)) TESSERA_SKIP_OR_FAIL_IN_CI(anchor << " not found");
   const Reconstruction model = ReadColmapModel(anchor / "sparse" / "0");
   const fs::path images = testing::SharedDir() / "datasets" / "fountain-P11" / "images";
   auto exporter = testing::LoadBundledPlugin<Exporter>("exporter", "transforms_json");
@@ -77,7 +77,7 @@ TEST(TransformsJsonGroundTruth, FountainReadsBackWithTheSameCameraCentres) {
 // those poses and intrinsics written by the exporter read back the same.
 TEST(TransformsJsonGroundTruth, FoxPosesAndIntrinsicsRoundTrip) {
   const fs::path fox = testing::SharedDir() / "datasets" / "fox" / "transforms.json";
-  if (!fs::is_regular_file(fox)) GTEST_SKIP() << fox << " not found";
+  if (!fs::is_regular_file(fox)) TESSERA_SKIP_OR_FAIL_IN_CI(fox << " not found");
   const nlohmann::json reference = ReadJson(fox);
   const std::map<std::string, GroundTruthPose> poses = ReadTransformsJson(fox);
   EXPECT_EQ(poses.size(), reference["frames"].size());

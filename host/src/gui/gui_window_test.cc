@@ -231,7 +231,7 @@ TEST_F(GuiWindowTest, CancelDuringMatchingThenRunReusesFeaturesAndPairs) {
 TEST_F(GuiWindowTest, ReferenceImageOfColmapsFountainModel) {
   const fs::path model =
       tessera::testing::SharedDir() / "anchors" / "colmap-3.8" / "fountain-P11" / "sparse" / "0";
-  if (!fs::exists(model / "points3D.bin")) GTEST_SKIP() << "skipped: " << model << " is missing";
+  if (!fs::exists(model / "points3D.bin")) TESSERA_SKIP_OR_FAIL_IN_CI(model << " is missing");
   GuiOptions options;
   options.model = model;
   options.width = 320;
@@ -273,7 +273,7 @@ TEST_F(GuiWindowTest, ReferenceImageOfColmapsFountainModel) {
 TEST_F(GuiWindowTest, ClickingACameraOrAPointShowsItsDetails) {
   const fs::path model =
       tessera::testing::SharedDir() / "anchors" / "colmap-3.8" / "fountain-P11" / "sparse" / "0";
-  if (!fs::exists(model / "points3D.bin")) GTEST_SKIP() << "skipped: " << model << " is missing";
+  if (!fs::exists(model / "points3D.bin")) TESSERA_SKIP_OR_FAIL_IN_CI(model << " is missing");
   GuiOptions options;
   options.model = model;
   // The photographs, for the camera's window, when the data set is there.
