@@ -28,7 +28,6 @@
 #include <sstream>
 #include <thread>
 
-#include "cli/exit_codes.h"
 #include "database/database.h"
 #include "eval/evaluation.h"
 #include "eval/ground_truth.h"
@@ -40,6 +39,7 @@
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
 #include "tessera/io/model_statistics.h"
+#include "util/exit_codes.h"
 #include "util/timer.h"
 
 extern char** environ;

@@ -7,13 +7,13 @@
 #include <memory>
 
 #include "cli/commands.h"
-#include "cli/exit_codes.h"
 #include "distributed/merge.h"
 #include "distributed/shard_database.h"
 #include "distributed/sharded_stages.h"
 #include "distributed/slurm.h"
 #include "pipeline/pipeline_context.h"
 #include "pipeline/workspace.h"
+#include "util/exit_codes.h"
 
 namespace tessera {
 namespace {

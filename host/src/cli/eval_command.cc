@@ -6,12 +6,12 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
-#include "cli/exit_codes.h"
 #include "eval/evaluation.h"
 #include "eval/ground_truth.h"
 #include "pipeline/workspace.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
+#include "util/exit_codes.h"
 
 namespace tessera {
 

@@ -7,13 +7,13 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
-#include "cli/exit_codes.h"
 #include "pipeline/workspace.h"
 #include "plugin/plugin_registry.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
 #include "tessera/io/model_statistics.h"
+#include "util/exit_codes.h"
 #include "util/paths.h"
 #include "util/timer.h"
 

@@ -2,8 +2,8 @@
 // display it exits 2 with one line; a build without GLFW/ImGui/OpenGL says so.
 
 #include "cli/commands.h"
-#include "cli/exit_codes.h"
 #include "tessera/errors.h"
+#include "util/exit_codes.h"
 
 #ifdef TESSERA_HAS_GUI
 #include "gui/gui_app.h"

@@ -4,7 +4,7 @@
 
 #include <csignal>
 
-#include "cli/exit_codes.h"
+#include "util/exit_codes.h"
 
 namespace tessera {
 namespace {

@@ -8,9 +8,9 @@
 #include <iostream>
 
 #include "cli/commands.h"
-#include "cli/exit_codes.h"
 #include "plugin/plugin_call.h"
 #include "tessera/errors.h"
+#include "util/exit_codes.h"
 
 int main(int argc, char** argv) {
   using namespace tessera;

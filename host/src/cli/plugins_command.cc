@@ -5,9 +5,9 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
-#include "cli/exit_codes.h"
 #include "manifest/manifest.h"
 #include "plugin/plugin_registry.h"
+#include "util/exit_codes.h"
 #include "util/paths.h"
 
 namespace tessera {

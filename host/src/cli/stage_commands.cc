@@ -7,7 +7,6 @@
 #include <memory>
 
 #include "cli/commands.h"
-#include "cli/exit_codes.h"
 #include "cli/interrupt.h"
 #include "distributed/shard_plan.h"
 #include "distributed/sharded_stages.h"
@@ -15,6 +14,7 @@
 #include "pipeline/match_stage.h"
 #include "pipeline/pipeline_context.h"
 #include "pipeline/run_pipeline.h"
+#include "util/exit_codes.h"
 #include "util/paths.h"
 
 namespace tessera {

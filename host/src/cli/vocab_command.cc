@@ -11,13 +11,13 @@
 #include <map>
 
 #include "cli/commands.h"
-#include "cli/exit_codes.h"
 #include "database/database.h"
 #include "feature/database_feature_reader.h"
 #include "pipeline/extract_stage.h"
 #include "pipeline/pipeline_context.h"
 #include "pipeline/workspace.h"
 #include "plugin/plugin_call.h"
+#include "util/exit_codes.h"
 #include "util/paths.h"
 #include "util/strings.h"
 #include "util/timer.h"

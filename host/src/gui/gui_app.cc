@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <cstdlib>
 
-#include "cli/exit_codes.h"
 #include "gui/gl.h"
 #include "gui/log_pane.h"
 #include "gui/match_matrix_panel.h"
@@ -20,6 +19,7 @@
 #include "gui/scene_view.h"
 #include "gui/setup_panel.h"
 #include "tessera/errors.h"
+#include "util/exit_codes.h"
 
 namespace tessera::gui {
 namespace fs = std::filesystem;

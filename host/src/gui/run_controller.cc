@@ -8,11 +8,11 @@
 #include <algorithm>
 #include <cerrno>
 
-#include "cli/exit_codes.h"
 #include "pipeline/pipeline_context.h"
 #include "pipeline/run_pipeline.h"
 #include "plugin/plugin_call.h"
 #include "tessera/errors.h"
+#include "util/exit_codes.h"
 
 namespace tessera::gui {
 
