@@ -77,6 +77,18 @@ TEST(Cli, PluginsMarksRefusedFilesWithWhy) {
             std::string::npos);
 }
 
+TEST(Cli, WarnsNamingAPluginPathFolderThatDoesNotExist) {
+  testing::TemporaryDir dir;
+  const std::string missing = (dir.path() / "no_such_plugins").string();
+  const auto result = RunTessera("plugins", "TESSERA_PLUGIN_PATH=" + missing);
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("TESSERA_PLUGIN_PATH: '" + missing +
+                               "' does not exist; no plugins are loaded from it"),
+            std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("sift"), std::string::npos) << result.output;  // bundled ones
+}
+
 TEST(Cli, MisspeltPluginFailsBeforeReadingImagesWithASuggestion) {
   testing::TemporaryDir dir;
   const auto manifest = dir.path() / "typo.json";

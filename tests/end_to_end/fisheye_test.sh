@@ -4,8 +4,9 @@
 # all 11 images registered in one model, with camera.model OPENCV_FISHEYE and the
 # calibration as camera.params; `colmap model_analyzer` reads the OPENCV_FISHEYE model
 # Tessera wrote (skipped without colmap, a failure under CI=true); the gaussian_splatting
-# export, undistorted to PINHOLE, loads as a 3DGS scene; a bad parameter count is exit 2
-# naming camera.params.
+# export, undistorted to PINHOLE, loads as a 3DGS scene, and so does its export with
+# field_of_view "full" (a mask per image); a bad parameter count is exit 2 naming
+# camera.params.
 # usage: fisheye_test.sh TESSERA WARP SOURCE_DIR
 set -uo pipefail
 tessera=$1
@@ -36,6 +37,13 @@ grep -q "OPENCV_FISHEYE" "$work/run.log" || fail "the camera is not OPENCV_FISHE
 echo "fisheye sample: 11 of 11 registered in one model"
 python3 "$source_dir/tests/tools/check_3dgs_scene.py" "$work/out/gaussian_splatting" 11 ||
   fail "the undistorted PINHOLE workspace does not load as a 3DGS scene"
+"$tessera" export --model "$work/out/sparse/0" --format gaussian_splatting --output "$work/out" \
+  --images "$work/images" --options '{"folder": "full_field", "field_of_view": "full"}' \
+  > "$work/full.log" 2>&1 || { cat "$work/full.log"; fail "export with field_of_view full"; }
+python3 "$source_dir/tests/tools/check_3dgs_scene.py" "$work/out/full_field" 11 ||
+  fail "the full-field PINHOLE workspace does not load as a 3DGS scene"
+[ "$(ls "$work/out/full_field/masks" | wc -l)" = 11 ] || fail "full field: not one mask per image"
+echo "full field of view: loads as a 3DGS scene, a mask per image"
 if have_colmap; then
   colmap model_analyzer --path "$work/out/sparse/0" > "$work/analyzer.log" 2>&1 ||
     { cat "$work/analyzer.log"; fail "colmap model_analyzer cannot read the OPENCV_FISHEYE model"; }

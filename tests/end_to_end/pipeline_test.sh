@@ -8,7 +8,8 @@
 #     message, when colmap is not installed; a failure under CI=true);
 #  3. kill -9 during matching, then a re-run: the same database content as an
 #     uninterrupted run, and nothing detected again;
-#  4. unreadable files in the folder are each named in a warning; the run completes.
+#  4. unreadable files, and entries named like photos that are none (a folder, a dangling
+#     link, a FIFO, a device), are each named in a warning and counted; none blocks.
 # usage: pipeline_test.sh TESSERA DOWNSCALE SHARED_DIR
 set -uo pipefail
 tessera=$1
@@ -103,11 +104,17 @@ cp -r "$work/images" "$work/bad_images"
 : > "$work/bad_images/empty.jpg"
 echo "not an image" > "$work/bad_images/notes.jpg"
 head -c 20000 "$work/images/0003.jpg" > "$work/bad_images/truncated.jpg"
-"$tessera" extract --images "$work/bad_images" --output "$work/bad" --camera-K "$work/K.txt" \
-  2> "$work/bad.log" || { cat "$work/bad.log"; fail "extract with bad files"; }
-for name in empty.jpg notes.jpg truncated.jpg; do
-  grep "warning" "$work/bad.log" | grep -q "$name" || { cat "$work/bad.log"; fail "no warning names $name"; }
+# Entries named like photos that are none: a folder, a dangling link, a FIFO (never
+# opened: the extract would wait for a writer), a link to a device outside the folder.
+mkdir "$work/bad_images/folder.jpg"
+ln -s missing.jpg "$work/bad_images/dangling.jpg"
+mkfifo "$work/bad_images/pipe.jpg"
+ln -s /dev/null "$work/bad_images/device.jpg"
+timeout 300 "$tessera" extract --images "$work/bad_images" --output "$work/bad" \
+  --camera-K "$work/K.txt" 2> "$work/bad.log" || { cat "$work/bad.log"; fail "extract with bad files"; }
+for name in empty.jpg notes.jpg truncated.jpg folder.jpg dangling.jpg pipe.jpg device.jpg; do
+  grep "warning" "$work/bad.log" | grep -q "'$name'" || { cat "$work/bad.log"; fail "no warning names $name"; }
 done
-grep -q "11 images (3 skipped files)" "$work/bad.log" || { cat "$work/bad.log"; fail "bad files count"; }
-echo "bad files: each named in a warning, 11 images kept"
+grep -q "11 images (7 skipped files)" "$work/bad.log" || { cat "$work/bad.log"; fail "bad files count"; }
+echo "bad files and entries: each named in a warning, 11 images kept"
 echo "PASS"

@@ -1,8 +1,13 @@
 #include "image/image_io.h"
 
+#include <dirent.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <xxhash.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -30,12 +35,103 @@ bool IsHidden(const fs::path& path) {
   return !name.empty() && name[0] == '.';
 }
 
+// A name on one line: its line breaks written as \n and \r.
+std::string OneLine(const std::string& name) {
+  std::string shown;
+  for (const char c : name) shown += c == '\n' ? "\\n" : c == '\r' ? "\\r" : std::string(1, c);
+  return shown;
+}
+
 std::string ContentHash(const Bytes& bytes) {
   const XXH128_hash_t hash = XXH3_128bits(bytes.data(), bytes.size());
   char text[33];
   std::snprintf(text, sizeof(text), "%016llx%016llx", static_cast<unsigned long long>(hash.high64),
                 static_cast<unsigned long long>(hash.low64));
   return text;
+}
+
+// What a special file is: "a named pipe (FIFO)", "a device", ...
+std::string SpecialFileKind(fs::file_type type) {
+  switch (type) {
+    case fs::file_type::fifo:
+      return "a named pipe (FIFO)";
+    case fs::file_type::block:
+    case fs::file_type::character:
+      return "a device";
+    case fs::file_type::socket:
+      return "a socket";
+    default:
+      return "not a regular file";
+  }
+}
+
+// Why an entry with an image extension is no image file, from its type and, for a
+// symbolic link, its target's; empty for a regular file or a link to one. Only
+// stat/lstat are called: a FIFO or device is never opened, so it cannot block the scan.
+std::string WhyNotAnImageFile(const fs::directory_entry& entry) {
+  std::error_code error;
+  const fs::file_status own = entry.symlink_status(error);
+  if (error) return "its type cannot be read (" + error.message() + ")";
+  fs::file_type type = own.type();
+  std::string what = "it is ";
+  if (type == fs::file_type::symlink) {
+    const std::string target = fs::read_symlink(entry.path(), error).string();
+    const fs::file_status status = entry.status(error);
+    what += "a symbolic link to '" + target + "', which ";
+    if (status.type() == fs::file_type::not_found) return what + "does not exist";
+    if (error) return what + "cannot be reached (" + error.message() + ")";
+    type = status.type();
+    what += "is ";
+  }
+  switch (type) {
+    case fs::file_type::regular:
+      return "";
+    case fs::file_type::directory:
+      return what + "a folder, not an image file";
+    default:
+      return what + SpecialFileKind(type) + ", not an image file; it was not opened";
+  }
+}
+
+// Reads a regular file whole; `problem` gets why not (naming the system's reason, e.g.
+// "Permission denied"). O_NONBLOCK and the fstat check keep a file swapped for a FIFO
+// after the listing from blocking the scan.
+std::optional<Bytes> ReadRegularFile(const fs::path& path, std::string* problem) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    *problem = std::string("the file cannot be read (") + std::strerror(errno) + ")";
+    return std::nullopt;
+  }
+  struct stat info {};
+  if (::fstat(fd, &info) != 0 || !S_ISREG(info.st_mode)) {
+    ::close(fd);
+    *problem = "it is no longer a regular file; it was not read";
+    return std::nullopt;
+  }
+  Bytes bytes(static_cast<size_t>(info.st_size));
+  size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      *problem = std::string("the file cannot be read (") + std::strerror(errno) + ")";
+      ::close(fd);
+      return std::nullopt;
+    }
+    if (n == 0) break;  // shrank while being read: what is there is checked as an image
+    done += static_cast<size_t>(n);
+  }
+  ::close(fd);
+  bytes.resize(done);
+  return bytes;
+}
+
+// Why a folder cannot be listed (e.g. "Permission denied"); empty when it can.
+std::string WhyFolderCannotBeListed(const fs::path& path) {
+  DIR* listing = ::opendir(path.c_str());
+  if (listing == nullptr) return std::strerror(errno);
+  ::closedir(listing);
+  return "";
 }
 
 }  // namespace
@@ -82,6 +178,7 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
 
   ImageScan scan;
   std::vector<std::pair<std::string, fs::path>> candidates;
+  std::vector<std::pair<std::string, std::string>> skipped;  // name, why; sorted at the end
   fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, error);
   if (error)
     throw InputError(dir.string() + ": cannot list the image folder (" + error.message() + ")");
@@ -93,27 +190,49 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
       if (it->is_directory(entry_error)) it.disable_recursion_pending();
       continue;
     }
+    const std::string name = path.lexically_relative(root).generic_string();
     if (it->is_directory(entry_error)) {
-      const std::string name = path.lexically_relative(root).generic_string();
+      const std::string folder = "Skipped the folder '" + OneLine(name) + "': ";
       std::error_code canonical_error;
       const fs::path canonical = fs::weakly_canonical(path, canonical_error);
       if (std::find(excluded.begin(), excluded.end(), canonical) != excluded.end()) {
-        scan.skipped_folders.push_back("Skipped the folder '" + name +
-                                       "': it is the output folder of this run.");
+        scan.skipped_folders.push_back(folder + "it is the output folder of this run.");
         it.disable_recursion_pending();
-      } else if (!mask_folder.empty() && canonical == mask_folder) {
-        scan.skipped_folders.push_back("Skipped the folder '" + name +
-                                       "': it is the mask folder of this run.");
+        continue;
+      }
+      if (!mask_folder.empty() && canonical == mask_folder) {
+        scan.skipped_folders.push_back(folder + "it is the mask folder of this run.");
         it.disable_recursion_pending();
-      } else if (IsTesseraWorkspace(path)) {
-        scan.skipped_folders.push_back("Skipped the folder '" + name +
-                                       "': it is a Tessera workspace.");
+        continue;
+      }
+      if (IsTesseraWorkspace(path)) {
+        scan.skipped_folders.push_back(folder + "it is a Tessera workspace.");
         it.disable_recursion_pending();
+        continue;
+      }
+      // Photos may be missing below these: each is a warning, not a note.
+      if (it->is_symlink(entry_error)) {
+        // Not followed: a link to a folder above would make the listing endless.
+        std::error_code link_error;
+        skipped.emplace_back(name, "it is a symbolic link to '" +
+                                       fs::read_symlink(path, link_error).string() +
+                                       "', a folder; the scan does not follow links to folders");
+      } else if (const std::string why = WhyFolderCannotBeListed(path); !why.empty()) {
+        skipped.emplace_back(name, "it is a folder that cannot be listed (" + why + ")");
+        it.disable_recursion_pending();
+      } else if (HasImageExtension(path)) {
+        skipped.emplace_back(name,
+                             "it is a folder, not an image file (its contents are scanned "
+                             "as a sub-folder)");
       }
       continue;
     }
-    if (!it->is_regular_file(entry_error) || !HasImageExtension(path)) continue;
-    candidates.emplace_back(path.lexically_relative(root).generic_string(), path);
+    if (!HasImageExtension(path)) continue;
+    if (std::string why = WhyNotAnImageFile(*it); !why.empty()) {
+      skipped.emplace_back(name, std::move(why));
+      continue;
+    }
+    candidates.emplace_back(name, path);
   }
   if (error) {
     throw InputError(dir.string() + ": cannot list the image folder (" + error.message() + ")");
@@ -123,17 +242,15 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
 
   for (const auto& [name, path] : candidates) {
     if (name.find_first_of("\r\n") != std::string::npos) {
-      std::string shown;  // one line: the breaks written as \n and \r
-      for (const char c : name) shown += c == '\n' ? "\\n" : c == '\r' ? "\\r" : std::string(1, c);
-      scan.warnings.push_back("Skipped '" + shown +
-                              "': the name contains a line break, which a COLMAP text model "
-                              "cannot hold.");
+      skipped.emplace_back(name,
+                           "the name contains a line break, which a COLMAP text model "
+                           "cannot hold");
       continue;
     }
-    const std::optional<Bytes> bytes = ReadFileBytes(path);
+    std::string problem;
+    const std::optional<Bytes> bytes = ReadRegularFile(path, &problem);
     ImageFileHeader header;
-    std::string problem =
-        bytes ? InspectImageData(*bytes, &header, nullptr) : "the file cannot be read";
+    if (bytes) problem = InspectImageData(*bytes, &header, nullptr);
     if (problem.empty() && static_cast<int64_t>(header.stored_width) * header.stored_height >
                                options.max_image_pixels) {
       problem = std::to_string(header.stored_width) + "x" + std::to_string(header.stored_height) +
@@ -141,7 +258,7 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
                 " (max_image_pixels)";
     }
     if (!problem.empty()) {
-      scan.warnings.push_back("Skipped '" + name + "': " + problem + ".");
+      skipped.emplace_back(name, problem);
       continue;
     }
     ImageEntry entry;
@@ -154,6 +271,11 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
     entry.file_size = bytes->size();
     entry.content_hash = ContentHash(*bytes);
     scan.images.push_back(std::move(entry));
+  }
+  std::stable_sort(skipped.begin(), skipped.end(),
+                   [](const auto& a, const auto& b) { return NaturalLess(a.first, b.first); });
+  for (const auto& [name, why] : skipped) {
+    scan.warnings.push_back("Skipped '" + OneLine(name) + "': " + why + ".");
   }
   return scan;
 }

@@ -18,7 +18,8 @@ namespace tessera {
 
 struct ImageScan {
   std::vector<ImageEntry> images;            // usable images, natural-sorted by name
-  std::vector<std::string> warnings;         // one sentence per skipped file, naming it and why
+  std::vector<std::string> warnings;         // one sentence per skipped entry, naming it and why;
+                                             // sorted by name
   std::vector<std::string> skipped_folders;  // one sentence per folder left out, and why
 };
 
@@ -42,9 +43,13 @@ bool IsTesseraWorkspace(const std::filesystem::path& dir);
 // are decoded. Throws InputError naming the folder if it does not exist. Files that
 // are not usable images are skipped with a warning each, and so are images of more
 // than options.max_image_pixels pixels and names with a line break (which a COLMAP
-// text model cannot hold). The excluded folders and every Tessera workspace below
-// `dir` are left out, each with a line in skipped_folders. Every image gets its size
-// and content hash.
+// text model cannot hold). So is every entry named like an image that is no readable
+// file: a folder, a dangling symbolic link, a FIFO, device or socket (or a link to
+// one), a file that cannot be opened (the system's reason quoted); and every folder
+// that cannot be listed or is a symbolic link (not followed). FIFOs and devices are
+// never opened, so none can block the scan. The excluded folders and every Tessera
+// workspace below `dir` are left out, each with a line in skipped_folders. Every
+// image gets its size and content hash.
 ImageScan ScanImageFolder(const std::filesystem::path& dir, const ImageScanOptions& options = {});
 
 }  // namespace tessera

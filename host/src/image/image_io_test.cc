@@ -1,8 +1,15 @@
 #include "image/image_io.h"
 
 #include <gtest/gtest.h>
+#include <sys/socket.h>
+#include <sys/stat.h>
+#include <sys/un.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <opencv2/imgcodecs.hpp>
 
@@ -347,6 +354,94 @@ TEST(ScanImageFolder, RecordsSizeAndContentHashAndRefusesOversizedOrLineBrokenNa
   EXPECT_EQ(scan.warnings[1],
             "Skipped 'line\\nbreak.png': the name contains a line break, which a COLMAP text "
             "model cannot hold.");
+}
+
+// Every entry named like an image that the scan does not use is named with why, in name
+// order, and counted; the FIFOs and the device are never opened, so the scan returns
+// (a scan that opened pipe.jpg would wait for a writer until the CTest TIMEOUT).
+TEST(ScanImageFolder, NamesEveryEntryItDoesNotUseAndOpensNoFifoOrDevice) {
+  TemporaryDir dir, outside;
+  Write(dir.path() / "good.png", Pattern(8, 6));
+  Write(dir.path() / "folder.jpg" / "inner.png", Pattern(8, 6));
+  fs::create_symlink("missing.jpg", dir.path() / "dangling.jpg");
+  ASSERT_EQ(mkfifo((dir.path() / "pipe.jpg").c_str(), 0644), 0) << std::strerror(errno);
+  fs::create_symlink("/dev/null", dir.path() / "null.jpg");
+  ASSERT_EQ(mkfifo((outside.path() / "fifo").c_str(), 0644), 0) << std::strerror(errno);
+  fs::create_symlink(outside.path() / "fifo", dir.path() / "outside_pipe.png");
+  Write(outside.path() / "more" / "photo.png", Pattern(8, 6));
+  fs::create_symlink(outside.path() / "more", dir.path() / "linked_folder");
+  fs::create_symlink(outside.path() / "more" / "photo.png", dir.path() / "linked_photo.png");
+  const fs::path socket_path = dir.path() / "sock.tif";
+  const int socket_fd = socket(AF_UNIX, SOCK_STREAM, 0);
+  ASSERT_GE(socket_fd, 0);
+  sockaddr_un address{};
+  address.sun_family = AF_UNIX;
+  ASSERT_LT(socket_path.string().size(), sizeof(address.sun_path));
+  std::strncpy(address.sun_path, socket_path.c_str(), sizeof(address.sun_path) - 1);
+  ASSERT_EQ(bind(socket_fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)), 0)
+      << std::strerror(errno);
+
+  const ImageScan scan = ScanImageFolder(dir.path());
+  close(socket_fd);
+  EXPECT_EQ(Names(scan),
+            (std::vector<std::string>{"folder.jpg/inner.png", "good.png", "linked_photo.png"}));
+  const std::string fifo = (outside.path() / "fifo").string();
+  const std::string more = (outside.path() / "more").string();
+  EXPECT_EQ(scan.warnings,
+            (std::vector<std::string>{
+                "Skipped 'dangling.jpg': it is a symbolic link to 'missing.jpg', which does not "
+                "exist.",
+                "Skipped 'folder.jpg': it is a folder, not an image file (its contents are "
+                "scanned as a sub-folder).",
+                "Skipped 'linked_folder': it is a symbolic link to '" + more +
+                    "', a folder; the scan does not follow links to folders.",
+                "Skipped 'null.jpg': it is a symbolic link to '/dev/null', which is a device, not "
+                "an image file; it was not opened.",
+                "Skipped 'outside_pipe.png': it is a symbolic link to '" + fifo +
+                    "', which is a named pipe (FIFO), not an image file; it was not opened.",
+                "Skipped 'pipe.jpg': it is a named pipe (FIFO), not an image file; it was not "
+                "opened.",
+                "Skipped 'sock.tif': it is a socket, not an image file; it was not opened."}));
+  EXPECT_TRUE(scan.skipped_folders.empty());
+}
+
+// Whether this process may run a child as the user nobody (root reads every file, so an
+// unreadable file can be tested as root only from a child without root's rights).
+bool ChildCanBecomeNobody() {
+  const pid_t pid = fork();
+  if (pid == 0) _exit(setgid(65534) == 0 && setuid(65534) == 0 ? 0 : 1);
+  int status = 0;
+  return pid > 0 && waitpid(pid, &status, 0) == pid && WIFEXITED(status) &&
+         WEXITSTATUS(status) == 0;
+}
+
+// A file and a folder the scan cannot open are named with the system's reason. As root
+// the scan runs in a child process as the user nobody, for whom they are unreadable.
+TEST(ScanImageFolder, NamesAFileItCannotReadAndAFolderItCannotList) {
+  const bool root = geteuid() == 0;
+  if (root && !ChildCanBecomeNobody()) {
+    GTEST_SKIP() << "running as root and a child cannot become the user nobody: no user here "
+                    "is refused a file";
+  }
+  TemporaryDir dir;
+  fs::permissions(dir.path(), fs::perms::all);  // nobody lists it
+  Write(dir.path() / "a.png", Pattern(8, 6));
+  Write(dir.path() / "locked.png", Pattern(8, 6));
+  Write(dir.path() / "closed" / "b.png", Pattern(8, 6));
+  fs::permissions(dir.path() / "locked.png", fs::perms::none);
+  fs::permissions(dir.path() / "closed", fs::perms::none);
+  EXPECT_EXIT(
+      {
+        if (root && (setgid(65534) != 0 || setuid(65534) != 0)) _exit(3);
+        const ImageScan scan = ScanImageFolder(dir.path());
+        for (const std::string& warning : scan.warnings)
+          std::fprintf(stderr, "%s\n", warning.c_str());
+        _exit(Names(scan) == std::vector<std::string>{"a.png"} ? 0 : 1);
+      },
+      ::testing::ExitedWithCode(0),
+      "^Skipped 'closed': it is a folder that cannot be listed \\(Permission denied\\)\\.\n"
+      "Skipped 'locked.png': the file cannot be read \\(Permission denied\\)\\.\n$");
+  fs::permissions(dir.path() / "closed", fs::perms::owner_all);  // for the clean-up
 }
 
 }  // namespace

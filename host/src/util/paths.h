@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace tessera {
@@ -15,8 +16,15 @@ std::filesystem::path BundledPluginDir();
 // <exe>/../share/tessera/manifests/default.json.
 std::filesystem::path DefaultManifestFile();
 
+// Why `folder` of TESSERA_PLUGIN_PATH gives no plugins (it does not exist, is a file,
+// ...), one sentence naming it; empty for a folder.
+std::string PluginPathProblem(const std::filesystem::path& folder);
+
 // The plugin search path: the manifest's folders first, then TESSERA_PLUGIN_PATH
-// (colon-separated), then the bundled folder.
+// (colon-separated), then the bundled folder. Each TESSERA_PLUGIN_PATH folder with a
+// PluginPathProblem is a warning (logged once per process), as a mistyped folder would
+// otherwise leave its plugins out without a word. (The manifest's folders are checked
+// when it is read.)
 std::vector<std::filesystem::path> PluginSearchPath(
     const std::vector<std::filesystem::path>& manifest_paths);
 

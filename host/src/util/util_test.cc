@@ -1,15 +1,56 @@
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
+#include <stdlib.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 #include "tessera/options.h"
 #include "util/parallel.h"
+#include "util/paths.h"
 #include "util/random.h"
 #include "util/strings.h"
 
 namespace tessera {
 namespace {
+
+// A folder of TESSERA_PLUGIN_PATH that does not exist, or is a file, is a warning naming
+// it, once per process; the folders that exist give none.
+TEST(PluginSearchPath, WarnsOnceNamingEachPluginPathFolderThatIsNone) {
+  const std::filesystem::path temp =
+      std::filesystem::temp_directory_path() / ("tessera-util-test-" + std::to_string(getpid()));
+  std::filesystem::create_directories(temp / "plugins");
+  std::ofstream(temp / "file") << "not a folder";
+  const std::string missing = (temp / "no-such-folder").string();
+  const std::string file = (temp / "file").string();
+  const std::string folder = (temp / "plugins").string();
+  ASSERT_EQ(setenv("TESSERA_PLUGIN_PATH", (missing + ":" + folder + "::" + file).c_str(), 1), 0);
+
+  std::ostringstream log;
+  const auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>(
+      "test", std::make_shared<spdlog::sinks::ostream_sink_mt>(log)));
+  spdlog::set_pattern("%l %v");
+  const std::vector<std::filesystem::path> paths = PluginSearchPath({});
+  PluginSearchPath({});  // asked again: no second warning
+  spdlog::set_default_logger(previous);
+  unsetenv("TESSERA_PLUGIN_PATH");
+  std::filesystem::remove_all(temp);
+
+  ASSERT_EQ(paths.size(), 4u);  // the three pieces and the bundled folder, in order
+  EXPECT_EQ(paths[0], missing);
+  EXPECT_EQ(paths[1], folder);
+  EXPECT_EQ(paths[2], file);
+  EXPECT_EQ(log.str(), "warning TESSERA_PLUGIN_PATH: '" + missing +
+                           "' does not exist; no plugins are loaded from it\n"
+                           "warning TESSERA_PLUGIN_PATH: '" +
+                           file + "' is not a folder; no plugins are loaded from it\n");
+}
 
 TEST(NaturalLess, OrdersDigitRunsByValue) {
   std::vector<std::string> names = {"img10.jpg", "img2.jpg", "IMG1.jpg",

@@ -3,8 +3,12 @@
 //   OUTPUT/<folder>/images/<name>                         undistorted images
 //   OUTPUT/<folder>/sparse/0/{cameras,images,points3D}.bin the model of those images
 //   OUTPUT/<folder>/masks/<name>.png                      with mask_path: their masks
+// With field_of_view "full" the images are larger and hold the whole field of a wide
+// lens; every image then gets a mask, black on the blank border.
 
+#include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <map>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -21,15 +25,110 @@
 namespace tessera {
 namespace {
 
-// The camera of the undistorted images. Size, focal lengths and principal point stay
-// those of the original camera, as COLMAP's image_undistorter keeps them by default:
-// nothing is cropped or scaled, and only the corners that barrel distortion pulls in
-// are left black (for pincushion distortion the border of the original is cut off).
+constexpr double kPi = 3.14159265358979323846;
+
+// The camera of the undistorted images with field_of_view "crop". Size, focal lengths
+// and principal point stay those of the original camera, as COLMAP's image_undistorter
+// keeps them by default: nothing is scaled, and only the corners that barrel distortion
+// pulls in are left black (for pincushion distortion or a fisheye lens, the border of
+// the original is cut off).
 Camera PinholeCamera(const Camera& camera) {
   Camera pinhole = camera;
   pinhole.model_id = CameraModelId::kPinhole;
   pinhole.params = {camera.FocalLengthX(), camera.FocalLengthY(), camera.PrincipalPointX(),
                     camera.PrincipalPointY()};
+  return pinhole;
+}
+
+// The largest |x| and |y| on the normalized image plane of the rays that the original
+// camera sees through a pixel centre, up to `max_ray_angle` radians off the optical axis.
+struct FieldExtent {
+  double x = 0;
+  double y = 0;
+};
+
+// The kept rays form a region whose extremes lie on its boundary: the image border (every
+// border pixel centre, within the angle) and the circle of rays at the angle limit (where
+// it projects inside the image; where it meets the border is found by bisection).
+FieldExtent MeasureFieldExtent(const Camera& camera, double max_ray_angle) {
+  const double width = static_cast<double>(camera.width);
+  const double height = static_cast<double>(camera.height);
+  const double max_radius = std::tan(max_ray_angle);
+  FieldExtent extent;
+  const auto keep = [&](const Eigen::Vector2d& normalized) {
+    extent.x = std::max(extent.x, std::abs(normalized.x()));
+    extent.y = std::max(extent.y, std::abs(normalized.y()));
+  };
+  const auto keep_border_pixel = [&](double x, double y) {
+    const Eigen::Vector2d pixel(x, y);
+    const Eigen::Vector2d normalized = camera.CamFromImg(pixel);
+    if (!normalized.allFinite() || normalized.norm() > max_radius) return;
+    // A fisheye pixel beyond what the model can reach (rays past 90 degrees) does not
+    // come back to itself: it is outside every pinhole image.
+    if ((camera.ImgFromCam(normalized.homogeneous()) - pixel).norm() > 1e-3) return;
+    keep(normalized);
+  };
+  for (double x = 0.5; x < width; x += 1) {
+    keep_border_pixel(x, 0.5);
+    keep_border_pixel(x, height - 0.5);
+  }
+  for (double y = 0.5; y < height; y += 1) {
+    keep_border_pixel(0.5, y);
+    keep_border_pixel(width - 0.5, y);
+  }
+  const auto on_limit = [&](double angle) {
+    return Eigen::Vector2d(max_radius * std::cos(angle), max_radius * std::sin(angle));
+  };
+  const auto inside = [&](double angle) {
+    const Eigen::Vector2d pixel = camera.ImgFromCam(on_limit(angle).homogeneous());
+    return pixel.allFinite() && pixel.x() >= 0.5 && pixel.x() <= width - 0.5 && pixel.y() >= 0.5 &&
+           pixel.y() <= height - 0.5;
+  };
+  constexpr int kDirections = 4096;  // a multiple of 4: the axes' directions are sampled
+  const double step = 2 * kPi / kDirections;
+  for (int i = 0; i < kDirections; ++i) {
+    const double angle = i * step;
+    const bool here = inside(angle);
+    if (here) keep(on_limit(angle));
+    if (here == inside(angle + step)) continue;
+    double in = here ? angle : angle + step, out = here ? angle + step : angle;
+    for (int k = 0; k < 40; ++k) {
+      const double middle = (in + out) / 2;
+      (inside(middle) ? in : out) = middle;
+    }
+    keep(on_limit(in));
+  }
+  return extent;
+}
+
+// The camera of the undistorted images with field_of_view "full": every pixel of the
+// original whose ray is at most `max_ray_angle` off the axis lands inside the image, with
+// a pixel to spare. The principal point is the image centre (the reference 3DGS trainer
+// assumes it there). The focal lengths stay the original's unless the image would then
+// be more than `max_scale` times the original's width or height: then both shrink by
+// the same factor until it fits.
+Camera FullFieldPinholeCamera(const Camera& camera, double max_scale, double max_ray_angle) {
+  const FieldExtent extent = MeasureFieldExtent(camera, max_ray_angle);
+  const double fx = camera.FocalLengthX(), fy = camera.FocalLengthY();
+  constexpr double kMargin = 1;  // pixels beyond the outermost pixel centre
+  const double max_half_width = std::floor(max_scale * static_cast<double>(camera.width) / 2);
+  const double max_half_height = std::floor(max_scale * static_cast<double>(camera.height) / 2);
+  // A hair under the limit, so that rounding the size up stays within max_scale.
+  constexpr double kUnder = 1 - 1e-12;
+  double scale = 1;
+  if (fx * extent.x > 0) {
+    scale = std::min(scale, kUnder * (max_half_width - kMargin) / (fx * extent.x));
+  }
+  if (fy * extent.y > 0) {
+    scale = std::min(scale, kUnder * (max_half_height - kMargin) / (fy * extent.y));
+  }
+  const double half_width = std::max(1.0, std::ceil(scale * fx * extent.x + kMargin));
+  const double half_height = std::max(1.0, std::ceil(scale * fy * extent.y + kMargin));
+  Camera pinhole = camera;
+  pinhole.model_id = CameraModelId::kPinhole;
+  pinhole.width = static_cast<size_t>(2 * half_width);
+  pinhole.height = static_cast<size_t>(2 * half_height);
+  pinhole.params = {scale * fx, scale * fy, half_width, half_height};
   return pinhole;
 }
 
@@ -42,7 +141,7 @@ struct UndistortionMaps {
 };
 
 UndistortionMaps MakeUndistortionMaps(const Camera& camera, const Camera& pinhole) {
-  const int width = static_cast<int>(camera.width), height = static_cast<int>(camera.height);
+  const int width = static_cast<int>(pinhole.width), height = static_cast<int>(pinhole.height);
   UndistortionMaps maps{cv::Mat(height, width, CV_32FC1), cv::Mat(height, width, CV_32FC1)};
   const Eigen::Matrix3d K_inverse = pinhole.CalibrationMatrix().inverse();
   cv::parallel_for_(cv::Range(0, height), [&](const cv::Range& rows) {
@@ -98,8 +197,22 @@ class GaussianSplattingExporter : public Exporter {
     folder_ = reader.GetRelativePath("folder", "gaussian_splatting");
     jpeg_quality_ = reader.Get<int>("jpeg_quality", 95, 1, 100);
     mask_path_ = reader.GetString("mask_path", "");
+    full_field_ = reader.GetString("field_of_view", "crop", {"crop", "full"}) == "full";
+    max_scale_ = reader.Get<double>("max_scale", 2.0, 1.0, 10.0);
+    max_ray_angle_degrees_ = reader.Get<double>("max_ray_angle", 80.0, 1.0, 89.0);
     reader.Finish();
-    effective_options_ = reader.Effective();
+    nlohmann::json effective = reader.Effective();
+    for (const char* key : {"max_scale", "max_ray_angle"}) {
+      if (full_field_) continue;
+      // Meaningless when cropping: a value given there is a mistake worth naming.
+      if (reader.Has(key)) {
+        throw OptionError(key,
+                          "is used only with field_of_view \"full\" (field_of_view is "
+                          "\"crop\")");
+      }
+      effective.erase(key);
+    }
+    effective_options_ = effective;
   }
 
   // Writes OUTPUT/<folder> for model 0 and OUTPUT/<folder>_<k> for model k, each a
@@ -112,7 +225,12 @@ class GaussianSplattingExporter : public Exporter {
                        "(tessera export --images DIR)");
     }
     Reconstruction undistorted = reconstruction;
-    for (auto& [camera_id, camera] : undistorted.cameras) camera = PinholeCamera(camera);
+    for (auto& [camera_id, camera] : undistorted.cameras) {
+      // A camera without distortion loses nothing: it is kept as it is in both modes.
+      camera = full_field_ && camera.HasDistortion()
+                   ? FullFieldPinholeCamera(camera, max_scale_, max_ray_angle_degrees_ * kPi / 180)
+                   : PinholeCamera(camera);
+    }
     std::map<camera_t, UndistortionMaps> maps;
     for (auto& [image_id, image] : undistorted.images) {
       if (!image.registered) continue;
@@ -143,23 +261,33 @@ class GaussianSplattingExporter : public Exporter {
       const std::filesystem::path target = root / "images" / image.name;
       CreateFolder(target.parent_path());
       WriteFileAtomically(target, EncodeImage(pixels, target, jpeg_quality_));
+      cv::Mat mask;  // of the written image; empty: none written
       if (!mask_path_.empty()) {
         const std::filesystem::path mask_file = FindMask(mask_path_, image.name);
-        cv::Mat mask;
         if (!mask_file.empty()) mask = cv::imread(mask_file.string(), cv::IMREAD_GRAYSCALE);
-        // No mask, or one of another size: none written (the extract stage warned).
-        if (mask.cols == pixels.cols && mask.rows == pixels.rows) {
-          if (camera.HasDistortion()) {
-            const UndistortionMaps& map = maps.at(camera.camera_id);
-            cv::Mat remapped;
-            cv::remap(mask, remapped, map.map_x, map.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
-                      cv::Scalar::all(0));
-            mask = remapped;
-          }
-          const std::filesystem::path mask_target = root / "masks" / (image.name + ".png");
-          CreateFolder(mask_target.parent_path());
-          WriteFileAtomically(mask_target, EncodeImage(mask, mask_target, jpeg_quality_));
+        // No mask, or one of another size: none from mask_path (the extract stage warned).
+        if (mask.cols != static_cast<int>(camera.width) ||
+            mask.rows != static_cast<int>(camera.height)) {
+          mask = cv::Mat();
         }
+      }
+      const bool blank_borders = full_field_ && camera.HasDistortion();
+      if (mask.empty() && blank_borders) {
+        // The blank borders of the larger image are masked out: the original, all white.
+        mask = cv::Mat(static_cast<int>(camera.height), static_cast<int>(camera.width), CV_8UC1,
+                       cv::Scalar(255));
+      }
+      if (!mask.empty()) {
+        if (camera.HasDistortion()) {
+          const UndistortionMaps& map = maps.at(camera.camera_id);
+          cv::Mat remapped;  // black outside the original
+          cv::remap(mask, remapped, map.map_x, map.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                    cv::Scalar::all(0));
+          mask = remapped;
+        }
+        const std::filesystem::path mask_target = root / "masks" / (image.name + ".png");
+        CreateFolder(mask_target.parent_path());
+        WriteFileAtomically(mask_target, EncodeImage(mask, mask_target, jpeg_quality_));
       }
     }
     // Last, so that a model in place means its images are complete.
@@ -169,7 +297,10 @@ class GaussianSplattingExporter : public Exporter {
  private:
   std::string folder_;
   int jpeg_quality_ = 95;
-  std::string mask_path_;  // empty: no masks written
+  std::string mask_path_;    // empty: no masks written
+  bool full_field_ = false;  // field_of_view "full": nothing of the original cut off
+  double max_scale_ = 2.0;
+  double max_ray_angle_degrees_ = 80.0;
 };
 
 }  // namespace tessera

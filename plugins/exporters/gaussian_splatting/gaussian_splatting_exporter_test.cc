@@ -145,6 +145,174 @@ TEST(GaussianSplattingExporter, UndistortsAnOpenCVFisheyeCameraToPinholeWithItsM
   EXPECT_FALSE(fs::exists(root / "masks" / "img_2.png.png"));  // no mask given
 }
 
+// An equidistant fisheye (OPENCV_FISHEYE, k = 0) whose image circle, 150 degrees across,
+// lies inside the 200x160 frame. With field_of_view "full" (rays up to 80 degrees, or to
+// the circle's 75) every pixel of the circle lands inside the larger PINHOLE image, where
+// its mask is white, and the blank border is black in the mask; with "crop" (the
+// default) the periphery of the circle is lost.
+TEST(GaussianSplattingExporter, FullFieldKeepsEveryPixelOfAFisheyeImageCircle) {
+  constexpr double kPi = 3.14159265358979323846;
+  constexpr double kCircleRadius = 78;  // pixels: 75 degrees off the axis
+  const double focal = kCircleRadius / (75 * kPi / 180);
+  const Camera camera = Camera::Create(3, CameraModelId::kOpenCVFisheye, focal, 200, 160);
+  ASSERT_EQ(camera.params, (std::vector<double>{focal, focal, 100, 80, 0, 0, 0, 0}));
+  const Reconstruction model = testing::MakeSyntheticModel(camera, 2, 150);
+  const Eigen::Vector2d center(100, 80);
+  const auto in_circle = [&](const Eigen::Vector2d& xy) {
+    return (xy - center).norm() <= kCircleRadius;
+  };
+  cv::Mat original =
+      RenderPattern(camera, [&](const Eigen::Vector2d& xy) { return camera.CamFromImg(xy); });
+  std::vector<Eigen::Vector2d> circle;  // pixel centres
+  for (int row = 0; row < original.rows; ++row) {
+    for (int col = 0; col < original.cols; ++col) {
+      const Eigen::Vector2d xy(col + 0.5, row + 0.5);
+      if (in_circle(xy)) {
+        circle.push_back(xy);
+      } else {
+        original.at<cv::Vec3b>(row, col) = cv::Vec3b::all(0);
+      }
+    }
+  }
+  testing::TemporaryDir images, output;
+  for (const auto& [image_id, image] : model.images) {
+    ASSERT_TRUE(cv::imwrite((images.path() / image.name).string(), original));
+  }
+  ExportContext context;
+  context.output_dir = output.path();
+  context.image_dir = images.path();
+  testing::Unguarded(testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting",
+                                       {{"folder", "full"}, {"field_of_view", "full"}})).Export(model, context);
+  testing::Unguarded(testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting", {{"folder", "crop"}})).Export(model, context);
+  testing::Unguarded(testing::LoadBundledPlugin<Exporter>(
+      "exporter", "gaussian_splatting",
+      {{"folder", "circle"}, {"field_of_view", "full"}, {"max_ray_angle", 75}})).Export(model, context);
+
+  // How many circle pixels land outside `pinhole`'s image, or (with a mask) on black.
+  const auto count_lost = [&](const Camera& pinhole, const cv::Mat& mask) {
+    int lost = 0;
+    for (const Eigen::Vector2d& xy : circle) {
+      const Eigen::Vector2d in_output = pinhole.ImgFromCam(camera.CamFromImg(xy).homogeneous());
+      const bool inside = in_output.x() >= 0 && in_output.y() >= 0 &&
+                          in_output.x() <= pinhole.width && in_output.y() <= pinhole.height;
+      if (!inside) {
+        ++lost;
+      } else if (!mask.empty()) {
+        const int col = std::min(static_cast<int>(in_output.x()), mask.cols - 1);
+        const int row = std::min(static_cast<int>(in_output.y()), mask.rows - 1);
+        if (mask.at<uchar>(row, col) == 0) ++lost;
+      }
+    }
+    return lost;
+  };
+  const fs::path full = output.path() / "full";
+  const Camera pinhole = ReadColmapModel(full / "sparse" / "0").cameras.at(3);
+  EXPECT_EQ(pinhole.model_id, CameraModelId::kPinhole);
+  // Rays up to 80 degrees (the default max_ray_angle) in at most twice the frame's width
+  // and height (the default max_scale): the focal length shrinks.
+  EXPECT_LE(pinhole.width, 400u);
+  EXPECT_EQ(pinhole.height, 320u);
+  EXPECT_LT(pinhole.params[0], 0.75 * focal);
+  EXPECT_DOUBLE_EQ(pinhole.params[0], pinhole.params[1]);
+  EXPECT_DOUBLE_EQ(pinhole.params[2], pinhole.width / 2.0);  // centred, as 3DGS assumes
+  EXPECT_DOUBLE_EQ(pinhole.params[3], pinhole.height / 2.0);
+  const cv::Mat written = cv::imread((full / "images" / "img_1.png").string(), cv::IMREAD_COLOR);
+  const cv::Mat mask =
+      cv::imread((full / "masks" / "img_1.png.png").string(), cv::IMREAD_GRAYSCALE);
+  ASSERT_EQ(written.size(), cv::Size(pinhole.width, pinhole.height));
+  ASSERT_EQ(mask.size(), written.size());
+  EXPECT_EQ(count_lost(pinhole, mask), 0) << "of " << circle.size() << " circle pixels";
+
+  // The mask is white exactly where the ray falls inside the original frame.
+  int wrong_mask = 0, blank = 0;
+  for (int row = 0; row < mask.rows; ++row) {
+    for (int col = 0; col < mask.cols; ++col) {
+      const Eigen::Vector2d source = camera.ImgFromCam(
+          pinhole.CamFromImg(Eigen::Vector2d(col + 0.5, row + 0.5)).homogeneous());
+      const double margin = std::min({source.x(), source.y(), 200 - source.x(), 160 - source.y()});
+      if (std::abs(margin) < 1e-3) continue;  // on the frame's edge: either is right
+      if ((margin > 0) != (mask.at<uchar>(row, col) == 255)) ++wrong_mask;
+      if (margin < 0) ++blank;
+    }
+  }
+  EXPECT_EQ(wrong_mask, 0);
+  EXPECT_GT(blank, 1000);  // the blank border is there, and masked
+  // The centre (rays up to 40 degrees) shows the pattern as the PINHOLE camera sees it.
+  const cv::Mat expected =
+      RenderPattern(pinhole, [&](const Eigen::Vector2d& xy) { return pinhole.CamFromImg(xy); });
+  double difference = 0;
+  int compared = 0;
+  for (int row = 0; row < written.rows; ++row) {
+    for (int col = 0; col < written.cols; ++col) {
+      if (pinhole.CamFromImg(Eigen::Vector2d(col + 0.5, row + 0.5)).norm() > std::tan(0.7))
+        continue;
+      difference +=
+          std::abs(written.at<cv::Vec3b>(row, col)[0] - expected.at<cv::Vec3b>(row, col)[0]);
+      ++compared;
+    }
+  }
+  ASSERT_GT(compared, 1000);
+  EXPECT_LT(difference / compared, 2.0);
+  // The points still reproject onto their keypoints.
+  const Reconstruction undistorted = ReadColmapModel(full / "sparse" / "0");
+  double max_error = 0;
+  for (const auto& [point3D_id, point3D] : undistorted.points3D) {
+    for (const TrackElement& element : point3D.track) {
+      const Image& image = undistorted.images.at(element.image_id);
+      const Eigen::Vector2d projection = pinhole.ImgFromCam(image.cam_from_world * point3D.xyz);
+      max_error =
+          std::max(max_error, (projection - image.points2D.at(element.point2D_idx).xy).norm());
+    }
+  }
+  EXPECT_LT(max_error, 1e-3);
+
+  // Rays up to 75 degrees only, the circle's edge: it still fits, at a longer focal length
+  // (more detail); the frame fills the image, so no pixel is blank (a circle mask given as
+  // mask_path would black out the corners).
+  const fs::path circle_root = output.path() / "circle";
+  const Camera circle_pinhole = ReadColmapModel(circle_root / "sparse" / "0").cameras.at(3);
+  EXPECT_GT(circle_pinhole.params[0], 1.3 * pinhole.params[0]);
+  const cv::Mat circle_mask =
+      cv::imread((circle_root / "masks" / "img_1.png.png").string(), cv::IMREAD_GRAYSCALE);
+  ASSERT_EQ(circle_mask.size(), cv::Size(circle_pinhole.width, circle_pinhole.height));
+  EXPECT_EQ(count_lost(circle_pinhole, circle_mask), 0) << "of " << circle.size();
+
+  // Cropping keeps the frame and the focal length: the periphery of the circle is lost.
+  const Camera cropped = ReadColmapModel(output.path() / "crop" / "sparse" / "0").cameras.at(3);
+  EXPECT_EQ(cropped.width, 200u);
+  EXPECT_GT(count_lost(cropped, cv::Mat()), static_cast<int>(circle.size()) / 4);
+  EXPECT_FALSE(fs::exists(output.path() / "crop" / "masks"));
+}
+
+// The full-field options are range-checked, and refused with "crop", each error naming
+// the option.
+TEST(GaussianSplattingExporter, FullFieldOptionsAreCheckedNamingTheOption) {
+  const std::vector<std::pair<nlohmann::json, std::string>> bad = {
+      {{{"field_of_view", "wide"}}, "pipeline.test.options.field_of_view: 'wide' is not one of"},
+      {{{"field_of_view", "full"}, {"max_scale", 0.5}},
+       "pipeline.test.options.max_scale: = 0.5 is out of range; must be in [1, 10]"},
+      {{{"field_of_view", "full"}, {"max_ray_angle", 90}},
+       "pipeline.test.options.max_ray_angle: = 90 is out of range; must be in [1, 89]"},
+      {{{"max_scale", 3}},
+       "pipeline.test.options.max_scale: is used only with field_of_view \"full\""},
+  };
+  for (const auto& [options, message] : bad) {
+    try {
+      testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting", options);
+      ADD_FAILURE() << options.dump() << ": expected InputError";
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what()).find(message), std::string::npos) << error.what();
+    }
+  }
+  auto full = testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting",
+                                                   {{"field_of_view", "full"}, {"max_scale", 3}});
+  EXPECT_EQ(full.Provenance()["options"]["max_scale"], 3.0);
+  EXPECT_EQ(full.Provenance()["options"]["max_ray_angle"], 80.0);
+  auto crop = testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting");
+  EXPECT_EQ(crop.Provenance()["options"]["field_of_view"], "crop");
+  EXPECT_FALSE(crop.Provenance()["options"].contains("max_scale"));
+}
+
 TEST(GaussianSplattingExporter, FolderOptionAndErrorsNameTheFile) {
   const Camera camera = Camera::Create(1, CameraModelId::kSimplePinhole, 50, 40, 30);
   const Reconstruction model = testing::MakeSyntheticModel(camera, 2, 40);
