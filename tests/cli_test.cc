@@ -376,6 +376,27 @@ TEST(Cli, ASecondWriterOfAWorkspaceIsRefusedNamingTheFirst) {
   EXPECT_FALSE(std::filesystem::exists(workspace / "database.db"));
 }
 
+// --threads is bounded as the manifest's "threads" is: 65537 threads crashed OpenCV's
+// TBB at exit, and -1 was answered with DBL_MAX written out.
+TEST(Cli, ThreadsOutsideZeroTo1024AreRefusedByEveryVerb) {
+  testing::TemporaryDir dir;
+  for (const std::string& verb :
+       {"run --images " + dir.path().string() + " --output " + (dir.path() / "o").string(),
+        "extract --images " + dir.path().string() + " --output " + (dir.path() / "o").string(),
+        "match --output " + (dir.path() / "o").string(),
+        "bench --images " + dir.path().string() + " --output " + (dir.path() / "o").string(),
+        "vocab --images " + dir.path().string() + " --output " + (dir.path() / "c").string()}) {
+    for (const std::string threads : {"65537", "-1"}) {
+      const auto result = RunTessera(verb + " --threads " + threads);
+      EXPECT_EQ(result.exit_code, 2) << verb << ": " << result.output;
+      EXPECT_NE(result.output.find("--threads: Value " + threads + " not in range 0 to 1024"),
+                std::string::npos)
+          << verb << ": " << result.output;
+    }
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "o"));
+}
+
 // An image folder that is the output folder, or lies where models are replaced, is
 // refused before anything is written: the photos stay as they were, and no lock or
 // database is left among them.

@@ -23,7 +23,7 @@ CommandRegistration RegisterBenchCommand(CLI::App& app, const GlobalOptions&) {
                   "Also draw time per stage and position error per row as SVG (gnuplot)");
   sub->add_option("--camera-K", options->camera_K, "Known intrinsics for every manifest");
   sub->add_option("--threads", options->threads, "Worker threads of every run (default: all)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 1024));
   sub->add_flag("--with-colmap", options->with_colmap,
                 "Add a row for COLMAP 3.8 (CPU, exhaustive) on the same images");
   sub->add_option("MANIFEST", options->manifests, "Manifests to compare")->required();

@@ -104,7 +104,7 @@ CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions&) {
   sub->add_option("--camera-K", options->camera_K,
                   "Known intrinsics: a text file with the 3x3 matrix K (overrides EXIF)");
   sub->add_option("--threads", options->threads, "Threads per task (--cpus-per-task)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 1024));
   sub->add_option("--partition", options->partition, "Slurm partition");
   sub->add_option("--time", options->time, "Time limit of each job (sbatch --time)");
   sub->add_option("--sbatch-arg", options->sbatch_args,

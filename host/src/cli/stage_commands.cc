@@ -61,7 +61,7 @@ void AddCommonOptions(CLI::App* sub, StageOptions* options, bool needs_images) {
   }
   sub->add_option("--threads", options->threads,
                   "Worker threads (default: manifest, else all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 1024));
 }
 
 PipelineContext LoadContext(const StageOptions& options) {

@@ -88,7 +88,7 @@ CommandRegistration RegisterVocabCommand(CLI::App& app, const GlobalOptions&) {
                   "Workspace folder for the features, kept (default: a temporary one)");
   sub->add_option("--threads", options->threads,
                   "Worker threads (default: manifest, else all cores)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 1024));
   return {
       sub, [options]() {
         const Timer timer;

@@ -142,6 +142,119 @@ bool IsTesseraWorkspace(const fs::path& dir) {
          fs::is_regular_file(dir / ".tessera.lock", error);
 }
 
+namespace {
+
+// The folders a scan leaves out, as canonical paths.
+struct ScanExclusions {
+  std::vector<fs::path> excluded;  // the output folder and other excluded ones
+  fs::path mask_folder;            // empty: none
+};
+
+// The excluded folders and the mask folder of `options`. Throws InputError when the
+// image folder `dir` (`root`, absolute) is one of them.
+ScanExclusions ResolveExclusions(const fs::path& dir, const fs::path& root,
+                                 const ImageScanOptions& options) {
+  ScanExclusions exclusions;
+  std::error_code root_error;
+  const fs::path canonical_root = fs::weakly_canonical(root, root_error);
+  for (const fs::path& folder : options.excluded_folders) {
+    std::error_code canonical_error;
+    const fs::path canonical = fs::weakly_canonical(fs::absolute(folder), canonical_error);
+    exclusions.excluded.push_back(canonical_error ? fs::absolute(folder).lexically_normal()
+                                                  : canonical);
+    if (exclusions.excluded.back() == canonical_root) {
+      throw InputError(dir.string() +
+                       ": the image folder is the output folder of this run; choose another "
+                       "output folder (a sub-folder of the image folder is fine)");
+    }
+  }
+  if (!options.mask_folder.empty()) {
+    std::error_code canonical_error;
+    exclusions.mask_folder =
+        fs::weakly_canonical(fs::absolute(options.mask_folder), canonical_error);
+    if (!canonical_error && exclusions.mask_folder == canonical_root) {
+      throw InputError(dir.string() +
+                       ": the image folder is the mask folder of this run; put the masks in a "
+                       "folder of their own");
+    }
+  }
+  return exclusions;
+}
+
+using SkippedEntries = std::vector<std::pair<std::string, std::string>>;  // name, why
+
+// A folder met by the listing (`name` relative to the image folder). Returns whether the
+// listing must not descend into it; a left-out folder is a note in the scan, a folder
+// whose photos may be missing a warning in `skipped`.
+bool SkipFolder(const fs::directory_entry& entry, const std::string& name,
+                const ScanExclusions& exclusions, ImageScan* scan, SkippedEntries* skipped) {
+  const fs::path& path = entry.path();
+  const std::string folder = "Skipped the folder '" + OneLine(name) + "': ";
+  std::error_code error;
+  const fs::path canonical = fs::weakly_canonical(path, error);
+  const auto& excluded = exclusions.excluded;
+  if (std::find(excluded.begin(), excluded.end(), canonical) != excluded.end()) {
+    scan->skipped_folders.push_back(folder + "it is the output folder of this run.");
+    return true;
+  }
+  if (!exclusions.mask_folder.empty() && canonical == exclusions.mask_folder) {
+    scan->skipped_folders.push_back(folder + "it is the mask folder of this run.");
+    return true;
+  }
+  if (IsTesseraWorkspace(path)) {
+    scan->skipped_folders.push_back(folder + "it is a Tessera workspace.");
+    return true;
+  }
+  // Photos may be missing below these: each is a warning, not a note.
+  if (entry.is_symlink(error)) {
+    // Not followed: a link to a folder above would make the listing endless.
+    std::error_code link_error;
+    skipped->emplace_back(name, "it is a symbolic link to '" +
+                                    fs::read_symlink(path, link_error).string() +
+                                    "', a folder; the scan does not follow links to folders");
+  } else if (const std::string why = WhyFolderCannotBeListed(path); !why.empty()) {
+    skipped->emplace_back(name, "it is a folder that cannot be listed (" + why + ")");
+    return true;
+  } else if (HasImageExtension(path)) {
+    skipped->emplace_back(name,
+                          "it is a folder, not an image file (its contents are scanned as a "
+                          "sub-folder)");
+  }
+  return false;
+}
+
+// The image file `name` at `path`: its entry, or nullopt and `problem` saying why it is
+// not used.
+std::optional<ImageEntry> ReadImageEntry(const std::string& name, const fs::path& path,
+                                         int64_t max_image_pixels, std::string* problem) {
+  if (name.find_first_of("\r\n") != std::string::npos) {
+    *problem = "the name contains a line break, which a COLMAP text model cannot hold";
+    return std::nullopt;
+  }
+  const std::optional<Bytes> bytes = ReadRegularFile(path, problem);
+  ImageFileHeader header;
+  if (bytes) *problem = InspectImageData(*bytes, &header, nullptr);
+  if (problem->empty() &&
+      static_cast<int64_t>(header.stored_width) * header.stored_height > max_image_pixels) {
+    *problem = std::to_string(header.stored_width) + "x" + std::to_string(header.stored_height) +
+               " pixels is over the limit of " + std::to_string(max_image_pixels) +
+               " (max_image_pixels)";
+  }
+  if (!problem->empty()) return std::nullopt;
+  ImageEntry entry;
+  entry.name = name;
+  entry.path = path;
+  entry.exif = header.exif;
+  const bool swap = OrientationSwapsAxes(header.exif.orientation);
+  entry.width = swap ? header.stored_height : header.stored_width;
+  entry.height = swap ? header.stored_width : header.stored_height;
+  entry.file_size = bytes->size();
+  entry.content_hash = ContentHash(*bytes);
+  return entry;
+}
+
+}  // namespace
+
 ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) {
   std::error_code error;
   if (!fs::exists(dir, error)) {
@@ -151,34 +264,11 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
     throw InputError(dir.string() + ": the image folder path is not a folder");
   }
   const fs::path root = fs::absolute(dir).lexically_normal();
-  std::vector<fs::path> excluded;
-  for (const fs::path& folder : options.excluded_folders) {
-    std::error_code canonical_error;
-    const fs::path canonical = fs::weakly_canonical(fs::absolute(folder), canonical_error);
-    excluded.push_back(canonical_error ? fs::absolute(folder).lexically_normal() : canonical);
-    std::error_code root_error;
-    if (excluded.back() == fs::weakly_canonical(root, root_error)) {
-      throw InputError(dir.string() +
-                       ": the image folder is the output folder of this run; choose another "
-                       "output folder (a sub-folder of the image folder is fine)");
-    }
-  }
-
-  fs::path mask_folder;
-  if (!options.mask_folder.empty()) {
-    std::error_code canonical_error;
-    mask_folder = fs::weakly_canonical(fs::absolute(options.mask_folder), canonical_error);
-    std::error_code root_error;
-    if (!canonical_error && mask_folder == fs::weakly_canonical(root, root_error)) {
-      throw InputError(dir.string() +
-                       ": the image folder is the mask folder of this run; put the masks in a "
-                       "folder of their own");
-    }
-  }
+  const ScanExclusions exclusions = ResolveExclusions(dir, root, options);
 
   ImageScan scan;
   std::vector<std::pair<std::string, fs::path>> candidates;
-  std::vector<std::pair<std::string, std::string>> skipped;  // name, why; sorted at the end
+  SkippedEntries skipped;  // sorted at the end
   fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, error);
   if (error)
     throw InputError(dir.string() + ": cannot list the image folder (" + error.message() + ")");
@@ -192,39 +282,7 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
     }
     const std::string name = path.lexically_relative(root).generic_string();
     if (it->is_directory(entry_error)) {
-      const std::string folder = "Skipped the folder '" + OneLine(name) + "': ";
-      std::error_code canonical_error;
-      const fs::path canonical = fs::weakly_canonical(path, canonical_error);
-      if (std::find(excluded.begin(), excluded.end(), canonical) != excluded.end()) {
-        scan.skipped_folders.push_back(folder + "it is the output folder of this run.");
-        it.disable_recursion_pending();
-        continue;
-      }
-      if (!mask_folder.empty() && canonical == mask_folder) {
-        scan.skipped_folders.push_back(folder + "it is the mask folder of this run.");
-        it.disable_recursion_pending();
-        continue;
-      }
-      if (IsTesseraWorkspace(path)) {
-        scan.skipped_folders.push_back(folder + "it is a Tessera workspace.");
-        it.disable_recursion_pending();
-        continue;
-      }
-      // Photos may be missing below these: each is a warning, not a note.
-      if (it->is_symlink(entry_error)) {
-        // Not followed: a link to a folder above would make the listing endless.
-        std::error_code link_error;
-        skipped.emplace_back(name, "it is a symbolic link to '" +
-                                       fs::read_symlink(path, link_error).string() +
-                                       "', a folder; the scan does not follow links to folders");
-      } else if (const std::string why = WhyFolderCannotBeListed(path); !why.empty()) {
-        skipped.emplace_back(name, "it is a folder that cannot be listed (" + why + ")");
-        it.disable_recursion_pending();
-      } else if (HasImageExtension(path)) {
-        skipped.emplace_back(name,
-                             "it is a folder, not an image file (its contents are scanned "
-                             "as a sub-folder)");
-      }
+      if (SkipFolder(*it, name, exclusions, &scan, &skipped)) it.disable_recursion_pending();
       continue;
     }
     if (!HasImageExtension(path)) continue;
@@ -239,38 +297,14 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
   }
   std::sort(candidates.begin(), candidates.end(),
             [](const auto& a, const auto& b) { return NaturalLess(a.first, b.first); });
-
   for (const auto& [name, path] : candidates) {
-    if (name.find_first_of("\r\n") != std::string::npos) {
-      skipped.emplace_back(name,
-                           "the name contains a line break, which a COLMAP text model "
-                           "cannot hold");
-      continue;
-    }
     std::string problem;
-    const std::optional<Bytes> bytes = ReadRegularFile(path, &problem);
-    ImageFileHeader header;
-    if (bytes) problem = InspectImageData(*bytes, &header, nullptr);
-    if (problem.empty() && static_cast<int64_t>(header.stored_width) * header.stored_height >
-                               options.max_image_pixels) {
-      problem = std::to_string(header.stored_width) + "x" + std::to_string(header.stored_height) +
-                " pixels is over the limit of " + std::to_string(options.max_image_pixels) +
-                " (max_image_pixels)";
-    }
-    if (!problem.empty()) {
+    if (std::optional<ImageEntry> entry =
+            ReadImageEntry(name, path, options.max_image_pixels, &problem)) {
+      scan.images.push_back(std::move(*entry));
+    } else {
       skipped.emplace_back(name, problem);
-      continue;
     }
-    ImageEntry entry;
-    entry.name = name;
-    entry.path = path;
-    entry.exif = header.exif;
-    const bool swap = OrientationSwapsAxes(header.exif.orientation);
-    entry.width = swap ? header.stored_height : header.stored_width;
-    entry.height = swap ? header.stored_width : header.stored_height;
-    entry.file_size = bytes->size();
-    entry.content_hash = ContentHash(*bytes);
-    scan.images.push_back(std::move(entry));
   }
   std::stable_sort(skipped.begin(), skipped.end(),
                    [](const auto& a, const auto& b) { return NaturalLess(a.first, b.first); });
