@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
+#include "outputs/output_transaction.h"
 #include "pipeline/workspace.h"
 #include "plugin/plugin_registry.h"
 #include "tessera/errors.h"
@@ -63,13 +64,23 @@ CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions&) {
     const auto workspaces = HoldEnclosingWorkspaces({options->model, options->output});
     const Reconstruction reconstruction = ReadColmapModel(options->model);
 
+    // Written as one set (outputs/output_transaction.h): placed whole or not at all,
+    // replacing only what Tessera wrote in the output folder.
+    CreateFolder(options->output);
+    OutputTransaction outputs(options->output, OutputTransaction::Mode::kAddToSet);
+    outputs.Protect(options->images);
     ExportContext context;
-    context.output_dir = options->output;
+    context.output_dir = outputs.StageFor(exporter.name());
     context.image_dir = options->images;
     context.model_index = options->model_index;
-    CreateFolder(context.output_dir);
-    exporter.Call(PluginStage::kExport, "model " + std::to_string(context.model_index),
-                  [&](auto& plugin) { plugin.Export(reconstruction, context); });
+    try {
+      exporter.Call(PluginStage::kExport, "model " + std::to_string(context.model_index),
+                    [&](auto& plugin) { plugin.Export(reconstruction, context); });
+    } catch (const PluginError& error) {
+      outputs.Keep();
+      throw error.Reworded(outputs.NamedAsOutput(error.message()));
+    }
+    outputs.Commit();
 
     const size_t num_observations = NumObservations(reconstruction);
     spdlog::info(

@@ -1,6 +1,10 @@
 #include "tessera/io/file_io.h"
 
+#include <fcntl.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
 
 #include <fstream>
 #include <iterator>
@@ -21,27 +25,39 @@ std::string ReadFileContents(const fs::path& path) {
 }
 
 void WriteFileAtomically(const fs::path& path, const std::string& contents) {
-  // In the same folder, so that the rename stays on one file system and is atomic.
+  // In the same folder, so that the rename stays on one file system and is atomic. The
+  // temporary is a new file (O_EXCL, O_NOFOLLOW): a link planted under its name is
+  // never followed, and the rename replaces a link at `path` instead of writing through.
   const fs::path temporary = path.parent_path() / ("." + path.filename().string() + ".tmp-" +
                                                    std::to_string(static_cast<long>(getpid())));
-  {
-    std::ofstream file(temporary, std::ios::binary | std::ios::trunc);
-    if (!file)
-      throw InputError("Cannot create " + temporary.string() + " to write " + path.string() + ".");
-    file.write(contents.data(), static_cast<std::streamsize>(contents.size()));
-    file.close();
-    if (!file) {
-      std::error_code error;
-      fs::remove(temporary, error);
-      throw InputError("Cannot write " + path.string() + " (is the disk full?).");
-    }
+  unlink(temporary.c_str());
+  const int fd = open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  if (fd < 0) {
+    throw InputError("Cannot create " + temporary.string() + " to write " + path.string() + ": " +
+                     std::strerror(errno) + ".");
   }
-  std::error_code error;
-  fs::rename(temporary, path, error);
-  if (error) {
-    fs::remove(temporary, error);
+  size_t written = 0;
+  int error_number = 0;
+  while (written < contents.size()) {
+    const ssize_t count = write(fd, contents.data() + written, contents.size() - written);
+    if (count < 0 && errno == EINTR) continue;
+    if (count <= 0) {
+      error_number = count < 0 ? errno : ENOSPC;
+      break;
+    }
+    written += static_cast<size_t>(count);
+  }
+  if (close(fd) != 0 && error_number == 0) error_number = errno;
+  if (error_number != 0) {
+    unlink(temporary.c_str());
+    throw InputError("Cannot write " + path.string() + " (is the disk full?): " +
+                     std::strerror(error_number) + ".");
+  }
+  if (rename(temporary.c_str(), path.c_str()) != 0) {
+    const int rename_error = errno;
+    unlink(temporary.c_str());
     throw InputError("Cannot rename " + temporary.string() + " to " + path.string() + ": " +
-                     error.message() + ".");
+                     std::strerror(rename_error) + ".");
   }
 }
 

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "outputs/output_transaction.h"
 #include "pipeline/workspace.h"
 #include "plugin/bundle_adjuster_guard.h"
 #include "plugin/plugin_call.h"
@@ -15,22 +16,6 @@
 #include "util/timer.h"
 
 namespace tessera {
-
-void RemoveStaleModels(const std::filesystem::path& sparse_dir, size_t num_models) {
-  std::error_code error;
-  if (!std::filesystem::is_directory(sparse_dir, error)) return;
-  for (const auto& entry : std::filesystem::directory_iterator(sparse_dir, error)) {
-    const std::string name = entry.path().filename().string();
-    if (!entry.is_directory() || name.empty() ||
-        name.find_first_not_of("0123456789") != std::string::npos || name.size() > 6) {
-      continue;
-    }
-    if (static_cast<size_t>(std::stoul(name)) >= num_models) {
-      spdlog::info("map: removing {} from an earlier run", entry.path().string());
-      std::filesystem::remove_all(entry.path(), error);
-    }
-  }
-}
 
 MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& input,
                                 const std::filesystem::path& sparse_dir,
@@ -72,6 +57,73 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
   return summary;
 }
 
+// Writes model `index` into the transaction: with each exporter in its own staging
+// folder, or as COLMAP binary in sparse/<index> when there is none. A failing exporter
+// stops the set: its error is thrown, the earlier outputs stay whole, and what this run
+// wrote is kept in the staging folder until the next run.
+void ExportModel(const Reconstruction& model, size_t index, const MapSettings& settings,
+                 const std::filesystem::path& image_dir, OutputTransaction* outputs) {
+  if (settings.exporters == nullptr || settings.exporters->empty()) {
+    WriteColmapModel(model, outputs->StageFor("tessera") / "sparse" / std::to_string(index),
+                     ColmapModelFormat::kBinary);
+    return;
+  }
+  for (size_t k = 0; k < settings.exporters->size(); ++k) {
+    const PluginInstance<Exporter>& exporter = (*settings.exporters)[k];
+    const std::filesystem::path staged = outputs->StageFor(exporter.name(), k);
+    try {
+      exporter.Call(PluginStage::kExport, "model " + std::to_string(index), [&](auto& plugin) {
+        plugin.Export(model, {staged, image_dir, static_cast<int>(index)});
+      });
+    } catch (const PluginError& error) {
+      outputs->Keep();
+      spdlog::info(
+          "map: the exporters after '{}' are not run; the earlier outputs are kept whole, "
+          "and what this run wrote is in {} until the next run",
+          exporter.name(), outputs->staging_folder().string());
+      throw error.Reworded(outputs->NamedAsOutput(error.message()));
+    }
+  }
+}
+
+// Places the models of `result`, their exports and OUTPUT/mapping_summary.json as one
+// set (OutputTransaction): with no model, what the earlier runs wrote is removed.
+// Returns false when cancelled before the set was placed (nothing of it is).
+bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
+                     const MapperResult& result, const MapperInput& input,
+                     const std::filesystem::path& image_dir, const StageControl& control,
+                     MapStageSummary* summary) {
+  const std::filesystem::path& output_dir = workspace.folder();
+  MappingSummary mapping =
+      SummarizeMapping(result, input, output_dir / "sparse", settings.mapper, settings.seed);
+  summary->num_models = result.models.size();
+  OutputTransaction outputs(output_dir);
+  outputs.Protect(image_dir);
+  outputs.Protect(settings.mask_dir);
+  if (result.models.empty()) control.Report("export", 0, 0);
+  for (size_t index = 0; index < result.models.size(); ++index) {
+    if (control.Cancelled()) return false;
+    const Reconstruction& model = result.models[index];
+    ExportModel(model, index, settings, image_dir, &outputs);
+    summary->num_registered += model.images.size();
+    summary->images_per_model.push_back(model.images.size());
+    const MappingSummary::Model& entry = mapping.models[index];
+    spdlog::info(
+        "map: model {}: {} images, {} points, mean track length {:.2f}, mean reprojection "
+        "error {:.3f} px",
+        index, entry.num_images, entry.num_points3D, entry.mean_track_length,
+        entry.mean_reprojection_error);
+    control.Report("export", index + 1, result.models.size());
+  }
+  for (const MappingSummary::Unregistered& image : mapping.unregistered) {
+    spdlog::warn("map: {} is in no model: {}", image.image, image.reason);
+  }
+  mapping.seconds = summary->seconds;
+  mapping.Write(outputs.StageFor("tessera") / "mapping_summary.json");
+  outputs.Commit();
+  return true;
+}
+
 MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& settings,
                              const StageScope& scope, const StageControl& control) {
   const Timer timer;
@@ -80,21 +132,8 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
     throw std::logic_error("MapWorkspace: no bundle adjuster, or a scope it cannot map");
   }
   Database* database = &workspace.database();
-  const std::filesystem::path& output_dir = workspace.folder();
   const MapperInput input = LoadMapperInput(*database);
-  if (input.pairs.empty()) {
-    if (!database->ReadStageProvenance(Database::kTwoViewGeometriesStage)) {
-      throw InputError(database->path().string() +
-                       ": no verified image pairs in the workspace; run match first");
-    }
-    // Matching ran and verified no pair: no model can be built (exit 3).
-    spdlog::error("map: {}: matching verified none of the {} matched image pairs",
-                  database->path().string(), database->NumMatchedPairs());
-    summary.num_images = database->NumImages();
-    summary.seconds = timer.ElapsedSeconds();
-    return summary;
-  }
-  summary.num_images = input.images.size();
+  const std::filesystem::path image_dir = ImageFolder(settings.image_dir, *database);
   const auto cancelled = [&] {
     if (!control.Cancelled()) return false;
     summary.status = StageStatus::kCancelled;
@@ -102,6 +141,23 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
     spdlog::info("map: cancelled");
     return true;
   };
+  if (input.pairs.empty()) {
+    if (!database->ReadStageProvenance(Database::kTwoViewGeometriesStage)) {
+      throw InputError(database->path().string() +
+                       ": no verified image pairs in the workspace; run match first");
+    }
+    // Matching ran and verified no pair: no model can be built (exit 3), and none of an
+    // earlier run's is left to be taken for this run's.
+    spdlog::error("map: {}: matching verified none of the {} matched image pairs",
+                  database->path().string(), database->NumMatchedPairs());
+    summary.num_images = database->NumImages();
+    summary.seconds = timer.ElapsedSeconds();
+    if (!PlaceMapOutputs(workspace, settings, {}, input, image_dir, control, &summary)) {
+      cancelled();
+    }
+    return summary;
+  }
+  summary.num_images = input.images.size();
   if (cancelled()) return summary;
   control.Report("map", 0, 1);
   const BundleAdjusterGuard bundle_adjuster(*settings.bundle_adjuster);
@@ -114,7 +170,6 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
   if (cancelled()) return summary;
   control.Report("map", 1, 1);
 
-  const std::filesystem::path image_dir = ImageFolder(settings.image_dir, *database);
   if (image_dir.empty()) {
     spdlog::warn("map: the image folder is unknown (pass --images); points are not coloured");
   } else {
@@ -124,55 +179,17 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
       }
     }
   }
-
-  const std::filesystem::path sparse_dir = output_dir / "sparse";
-  RemoveStaleModels(sparse_dir, result.models.size());
-  MappingSummary mapping =
-      SummarizeMapping(result, input, sparse_dir, settings.mapper, settings.seed);
-  std::optional<PluginError> first_export_error;
-  summary.num_models = result.models.size();
-  if (result.models.empty()) control.Report("export", 0, 0);
-  for (size_t index = 0; index < result.models.size(); ++index) {
-    if (cancelled()) return summary;
-    const Reconstruction& model = result.models[index];
-    if (settings.exporters == nullptr || settings.exporters->empty()) {
-      WriteColmapModel(model, sparse_dir / std::to_string(index), ColmapModelFormat::kBinary);
-    } else {
-      // One failing exporter does not stop the others; the first failure is reported
-      // once all have run, so that nothing computed is lost.
-      for (const auto& exporter : *settings.exporters) {
-        try {
-          exporter.Call(PluginStage::kExport, "model " + std::to_string(index), [&](auto& plugin) {
-            plugin.Export(model, {output_dir, image_dir, static_cast<int>(index)});
-          });
-        } catch (const PluginError& error) {
-          spdlog::error("map: {}", error.what());
-          if (!first_export_error) first_export_error = error;
-        }
-      }
-    }
-    summary.num_registered += model.images.size();
-    summary.images_per_model.push_back(model.images.size());
-    const MappingSummary::Model& entry = mapping.models[index];
-    spdlog::info(
-        "map: model {}: {} images, {} points, mean track length {:.2f}, mean reprojection "
-        "error {:.3f} px",
-        index, entry.num_images, entry.num_points3D, entry.mean_track_length,
-        entry.mean_reprojection_error);
-    control.Report("export", index + 1, result.models.size());
-  }
-  for (const MappingSummary::Unregistered& image : mapping.unregistered) {
-    spdlog::warn("map: {} is in no model: {}", image.image, image.reason);
+  summary.seconds = timer.ElapsedSeconds();
+  if (!PlaceMapOutputs(workspace, settings, result, input, image_dir, control, &summary)) {
+    cancelled();
+    return summary;
   }
   summary.seconds = timer.ElapsedSeconds();
-  mapping.seconds = summary.seconds;
-  mapping.Write(output_dir / "mapping_summary.json");
   spdlog::info(
       "map: {} of {} images registered in {} model(s), {} global and {} local bundle "
       "adjustments, {:.2f} s",
       summary.num_registered, summary.num_images, summary.num_models, result.num_global_ba,
       result.num_local_ba, summary.seconds);
-  if (first_export_error) throw *first_export_error;
   return summary;
 }
 

@@ -30,11 +30,9 @@ struct MapSettings {
   // The images the points are coloured from and the exporters read; empty: the folder
   // extract recorded.
   std::filesystem::path image_dir;
+  // The mask folder, if any: like the image folder, never written or deleted in.
+  std::filesystem::path mask_dir;
 };
-
-// Removes sparse/<k> folders of an earlier run for k >= num_models, so that the folder
-// never mixes this run's models with stale ones. Other entries are left alone.
-void RemoveStaleModels(const std::filesystem::path& sparse_dir, size_t num_models);
 
 // The mapping summary of a mapper result: models (sparse_dir/<index>), why images were
 // left out, focal lengths estimated; the options as given; `seconds` left 0.
@@ -44,17 +42,19 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
 
 // Maps the workspace's verified matches and writes every model: through the settings'
 // exporters, or as COLMAP binary in OUTPUT/sparse/<index>/ when there are none; then
-// OUTPUT/mapping_summary.json. `scope` must be whole (clusters are for later).
-// No verified pair after matching: a summary with no model (the caller exits 3).
-// Throws InputError when matching has not run, and the first exporter's PluginError
-// once every exporter has run.
+// OUTPUT/mapping_summary.json. The models, their exports and the summary are one set
+// (outputs/output_transaction.h): placed whole, each entry with one rename, or not at
+// all; what earlier runs wrote and this set no longer holds is removed, and nothing
+// Tessera did not write is replaced or removed. `scope` must be whole.
+// No verified pair after matching: a summary with no model (the caller exits 3), and
+// the earlier runs' models are removed. Throws InputError when matching has not run or
+// the set cannot be placed, and the first failing exporter's PluginError (the
+// exporters after it are not run; the earlier outputs stay whole).
 //
 // `control`: progress ("map" 0/1 then 1/1; "export", models written of all) and
 // cancellation, checked before mapping, by the mapper before each registration, and
-// before each model is written; `control.model_changed` sees the model grow. Cancelled
-// before writing: nothing of the old
-// output is touched; cancelled between models: the models written are whole, and
-// mapping_summary.json is not written. Status kCancelled either way.
+// before each model is written; `control.model_changed` sees the model grow. Cancelled:
+// nothing of the old output is touched, nothing new is placed. Status kCancelled.
 MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& settings,
                              const StageScope& scope = {}, const StageControl& control = {});
 

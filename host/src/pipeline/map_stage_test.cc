@@ -14,22 +14,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-TEST(MapStage, RemoveStaleModelsRemovesNumberedFoldersFromNumModelsOn) {
-  const testing::TemporaryDir dir;
-  const fs::path sparse = dir.path() / "sparse";
-  for (const std::string name : {"0", "1", "5", "notes", "1234567"}) {
-    fs::create_directories(sparse / name);
-  }
-  std::ofstream(sparse / "2") << "a file";
-  RemoveStaleModels(sparse, 1);
-  EXPECT_TRUE(fs::exists(sparse / "0"));
-  EXPECT_FALSE(fs::exists(sparse / "1"));
-  EXPECT_FALSE(fs::exists(sparse / "5"));
-  EXPECT_TRUE(fs::exists(sparse / "notes"));
-  EXPECT_TRUE(fs::exists(sparse / "1234567"));  // more than 6 digits: not a model folder
-  EXPECT_TRUE(fs::exists(sparse / "2"));        // a file, not a folder
-}
-
 // Cancelled before mapping: the earlier run's output is untouched, nothing is written.
 TEST(MapStage, CancelledBeforeMappingTouchesNoOutput) {
   const testing::TemporaryDir dir;

@@ -112,6 +112,7 @@ MapSettings PipelineContext::MakeMapSettings(const std::filesystem::path& image_
   settings.mapper = mapper_options;
   settings.seed = manifest.seed;
   settings.image_dir = image_dir;
+  settings.mask_dir = manifest.camera.mask_path;
   return settings;
 }
 

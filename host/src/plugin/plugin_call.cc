@@ -218,6 +218,14 @@ PluginError::PluginError(const std::string& plugin, PluginStage stage, const std
   option_path_ = error.path();
 }
 
+PluginError PluginError::Reworded(const std::string& message) const {
+  PluginError error(plugin_, stage_, subject_, message, input_error_);
+  error.option_message_ = option_message_;
+  error.option_error_ = option_error_;
+  error.option_path_ = option_path_;
+  return error;
+}
+
 InputError PluginError::AsSlotError(const std::string& json_path, const std::string& what) const {
   if (option_error_) {
     return InputError(json_path + ".options" + (option_path_.empty() ? "" : "." + option_path_) +

@@ -65,6 +65,8 @@ class PluginError : public std::runtime_error {
   // plugin's slot ("pipeline.pair_selector[1]"), `what` the plugin ("pair selector
   // 'x'"). Only for input errors.
   InputError AsSlotError(const std::string& json_path, const std::string& what) const;
+  // The same error with another message (a path in it named as the user knows it).
+  PluginError Reworded(const std::string& message) const;
 
  private:
   std::string plugin_;

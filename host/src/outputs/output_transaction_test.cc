@@ -1,0 +1,256 @@
+#include "outputs/output_transaction.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "test_support.h"
+#include "tessera/errors.h"
+
+namespace tessera {
+namespace {
+
+namespace fs = std::filesystem;
+
+void WriteText(const fs::path& path, const std::string& text) {
+  fs::create_directories(path.parent_path());
+  std::ofstream(path, std::ios::binary) << text;
+}
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream file(path, std::ios::binary);
+  std::stringstream text;
+  text << file.rdbuf();
+  return text.str();
+}
+
+// One committed set: writer name to {relative path: contents}.
+OutputTransaction::Result CommitSet(
+    const fs::path& output, const std::map<std::string, std::map<std::string, std::string>>& set,
+    OutputTransaction::Mode mode = OutputTransaction::Mode::kWholeSet) {
+  OutputTransaction outputs(output, mode);
+  for (const auto& [writer, files] : set) {
+    const fs::path staged = outputs.StageFor(writer);
+    for (const auto& [relative, text] : files) WriteText(staged / relative, text);
+  }
+  return outputs.Commit();
+}
+
+bool Mentions(const std::vector<std::string>& lines, const std::string& text) {
+  for (const std::string& line : lines) {
+    if (line.find(text) != std::string::npos) return true;
+  }
+  return false;
+}
+
+TEST(OutputTransaction, PlacesTheSetAndRecordsIt) {
+  const testing::TemporaryDir dir;
+  const auto result = CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "a"}}},
+                                             {"ply", {{"model.ply", "p"}}}});
+  EXPECT_EQ(result.files_placed, 2u);
+  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.bin"), "a");
+  EXPECT_EQ(ReadText(dir.path() / "model.ply"), "p");
+  const OutputLedger ledger = OutputLedger::Read(dir.path());
+  EXPECT_TRUE(ledger.Owns(dir.path(), "sparse"));
+  EXPECT_TRUE(ledger.Owns(dir.path(), "model.ply"));
+  EXPECT_FALSE(fs::exists(dir.path() / OutputTransaction::kStagingFolderName));
+}
+
+// Two models, binary and a PLY; then one model, text, no PLY: nothing of the first set
+// is left to be read in place of the second.
+TEST(OutputTransaction, ARerunRemovesWhatItsSetNoLongerHolds) {
+  const testing::TemporaryDir dir;
+  CommitSet(dir.path(), {{"colmap_binary",
+                          {{"sparse/0/images.bin", "0"}, {"sparse/1/images.bin", "1"}}},
+                         {"ply", {{"model.ply", "p"}}},
+                         {"transforms_json", {{"transforms_1.json", "t"}}}});
+  const auto result =
+      CommitSet(dir.path(), {{"colmap_text", {{"sparse/0/images.txt", "text"}}}});
+  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.txt"), "text");
+  EXPECT_FALSE(fs::exists(dir.path() / "sparse/0/images.bin"));
+  EXPECT_FALSE(fs::exists(dir.path() / "sparse/1"));
+  EXPECT_FALSE(fs::exists(dir.path() / "model.ply"));
+  EXPECT_FALSE(fs::exists(dir.path() / "transforms_1.json"));
+  EXPECT_TRUE(result.warnings.empty());
+}
+
+// A COLMAP project's own model folders and notes are never touched, and named where a
+// reader would take them for Tessera's models.
+TEST(OutputTransaction, WhatTesseraDidNotWriteIsLeftAndNamed) {
+  const testing::TemporaryDir dir;
+  WriteText(dir.path() / "sparse/1/notes.txt", "mine");
+  WriteText(dir.path() / "sparse/2/images.bin", "theirs");
+  CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "a"}}}});
+  const auto result = CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "b"}}}});
+  EXPECT_EQ(ReadText(dir.path() / "sparse/1/notes.txt"), "mine");
+  EXPECT_EQ(ReadText(dir.path() / "sparse/2/images.bin"), "theirs");
+  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.bin"), "b");
+  EXPECT_TRUE(Mentions(result.warnings, (dir.path() / "sparse/1").string()));
+  EXPECT_TRUE(Mentions(result.warnings, (dir.path() / "sparse/2").string()));
+}
+
+// A model folder the user added a note to: Tessera's files in it are replaced one by
+// one, and the note stays.
+TEST(OutputTransaction, AFolderWithAFileOfTheUsersIsReplacedFileByFile) {
+  const testing::TemporaryDir dir;
+  CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "a"}}}});
+  WriteText(dir.path() / "sparse/0/notes.txt", "mine");
+  CommitSet(dir.path(), {{"colmap_text", {{"sparse/0/images.txt", "b"}}}});
+  EXPECT_EQ(ReadText(dir.path() / "sparse/0/notes.txt"), "mine");
+  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.txt"), "b");
+  EXPECT_FALSE(fs::exists(dir.path() / "sparse/0/images.bin"));
+}
+
+TEST(OutputTransaction, RefusesToReplaceAFileTesseraDidNotWriteAndMovesNothing) {
+  const testing::TemporaryDir dir;
+  WriteText(dir.path() / "sparse/0/images.bin", "theirs");
+  OutputTransaction outputs(dir.path());
+  WriteText(outputs.StageFor("colmap_binary") / "sparse/0/images.bin", "ours");
+  WriteText(outputs.StageFor("ply") / "model.ply", "p");
+  try {
+    outputs.Commit();
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find((dir.path() / "sparse/0/images.bin").string()),
+              std::string::npos)
+        << error.what();
+    EXPECT_NE(std::string(error.what()).find("colmap_binary"), std::string::npos);
+  }
+  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.bin"), "theirs");
+  EXPECT_FALSE(fs::exists(dir.path() / "model.ply"));  // nothing of the set moved
+  EXPECT_TRUE(fs::exists(outputs.staging_folder()));   // kept until the next run
+}
+
+TEST(OutputTransaction, ChangedOutputsOfAnEarlierRunAreLeftWithAWarning) {
+  const testing::TemporaryDir dir;
+  CommitSet(dir.path(), {{"ply", {{"model.ply", "p"}}}});
+  WriteText(dir.path() / "model.ply", "edited by hand");
+  const auto result = CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "a"}}}});
+  EXPECT_EQ(ReadText(dir.path() / "model.ply"), "edited by hand");
+  EXPECT_TRUE(Mentions(result.warnings, "model.ply"));
+  // No longer Tessera's: a later set may not replace it either.
+  EXPECT_THROW(CommitSet(dir.path(), {{"ply", {{"model.ply", "q"}}}}), InputError);
+}
+
+TEST(OutputTransaction, AnExporterMayNotWriteTheWorkspacesOwnFiles) {
+  const testing::TemporaryDir dir;
+  WriteText(dir.path() / "database.db", "db");
+  for (const std::string name : {"database.db", "cache/x", ".tessera.lock", "run_summary.json"}) {
+    EXPECT_THROW(CommitSet(dir.path(), {{"transforms_json", {{name, "{}"}}}}), InputError) << name;
+  }
+  EXPECT_EQ(ReadText(dir.path() / "database.db"), "db");
+}
+
+TEST(OutputTransaction, TwoWritersOfOneFileAreRefusedNamingBoth) {
+  const testing::TemporaryDir dir;
+  try {
+    CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "a"}}},
+                           {"gaussian_splatting", {{"sparse/0/images.bin", "b"}}}});
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("'colmap_binary' and 'gaussian_splatting'"),
+              std::string::npos)
+        << error.what();
+  }
+  EXPECT_FALSE(fs::exists(dir.path() / "sparse"));
+}
+
+// OUTPUT/sparse a link to another folder: nothing is written or deleted through it.
+TEST(OutputTransaction, NothingIsWrittenOrDeletedThroughALink) {
+  const testing::TemporaryDir dir;
+  const fs::path elsewhere = dir.path() / "elsewhere";
+  WriteText(elsewhere / "0/images.bin", "precious");
+  const fs::path output = dir.path() / "out";
+  fs::create_directories(output);
+  fs::create_directory_symlink(elsewhere, output / "sparse");
+  EXPECT_THROW(CommitSet(output, {{"colmap_binary", {{"sparse/0/images.bin", "a"}}}}),
+               InputError);
+  EXPECT_EQ(ReadText(elsewhere / "0/images.bin"), "precious");
+  // A link where Tessera's file was: not Tessera's any more, not followed.
+  const fs::path output2 = dir.path() / "out2";
+  CommitSet(output2, {{"ply", {{"model.ply", "p"}}}});
+  fs::remove(output2 / "model.ply");
+  fs::create_symlink(elsewhere / "0/images.bin", output2 / "model.ply");
+  CommitSet(output2, {{"colmap_binary", {{"sparse/0/images.bin", "a"}}}});
+  EXPECT_EQ(ReadText(elsewhere / "0/images.bin"), "precious");
+  EXPECT_TRUE(fs::is_symlink(output2 / "model.ply"));
+}
+
+// The image folder inside a folder Tessera wrote (a 3DGS export's images) is never
+// replaced or emptied.
+TEST(OutputTransaction, AProtectedFolderIsNeverReplacedOrWrittenIn) {
+  const testing::TemporaryDir dir;
+  CommitSet(dir.path(), {{"gaussian_splatting", {{"gaussian_splatting/images/a.jpg", "a"}}}});
+  {
+    OutputTransaction outputs(dir.path());
+    outputs.Protect(dir.path() / "gaussian_splatting/images");
+    WriteText(outputs.StageFor("gaussian_splatting") / "gaussian_splatting/images/b.jpg", "b");
+    EXPECT_THROW(outputs.Commit(), InputError);
+  }
+  EXPECT_EQ(ReadText(dir.path() / "gaussian_splatting/images/a.jpg"), "a");
+  {
+    OutputTransaction outputs(dir.path());  // a set without it would remove it
+    outputs.Protect(dir.path() / "gaussian_splatting/images");
+    WriteText(outputs.StageFor("ply") / "model.ply", "p");
+    outputs.Commit();
+  }
+  EXPECT_EQ(ReadText(dir.path() / "gaussian_splatting/images/a.jpg"), "a");
+}
+
+// A kill between the ledger's journal and the last rename leaves files that all count
+// as Tessera's: the next set replaces them. Its leftovers are removed.
+TEST(OutputTransaction, LeftoversOfAKilledRunAreRemovedAndItsOutputsStayTesseras) {
+  const testing::TemporaryDir dir;
+  CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "old"}}}});
+  // As a kill leaves it: the journal accepts both versions, one is in place, the
+  // staging folder and an atomic write's temporary remain.
+  OutputLedger journal = OutputLedger::Read(dir.path());
+  WriteText(dir.path() / "new.bin", "new");
+  journal.AddFile("sparse/0/images.bin", DigestFile(dir.path() / "new.bin"));
+  fs::remove(dir.path() / "new.bin");
+  journal.Write(dir.path());
+  WriteText(dir.path() / "sparse/0/images.bin", "new");
+  const fs::path leftover = dir.path() / OutputTransaction::kStagingFolderName / "1/set/x";
+  WriteText(leftover, "partial");
+  WriteText(dir.path() / "sparse/0/.images.bin.tmp-999999999", "partial");
+  CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "newer"}}}});
+  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.bin"), "newer");
+  EXPECT_FALSE(fs::exists(leftover));
+  EXPECT_FALSE(fs::exists(dir.path() / "sparse/0/.images.bin.tmp-999999999"));
+}
+
+TEST(OutputTransaction, AddingToTheSetKeepsTheOtherModels) {
+  const testing::TemporaryDir dir;
+  CommitSet(dir.path(), {{"colmap_binary",
+                          {{"sparse/0/images.bin", "0"}, {"sparse/1/images.bin", "1"}}},
+                         {"gaussian_splatting", {{"gaussian_splatting/images/a.jpg", "a"},
+                                                 {"gaussian_splatting/images/b.jpg", "b"}}}});
+  CommitSet(dir.path(),
+            {{"colmap_text", {{"sparse/1/images.txt", "1"}}},
+             {"gaussian_splatting", {{"gaussian_splatting/images/a.jpg", "a2"}}}},
+            OutputTransaction::Mode::kAddToSet);
+  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.bin"), "0");
+  EXPECT_EQ(ReadText(dir.path() / "sparse/1/images.txt"), "1");
+  EXPECT_FALSE(fs::exists(dir.path() / "sparse/1/images.bin"));  // the model folder, whole
+  EXPECT_FALSE(fs::exists(dir.path() / "gaussian_splatting/images/b.jpg"));
+  // The files it kept are still Tessera's: a whole set removes them.
+  CommitSet(dir.path(), {{"ply", {{"model.ply", "p"}}}});
+  EXPECT_FALSE(fs::exists(dir.path() / "sparse"));
+}
+
+TEST(OutputLedger, ARecordThatIsNotALedgerIsAnErrorNamingIt) {
+  const testing::TemporaryDir dir;
+  WriteText(dir.path() / OutputLedger::kFileName, "not json");
+  try {
+    OutputLedger::Read(dir.path());
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find(OutputLedger::kFileName), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace tessera
