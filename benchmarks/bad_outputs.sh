@@ -79,9 +79,12 @@ check() {
   for f in $foreign_files; do after+="$(sha1sum "$f" 2> /dev/null || echo "missing $f")"$'\n'; done
   if [ "$sums" != "$after" ]; then verdict="foreign files deleted"; foreign=$((foreign + 1)); fi
   printf "%-52s exit %s  %s\n" "$name" "$code" "$verdict"
+  [ "$code" = 0 ] || grep -m1 '\[error\]' "$work/case.log" | cut -c1-150 | sed 's/^/    /' 
   [ "$verdict" = ok ] || sed 's/^/    /' "$work/case.log" | grep -v '^\s*\[info\]' | tail -3
 }
 sums_of() { (cd "$1" && find . -type f ! -name '.tessera_outputs.json' | sort | xargs -r sha1sum); }
+# The outputs of a workspace: its models and exports, not its database.
+outputs_of() { (cd "$1" && find sparse gaussian_splatting* transforms*.json mapping_summary.json -type f 2> /dev/null | sort | xargs -r sha1sum); }
 
 # --- Data loss --------------------------------------------------------------------------
 fresh "$work/p"; mkdir -p "$work/p/sparse/1" "$work/p/sparse/2"
@@ -120,8 +123,8 @@ check "run --images A --output A (refused)" 2 '[ ! -e "$work/a/.tessera.lock" ] 
   t run --images "$work/a" --output "$work/a" --manifest "$work/bin.json"
 fresh "$work/f"
 manifest "$work/fail.json" '[{"plugin": "colmap_text"}, {"plugin": "failing_exporter", "options": {"fail": "custom"}}, {"plugin": "gaussian_splatting"}]'
-f_before=$(sums_of "$work/f")
-check "a failing exporter mid-set" "1 2" '[ "$(sums_of "$work/f")" = "$f_before" ]' "" -- \
+f_before=$(outputs_of "$work/f")
+check "a failing exporter mid-set" "1 2" '[ "$(outputs_of "$work/f")" = "$f_before" ]' "" -- \
   env TESSERA_PLUGIN_PATH="$bin/../test_plugins/failing" "$tessera" map --images "$work/d" --output "$work/f" --manifest "$work/fail.json" --threads 2
 
 # --- Security ---------------------------------------------------------------------------
@@ -132,14 +135,14 @@ TXT
 printf '1 1 0 0 0 0 0 0 1 %s\n\n2 1 0 0 0 1 0 0 1 ../../escape.jpg\n\n' "$work/outside/victim.txt" > "$work/names/sparse0/images.txt"
 : > "$work/names/sparse0/points3D.txt"
 check "3DGS: absolute and ../ image names" 2 '[ ! -e "$work/names/escape.jpg" ]' "" -- \
-  t export --model "$work/names/sparse0" --format gaussian_splatting --images "$work/d" --output "$work/names/out"
+  "$tessera" export --model "$work/names/sparse0" --format gaussian_splatting --images "$work/d" --output "$work/names/out"
 fresh "$work/lock"; rm -f "$work/lock/.tessera.lock"; ln -s "$work/outside/victim.txt" "$work/lock/.tessera.lock"
 check ".tessera.lock a link to another file" "0 2" "" "" -- \
   t map --images "$work/d" --output "$work/lock" --manifest "$work/bin.json"
 check "Slurm --partition with a newline" 2 '! grep -rqs "^touch pwned" "$work/slurm"' "" -- \
-  t slurm --images "$work/d" --output "$work/slurm" --manifest "$work/bin.json" --partition $'debug\ntouch pwned'
+  t slurm --images "$work/d" --output "$work/slurm" --manifest "$work/bin.json" --workers 2 --dry-run --partition $'debug\ntouch pwned'
 check "Slurm --sbatch-arg with a newline" 2 '! grep -rqs "^touch pwned" "$work/slurm2"' "" -- \
-  t slurm --images "$work/d" --output "$work/slurm2" --manifest "$work/bin.json" --sbatch-arg $'--mem=1G\ntouch pwned'
+  t slurm --images "$work/d" --output "$work/slurm2" --manifest "$work/bin.json" --workers 2 --dry-run --sbatch-arg=$'--mem=1G\ntouch pwned'
 
 # --- Silent wrong -----------------------------------------------------------------------
 fresh "$work/cam"; cam_before=$(sha1sum < "$work/cam/sparse/0/cameras.bin")
