@@ -62,7 +62,8 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
 // stops the set: its error is thrown, the earlier outputs stay whole, and what this run
 // wrote is kept in the staging folder until the next run.
 void ExportModel(const Reconstruction& model, size_t index, const MapSettings& settings,
-                 const std::filesystem::path& image_dir, OutputTransaction* outputs) {
+                 const std::filesystem::path& image_dir, const PluginCrashLog& crash_log,
+                 OutputTransaction* outputs, std::vector<std::string>* quarantined) {
   if (settings.exporters == nullptr || settings.exporters->empty()) {
     WriteColmapModel(model, outputs->StageFor("tessera") / "sparse" / std::to_string(index),
                      ColmapModelFormat::kBinary);
@@ -70,9 +71,17 @@ void ExportModel(const Reconstruction& model, size_t index, const MapSettings& s
   }
   for (size_t k = 0; k < settings.exporters->size(); ++k) {
     const PluginInstance<Exporter>& exporter = (*settings.exporters)[k];
+    const std::string subject = "model " + std::to_string(index);
+    if (crash_log.IsQuarantined(exporter.name(), PluginStage::kExport, subject)) {
+      const std::string line = "exporter '" + exporter.name() + "' skipped for " + subject +
+                               ": it crashed twice exporting it (plugin_crashes.tsv)";
+      spdlog::warn("map: {}", line);
+      quarantined->push_back(line);
+      continue;
+    }
     const std::filesystem::path staged = outputs->StageFor(exporter.name(), k);
     try {
-      exporter.Call(PluginStage::kExport, "model " + std::to_string(index), [&](auto& plugin) {
+      exporter.Call(PluginStage::kExport, subject, [&](auto& plugin) {
         plugin.Export(model, {staged, image_dir, static_cast<int>(index)});
       });
     } catch (const PluginError& error) {
@@ -104,7 +113,8 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
   for (size_t index = 0; index < result.models.size(); ++index) {
     if (control.Cancelled()) return false;
     const Reconstruction& model = result.models[index];
-    ExportModel(model, index, settings, image_dir, &outputs);
+    ExportModel(model, index, settings, image_dir, workspace.crash_log(), &outputs,
+                &mapping.quarantined);
     summary->num_registered += model.images.size();
     summary->images_per_model.push_back(model.images.size());
     const MappingSummary::Model& entry = mapping.models[index];
@@ -160,7 +170,7 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
   summary.num_images = input.images.size();
   if (cancelled()) return summary;
   control.Report("map", 0, 1);
-  const BundleAdjusterGuard bundle_adjuster(*settings.bundle_adjuster);
+  const BundleAdjusterGuard bundle_adjuster(*settings.bundle_adjuster, &workspace.crash_log());
   const IncrementalPipeline mapper(settings.mapper, bundle_adjuster, settings.seed);
   MapperObserver observer;
   observer.should_stop = [&control] { return control.Cancelled(); };

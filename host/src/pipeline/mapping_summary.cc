@@ -39,6 +39,7 @@ nlohmann::json MappingSummary::ToJson() const {
   json["view_graph_pairs_dropped"] = view_graph_pairs_dropped;
   json["registrations_refused"] = registrations_refused;
   json["merges"] = merges;
+  json["quarantined"] = quarantined;
   json["seconds"] = seconds;
   json["mapper_options"] = mapper_options;
   json["seed"] = seed;
@@ -82,6 +83,9 @@ MappingSummary MappingSummary::FromJson(const nlohmann::json& json) {
   summary.view_graph_pairs_dropped = json.at("view_graph_pairs_dropped").get<size_t>();
   summary.registrations_refused = json.at("registrations_refused").get<size_t>();
   summary.merges = json.at("merges").get<std::vector<std::string>>();
+  // Absent in summaries written before quarantine covered the map stage.
+  summary.quarantined =
+      json.value("quarantined", nlohmann::json::array()).get<std::vector<std::string>>();
   summary.seconds = json.at("seconds").get<double>();
   summary.mapper_options = json.at("mapper_options");
   summary.seed = json.at("seed").get<uint64_t>();

@@ -53,6 +53,9 @@ struct MappingSummary {
   size_t view_graph_pairs_dropped = 0;
   size_t registrations_refused = 0;
   std::vector<std::string> merges;  // one line per merge, and per pair of models not merged
+  // Plugins skipped for a subject that crashed them twice (PluginCrashLog): "exporter
+  // 'x' skipped for model 0: it crashed twice exporting it".
+  std::vector<std::string> quarantined;
   double seconds = 0;
   nlohmann::json mapper_options = nlohmann::json::object();  // as IncrementalMapperOptions
   uint64_t seed = 0;

@@ -1,9 +1,12 @@
 #include "plugin/bundle_adjuster_guard.h"
 
+#include "tessera/errors.h"
+
 namespace tessera {
 
-BundleAdjusterGuard::BundleAdjusterGuard(const PluginInstance<BundleAdjuster>& plugin)
-    : plugin_(plugin) {
+BundleAdjusterGuard::BundleAdjusterGuard(const PluginInstance<BundleAdjuster>& plugin,
+                                         const PluginCrashLog* crash_log)
+    : plugin_(plugin), crash_log_(crash_log) {
   effective_options_ = plugin_.Provenance()["options"];
 }
 
@@ -21,7 +24,13 @@ std::string BundleAdjusterGuard::Subject(const BundleAdjustmentConfig& config,
 
 BundleAdjustmentSummary BundleAdjusterGuard::Adjust(const BundleAdjustmentConfig& config,
                                                     Reconstruction* reconstruction) const {
-  return plugin_.Call(PluginStage::kAdjust, Subject(config, reconstruction),
+  const std::string subject = Subject(config, reconstruction);
+  if (crash_log_ != nullptr && crash_log_->IsQuarantined(plugin_.name(), PluginStage::kAdjust, subject)) {
+    throw InputError("bundle adjuster '" + plugin_.name() + "' crashed twice on " + subject +
+                     " in this workspace (plugin_crashes.tsv) and is not given it again; "
+                     "choose another pipeline.bundle_adjuster, or fix the plugin");
+  }
+  return plugin_.Call(PluginStage::kAdjust, subject,
                       [&](auto& plugin) { return plugin.Adjust(config, reconstruction); });
 }
 

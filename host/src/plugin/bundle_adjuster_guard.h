@@ -1,5 +1,6 @@
 #pragma once
 
+#include "plugin/plugin_crash_log.h"
 #include "plugin/plugin_registry.h"
 #include "tessera/bundle_adjuster.h"
 
@@ -10,8 +11,11 @@ namespace tessera {
 // names the plugin and the bundle.
 class BundleAdjusterGuard : public BundleAdjuster {
  public:
-  // `plugin` must outlive the guard.
-  explicit BundleAdjusterGuard(const PluginInstance<BundleAdjuster>& plugin);
+  // `plugin` must outlive the guard, and so must `crash_log` when given: a bundle that
+  // crashed the plugin twice in the workspace is then refused (an InputError naming the
+  // plugin and the bundle) instead of being handed to it a third time.
+  explicit BundleAdjusterGuard(const PluginInstance<BundleAdjuster>& plugin,
+                               const PluginCrashLog* crash_log = nullptr);
 
   BundleAdjustmentSummary Adjust(const BundleAdjustmentConfig& config,
                                  Reconstruction* reconstruction) const override;
@@ -22,6 +26,7 @@ class BundleAdjusterGuard : public BundleAdjuster {
 
  private:
   const PluginInstance<BundleAdjuster>& plugin_;
+  const PluginCrashLog* crash_log_;
 };
 
 }  // namespace tessera

@@ -93,20 +93,36 @@ PluginCrashLog PluginCrashLog::Open(const std::filesystem::path& folder, const s
   return log;
 }
 
+namespace {
+
+// What the quarantine of a crash's subject does: skip it where the stage can go on
+// without it, else refuse the plugin on it.
+std::string QuarantineOutcome(const PluginCrash& crash) {
+  if (crash.stage == PluginStageName(PluginStage::kDetect) ||
+      crash.stage == PluginStageName(PluginStage::kMatch) ||
+      crash.stage == PluginStageName(PluginStage::kPrepare)) {
+    return crash.subject + " is skipped from now on";
+  }
+  if (crash.stage == PluginStageName(PluginStage::kExport)) {
+    return "'" + crash.plugin + "' is not run on " + crash.subject + " from now on";
+  }
+  return "'" + crash.plugin + "' is refused on " + crash.subject +
+         " from now on; choose another plugin";
+}
+
+}  // namespace
+
 std::vector<std::string> PluginCrashLog::NewCrashReports() const {
   std::vector<std::string> reports;
   for (const PluginCrash& crash : new_crashes_) {
     std::string report = "the previous run ended in a crash: " + crash.Describe();
-    const bool per_subject = crash.stage == PluginStageName(PluginStage::kDetect) ||
-                             crash.stage == PluginStageName(PluginStage::kMatch);
     size_t count = 0;
     for (const PluginCrash& other : history_) {
       count += other.plugin == crash.plugin && other.stage == crash.stage &&
                other.subject == crash.subject;
     }
-    if (per_subject && count >= kQuarantineCrashes) {
-      report += " (" + std::to_string(count) + " crashes there: " + crash.subject +
-                " is skipped from now on)";
+    if (count >= kQuarantineCrashes) {
+      report += " (" + std::to_string(count) + " crashes there: " + QuarantineOutcome(crash) + ")";
     }
     reports.push_back(report);
   }
