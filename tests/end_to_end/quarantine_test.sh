@@ -1,6 +1,6 @@
 #!/bin/bash
-# Crash quarantine in the map stage (issue 28, item 3), on a 512 px copy of the sample
-# (5 images, ORB): a bundle adjuster that crashes is named (exit 4), reported by the
+# Crash quarantine beyond detectors and matchers (issue 28, item 3), on a 512 px copy of
+# the sample (5 images, ORB): a pair selector or a bundle adjuster that crashes is named (exit 4), reported by the
 # next run, and refused with its name once it has crashed twice on the same bundle
 # (exit 2), the workspace kept; an exporter that crashes twice on a model is skipped for
 # it, with a warning and a line in mapping_summary.json, and the other exporters' set is
@@ -22,7 +22,7 @@ for i in 3 4 5 6 7; do cp "$work/all/$(printf %04d "$i").jpg" "$work/d/"; done
 manifest() {  # manifest FILE BUNDLE_ADJUSTER_JSON EXPORTERS_JSON
   cat > "$1" <<JSON
 {"pipeline": {"detector": {"plugin": "orb", "options": {"max_num_features": 1500}},
-              "pair_selector": {"plugin": "exhaustive"},
+              "pair_selector": ${PAIRS:-{\"plugin\": \"exhaustive\"\}},
               "matcher": {"plugin": "brute_force", "options": {"ratio": 0.8, "cross_check": true}},
               "bundle_adjuster": $2,
               "exporters": $3},
@@ -31,6 +31,8 @@ manifest() {  # manifest FILE BUNDLE_ADJUSTER_JSON EXPORTERS_JSON
 JSON
 }
 manifest "$work/ba.json" '{"plugin": "failing_bundle_adjuster", "options": {"fail": "segv"}}' '[{"plugin": "colmap_binary"}]'
+PAIRS='{"plugin": "failing_pair_selector", "options": {"fail": "segv"}}' \
+  manifest "$work/ps.json" '{"plugin": "ceres"}' '[{"plugin": "colmap_binary"}]'
 manifest "$work/ex.json" '{"plugin": "ceres"}' '[{"plugin": "failing_exporter", "options": {"fail": "segv"}}, {"plugin": "colmap_text"}]'
 tess() {  # tess LOG MANIFEST VERB ARGS...
   local log=$1 file=$2
@@ -59,6 +61,20 @@ grep -q "\[error\] bundle adjuster 'failing_bundle_adjuster' crashed twice on a 
 [ "$(sqlite3 "$work/b/database.db" 'SELECT COUNT(*) FROM two_view_geometries WHERE rows > 0')" -gt 0 ] ||
   fail "the verified matches were lost"
 echo "bundle adjuster: named at each crash, refused by name after two, the matches kept"
+
+# A pair selector that crashes: exit 4 twice, then refused by name; features kept.
+for k in 1 2; do
+  tess "$work/p$k.log" "$work/ps.json" run --images "$work/d" --output "$work/p"
+  code=$?
+  [ "$code" = 4 ] || { cat "$work/p$k.log"; fail "pair selector crash $k: exit $code, expected 4"; }
+done
+tess "$work/p3.log" "$work/ps.json" run --images "$work/d" --output "$work/p"
+code=$?
+[ "$code" = 2 ] || { cat "$work/p3.log"; fail "quarantined pair selector: exit $code, expected 2"; }
+grep -q "\[error\] pipeline.pair_selector: pair selector 'failing_pair_selector' crashed twice selecting pairs among 5 images" "$work/p3.log" ||
+  { cat "$work/p3.log"; fail "quarantined pair selector: message"; }
+[ "$(sqlite3 "$work/p/database.db" 'SELECT COUNT(*) FROM keypoints')" = 5 ] || fail "the features were lost"
+echo "pair selector: named at each crash, refused by name after two, the features kept"
 
 # An exporter that crashes: skipped for the model after two crashes, the rest placed.
 tess "$work/e1.log" "$work/ex.json" run --images "$work/d" --output "$work/e"

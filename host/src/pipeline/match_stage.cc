@@ -100,6 +100,7 @@ constexpr size_t kFeatureCacheBytes = size_t{1} << 30;
 // (min, max). Throws for an index out of range or a self pair: a broken plugin.
 std::vector<ImageIndexPair> SelectPairs(const MatchSettings& settings,
                                         const PairSelectionInput& input,
+                                        const PluginCrashLog& crash_log,
                                         std::vector<SelectorPairs>* per_selector) {
   const size_t n = input.images.size();
   std::vector<ImageIndexPair> united;
@@ -109,8 +110,16 @@ std::vector<ImageIndexPair> SelectPairs(const MatchSettings& settings,
     const auto& selector = pair_selectors[s];
     const std::string& json_path = settings.pair_selector_paths.at(s);
     std::vector<ImageIndexPair> pairs;
+    // Crashed twice on these images: refused by name, the stage cannot go on without it.
+    const std::string subject = std::to_string(n) + " images";
+    if (crash_log.IsQuarantined(selector.name(), PluginStage::kSelectPairs, subject)) {
+      throw InputError(json_path + ": pair selector '" + selector.name() +
+                       "' crashed twice selecting pairs among " + subject +
+                       " in this workspace (plugin_crashes.tsv) and is not run on them again; "
+                       "choose another pair selector, or fix the plugin");
+    }
     try {
-      pairs = selector.Call(PluginStage::kSelectPairs, std::to_string(n) + " images",
+      pairs = selector.Call(PluginStage::kSelectPairs, subject,
                             [&](auto& plugin) { return plugin.SelectPairs(input); });
     } catch (const PluginError& error) {
       if (!error.input_error()) throw;
@@ -240,7 +249,7 @@ MatchPlan PlanMatching(const Workspace& workspace, const MatchSettings& settings
                                              descriptors.dimension);
   input.features = &feature_reader;
 
-  plan.pairs = SelectPairs(settings, input, &plan.pairs_per_selector);
+  plan.pairs = SelectPairs(settings, input, workspace.crash_log(), &plan.pairs_per_selector);
   const std::vector<bool> in_scope =
       scope.pairs ? scope.pairs(plan.pairs, images) : std::vector<bool>(plan.pairs.size(), true);
   // Pairs the source holds with this run's provenance are done; others are redone.
