@@ -426,6 +426,40 @@ TEST(Cli, AnImageFolderInTheOutputsPlaceIsRefusedBeforeAnythingIsWritten) {
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "database.db"));
 }
 
+// -v and -q work after the verb as before it.
+TEST(Cli, VerboseAndQuietAreTakenAfterTheVerb) {
+  testing::TemporaryDir dir;
+  WriteSmallTextModel(dir.path() / "text");
+  const std::string export_command = "export --model " + (dir.path() / "text").string() +
+                                     " --format ply --output " + (dir.path() / "out").string();
+  const auto loud = RunTessera(export_command);
+  ASSERT_EQ(loud.exit_code, 0) << loud.output;
+  EXPECT_NE(loud.output.find("[info] export:"), std::string::npos) << loud.output;
+  const auto quiet = RunTessera(export_command + " -q");
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.output;
+  EXPECT_EQ(quiet.output, "");
+  EXPECT_EQ(RunTessera("plugins -v").exit_code, 0);
+  const auto unknown = RunTessera("plugins --verbosest");
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.output;
+}
+
+// `bench` replaces a row's workspace only when it made it (.tessera_bench): a folder of
+// the user's where a row would go is refused before any row runs, and left as it was.
+TEST(Cli, BenchReplacesOnlyTheWorkspacesItMade) {
+  testing::TemporaryDir dir;
+  const auto theirs = dir.path() / "o" / "default";
+  std::filesystem::create_directories(theirs);
+  std::ofstream(theirs / "notes.txt") << "mine";
+  const std::string manifest = (testing::SourceDir() / "manifests" / "default.json").string();
+  const auto result = RunTessera("bench --images " + dir.path().string() + " --output " +
+                                 (dir.path() / "o").string() + " " + manifest);
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find(theirs.string() + ": exists and was not made by tessera bench"),
+            std::string::npos)
+      << result.output;
+  EXPECT_TRUE(std::filesystem::exists(theirs / "notes.txt"));
+}
+
 // The verbs beside the stages take the same lock: `vocab --workspace`, `merge`, and
 // `export` and `eval` of a model in the workspace (or `export` into it).
 TEST(Cli, EveryVerbThatTouchesAWorkspaceTakesItsLock) {

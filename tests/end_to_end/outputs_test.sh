@@ -87,6 +87,9 @@ fresh "$work/t"
 tess "$work/t.log" "$work/text.json" map --images "$work/d" --output "$work/t" ||
   { cat "$work/t.log"; fail "re-map as text"; }
 [ -f "$work/t/sparse/0/images.txt" ] || fail "no text model"
+grep -q "\[info\] map: exporter 'colmap_text' wrote $work/t/sparse/0$" "$work/t.log" &&
+  grep -q "\[info\] map: exporter 'transforms_json' wrote $work/t/transforms.json$" "$work/t.log" ||
+  { cat "$work/t.log"; fail "the exporters' outputs were not logged"; }
 stale=$(cd "$work/t" && find . -name '*.bin' -o -name '*.ply')
 [ -z "$stale" ] || fail "stale outputs left beside the new ones: $stale"
 echo "binary to text, PLY dropped: no stale output left"

@@ -190,6 +190,35 @@ std::string PairsBySelector(const BenchRow& row) {
   return text;
 }
 
+// A row's workspace is bench's own scratch folder, marked with this file when made: a
+// rerun replaces it whole. A folder without the mark is never deleted.
+constexpr const char* kBenchMark = ".tessera_bench";
+
+// Throws InputError naming `folder` when it exists and bench did not make it (a link,
+// a file, or a folder without the mark that is not empty).
+void CheckBenchWorkspace(const fs::path& folder) {
+  std::error_code error;
+  const fs::file_status status = fs::symlink_status(folder, error);
+  if (status.type() == fs::file_type::not_found) return;
+  const bool made_by_bench = status.type() == fs::file_type::directory &&
+                             fs::symlink_status(folder / kBenchMark, error).type() ==
+                                 fs::file_type::regular;
+  if (made_by_bench) return;
+  if (status.type() == fs::file_type::directory && fs::is_empty(folder, error)) return;
+  throw InputError(folder.string() +
+                   ": exists and was not made by tessera bench (no " + kBenchMark +
+                   "), so it is not replaced; choose another --output or move it away");
+}
+
+// Empties a row's workspace (CheckBenchWorkspace passed) and marks it as bench's.
+void ResetBenchWorkspace(const fs::path& folder) {
+  CheckBenchWorkspace(folder);
+  std::error_code error;
+  fs::remove_all(folder, error);
+  CreateFolder(folder);
+  WriteFileAtomically(folder / kBenchMark, "made by tessera bench; replaced by each bench run\n");
+}
+
 BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_truth,
                      const std::string& manifest_file, const nlohmann::json& manifest,
                      const std::string& name, const std::string& shared_from,
@@ -200,8 +229,7 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
   row.plugins = SlotPlugin(manifest, "detector") + " / " + SlotPlugin(manifest, "pair_selector") +
                 " / " + SlotPlugin(manifest, "matcher") + " / " +
                 SlotPlugin(manifest, "bundle_adjuster");
-  fs::remove_all(workspace);
-  CreateFolder(workspace);
+  ResetBenchWorkspace(workspace);
   if (!shared_from.empty()) {
     fs::copy_file(fs::path(options.output) / shared_from / "database.db",
                   workspace / "database.db");
@@ -257,7 +285,7 @@ BenchRow RunColmap(const BenchOptions& options, const GroundTruth* ground_truth,
   row.name = "colmap";
   row.plugins = "COLMAP 3.8: sift / exhaustive / sift_matcher / mapper";
   row.workspace = workspace.string();
-  fs::remove_all(workspace);
+  ResetBenchWorkspace(workspace);
   CreateFolder(workspace / "sparse");
   setenv("QT_QPA_PLATFORM", "offscreen", 1);
   const std::string database = (workspace / "database.db").string();
@@ -522,6 +550,9 @@ int RunBench(const BenchOptions& options) {
     manifests.push_back(std::move(manifest));
   }
   CreateFolder(options.output);
+  // Every row's folder is checked before the first row runs.
+  for (const std::string& name : names) CheckBenchWorkspace(fs::path(options.output) / name);
+  if (options.with_colmap) CheckBenchWorkspace(fs::path(options.output) / "colmap");
 
   std::vector<BenchRow> rows;
   for (size_t i = 0; i < options.manifests.size(); ++i) {

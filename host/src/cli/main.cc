@@ -21,6 +21,9 @@ int main(int argc, char** argv) {
   GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "Only warnings and errors on stderr");
   app.add_flag("-v,--verbose", global.verbose, "Debug output");
+  // -q and -v are taken after the verb too (`tessera map ... -v`): what a verb does not
+  // know falls through to these.
+  app.fallthrough();
 
   std::vector<CommandRegistration> commands = RegisterCommands(app, global);
 

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <iterator>
 #include <set>
 
 #include "tessera/errors.h"
@@ -321,6 +322,13 @@ OutputTransaction::Result OutputTransaction::Commit() {
   });
   for (const Placement& placement : placements) Place(set, placement);
   result.files_placed = files.size();
+  for (const auto& [relative, writer] : writer_of_file_) {
+    const fs::path path(relative);
+    auto part = path.begin();
+    fs::path entry = *part;
+    if (entry == "sparse" && ++part != path.end() && std::next(part) != path.end()) entry /= *part;
+    result.entries_by_writer[writer].insert((output_ / entry).string());
+  }
   OutputLedger final_ledger = placed;
   if (mode_ == Mode::kWholeSet) {
     result.files_removed = RemoveStale(previous, placed, &result.warnings);

@@ -21,6 +21,7 @@
 
 #include <filesystem>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,9 @@ class OutputTransaction {
     // folder in sparse/, images.bin beside images.txt), and earlier outputs left
     // because they were changed since; each is logged as a warning too.
     std::vector<std::string> warnings;
+    // What each writer placed, as the paths a user opens: OUTPUT/transforms.json,
+    // OUTPUT/gaussian_splatting, OUTPUT/sparse/0 (a model folder in sparse/).
+    std::map<std::string, std::set<std::string>> entries_by_writer;
   };
 
   enum class Mode {

@@ -130,7 +130,13 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
   }
   mapping.seconds = summary->seconds;
   mapping.Write(outputs.StageFor("tessera") / "mapping_summary.json");
-  outputs.Commit();
+  const OutputTransaction::Result placed = outputs.Commit();
+  for (const auto& [writer, entries] : placed.entries_by_writer) {
+    if (writer == "tessera") continue;
+    std::string paths;
+    for (const std::string& entry : entries) paths += (paths.empty() ? "" : ", ") + entry;
+    spdlog::info("map: exporter '{}' wrote {}", writer, paths);
+  }
   return true;
 }
 
