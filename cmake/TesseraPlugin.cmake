@@ -13,6 +13,10 @@ function(tessera_add_plugin name)
     target_link_libraries(${name} PRIVATE Tessera::sdk)
   endif()
   target_link_libraries(${name} PRIVATE ${ARG_LIBRARIES})
+  # Every symbol resolved at link time: a plugin that uses Tessera::io (or any library)
+  # without linking it fails to build, instead of loading only where the host happens to
+  # have the library loaded already.
+  target_link_options(${name} PRIVATE "LINKER:--no-undefined")
   set_target_properties(${name} PROPERTIES PREFIX "lib" CXX_VISIBILITY_PRESET hidden
                                            VISIBILITY_INLINES_HIDDEN ON)
   if(ARG_OUTPUT_DIRECTORY)

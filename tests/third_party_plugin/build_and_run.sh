@@ -22,6 +22,27 @@ cmake -S "$source_dir" -B "$work/build" -DCMAKE_BUILD_TYPE=Release \
       -DCMAKE_PREFIX_PATH="$work/prefix" > "$work/configure.log"
 cmake --build "$work/build" -j2 > "$work/build.log"
 
+# The bundler exporter without `LIBRARIES Tessera::io`: tessera_add_plugin links with
+# --no-undefined, so the build fails naming a missing symbol instead of producing a
+# plugin that loads only where the host has Tessera::io loaded already.
+mkdir -p "$work/unlinked"
+cat > "$work/unlinked/CMakeLists.txt" <<CMAKE
+cmake_minimum_required(VERSION 3.25)
+project(unlinked LANGUAGES CXX)
+find_package(Tessera REQUIRED)
+find_package(OpenCV 4 REQUIRED COMPONENTS core imgcodecs)
+tessera_add_plugin(tessera_exporter_unlinked SOURCES $(cd "$(dirname "$0")" && pwd)/bundler_exporter.cc
+                   LIBRARIES opencv_imgcodecs)
+CMAKE
+cmake -S "$work/unlinked" -B "$work/unlinked/build" -DCMAKE_PREFIX_PATH="$work/prefix" \
+  > "$work/unlinked.log" 2>&1 || { cat "$work/unlinked.log"; exit 1; }
+if cmake --build "$work/unlinked/build" >> "$work/unlinked.log" 2>&1; then
+  echo "a plugin using Tessera::io without linking it built"; exit 1
+fi
+grep -q "undefined reference to .*tessera::" "$work/unlinked.log" ||
+  { cat "$work/unlinked.log"; echo "the failed build does not name the missing symbol"; exit 1; }
+echo "a plugin using Tessera::io without linking it: the build fails naming the symbol"
+
 cat > "$work/manifest.json" <<JSON
 {
   "plugin_paths": ["build/plugins"],
