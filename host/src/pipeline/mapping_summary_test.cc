@@ -29,6 +29,7 @@ MappingSummary Example() {
   summary.seconds = 4.5;
   summary.mapper_options = {{"init_min_num_inliers", 100}};
   summary.seed = 42;
+  summary.quarantined = {"bundle adjuster 'ceres' refused: it crashed twice on this bundle"};
   return summary;
 }
 
@@ -41,7 +42,8 @@ TEST(MappingSummary, JsonKeys) {
   EXPECT_EQ(json.at("unregistered").at(0).at("reason"), "no verified pair");
   EXPECT_EQ(json.at("focal_lengths_estimated").at(0).at("method"), "view graph");
   EXPECT_EQ(json.at("seed").get<uint64_t>(), 42u);
-  EXPECT_EQ(json.size(), 9u);
+  EXPECT_EQ(json.at("quarantined").size(), 1u);
+  EXPECT_EQ(json.size(), 10u);
 }
 
 TEST(MappingSummary, RoundTripThroughAFile) {
@@ -56,6 +58,7 @@ TEST(MappingSummary, RoundTripThroughAFile) {
   EXPECT_EQ(back.focal_lengths_estimated.at(0).camera_id, 1u);
   EXPECT_DOUBLE_EQ(back.focal_lengths_estimated.at(0).estimated, 1150.5);
   EXPECT_EQ(back.merges, summary.merges);
+  EXPECT_EQ(back.quarantined, summary.quarantined);
 }
 
 TEST(MappingSummary, AFileThatIsNoSummaryIsRefusedNamingIt) {
