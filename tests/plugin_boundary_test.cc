@@ -309,6 +309,25 @@ TEST(PluginBoundaryCli, PairSelectorAndMatcherErrorsNameThePluginAndThePair) {
       << matcher.output;
 }
 
+// A match beyond the keypoints was exit 2 (bad input) with a message naming neither the
+// matcher nor the images: it is the matcher's bug, reported as its other failures are.
+TEST(PluginBoundaryCli, AMatcherThatReturnsIndicesBeyondTheKeypointsIsNamedWithThePair) {
+  testing::TemporaryDir dir;
+  WriteImages(dir.path());
+  ASSERT_EQ(RunTessera(Extract(dir.path(), WriteManifest(dir.path(), nlohmann::json::object())))
+                .exit_code,
+            0);
+  const auto result = RunTessera(
+      "match --output " + (dir.path() / "out").string() + " --manifest " +
+      WriteManifest(dir.path(), nlohmann::json::object(), {}, {{"fail", "bad_indices"}}).string());
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_TRUE(Contains(result.output,
+                       "[error] plugin 'failing_matcher' failed while matching images a.png and "
+                       "b.png: it returned match 16 (0, 23), beyond the images' 16 and 16 "
+                       "keypoints\n"))
+      << result.output;
+}
+
 TEST(PluginBoundaryCli, CrashInDetectIsOneLineAndExit4ThenReportedResumedAndQuarantined) {
   testing::TemporaryDir dir;
   WriteImages(dir.path());

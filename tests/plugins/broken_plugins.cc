@@ -50,9 +50,9 @@ struct NotAnException {
 
 // Options shared by the failing plugins: "fail" says how (none, input_error,
 // option_error, runtime_error, custom, non_std, segv, abort, exit: exit(0), quick_exit:
-// quick_exit(0)) and "in" where (call:
-// the kind's main method; factory: the constructor). A detector fails only on images
-// "on_width" pixels wide when that is not 0.
+// quick_exit(0); bad_indices: a matcher returns a match beyond the keypoints) and "in"
+// where (call: the kind's main method; factory: the constructor). A detector fails only
+// on images "on_width" pixels wide when that is not 0.
 struct Failure {
   std::string how;
   std::string where;
@@ -61,7 +61,7 @@ struct Failure {
   explicit Failure(tessera::OptionReader* reader)
       : how(reader->GetString("fail", "none",
                               {"none", "input_error", "option_error", "runtime_error", "custom",
-                               "non_std", "segv", "abort", "exit", "quick_exit"})),
+                               "non_std", "segv", "abort", "exit", "quick_exit", "bad_indices"})),
         where(reader->GetString("in", "call", {"call", "factory"})),
         on_width(reader->Get<int>("on_width", 0, 0, 100000)) {}
 
@@ -125,6 +125,9 @@ class FailingMatcher : public tessera::Matcher {
     tessera::FeatureMatches matches;
     for (Eigen::Index i = 0; i < std::min(descriptors1.size(), descriptors2.size()); ++i) {
       matches.push_back({static_cast<tessera::point2D_t>(i), static_cast<tessera::point2D_t>(i)});
+    }
+    if (failure_.how == "bad_indices") {
+      matches.push_back({0, static_cast<tessera::point2D_t>(descriptors2.size() + 7)});
     }
     return matches;
   }
