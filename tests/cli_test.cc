@@ -474,6 +474,18 @@ TEST(Cli, ThreadsOutsideZeroTo1024AreRefusedByEveryVerb) {
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "o"));
 }
 
+// CLI11's PositiveNumber wrote its upper bound, DBL_MAX, out in 309 digits.
+TEST(Cli, ANumberBelowItsMinimumIsRefusedPlainly) {
+  for (const std::string value : {"-1", "0", "2.5"}) {
+    const auto result = RunTessera("gui --screenshot /nonexistent/s.png --frames " + value);
+    EXPECT_EQ(result.exit_code, 2) << result.output;
+    EXPECT_EQ(result.output.rfind(
+                  "--frames: Value " + value + " is not a whole number of at least 1\n", 0),
+              0u)
+        << result.output;
+  }
+}
+
 // An image folder that is the output folder, or lies where models are replaced, is
 // refused before anything is written: the photos stay as they were, and no lock or
 // database is left among them.
