@@ -276,6 +276,83 @@ TEST(Cli, ExportOfABadModelIsOneLineNamingTheFile) {
       << missing.output;
 }
 
+// Four images at (0,0,0), (1,0,0), (0,1,0) and (0,0,1), looking down z: a text model,
+// and its ground truth as a transforms.json with `centers` in place of those.
+void WriteEvalModel(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "cameras.txt") << "1 SIMPLE_PINHOLE 640 480 500 320 240\n";
+  std::ofstream(dir / "images.txt") << "1 1 0 0 0 0 0 0 1 a.jpg\n\n"
+                                       "2 1 0 0 0 -1 0 0 1 b.jpg\n\n"
+                                       "3 1 0 0 0 0 -1 0 1 c.jpg\n\n"
+                                       "4 1 0 0 0 0 0 -1 1 d.jpg\n\n";
+  std::ofstream(dir / "points3D.txt") << "";
+}
+
+std::filesystem::path WriteEvalGroundTruth(const std::filesystem::path& dir,
+                                           const std::vector<std::string>& names,
+                                           const std::vector<std::array<double, 3>>& centers) {
+  nlohmann::json frames = nlohmann::json::array();
+  for (size_t i = 0; i < names.size(); ++i) {
+    const auto& c = centers[i];
+    frames.push_back({{"file_path", "images/" + names[i]},
+                      {"transform_matrix",
+                       {{1, 0, 0, c[0]}, {0, -1, 0, c[1]}, {0, 0, -1, c[2]}, {0, 0, 0, 1}}}});
+  }
+  const auto file = dir / "transforms.json";
+  std::ofstream(file) << nlohmann::json{{"frames", frames}}.dump();
+  return file;
+}
+
+// Ground truth and models eval cannot judge were scored, mostly as perfect: exit 2 now,
+// with one error line naming the file and the frame.
+TEST(Cli, EvalRefusesGroundTruthAndModelsItCannotJudge) {
+  testing::TemporaryDir dir;
+  const auto model = dir.path() / "model";
+  WriteEvalModel(model);
+  const std::vector<std::string> names = {"a.jpg", "b.jpg", "c.jpg", "d.jpg"};
+  const std::vector<std::array<double, 3>> centers = {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}, {0, 0, 2}};
+  const auto eval = [&](const std::filesystem::path& gt) {
+    return RunTessera("eval " + model.string() + " " + gt.string());
+  };
+  const auto good = eval(WriteEvalGroundTruth(dir.path(), names, centers));
+  ASSERT_EQ(good.exit_code, 0) << good.output;
+  EXPECT_NE(good.output.find("registered: 4/4\nposition error (ground-truth units): mean "),
+            std::string::npos)
+      << good.output;
+
+  const std::string gt = (dir.path() / "transforms.json").string();
+  const auto duplicate =
+      eval(WriteEvalGroundTruth(dir.path(), {"a.jpg", "b.jpg", "c.jpg", "d.jpg", "a.jpg"},
+                                {{0, 0, 0}, {2, 0, 0}, {0, 2, 0}, {0, 0, 2}, {5, 5, 5}}));
+  EXPECT_EQ(duplicate.exit_code, 2) << duplicate.output;
+  EXPECT_EQ(duplicate.output, "[error] " + gt +
+                                  ": frames[4] (images/a.jpg) has the image name a.jpg of "
+                                  "frames[0], so the two cannot be told apart.\n");
+
+  const auto far = eval(
+      WriteEvalGroundTruth(dir.path(), names, {{0, 0, 0}, {1e308, 0, 0}, {0, 2, 0}, {0, 0, 2}}));
+  EXPECT_EQ(far.exit_code, 2) << far.output;
+  EXPECT_EQ(far.output, "[error] " + gt +
+                            ": frames[1] (images/b.jpg): the camera centre (1e+308, 0, 0) lies "
+                            "beyond 1e+100.\n");
+
+  const auto identical =
+      eval(WriteEvalGroundTruth(dir.path(), names, {{1, 1, 1}, {1, 1, 1}, {1, 1, 1}, {1, 1, 1}}));
+  EXPECT_EQ(identical.exit_code, 2) << identical.output;
+  EXPECT_NE(identical.output.find("[error] Cannot score " + model.string() + " against " + gt +
+                                  ": the ground truth places the 4 images in both at only 1 "
+                                  "distinct camera centre; aligning needs at least 3.\n"),
+            std::string::npos)
+      << identical.output;
+
+  std::ofstream(model / "images.txt") << "1 1 0 0 0 0 0 0 1 a.jpg\n\n"
+                                         "2 1 0 0 0 nan 0 0 1 b.jpg\n\n";
+  const auto nan = eval(WriteEvalGroundTruth(dir.path(), names, centers));
+  EXPECT_EQ(nan.exit_code, 2) << nan.output;
+  EXPECT_EQ(nan.output, "[error] " + (model / "images.txt").string() +
+                            " line 3: 'nan' is not a finite translation component.\n");
+}
+
 TEST(Cli, ExportOfAnUnknownFormatSuggestsTheClosest) {
   testing::TemporaryDir dir;
   WriteSmallTextModel(dir.path());
@@ -395,6 +472,18 @@ TEST(Cli, ThreadsOutsideZeroTo1024AreRefusedByEveryVerb) {
     }
   }
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "o"));
+}
+
+// CLI11's PositiveNumber wrote its upper bound, DBL_MAX, out in 309 digits.
+TEST(Cli, ANumberBelowItsMinimumIsRefusedPlainly) {
+  for (const std::string value : {"-1", "0", "2.5"}) {
+    const auto result = RunTessera("gui --screenshot /nonexistent/s.png --frames " + value);
+    EXPECT_EQ(result.exit_code, 2) << result.output;
+    EXPECT_EQ(result.output.rfind(
+                  "--frames: Value " + value + " is not a whole number of at least 1\n", 0),
+              0u)
+        << result.output;
+  }
 }
 
 // An image folder that is the output folder, or lies where models are replaced, is

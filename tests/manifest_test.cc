@@ -178,5 +178,60 @@ TEST(Manifest, BadKFileIsAnInputError) {
   }
 }
 
+// A tenth number was ignored, and "nan" reported as "found 0 numbers".
+TEST(Manifest, KFileOfOtherThanNineFiniteNumbersNamesTheFileAndTheCulprit) {
+  testing::TemporaryDir dir;
+  const auto k_file = dir.path() / "K.txt";
+  const auto error_of = [&](const std::string& contents) {
+    std::ofstream(k_file) << contents;
+    try {
+      ReadCalibrationMatrixFile(k_file);
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error_of("2759.48 0 1520.69\n0 2764.16 1006.81\n0 0 1\n7\n"),
+            k_file.string() + ": expected 9 numbers (a 3x3 matrix), found 10");
+  EXPECT_EQ(error_of("nan 0 1520.69\n0 2764.16 1006.81\n0 0 1\n"),
+            k_file.string() + ": 'nan' is not a finite number (number 1 of the file)");
+  EXPECT_EQ(error_of("2759.48 0 1520.69\n0 inf 1006.81\n0 0 1\n"),
+            k_file.string() + ": 'inf' is not a finite number (number 5 of the file)");
+  EXPECT_EQ(error_of("2759.48 0 1520.69\n0 2764.16 1006.81,\n0 0 1\n"),
+            k_file.string() + ": '1006.81,' is not a finite number (number 6 of the file)");
+  EXPECT_EQ(error_of("2759.48 0 1520.69\n0 2764.16 1006.81\n0 0 1\n"), "no error");
+}
+
+// A second "pipeline" replaced the first, which then read as "pipeline.detector:
+// missing"; any key given twice in one object is refused, named by its path.
+TEST(Manifest, ADuplicateKeyIsRefusedNamingItsPathAndTheFile) {
+  testing::TemporaryDir dir;
+  const auto file = dir.path() / "m.json";
+  const auto error_of = [&](const std::string& text) {
+    std::ofstream(file) << text;
+    try {
+      Manifest::Load(file);
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error_of(R"({"pipeline": {"detector": {"plugin": "sift"}},
+                         "pipeline": {"matcher": {"plugin": "flann"}}})"),
+            file.string() + ": pipeline: the key appears twice in one object; give it once");
+  EXPECT_EQ(error_of(R"({"pipeline": {"exporters": [{"plugin": "ply"},
+                                                    {"plugin": "ply", "plugin": "ply"}]}})"),
+            file.string() +
+                ": pipeline.exporters[1].plugin: the key appears twice in one object; give it "
+                "once");
+  EXPECT_EQ(error_of(R"({"plugin_paths": [[], 1, {"a": 1}], "seed": 1, "camera": {"model":
+                         "PINHOLE", "K": [1, 1, 0, 0], "K": [2, 2, 0, 0]}})"),
+            file.string() + ": camera.K: the key appears twice in one object; give it once");
+  // The same key in different objects is fine.
+  EXPECT_EQ(error_of(R"({"pipeline": {"detector": {"plugin": "sift"},
+                                      "matcher": {"plugin": "flann"}}})"),
+            "no error");
+}
+
 }  // namespace
 }  // namespace tessera

@@ -169,6 +169,21 @@ TEST(PluginBoundary, CrashLogMovesTheLastRunsCrashesIntoTheHistoryAndQuarantines
   SetPluginCrashFile("");
 }
 
+TEST(PluginBoundary, CrashLogCountsAPluginThatEndedTheProcessAsACrash) {
+  testing::TemporaryDir dir;
+  std::ofstream(PluginCrashLog::PendingFile(dir.path()))
+      << "exit\tsift\tdetect\timage b.png\nquick_exit\tsift\tdetect\timage b.png\n"
+         "exited\tsift\tdetect\timage b.png\n";  // not a cause the handlers write
+  const PluginCrashLog log = PluginCrashLog::Open(dir.path());
+  ASSERT_EQ(log.new_crashes().size(), 2u);
+  EXPECT_EQ(log.new_crashes()[0].Describe(),
+            "plugin 'sift' ended the process (exit) while detecting image b.png");
+  EXPECT_EQ(log.new_crashes()[1].Describe(),
+            "plugin 'sift' ended the process (quick_exit) while detecting image b.png");
+  EXPECT_TRUE(log.IsQuarantined("sift", PluginStage::kDetect, ImageSubject("b.png")));
+  SetPluginCrashFile("");
+}
+
 // --- The command line -----------------------------------------------------------------
 
 using testing::CommandResult;
@@ -294,6 +309,25 @@ TEST(PluginBoundaryCli, PairSelectorAndMatcherErrorsNameThePluginAndThePair) {
       << matcher.output;
 }
 
+// A match beyond the keypoints was exit 2 (bad input) with a message naming neither the
+// matcher nor the images: it is the matcher's bug, reported as its other failures are.
+TEST(PluginBoundaryCli, AMatcherThatReturnsIndicesBeyondTheKeypointsIsNamedWithThePair) {
+  testing::TemporaryDir dir;
+  WriteImages(dir.path());
+  ASSERT_EQ(RunTessera(Extract(dir.path(), WriteManifest(dir.path(), nlohmann::json::object())))
+                .exit_code,
+            0);
+  const auto result = RunTessera(
+      "match --output " + (dir.path() / "out").string() + " --manifest " +
+      WriteManifest(dir.path(), nlohmann::json::object(), {}, {{"fail", "bad_indices"}}).string());
+  EXPECT_EQ(result.exit_code, 1) << result.output;
+  EXPECT_TRUE(Contains(result.output,
+                       "[error] plugin 'failing_matcher' failed while matching images a.png and "
+                       "b.png: it returned match 16 (0, 23), beyond the images' 16 and 16 "
+                       "keypoints\n"))
+      << result.output;
+}
+
 TEST(PluginBoundaryCli, CrashInDetectIsOneLineAndExit4ThenReportedResumedAndQuarantined) {
   testing::TemporaryDir dir;
   WriteImages(dir.path());
@@ -384,6 +418,67 @@ TEST(PluginBoundaryCli, AbortInDetectAndCrashInTheFactoryNameThePlugin) {
                        "[error] plugin 'failing_detector' crashed (SIGSEGV) while starting from " +
                            (kFailing / "libtessera_test_failing_detector.so").string() + "\n"))
       << factory.output;
+}
+
+// A plugin that called exit(0) in Detect made `tessera run` exit 0 with nothing done.
+TEST(PluginBoundaryCli, APluginThatEndsTheProcessIsExit4NamingPluginAndStage) {
+  testing::TemporaryDir dir;
+  WriteImages(dir.path());
+  const std::string run = "run --images " + (dir.path() / "images").string() + " --output " +
+                          (dir.path() / "out").string() + " --manifest ";
+  const auto exits =
+      RunTessera(run + WriteManifest(dir.path(), {{"fail", "exit"}, {"on_width", 48}}).string());
+  EXPECT_EQ(exits.exit_code, 4) << exits.output;
+  EXPECT_TRUE(Contains(exits.output,
+                       "[error] plugin 'failing_detector' ended the process (exit) while "
+                       "detecting image b.png\n"))
+      << exits.output;
+  EXPECT_TRUE(Contains(exits.output, "[1/3] a.png: 16 features")) << exits.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "sparse")) << exits.output;
+
+  // Recorded as a crash: the rerun reports it, and the second one quarantines b.png.
+  const auto again = RunTessera(
+      run + WriteManifest(dir.path(), {{"fail", "quick_exit"}, {"on_width", 48}}).string());
+  EXPECT_EQ(again.exit_code, 4) << again.output;
+  EXPECT_TRUE(Contains(again.output,
+                       "the previous run ended in a crash: plugin 'failing_detector' ended the "
+                       "process (exit) while detecting image b.png\n"))
+      << again.output;
+  EXPECT_TRUE(Contains(again.output,
+                       "[error] plugin 'failing_detector' ended the process (quick_exit) while "
+                       "detecting image b.png\n"))
+      << again.output;
+  const auto skipped = RunTessera(
+      Extract(dir.path(), WriteManifest(dir.path(), {{"fail", "exit"}, {"on_width", 48}})));
+  EXPECT_EQ(skipped.exit_code, 0) << skipped.output;
+  EXPECT_TRUE(Contains(skipped.output,
+                       "extract: skipping b.png: it crashed detector 'failing_detector' twice"))
+      << skipped.output;
+
+  // Every stage: a matcher's quick_exit, an exporter's exit.
+  const auto matcher = RunTessera(
+      "match --output " + (dir.path() / "out").string() + " --manifest " +
+      WriteManifest(dir.path(), nlohmann::json::object(), {}, {{"fail", "quick_exit"}}).string());
+  EXPECT_EQ(matcher.exit_code, 4) << matcher.output;
+  EXPECT_TRUE(Contains(matcher.output,
+                       "[error] plugin 'failing_matcher' ended the process (quick_exit) while "
+                       "matching images a.png and b.png\n"))
+      << matcher.output;
+  const auto model = dir.path() / "model";
+  std::filesystem::create_directories(model);
+  std::ofstream(model / "cameras.txt") << "1 SIMPLE_RADIAL 640 480 500 320 240 0.01\n";
+  std::ofstream(model / "images.txt") << "1 1 0 0 0 0 0 0 1 a.jpg\n\n";
+  std::ofstream(model / "points3D.txt") << "";
+  const auto exporter = RunTessera("export --model " + model.string() +
+                                       " --format failing_exporter --options '{\"fail\": "
+                                       "\"exit\"}' --output " +
+                                       (dir.path() / "exported").string(),
+                                   "TESSERA_PLUGIN_PATH=" + kFailing.string());
+  EXPECT_EQ(exporter.exit_code, 4) << exporter.output;
+  EXPECT_TRUE(Contains(exporter.output,
+                       "[error] plugin 'failing_exporter' ended the process (exit) while "
+                       "exporting model 0\n"))
+      << exporter.output;
 }
 
 TEST(PluginBoundaryCli, CrashInMatchNamesThePairAndKeepsTheFeatures) {

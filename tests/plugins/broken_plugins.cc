@@ -1,7 +1,7 @@
 // Deliberately broken plugins, one per way the loader must refuse a plugin, and one
-// plugin of every kind that fails on request (throws every kind of exception, crashes
-// or aborts). Each is compiled into its own folder with one TESSERA_TEST_CASE_* macro
-// defined; see tests/CMakeLists.txt.
+// plugin of every kind that fails on request (throws every kind of exception, crashes,
+// aborts or ends the process). Each is compiled into its own folder with one
+// TESSERA_TEST_CASE_* macro defined; see tests/CMakeLists.txt.
 
 #include <algorithm>
 #include <cstdint>
@@ -49,9 +49,10 @@ struct NotAnException {
 }
 
 // Options shared by the failing plugins: "fail" says how (none, input_error,
-// option_error, runtime_error, custom, non_std, segv, abort) and "in" where (call:
-// the kind's main method; factory: the constructor). A detector fails only on images
-// "on_width" pixels wide when that is not 0.
+// option_error, runtime_error, custom, non_std, segv, abort, exit: exit(0), quick_exit:
+// quick_exit(0); bad_indices: a matcher returns a match beyond the keypoints) and "in"
+// where (call: the kind's main method; factory: the constructor). A detector fails only
+// on images "on_width" pixels wide when that is not 0.
 struct Failure {
   std::string how;
   std::string where;
@@ -60,7 +61,7 @@ struct Failure {
   explicit Failure(tessera::OptionReader* reader)
       : how(reader->GetString("fail", "none",
                               {"none", "input_error", "option_error", "runtime_error", "custom",
-                               "non_std", "segv", "abort"})),
+                               "non_std", "segv", "abort", "exit", "quick_exit", "bad_indices"})),
         where(reader->GetString("in", "call", {"call", "factory"})),
         on_width(reader->Get<int>("on_width", 0, 0, 100000)) {}
 
@@ -73,6 +74,8 @@ struct Failure {
     if (how == "non_std") throw NotAnException();
     if (how == "segv") Crash();
     if (how == "abort") std::abort();
+    if (how == "exit") std::exit(0);
+    if (how == "quick_exit") std::quick_exit(0);
   }
 };
 
@@ -122,6 +125,9 @@ class FailingMatcher : public tessera::Matcher {
     tessera::FeatureMatches matches;
     for (Eigen::Index i = 0; i < std::min(descriptors1.size(), descriptors2.size()); ++i) {
       matches.push_back({static_cast<tessera::point2D_t>(i), static_cast<tessera::point2D_t>(i)});
+    }
+    if (failure_.how == "bad_indices") {
+      matches.push_back({0, static_cast<tessera::point2D_t>(descriptors2.size() + 7)});
     }
     return matches;
   }

@@ -20,6 +20,11 @@ struct CommandRegistration {
 
 std::vector<CommandRegistration> RegisterCommands(CLI::App& app, const GlobalOptions& global);
 
+// A whole number of at least `minimum`, refused plainly ("--frames: Value -1 is not a
+// whole number of at least 1"): CLI11's PositiveNumber and NonNegativeNumber write their
+// upper bound, DBL_MAX, out in full.
+CLI::Validator AtLeast(int64_t minimum);
+
 // One registration function per verb, each in its own file.
 CommandRegistration RegisterPluginsCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions& global);

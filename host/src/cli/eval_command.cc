@@ -36,7 +36,7 @@ CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions&) {
     const auto workspaces = HoldEnclosingWorkspaces({options->model});
     const Reconstruction model = ReadColmapModel(options->model);
     const auto ground_truth = ReadGroundTruth(options->ground_truth);
-    const EvaluationResult result = EvaluateReconstruction(model, ground_truth);
+    const EvaluationResult result = EvaluateReconstruction(model, ground_truth, options->model);
     if (options->json) {
       std::cout << result.ToJson().dump(2) << std::endl;
     } else {

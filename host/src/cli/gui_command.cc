@@ -28,7 +28,7 @@ CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions&) {
                   "Write a PNG of the window (after the run, given --images and --output; or "
                   "of --model) and exit");
   sub->add_option("--frames", options->frames, "Frames drawn before the screenshot (at least 2)")
-      ->check(CLI::PositiveNumber);
+      ->check(AtLeast(1));
   sub->add_option("--width", options->width, "Window width")->check(CLI::Range(200, 8192));
   sub->add_option("--height", options->height, "Window height")->check(CLI::Range(200, 8192));
   sub->add_flag("--view-only", options->view_only, "Only the 3D view, without the panels");

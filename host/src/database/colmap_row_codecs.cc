@@ -26,10 +26,15 @@ Camera CameraFromRow(const SqliteStatement::Use& row) {
   const std::string what = "camera " + std::to_string(camera.camera_id);
   const int64_t model = row.ColumnInt64(1);
   if (!ExistsCameraModelWithId(static_cast<int>(model))) {
+    // The list comes from the model registry, so that it names every model there is.
+    std::string known;
+    for (const CameraModelId id : AllCameraModelIds()) {
+      known += (known.empty() ? "" : ", ") + std::to_string(static_cast<int>(id)) + " " +
+               CameraModelIdToName(id);
+    }
     throw InputError("Database '" + row.path().string() + "': " + what + " has camera model id " +
-                     std::to_string(model) +
-                     ", which Tessera does not support (it knows SIMPLE_PINHOLE, PINHOLE, "
-                     "SIMPLE_RADIAL, RADIAL and OPENCV).");
+                     std::to_string(model) + ", which Tessera does not support (it knows " + known +
+                     ").");
   }
   camera.model_id = static_cast<CameraModelId>(model);
   camera.width = static_cast<size_t>(row.ColumnInt64(2));

@@ -94,6 +94,13 @@ TEST_F(DatabaseTest, UnknownCameraModelIsAnInputError) {
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find("camera 1 has camera model id 10"), std::string::npos)
         << error.what();
+    // Every model Tessera knows, the fisheye ones among them (they were left out).
+    EXPECT_NE(std::string(error.what())
+                  .find(", which Tessera does not support (it knows 0 SIMPLE_PINHOLE, 1 PINHOLE, "
+                        "2 SIMPLE_RADIAL, 3 RADIAL, 4 OPENCV, 5 OPENCV_FISHEYE, 8 "
+                        "SIMPLE_RADIAL_FISHEYE)."),
+              std::string::npos)
+        << error.what();
   }
 }
 

@@ -13,6 +13,36 @@ namespace {
 
 constexpr size_t kMinNumAlignedImages = 3;
 
+// Distinct centres among `centers`, counted up to `enough`. Centres closer than 1e-12 of
+// the largest coordinate are one, as rounding could have made them: an alignment to
+// points that coincide is no alignment (every centre maps to their mean: a "perfect" 0).
+size_t NumDistinctCenters(const std::vector<Eigen::Vector3d>& centers, size_t enough) {
+  double magnitude = 0;
+  for (const Eigen::Vector3d& center : centers) {
+    magnitude = std::max(magnitude, center.cwiseAbs().maxCoeff());
+  }
+  const double tolerance = 1e-12 * magnitude;
+  std::vector<Eigen::Vector3d> distinct;
+  for (const Eigen::Vector3d& center : centers) {
+    if (distinct.size() == enough) break;
+    const bool seen = std::any_of(distinct.begin(), distinct.end(), [&](const auto& other) {
+      return (other - center).norm() <= tolerance;
+    });
+    if (!seen) distinct.push_back(center);
+  }
+  return distinct.size();
+}
+
+// Why `centers` (of the images both hold) cannot anchor an alignment; "" when they can.
+std::string DegenerateCentersError(const std::vector<Eigen::Vector3d>& centers,
+                                   const std::string& whose) {
+  const size_t num_distinct = NumDistinctCenters(centers, kMinNumAlignedImages);
+  if (num_distinct >= kMinNumAlignedImages) return "";
+  return whose + " places the " + std::to_string(centers.size()) + " images in both at only " +
+         std::to_string(num_distinct) + " distinct camera centre" + (num_distinct == 1 ? "" : "s") +
+         "; aligning needs at least " + std::to_string(kMinNumAlignedImages);
+}
+
 double Mean(const std::vector<double>& values) {
   return std::accumulate(values.begin(), values.end(), 0.0) / static_cast<double>(values.size());
 }
@@ -52,11 +82,12 @@ std::string FormatNumber(double value, const char* format) {
 
 }  // namespace
 
-EvaluationResult EvaluateReconstruction(
-    const Reconstruction& model, const std::map<std::string, GroundTruthPose>& ground_truth) {
+EvaluationResult EvaluateReconstruction(const Reconstruction& model,
+                                        const std::map<std::string, GroundTruthPose>& ground_truth,
+                                        const std::filesystem::path& model_dir) {
   EvaluationResult result;
   AddModelStatistics(model, &result);
-  const std::map<std::string, GroundTruthPose> estimated = PosesByBasename(model);
+  const std::map<std::string, GroundTruthPose> estimated = PosesByBasename(model, model_dir);
 
   std::vector<std::string> names;
   std::vector<Eigen::Vector3d> centers_model, centers_gt;
@@ -79,6 +110,11 @@ EvaluationResult EvaluateReconstruction(
                    " images of the model are in the ground truth; aligning needs at least " +
                    std::to_string(kMinNumAlignedImages);
     return result;
+  }
+  for (const auto& [centers, whose] :
+       {std::pair(&centers_gt, "the ground truth"), std::pair(&centers_model, "the model")}) {
+    result.error = DegenerateCentersError(*centers, whose);
+    if (!result.error.empty()) return result;
   }
 
   result.gt_from_model = EstimateSimilarity(centers_model, centers_gt);

@@ -5,6 +5,7 @@
 // follow /work/shared/anchors/eval_gt.py, the independent reference.
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -32,8 +33,9 @@ struct EvaluationResult {
   std::vector<ImageEvaluation> images;
   size_t num_registered = 0;  // ground-truth images registered in the model
   size_t num_total = 0;       // ground-truth images
-  // False (with `error` saying why) when fewer than 3 images could be aligned; the
-  // error figures are then NaN.
+  // False (with `error` saying why) when fewer than 3 images could be aligned, or the
+  // ground truth or the model places them at fewer than 3 distinct centres; the error
+  // figures are then NaN.
   bool aligned = false;
   std::string error;
   Similarity3d gt_from_model;  // the alignment
@@ -66,7 +68,10 @@ struct EvaluationResult {
   std::string ToTable() const;
 };
 
+// Throws InputError as PosesByBasename does for the model; `model_dir`, when given,
+// starts those messages.
 EvaluationResult EvaluateReconstruction(const Reconstruction& model,
-                                        const std::map<std::string, GroundTruthPose>& ground_truth);
+                                        const std::map<std::string, GroundTruthPose>& ground_truth,
+                                        const std::filesystem::path& model_dir = {});
 
 }  // namespace tessera

@@ -247,6 +247,65 @@ TEST(EvaluateReconstruction, FewerThanThreeImagesCannotBeAligned) {
   EXPECT_FALSE(result.ToJson().contains("pos_mean"));
 }
 
+// All ground-truth centres at one point once scored a perfect 0 (every model centre
+// aligned onto their mean); two points are no better.
+TEST(EvaluateReconstruction, CentresThatCoincideCannotBeAligned) {
+  const auto ring = RingGroundTruth(5);
+  const Reconstruction model = ModelFromGroundTruth(ring, KnownSimilarity());
+  for (const size_t num_places : {1u, 2u}) {
+    auto ground_truth = ring;
+    size_t i = 0;
+    for (auto& [name, pose] : ground_truth) {
+      pose.center_in_world = Eigen::Vector3d(1, 2, 3) + 1e-14 * Eigen::Vector3d::Random() +
+                             Eigen::Vector3d::UnitX() * static_cast<double>(i++ % num_places);
+    }
+    const EvaluationResult result = EvaluateReconstruction(model, ground_truth);
+    EXPECT_FALSE(result.aligned);
+    EXPECT_EQ(result.error, "the ground truth places the 5 images in both at only " +
+                                std::to_string(num_places) + " distinct camera centre" +
+                                (num_places == 1 ? "" : "s") + "; aligning needs at least 3");
+    EXPECT_TRUE(std::isnan(result.position_error_mean));
+  }
+  auto all_at_origin = ring;
+  for (auto& [name, pose] : all_at_origin) pose.center_in_world.setZero();
+  const EvaluationResult result =
+      EvaluateReconstruction(ModelFromGroundTruth(all_at_origin, Similarity3d()), ring);
+  EXPECT_FALSE(result.aligned);
+  EXPECT_EQ(result.error,
+            "the model places the 5 images in both at only 1 distinct camera centre; aligning "
+            "needs at least 3");
+}
+
+// A translation of 1e308 gave an infinite centre, and the alignment NaN figures.
+TEST(EvaluateReconstruction, ModelCentresThatAreNotFiniteAreRefusedNamingTheImage) {
+  const auto ground_truth = RingGroundTruth(4);
+  Reconstruction model = ModelFromGroundTruth(ground_truth, KnownSimilarity());
+  // Turned 45 degrees about z, the centre's x is -(1.7e308 + 1.7e308) / sqrt(2): infinite.
+  model.images.at(2).cam_from_world.rotation =
+      Eigen::AngleAxisd(M_PI / 4, Eigen::Vector3d::UnitZ());
+  model.images.at(2).cam_from_world.translation = Eigen::Vector3d(1.7e308, 1.7e308, 0);
+  try {
+    EvaluateReconstruction(model, ground_truth, "/data/model");
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    const std::string text = error.what();
+    EXPECT_EQ(text.rfind("/data/model: image 2 (images/0001.jpg): the camera centre (", 0), 0u)
+        << text;
+    EXPECT_NE(text.find(") is not finite."), std::string::npos) << text;
+  }
+  model.images.at(2).cam_from_world.translation = Eigen::Vector3d(0, 0, 1e200);
+  try {
+    EvaluateReconstruction(model, ground_truth);
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find("image 2 (images/0001.jpg): the camera centre ("),
+              std::string::npos)
+        << error.what();
+    EXPECT_NE(std::string(error.what()).find(") lies beyond 1e+100."), std::string::npos)
+        << error.what();
+  }
+}
+
 // Keypoints placed 3 px right and 4 px down of the exact projections: every
 // reprojection error is 5 px; a point behind a camera is left out and counted.
 TEST(EvaluateReconstruction, ReprojectionErrorFromPointsAndCameras) {
@@ -327,6 +386,91 @@ TEST(ReadGroundTruth, UnrecognisedPathThrows) {
               (dir.path() / "bad.json").string() +
                   ": frames[0].transform_matrix is not a 4x4 matrix of numbers.");
   }
+}
+
+// A transforms.json of frames a.jpg, b.jpg and c.jpg at distinct centres, with the
+// camera-to-world matrix of frame `odd_frame` replaced by `odd_matrix` when given.
+fs::path WriteTransformsJson(const fs::path& dir, const nlohmann::json& file_paths,
+                             size_t odd_frame = 0, const nlohmann::json& odd_matrix = nullptr) {
+  nlohmann::json frames = nlohmann::json::array();
+  for (size_t i = 0; i < file_paths.size(); ++i) {
+    nlohmann::json matrix = {{1, 0, 0, static_cast<double>(i)},
+                             {0, -1, 0, static_cast<double>(i * i)},
+                             {0, 0, -1, 1},
+                             {0, 0, 0, 1}};
+    if (i == odd_frame && !odd_matrix.is_null()) matrix = odd_matrix;
+    frames.push_back({{"file_path", file_paths[i]}, {"transform_matrix", matrix}});
+  }
+  const fs::path file = dir / "transforms.json";
+  std::ofstream(file) << nlohmann::json{{"frames", frames}}.dump();
+  return file;
+}
+
+std::string GroundTruthError(const fs::path& path) {
+  try {
+    ReadGroundTruth(path);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "no error";
+}
+
+// Each was read once, and scored: a later frame replaced an earlier one of the same
+// name; a zero matrix, a reflection or a scaled rotation gave rotation errors that mean
+// nothing; a centre at 1e308 overflowed the alignment into NaN.
+TEST(ReadGroundTruth, FramesThatCannotBeJudgedAreRefusedNamingFileAndFrame) {
+  TemporaryDir dir;
+  const nlohmann::json names = {"images/a.jpg", "images/b.jpg", "images/c.jpg"};
+  const std::string file = (dir.path() / "transforms.json").string();
+  EXPECT_EQ(ReadGroundTruth(WriteTransformsJson(dir.path(), names)).size(), 3u);
+  EXPECT_EQ(GroundTruthError(
+                WriteTransformsJson(dir.path(), {"images/a.jpg", "images/b.jpg", "other/a.jpg"})),
+            file +
+                ": frames[2] (other/a.jpg) has the image name a.jpg of frames[0], so the two "
+                "cannot be told apart.");
+  const nlohmann::json zero = {{0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 0}, {0, 0, 0, 1}};
+  EXPECT_EQ(GroundTruthError(WriteTransformsJson(dir.path(), names, 1, zero)),
+            file +
+                ": frames[1] (images/b.jpg): the rotation is not a rotation matrix (R^T R is "
+                "off the identity by 1, det R = 0; tolerance 0.001).");
+  const nlohmann::json mirror = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, -1, 0}, {0, 0, 0, 1}};
+  EXPECT_EQ(GroundTruthError(WriteTransformsJson(dir.path(), names, 2, mirror)),
+            file +
+                ": frames[2] (images/c.jpg): the rotation is not a rotation matrix (R^T R is "
+                "off the identity by 0, det R = -1; tolerance 0.001).");
+  const nlohmann::json scaled = {{2, 0, 0, 0}, {0, -2, 0, 0}, {0, 0, -2, 0}, {0, 0, 0, 1}};
+  EXPECT_EQ(GroundTruthError(WriteTransformsJson(dir.path(), names, 0, scaled)),
+            file +
+                ": frames[0] (images/a.jpg): the rotation is not a rotation matrix (R^T R is "
+                "off the identity by 3, det R = 8; tolerance 0.001).");
+  const nlohmann::json far = {{1, 0, 0, 1e308}, {0, -1, 0, 0}, {0, 0, -1, 0}, {0, 0, 0, 1}};
+  EXPECT_EQ(GroundTruthError(WriteTransformsJson(dir.path(), names, 0, far)),
+            file +
+                ": frames[0] (images/a.jpg): the camera centre (1e+308, 0, 0) lies beyond "
+                "1e+100.");
+  const nlohmann::json huge = {
+      {1e308, 1e308, 0, 0}, {-1e308, 1e308, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}};
+  EXPECT_NE(GroundTruthError(WriteTransformsJson(dir.path(), names, 0, huge))
+                .find(": frames[0] (images/a.jpg): the rotation is not a rotation matrix (R^T R "
+                      "is off the identity by inf"),
+            std::string::npos);
+
+  // Strecha files: NaN is no number, and the rotation is checked as well.
+  const fs::path strecha = dir.path() / "strecha";
+  std::map<std::string, GroundTruthPose> poses = RingGroundTruth(3);
+  WriteStrechaCameras(poses, strecha);
+  EXPECT_EQ(ReadGroundTruth(strecha).size(), 3u);
+  std::ofstream(strecha / "0001.jpg.camera") << "1000 0 500\n0 1000 400\n0 0 1\n0 0 0\n"
+                                                "1 0 0\n0 1 0\n0 0 1\nnan 0 0\n1000 800\n";
+  EXPECT_EQ(GroundTruthError(strecha),
+            (strecha / "0001.jpg.camera").string() +
+                ": 'nan' is not a finite number (number 22 of the file).");
+  poses.at("0001.jpg").R_cam_from_world.setZero();
+  WriteStrechaCameras(poses, strecha);
+  EXPECT_EQ(GroundTruthError(strecha),
+            (strecha / "0001.jpg.camera").string() +
+                ": the rotation is not a rotation matrix (R^T R is off the identity by 1, det R "
+                "= 0; tolerance 0.001).");
 }
 
 TEST(ReadGroundTruth, StrechaCamerasOfFountain) {

@@ -19,7 +19,10 @@ struct GroundTruthPose {
 
 // Poses by image basename ("0001.jpg"). `path` is a folder of Strecha `*.camera` files,
 // an instant-ngp/nerfstudio `transforms.json` (or a folder holding one), or a COLMAP
-// model folder. Throws InputError when the path is none of these or a file is malformed.
+// model folder. Throws InputError, naming the file and frame, when the path is none of
+// these, a file is malformed, two frames share an image name, or a pose cannot be judged
+// by: numbers that are not finite, a matrix that is not a rotation, or a centre beyond
+// 1e100.
 std::map<std::string, GroundTruthPose> ReadGroundTruth(const std::filesystem::path& path);
 
 // The readers behind ReadGroundTruth.
@@ -31,7 +34,9 @@ std::map<std::string, GroundTruthPose> ReadStrechaCameras(const std::filesystem:
 std::map<std::string, GroundTruthPose> ReadTransformsJson(const std::filesystem::path& file);
 
 // Poses of the registered images of a model, by basename. Throws InputError when two
-// registered images share a basename, since they could not be told apart.
-std::map<std::string, GroundTruthPose> PosesByBasename(const Reconstruction& reconstruction);
+// registered images share a basename, since they could not be told apart, or a centre
+// is not finite or beyond 1e100; messages start with `model_dir` when it is given.
+std::map<std::string, GroundTruthPose> PosesByBasename(const Reconstruction& reconstruction,
+                                                       const std::filesystem::path& model_dir = {});
 
 }  // namespace tessera

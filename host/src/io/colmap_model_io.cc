@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <iterator>
 #include <locale>
@@ -38,6 +39,10 @@ Eigen::Vector4d NormalizeQvec(const Eigen::Vector4d& qvec) {
   return qvec / norm;
 }
 
+// A quaternion NormalizeQvec would turn into the identity, as COLMAP does: no rotation,
+// so a reader refuses it rather than guess.
+bool IsZeroQvec(const Eigen::Vector4d& qvec) { return qvec.norm() == 0; }
+
 Eigen::Quaterniond QuaternionFromQvec(const Eigen::Vector4d& qvec) {
   const Eigen::Vector4d normalized = NormalizeQvec(qvec);
   return Eigen::Quaterniond(normalized(0), normalized(1), normalized(2), normalized(3));
@@ -69,6 +74,13 @@ class BinaryReader {
     pos_ += sizeof(T);
     T value;
     std::memcpy(&value, &bits, sizeof(T));
+    if constexpr (std::is_floating_point_v<T>) {
+      // NaN or infinity would flow into every figure and into exports (as JSON null).
+      if (!std::isfinite(value)) {
+        pos_ -= sizeof(T);
+        Fail(what + ": " + std::to_string(value) + " is not a finite number");
+      }
+    }
     return value;
   }
 
@@ -146,6 +158,7 @@ void ReadImagesBinary(const fs::path& path, Reconstruction* reconstruction,
     const std::string what = "image " + std::to_string(image.image_id);
     Eigen::Vector4d qvec;
     for (int k = 0; k < 4; ++k) qvec(k) = reader.Read<double>("the rotation of " + what);
+    if (IsZeroQvec(qvec)) reader.Fail("the rotation of " + what + " has length 0");
     image.cam_from_world.rotation = QuaternionFromQvec(qvec);
     for (int k = 0; k < 3; ++k) {
       image.cam_from_world.translation(k) = reader.Read<double>("the translation of " + what);
@@ -236,6 +249,10 @@ class TextLine {
     if (error != std::errc() || end != field.data() + field.size()) {
       Fail("'" + std::string(field) + "' is not a valid " + what);
     }
+    if constexpr (std::is_floating_point_v<T>) {
+      // from_chars reads "nan" and "inf"; a model holds finite numbers only.
+      if (!std::isfinite(value)) Fail("'" + std::string(field) + "' is not a finite " + what);
+    }
     return value;
   }
 
@@ -322,6 +339,9 @@ void ReadImagesText(const fs::path& path, Reconstruction* reconstruction,
     image.image_id = line.Parse<image_t>(0, "image id");
     Eigen::Vector4d qvec;
     for (int k = 0; k < 4; ++k) qvec(k) = line.Parse<double>(1 + k, "quaternion component");
+    if (IsZeroQvec(qvec)) {
+      line.Fail("the rotation of image " + std::to_string(image.image_id) + " has length 0");
+    }
     image.cam_from_world.rotation = QuaternionFromQvec(qvec);
     for (int k = 0; k < 3; ++k) {
       image.cam_from_world.translation(k) = line.Parse<double>(5 + k, "translation component");

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <random>
 
 #include "tessera/errors.h"
@@ -431,6 +432,91 @@ TEST(ColmapModelIo, MalformedTextNamesFileLineAndField) {
                  " line 1: the colour channel 300 is over 255.");
   expect_message("points3D.txt", "5 1 2 3 0 0 0 0.5 1 99\n",
                  ": the track of 3D point 5 refers to 2D point 99 of image 1, which has only 6.");
+}
+
+// NaN and infinity used to be read, and the transforms_json exporter then wrote them as
+// null; a quaternion of length 0 was read as the identity.
+TEST(ColmapModelIo, NonFiniteNumbersAndZeroRotationsAreRefusedNamingFileLineAndField) {
+  TemporaryDir dir;
+  WriteColmapModel(SyntheticReconstruction(), dir.path(), ColmapModelFormat::kText);
+  const auto expect_message = [&](const std::string& file, const std::string& contents,
+                                  const std::string& message) {
+    const std::string original = ReadBytes(dir.path() / file);
+    WriteBytes(dir.path() / file, contents);
+    try {
+      ReadColmapModel(dir.path());
+      ADD_FAILURE() << "expected InputError: " << message;
+    } catch (const InputError& error) {
+      EXPECT_EQ(std::string(error.what()), (dir.path() / file).string() + message);
+    }
+    WriteBytes(dir.path() / file, original);
+  };
+  expect_message("cameras.txt", "1 PINHOLE 10 10 1 nan 3 4\n",
+                 " line 1: 'nan' is not a finite camera parameter.");
+  expect_message("images.txt", "1 1 0 0 0 0 inf 0 3 a.jpg\n\n",
+                 " line 1: 'inf' is not a finite translation component.");
+  expect_message("images.txt", "1 1 0 0 0 0 0 0 3 a.jpg\n1 -NaN -1\n",
+                 " line 2: '-NaN' is not a finite 2D point y.");
+  expect_message("images.txt", "7 0 0 0 0 0 0 0 3 a.jpg\n\n",
+                 " line 1: the rotation of image 7 has length 0.");
+  expect_message("points3D.txt", "5 1 nan 3 0 0 0 0.5\n",
+                 " line 1: 'nan' is not a finite coordinate.");
+  expect_message("points3D.txt", "5 1 2 3 0 0 0 INFINITY\n",
+                 " line 1: 'INFINITY' is not a finite error.");
+}
+
+TEST(ColmapModelIo, NonFiniteNumbersAndZeroRotationsAreRefusedNamingBinaryRecordAndField) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const double inf = std::numeric_limits<double>::infinity();
+  const auto expect_message = [](const Reconstruction& reconstruction, const std::string& file,
+                                 const std::string& message) {
+    TemporaryDir dir;
+    WriteColmapModel(reconstruction, dir.path(), ColmapModelFormat::kBinary);
+    try {
+      ReadColmapModel(dir.path());
+      ADD_FAILURE() << "expected InputError: " << message;
+    } catch (const InputError& error) {
+      const std::string text = error.what();
+      EXPECT_EQ(text.rfind((dir.path() / file).string() + " is truncated or malformed at byte ", 0),
+                0u)
+          << text;
+      EXPECT_NE(text.find(message), std::string::npos) << text;
+    }
+  };
+  Reconstruction camera = SyntheticReconstruction();
+  camera.cameras.at(5).params[1] = nan;
+  expect_message(camera, "cameras.bin",
+                 ": the parameters of camera 5: nan is not a finite number.");
+  Reconstruction translation = SyntheticReconstruction();
+  translation.images.at(2).cam_from_world.translation.y() = -inf;
+  expect_message(translation, "images.bin",
+                 ": the translation of image 2: -inf is not a finite number.");
+  Reconstruction point2D = SyntheticReconstruction();
+  point2D.images.at(3).points2D.at(1).xy.x() = nan;
+  expect_message(point2D, "images.bin", ": a 2D point of image 3: nan is not a finite number.");
+  // The writer normalizes a zero quaternion to the identity, so the bytes are changed:
+  // the first record's rotation follows the count (8 bytes) and the image id (4).
+  TemporaryDir zero;
+  WriteColmapModel(SyntheticReconstruction(), zero.path(), ColmapModelFormat::kBinary);
+  std::string images = ReadBytes(zero.path() / "images.bin");
+  std::fill(images.begin() + 12, images.begin() + 12 + 4 * 8, '\0');
+  WriteBytes(zero.path() / "images.bin", images);
+  try {
+    ReadColmapModel(zero.path());
+    ADD_FAILURE() << "a zero quaternion was accepted";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              (zero.path() / "images.bin").string() +
+                  " is truncated or malformed at byte 44: the rotation of image 1 has length 0.");
+  }
+  Reconstruction point3D = SyntheticReconstruction();
+  point3D.points3D.at(20).xyz.z() = inf;
+  expect_message(point3D, "points3D.bin",
+                 ": the position of 3D point 20: inf is not a finite number.");
+  Reconstruction error = SyntheticReconstruction();
+  error.points3D.at(1000).error = nan;
+  expect_message(error, "points3D.bin",
+                 ": the error of 3D point 1000: nan is not a finite number.");
 }
 
 // --- COLMAP's own files -----------------------------------------------------------

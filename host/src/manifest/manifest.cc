@@ -1,8 +1,11 @@
 #include "manifest/manifest.h"
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <fstream>
 #include <iterator>
+#include <set>
 #include <sstream>
 #include <thread>
 
@@ -125,6 +128,56 @@ CameraSettings ParseCamera(const nlohmann::json& json, const std::filesystem::pa
   return camera;
 }
 
+// Refuses a key given twice in one object, which JSON parsers resolve silently (the last
+// wins: a second "pipeline" would drop the first's slots). Throws InputError naming the
+// key's JSON path and `file`.
+class DuplicateKeyCheck {
+ public:
+  explicit DuplicateKeyCheck(const std::filesystem::path& file) : file_(file) {}
+
+  bool operator()(int, nlohmann::json::parse_event_t event, nlohmann::json& parsed) {
+    using Event = nlohmann::json::parse_event_t;
+    if (event == Event::object_start || event == Event::array_start) {
+      frames_.push_back({event == Event::array_start, {}, "", 0});
+    } else if (event == Event::key) {
+      Frame& frame = frames_.back();
+      frame.key = parsed.get<std::string>();
+      if (!frame.keys.insert(frame.key).second) {
+        throw InputError(file_.string() + ": " + Path() +
+                         ": the key appears twice in one object; give it once");
+      }
+    } else if (event == Event::value || event == Event::object_end || event == Event::array_end) {
+      if (event != Event::value) frames_.pop_back();
+      if (!frames_.empty() && frames_.back().is_array) ++frames_.back().index;
+    }
+    return true;
+  }
+
+ private:
+  struct Frame {
+    bool is_array;
+    std::set<std::string> keys;  // an object's keys so far
+    std::string key;             // an object's current key
+    size_t index;                // an array's current element
+  };
+
+  // "pipeline.exporters[1].plugin": the path of the current key.
+  std::string Path() const {
+    std::string path;
+    for (const Frame& frame : frames_) {
+      if (frame.is_array) {
+        path += "[" + std::to_string(frame.index) + "]";
+      } else {
+        path += (path.empty() ? "" : ".") + frame.key;
+      }
+    }
+    return path;
+  }
+
+  std::filesystem::path file_;
+  std::vector<Frame> frames_;
+};
+
 VerificationSettings ParseVerification(const nlohmann::json& json) {
   OptionReader reader(json, "verification");
   VerificationSettings s;
@@ -148,13 +201,24 @@ VerificationSettings ParseVerification(const nlohmann::json& json) {
 Eigen::Matrix3d ReadCalibrationMatrixFile(const std::filesystem::path& file) {
   std::ifstream stream(file);
   if (!stream) throw InputError(file.string() + ": cannot read the calibration matrix file");
-  Eigen::Matrix3d K;
-  for (int i = 0; i < 9; ++i) {
-    if (!(stream >> K(i / 3, i % 3))) {
-      throw InputError(file.string() + ": expected 9 numbers (a 3x3 matrix), found " +
-                       std::to_string(i));
+  // Every token is read: a tenth number means the file is not what the user thinks.
+  std::vector<double> numbers;
+  std::string token;
+  while (stream >> token) {
+    double value = 0;
+    const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
+    if (error != std::errc() || end != token.data() + token.size() || !std::isfinite(value)) {
+      throw InputError(file.string() + ": '" + token + "' is not a finite number (number " +
+                       std::to_string(numbers.size() + 1) + " of the file)");
     }
+    numbers.push_back(value);
   }
+  if (numbers.size() != 9) {
+    throw InputError(file.string() + ": expected 9 numbers (a 3x3 matrix), found " +
+                     std::to_string(numbers.size()));
+  }
+  Eigen::Matrix3d K;
+  for (int i = 0; i < 9; ++i) K(i / 3, i % 3) = numbers[i];
   if (K(0, 0) <= 0 || K(1, 1) <= 0 || K(2, 2) != 1) {
     throw InputError(file.string() +
                      ": not a calibration matrix (need fx, fy > 0 and K[2][2] = 1)");
@@ -174,7 +238,7 @@ Manifest Manifest::Load(const std::filesystem::path& file) {
   if (stream.bad()) throw InputError(file.string() + ": cannot read the manifest");
   nlohmann::json json;
   try {
-    json = nlohmann::json::parse(text, nullptr, true, /*ignore_comments=*/true);
+    json = nlohmann::json::parse(text, DuplicateKeyCheck(file), true, /*ignore_comments=*/true);
   } catch (const nlohmann::json::parse_error& error) {
     std::string what = error.what();
     // "[json.exception.parse_error.101] parse error at line 3, column 5: ..." -> the part after

@@ -295,6 +295,28 @@ PairMatchVerifier::PairMatchVerifier(const MatchSettings& settings, const MatchP
 
 PairMatchVerifier::~PairMatchVerifier() = default;
 
+namespace {
+
+// A match beyond the keypoints of its images is the matcher's bug, not bad input: it is
+// reported as the matcher's failure (exit code 1), as a pair selector's bad pair is.
+void CheckMatcherIndices(const FeatureMatches& matches, size_t num_keypoints1,
+                         size_t num_keypoints2, const std::string& matcher,
+                         const std::string& subject) {
+  for (size_t m = 0; m < matches.size(); ++m) {
+    const FeatureMatch& match = matches[m];
+    if (match.point2D_idx1 < num_keypoints1 && match.point2D_idx2 < num_keypoints2) continue;
+    throw PluginError(matcher, PluginStage::kMatch, subject,
+                      "it returned match " + std::to_string(m) + " (" +
+                          std::to_string(match.point2D_idx1) + ", " +
+                          std::to_string(match.point2D_idx2) + "), beyond the images' " +
+                          std::to_string(num_keypoints1) + " and " +
+                          std::to_string(num_keypoints2) + " keypoints",
+                      /*input_error=*/false);
+  }
+}
+
+}  // namespace
+
 PairResult PairMatchVerifier::Run(const ImageIndexPair& pair) {
   const auto [i, j] = pair;
   const Image& image1 = plan_.images.at(i);
@@ -308,9 +330,12 @@ PairResult PairMatchVerifier::Run(const ImageIndexPair& pair) {
     std::lock_guard<std::mutex> lock(database_mutex_);
     matches = database_->ReadMatches(image1.image_id, image2.image_id);
   } else {
-    matches = matcher_.Call(
-        PluginStage::kMatch, PairSubject(image1.name, image2.name),
-        [&](auto& plugin) { return plugin.Match(features1->descriptors, features2->descriptors); });
+    const std::string subject = PairSubject(image1.name, image2.name);
+    matches = matcher_.Call(PluginStage::kMatch, subject, [&](auto& plugin) {
+      return plugin.Match(features1->descriptors, features2->descriptors);
+    });
+    CheckMatcherIndices(matches, features1->keypoints.size(), features2->keypoints.size(),
+                        matcher_.name(), subject);
   }
   result.match_seconds = step.ElapsedSeconds();
   step.Restart();

@@ -95,27 +95,31 @@ const char* SignalName(int signal_number) {
 
 constexpr int kFatalSignals[] = {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT};
 
-void CrashHandler(int signal_number, siginfo_t*, void*) {
-  CallRecord* record = t_record.active ? &t_record : nullptr;
-  if (record == nullptr) {
-    CallRecord* last = g_last_started.load();
-    if (last != nullptr && last->active) record = last;
-  }
-  if (record == nullptr) {
-    // Not in a plugin: the host's own crash keeps its default action (core dump).
-    signal(signal_number, SIG_DFL);
-    raise(signal_number);
-    return;
-  }
+// Whether a plugin's exit() or quick_exit() ends the process as a crash does.
+std::atomic<bool> g_exit_guard_armed{false};
+
+// The plugin call in progress: the calling thread's, else the one started last (for a
+// thread the plugin started itself); nullptr outside plugin calls.
+CallRecord* ActiveRecord() {
+  if (t_record.active) return &t_record;
+  CallRecord* last = g_last_started.load();
+  return last != nullptr && last->active ? last : nullptr;
+}
+
+// Writes "[error] plugin 'X' crashed (SIGSEGV) while detecting image Y" (or "ended the
+// process (exit)") to stderr, appends "CAUSE\tplugin\tstage\tsubject" to the crash file
+// and ends the process with the crash exit code. Async-signal-safe.
+[[noreturn]] void ReportPluginCrash(const CallRecord* record, const char* what, const char* cause) {
   static std::atomic<int> entered{0};
   if (entered.fetch_add(1) != 0) {
     for (;;) pause();  // another thread is reporting; it ends the process
   }
-  const char* name = SignalName(signal_number);
   WriteAll(STDERR_FILENO, "[error] plugin '");
   WriteAll(STDERR_FILENO, record->plugin);
-  WriteAll(STDERR_FILENO, "' crashed (");
-  WriteAll(STDERR_FILENO, name);
+  WriteAll(STDERR_FILENO, "' ");
+  WriteAll(STDERR_FILENO, what);
+  WriteAll(STDERR_FILENO, " (");
+  WriteAll(STDERR_FILENO, cause);
   WriteAll(STDERR_FILENO, ") while ");
   WriteAll(STDERR_FILENO, record->activity);
   if (record->subject[0] != '\0') {
@@ -126,7 +130,7 @@ void CrashHandler(int signal_number, siginfo_t*, void*) {
   if (g_crash_file[0] != '\0') {
     const int fd = open(g_crash_file, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
     if (fd >= 0) {
-      WriteAll(fd, name);
+      WriteAll(fd, cause);
       WriteAll(fd, "\t");
       WriteAll(fd, record->plugin);
       WriteAll(fd, "\t");
@@ -139,6 +143,28 @@ void CrashHandler(int signal_number, siginfo_t*, void*) {
   }
   _exit(g_crash_exit_code);
 }
+
+void CrashHandler(int signal_number, siginfo_t*, void*) {
+  const CallRecord* record = ActiveRecord();
+  if (record == nullptr) {
+    // Not in a plugin: the host's own crash keeps its default action (core dump).
+    signal(signal_number, SIG_DFL);
+    raise(signal_number);
+    return;
+  }
+  ReportPluginCrash(record, "crashed", SignalName(signal_number));
+}
+
+// At exit: a plugin that called exit(0) mid-call would otherwise end the run with
+// success and nothing done. The host itself never exits inside a plugin call.
+void EndedInPlugin(const char* how) {
+  if (!g_exit_guard_armed.load()) return;
+  const CallRecord* record = ActiveRecord();
+  if (record != nullptr) ReportPluginCrash(record, "ended the process", how);
+}
+
+void ExitGuard() { EndedInPlugin("exit"); }
+void QuickExitGuard() { EndedInPlugin("quick_exit"); }
 
 }  // namespace
 
@@ -266,6 +292,16 @@ void InstallPluginCrashHandler(int exit_code) {
   action.sa_flags = SA_SIGINFO | SA_ONSTACK;
   sigemptyset(&action.sa_mask);
   for (const int signal_number : kFatalSignals) sigaction(signal_number, &action, nullptr);
+  // Registered once: handlers registered later (static destructors of the plugins and
+  // of objects made since) run before it.
+  static const bool registered =
+      std::atexit(ExitGuard) == 0 && std::at_quick_exit(QuickExitGuard) == 0;
+  g_exit_guard_armed = registered;
+}
+
+void UninstallPluginCrashHandler() {
+  g_exit_guard_armed = false;
+  for (const int signal_number : kFatalSignals) signal(signal_number, SIG_DFL);
 }
 
 void SetPluginCrashFile(const std::string& file) {

@@ -117,8 +117,15 @@ auto CallPlugin(const std::string& plugin, PluginStage stage, const std::string&
 // call it writes one line to stderr, "[error] plugin 'X' crashed (SIGSEGV) while
 // detecting image Y", appends the crash to the file set by SetPluginCrashFile (if any)
 // and ends the process with `exit_code`, using async-signal-safe calls only. Outside
-// plugin calls the signal takes its default action.
+// plugin calls the signal takes its default action. A plugin that calls exit() or
+// quick_exit() during a call is reported the same way, "[error] plugin 'X' ended the
+// process (exit) while detecting image Y", through handlers registered with std::atexit
+// and std::at_quick_exit. (_exit() and _Exit() run no handlers and cannot be caught.)
 void InstallPluginCrashHandler(int exit_code);
+
+// Back to the default actions, and exit() ends the process as it would: for a child
+// process that reports plugins' crashes and exit codes by its own (plugin_probe.h).
+void UninstallPluginCrashHandler();
 
 // Where the crash handler appends its record: one line "SIGNAL\tplugin\tstage\tsubject".
 // Empty: nowhere.

@@ -14,14 +14,18 @@ constexpr PluginStage kStages[] = {
     PluginStage::kMatch, PluginStage::kSelectPairs, PluginStage::kAdjust,  PluginStage::kExport,
     PluginStage::kTrain, PluginStage::kPrepare};
 
-// Lines "SIGNAL\tplugin\tstage\tsubject"; a line cut short by a crash is skipped.
+bool IsSignal(const std::string& cause) { return cause.rfind("SIG", 0) == 0; }
+
+// Lines "CAUSE\tplugin\tstage\tsubject", CAUSE a signal ("SIGSEGV") or how the plugin
+// ended the process ("exit", "quick_exit"); a line cut short by a crash is skipped.
 std::vector<PluginCrash> ParseCrashes(const std::string& text) {
   std::vector<PluginCrash> crashes;
   std::istringstream stream(text);
   std::string line;
   while (std::getline(stream, line)) {
     const std::vector<std::string> fields = Split(line, '\t');
-    if (fields.size() != 4 || fields[0].rfind("SIG", 0) != 0) continue;
+    if (fields.size() != 4) continue;
+    if (!IsSignal(fields[0]) && fields[0] != "exit" && fields[0] != "quick_exit") continue;
     crashes.push_back({fields[0], fields[1], fields[2], fields[3]});
   }
   return crashes;
@@ -38,8 +42,8 @@ std::string PluginCrash::Describe() const {
   for (const PluginStage known : kStages) {
     if (stage == PluginStageName(known)) activity = PluginStageActivity(known);
   }
-  return "plugin '" + plugin + "' crashed (" + signal + ") while " + activity +
-         (subject.empty() ? "" : " " + subject);
+  return "plugin '" + plugin + "' " + (IsSignal(signal) ? "crashed" : "ended the process") + " (" +
+         signal + ") while " + activity + (subject.empty() ? "" : " " + subject);
 }
 
 std::filesystem::path PluginCrashLog::HistoryFile(const std::filesystem::path& folder,

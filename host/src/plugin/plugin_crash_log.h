@@ -3,7 +3,8 @@
 // The plugin crashes of a workspace. The crash handler appends each crash to
 // WORKSPACE/plugin_crashes.new; the next run moves those lines into the history,
 // WORKSPACE/plugin_crashes.tsv, reports them, and skips (quarantines) an image or pair
-// that crashed the same plugin in the same stage twice.
+// that crashed the same plugin in the same stage twice. A plugin that ended the process
+// (exit, quick_exit) during a call counts as a crash.
 
 #include <filesystem>
 #include <string>
@@ -14,12 +15,13 @@
 namespace tessera {
 
 struct PluginCrash {
-  std::string signal;  // "SIGSEGV"
+  std::string signal;  // "SIGSEGV"; "exit" or "quick_exit" for a plugin that called it
   std::string plugin;
   std::string stage;    // PluginStageName()
   std::string subject;  // "image a.jpg"
 
-  // "plugin 'X' crashed (SIGSEGV) while detecting image a.jpg"
+  // "plugin 'X' crashed (SIGSEGV) while detecting image a.jpg", "plugin 'X' ended the
+  // process (exit) while detecting image a.jpg"
   std::string Describe() const;
 };
 

@@ -13,6 +13,8 @@
 #include <cstring>
 #include <sstream>
 
+#include "plugin/plugin_call.h"
+
 namespace tessera {
 namespace {
 
@@ -27,7 +29,7 @@ void WriteLine(int fd, const std::string& line) {
   }
 }
 
-// In the child: quiet, no core files, default signal actions; loads files[first...]
+// In the child: quiet, no core files, default signal and exit actions; loads files[first...]
 // and reports "begin i" and "end i" for each on `fd`.
 [[noreturn]] void ProbeInChild(const std::vector<std::filesystem::path>& files, size_t first,
                                int fd) {
@@ -38,9 +40,7 @@ void WriteLine(int fd, const std::string& line) {
   }
   const struct rlimit no_core = {0, 0};
   setrlimit(RLIMIT_CORE, &no_core);
-  for (const int signal_number : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) {
-    signal(signal_number, SIG_DFL);
-  }
+  UninstallPluginCrashHandler();
   for (size_t i = first; i < files.size(); ++i) {
     WriteLine(fd, "begin " + std::to_string(i) + "\n");
     const nlohmann::json record = InspectPluginFile(files[i]).ToJson();  // opens and closes
