@@ -99,6 +99,31 @@ std::optional<Camera> Database::ReadCamera(camera_t camera_id) const {
   return impl_->cameras.Read(camera_id);
 }
 
+void Database::ReplaceCameras(const std::vector<Camera>& cameras,
+                              const std::map<image_t, camera_t>& image_cameras) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  const std::string operation = "replace the cameras";
+  for (const Camera& camera : cameras) impl_->cameras.CheckWritable(camera);
+  // In an order that keeps every image's camera in the table (foreign keys are on).
+  impl_->connection.Atomically(operation, [&] {
+    for (const Camera& camera : cameras) {
+      if (impl_->cameras.Read(camera.camera_id)) {
+        impl_->cameras.Update(camera, operation);
+      } else {
+        impl_->cameras.Insert(camera, true, operation);
+      }
+      impl_->tessera.WriteCalibrationSource(camera.camera_id, camera.calibration_source);
+    }
+    for (const auto& [image_id, camera_id] : image_cameras) {
+      impl_->images.UpdateCamera(image_id, camera_id);
+    }
+    impl_->connection.Exec(
+        "DELETE FROM tessera_camera_priors WHERE camera_id NOT IN (SELECT camera_id FROM images); "
+        "DELETE FROM cameras WHERE camera_id NOT IN (SELECT camera_id FROM images);",
+        operation);
+  });
+}
+
 image_t Database::WriteImage(const Image& image, bool use_image_id) {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   return impl_->images.Insert(image, use_image_id);
@@ -224,6 +249,25 @@ std::vector<std::pair<image_pair_t, TwoViewGeometry>> Database::ReadAllTwoViewGe
 size_t Database::NumVerifiedPairs() const {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   return impl_->two_view_geometries.NumVerifiedPairs();
+}
+
+void Database::DeleteTwoViewGeometries(const std::vector<image_pair_t>& pair_ids) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  impl_->connection.Atomically("delete two-view geometries", [&] {
+    for (const image_pair_t pair_id : pair_ids) impl_->two_view_geometries.Delete(pair_id);
+  });
+}
+
+void Database::WriteSelectedPairs(const std::vector<image_pair_t>& pair_ids,
+                                  const nlohmann::json& provenance) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  impl_->connection.Atomically("write the selected pairs",
+                               [&] { impl_->tessera.WriteSelectedPairs(pair_ids, provenance); });
+}
+
+std::optional<std::vector<image_pair_t>> Database::ReadSelectedPairs() const {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  return impl_->tessera.ReadSelectedPairs();
 }
 
 void Database::ClearKeypointsAndDescriptors() {

@@ -41,6 +41,11 @@ class Database {
   // Not a table: the image folder the images table was filled from, {"folder": path},
   // so that later stages (point colours, exporters) find the images.
   static constexpr const char* kImagesStage = "images";
+  // Not a table: the camera settings the cameras were made with (extract_stage.cc), so
+  // that a change of them re-creates the cameras.
+  static constexpr const char* kCamerasStage = "cameras";
+  // The pair selection that chose the pairs of tessera_pairs (WriteSelectedPairs).
+  static constexpr const char* kPairSelectionStage = "pair_selection";
 
   // Opens or creates the database at `path` and creates missing tables. Throws
   // InputError naming the file if it cannot be opened or is not a SQLite database /
@@ -85,6 +90,11 @@ class Database {
   // Throws InputError for a camera model Tessera does not know.
   std::vector<Camera> ReadAllCameras() const;
   std::optional<Camera> ReadCamera(camera_t camera_id) const;
+  // Replaces every camera by `cameras` (written with their ids) and sets the camera of
+  // each image of `image_cameras`, in one step. Images not named keep their camera id,
+  // which must be among the new ones.
+  void ReplaceCameras(const std::vector<Camera>& cameras,
+                      const std::map<image_t, camera_t>& image_cameras);
 
   // Images: name and camera_id (COLMAP's pose priors are left NULL, as COLMAP 3.8
   // writes them when it has none). Returns the new id.
@@ -139,6 +149,19 @@ class Database {
   std::vector<std::pair<image_pair_t, TwoViewGeometry>> ReadAllTwoViewGeometries() const;
   // Rows with at least one inlier and a config other than DEGENERATE/UNDEFINED.
   size_t NumVerifiedPairs() const;
+  // Removes the geometries of these pairs (their matches stay), so that they are
+  // verified again.
+  void DeleteTwoViewGeometries(const std::vector<image_pair_t>& pair_ids);
+
+  // The pairs that the last pair selection chose (table tessera_pairs) and that
+  // selection's provenance (kPairSelectionStage), replaced together: mapping uses these
+  // pairs only, while the matches and geometries of pairs that earlier selections chose
+  // stay cached for a selection that chooses them again. Read: sorted; nullopt when no
+  // selection was recorded (a COLMAP database, or one matched before the table), in
+  // which case every verified pair counts.
+  void WriteSelectedPairs(const std::vector<image_pair_t>& pair_ids,
+                          const nlohmann::json& provenance);
+  std::optional<std::vector<image_pair_t>> ReadSelectedPairs() const;
 
   // Each clear also clears the tables that depend on the cleared one, and the
   // provenance of every stage it clears.

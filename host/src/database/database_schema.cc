@@ -90,10 +90,13 @@ constexpr const char* kCreateTesseraTables =
     "    image_id     INTEGER,"
     "    size         INTEGER               NOT NULL,"
     "    hash         TEXT                  NOT NULL,"
-    "    skip_reason  TEXT);";
+    "    skip_reason  TEXT);"
+    "CREATE TABLE IF NOT EXISTS tessera_pairs"
+    "   (pair_id  INTEGER  PRIMARY KEY  NOT NULL);";
 
 // Columns that Tessera reads or writes, per COLMAP table. Others may exist (newer
-// COLMAP versions add some); these must.
+// COLMAP versions add some); these must. tessera_pairs is not among them: a read-only
+// database made before it is still read (TesseraRecords::ReadSelectedPairs).
 const std::map<std::string, std::vector<std::string>>& RequiredColumns() {
   static const std::map<std::string, std::vector<std::string>> columns = {
       {"cameras", {"camera_id", "model", "width", "height", "params", "prior_focal_length"}},

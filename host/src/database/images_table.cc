@@ -31,6 +31,13 @@ std::vector<Image> ImagesTable::ReadAll() const {
   return images;
 }
 
+void ImagesTable::UpdateCamera(image_t image_id, camera_t camera_id) const {
+  SqliteStatement::Use use(update_camera_, "set the camera of image " + std::to_string(image_id));
+  use.BindInt64(1, camera_id);
+  use.BindInt64(2, image_id);
+  use.Step();
+}
+
 size_t ImagesTable::Count() const {
   return static_cast<size_t>(count_.QueryInt64("count the images"));
 }

@@ -23,6 +23,7 @@ class ImagesTable {
   image_t Insert(const Image& image, bool use_image_id) const;
   std::optional<Image> ReadWithName(const std::string& name) const;
   std::vector<Image> ReadAll() const;  // sorted by image_id
+  void UpdateCamera(image_t image_id, camera_t camera_id) const;
   size_t Count() const;
 
  private:
@@ -34,6 +35,8 @@ class ImagesTable {
                                   "SELECT image_id, name, camera_id FROM images WHERE name = ?;"};
   SqliteStatement read_all_{connection_,
                             "SELECT image_id, name, camera_id FROM images ORDER BY image_id;"};
+  SqliteStatement update_camera_{connection_,
+                                 "UPDATE images SET camera_id = ? WHERE image_id = ?;"};
   SqliteStatement count_{connection_, "SELECT COUNT(*) FROM images;"};
 };
 

@@ -158,4 +158,27 @@ void TesseraRecords::DeleteImageFile(const std::string& name) const {
   use.Step();
 }
 
+void TesseraRecords::WriteSelectedPairs(const std::vector<image_pair_t>& pair_ids,
+                                        const nlohmann::json& provenance) const {
+  connection_.Exec("DELETE FROM tessera_pairs;", "clear the selected pairs");
+  const SqliteStatement insert(connection_,
+                               "INSERT OR IGNORE INTO tessera_pairs(pair_id) VALUES(?);", false);
+  for (const image_pair_t pair_id : pair_ids) {
+    SqliteStatement::Use use(insert, "write the selected pairs");
+    use.BindInt64(1, static_cast<int64_t>(pair_id));
+    use.Step();
+  }
+  WriteStageProvenance(Database::kPairSelectionStage, provenance);
+}
+
+std::optional<std::vector<image_pair_t>> TesseraRecords::ReadSelectedPairs() const {
+  if (!ReadStageProvenance(Database::kPairSelectionStage)) return std::nullopt;
+  const SqliteStatement read(connection_, "SELECT pair_id FROM tessera_pairs ORDER BY pair_id;",
+                             false);
+  SqliteStatement::Use use(read, "read the selected pairs");
+  std::vector<image_pair_t> pair_ids;
+  while (use.Step()) pair_ids.push_back(static_cast<image_pair_t>(use.ColumnInt64(0)));
+  return pair_ids;
+}
+
 }  // namespace tessera

@@ -2,8 +2,9 @@
 
 // Tessera's own tables (prefixed `tessera_`, which COLMAP ignores): the provenance of
 // each stage (tessera_stages), the calibration source of each camera
-// (tessera_camera_priors), each image's EXIF metadata (tessera_image_metadata) and the
-// image files the images table was made from (tessera_images).
+// (tessera_camera_priors), each image's EXIF metadata (tessera_image_metadata), the
+// image files the images table was made from (tessera_images) and the pairs the last
+// pair selection chose (tessera_pairs).
 
 #include <map>
 #include <optional>
@@ -39,6 +40,13 @@ class TesseraRecords {
   std::vector<Database::ImageFile> ReadImageFiles() const;  // sorted by name
   void WriteImageFile(const Database::ImageFile& file) const;
   void DeleteImageFile(const std::string& name) const;
+
+  // tessera_pairs with the provenance of the selection (Database::WriteSelectedPairs).
+  // The table's statements are prepared on use: a read-only database made before the
+  // table has none, and is never asked for it (no provenance, no table read).
+  void WriteSelectedPairs(const std::vector<image_pair_t>& pair_ids,
+                          const nlohmann::json& provenance) const;
+  std::optional<std::vector<image_pair_t>> ReadSelectedPairs() const;
 
  private:
   const SqliteConnection& connection_;

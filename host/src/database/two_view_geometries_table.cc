@@ -81,4 +81,11 @@ size_t TwoViewGeometriesTable::NumVerifiedPairs() const {
   return static_cast<size_t>(num_verified_pairs_.QueryInt64("count the verified pairs"));
 }
 
+void TwoViewGeometriesTable::Delete(image_pair_t pair_id) const {
+  const auto [image_id1, image_id2] = PairIdToImagePair(pair_id);
+  SqliteStatement::Use use(delete_, "delete " + GeometryOfImages(image_id1, image_id2));
+  use.BindInt64(1, static_cast<int64_t>(pair_id));
+  use.Step();
+}
+
 }  // namespace tessera

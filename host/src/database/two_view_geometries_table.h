@@ -28,6 +28,7 @@ class TwoViewGeometriesTable {
   std::vector<std::pair<image_pair_t, TwoViewGeometry>> ReadAll() const;
   // Rows with at least one inlier and a config other than DEGENERATE/UNDEFINED.
   size_t NumVerifiedPairs() const;
+  void Delete(image_pair_t pair_id) const;
 
  private:
   const SqliteConnection& connection_;
@@ -43,6 +44,7 @@ class TwoViewGeometriesTable {
   SqliteStatement read_all_{connection_,
                             "SELECT rows, cols, data, config, F, E, H, qvec, tvec, pair_id FROM "
                             "two_view_geometries ORDER BY pair_id;"};
+  SqliteStatement delete_{connection_, "DELETE FROM two_view_geometries WHERE pair_id = ?;"};
   SqliteStatement num_verified_pairs_{
       connection_,
       "SELECT COUNT(*) FROM two_view_geometries WHERE rows >= 1 AND config NOT IN (0, 1);"};

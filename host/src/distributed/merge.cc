@@ -201,6 +201,15 @@ MergeSummary MergeMatching(Workspace& workspace, int count) {
   }
   database.WriteStageProvenance(Database::kMatchesStage, matches_provenance);
   database.WriteStageProvenance(Database::kTwoViewGeometriesStage, geometries_provenance);
+  // Each shard recorded every pair the selection chose (the same manifest and images):
+  // mapping uses those. Shards without the record leave every pair counting.
+  const Database& first_database = *shards.front().database;
+  if (const auto selected = first_database.ReadSelectedPairs()) {
+    database.WriteSelectedPairs(*selected,
+                                *first_database.ReadStageProvenance(Database::kPairSelectionStage));
+  } else {
+    database.DeleteStageProvenance(Database::kPairSelectionStage);
+  }
   for (const OpenShard& shard : shards) {
     const Database& from = *shard.database;
     try {

@@ -145,6 +145,159 @@ std::vector<Image> RegisterImages(const ImageScan& scan, const CameraSettings& s
   return images;
 }
 
+// What shapes the cameras, recorded as the kCamerasStage provenance: a change re-creates
+// them. The mask folder and the name of the K file do not.
+nlohmann::json CameraSettingsRecord(const CameraSettings& settings) {
+  nlohmann::json K = nullptr;
+  if (const auto& k = settings.known_intrinsics) K = {(*k)(0), (*k)(1), (*k)(2), (*k)(3)};
+  return {{"model", settings.model},
+          {"single_camera", settings.single_camera},
+          {"default_focal_length_factor", settings.default_focal_length_factor},
+          {"K", K},
+          {"params", settings.known_params}};
+}
+
+// Why the cameras are made again: "camera.K, camera.single_camera changed".
+std::string WhyCamerasChanged(const std::optional<nlohmann::json>& stored,
+                              const nlohmann::json& now) {
+  if (!stored)
+    return "the workspace has no record of the camera settings its cameras were made with";
+  std::string keys;
+  for (const auto& [key, value] : now.items()) {
+    if (stored->value(key, nlohmann::json()) == value) continue;
+    keys += (keys.empty() ? "camera." : ", camera.") + key;
+    if (key == "K") keys += " (or --camera-K)";
+  }
+  return (keys.empty() ? "the camera settings" : keys) + " changed";
+}
+
+// Whether two-view geometry estimation sees the two cameras alike (it uses the
+// intrinsics of a pair whose cameras both have a focal length prior).
+bool SameIntrinsics(const Camera& a, const Camera& b) {
+  return a.model_id == b.model_id && a.width == b.width && a.height == b.height &&
+         a.params == b.params && a.has_prior_focal_length == b.has_prior_focal_length;
+}
+
+// "camera 1 (SIMPLE_RADIAL 640x480, focal 768.0 px, default)", the first few of them.
+std::string DescribeCameras(const std::vector<Camera>& cameras) {
+  constexpr size_t kMaxShown = 3;
+  std::string text;
+  for (size_t k = 0; k < cameras.size() && k < kMaxShown; ++k) {
+    const Camera& camera = cameras[k];
+    text += fmt::format("{}camera {} ({} {}x{}, focal {:.1f} px, {})", k > 0 ? ", " : "",
+                        camera.camera_id, camera.ModelName(), camera.width, camera.height,
+                        camera.MeanFocalLength(), CalibrationSourceName(camera.calibration_source));
+  }
+  if (cameras.size() > kMaxShown) text += fmt::format(" and {} more", cameras.size() - kMaxShown);
+  return text;
+}
+
+// Discards the two-view geometries that used the intrinsics of a camera that changed
+// (their matches stay, so they are verified again without matching). Returns how many.
+size_t DiscardGeometriesOfChangedCameras(const std::map<image_t, const Camera*>& before,
+                                         const std::map<image_t, const Camera*>& after,
+                                         Database* database) {
+  std::vector<image_pair_t> stale;
+  for (const image_pair_t pair_id : database->ReadMatchedPairIds()) {
+    const auto [id1, id2] = PairIdToImagePair(pair_id);
+    const auto old1 = before.find(id1), old2 = before.find(id2);
+    const auto new1 = after.find(id1), new2 = after.find(id2);
+    if (old1 == before.end() || old2 == before.end() || new1 == after.end() ||
+        new2 == after.end()) {
+      continue;
+    }
+    const Camera &a = *old1->second, &b = *old2->second, &c = *new1->second, &d = *new2->second;
+    const bool used = (a.has_prior_focal_length && b.has_prior_focal_length) ||
+                      (c.has_prior_focal_length && d.has_prior_focal_length);
+    if (used && (!SameIntrinsics(a, c) || !SameIntrinsics(b, d)) &&
+        database->ExistsTwoViewGeometry(id1, id2)) {
+      stale.push_back(pair_id);
+    }
+  }
+  database->DeleteTwoViewGeometries(stale);
+  return stale.size();
+}
+
+// The camera of each image of `assignment`, in input order.
+std::vector<const Camera*> AssignedCameras(const CameraAssignment& assignment) {
+  std::map<camera_t, const Camera*> by_id;
+  for (const Camera& camera : assignment.cameras) by_id[camera.camera_id] = &camera;
+  std::vector<const Camera*> cameras;
+  for (const camera_t id : assignment.image_camera_ids) cameras.push_back(by_id.at(id));
+  return cameras;
+}
+
+// Whether `assignment` gives each image the camera it has, in the same grouping.
+bool SameCameras(const std::vector<Image*>& images, const std::map<camera_t, Camera>& cameras,
+                 const CameraAssignment& assignment) {
+  const std::vector<const Camera*> assigned = AssignedCameras(assignment);
+  std::map<camera_t, camera_t> new_of_old, old_of_new;
+  for (size_t k = 0; k < images.size(); ++k) {
+    const camera_t old_id = images[k]->camera_id, new_id = assignment.image_camera_ids[k];
+    const auto old_camera = cameras.find(old_id);
+    if (old_camera == cameras.end()) return false;
+    const Camera& camera = *assigned[k];
+    if (!SameIntrinsics(old_camera->second, camera) ||
+        old_camera->second.calibration_source != camera.calibration_source ||
+        new_of_old.emplace(old_id, new_id).first->second != new_id ||
+        old_of_new.emplace(new_id, old_id).first->second != old_id) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Step 3b: cameras made with other camera settings (camera.model, camera.K or
+// --camera-K, camera.params, single_camera, default_focal_length_factor) are made again
+// from the current ones for every image, as a new workspace would make them, and the
+// two-view geometries that used a changed camera's intrinsics are discarded. Features
+// and matches do not depend on the cameras and stay. Updates the images' camera ids.
+void UpdateCameras(const ImageScan& scan, const CameraSettings& settings,
+                   std::vector<Image>* images, Database* database) {
+  const nlohmann::json record = CameraSettingsRecord(settings);
+  const std::optional<nlohmann::json> stored =
+      database->ReadStageProvenance(Database::kCamerasStage);
+  if (stored == record) return;
+  std::vector<ImageEntry> entries;
+  std::vector<Image*> registered;  // in scan order, as a new workspace numbers cameras
+  for (size_t i = 0; i < images->size(); ++i) {
+    if ((*images)[i].image_id == kInvalidImageId) continue;
+    entries.push_back(scan.images[i]);
+    registered.push_back(&(*images)[i]);
+  }
+  std::map<camera_t, Camera> cameras;
+  for (Camera& camera : database->ReadAllCameras()) cameras[camera.camera_id] = camera;
+  const CameraAssignment assignment = AssignCameras(entries, settings);
+  if (!SameCameras(registered, cameras, assignment)) {
+    for (const auto& warning : assignment.warnings) spdlog::warn("{}", warning);
+    const std::vector<const Camera*> assigned = AssignedCameras(assignment);
+    std::map<image_t, const Camera*> before, after;
+    std::map<image_t, camera_t> image_cameras;
+    for (size_t k = 0; k < registered.size(); ++k) {
+      const image_t image_id = registered[k]->image_id;
+      before[image_id] = &cameras.at(registered[k]->camera_id);
+      after[image_id] = assigned[k];
+      image_cameras[image_id] = assignment.image_camera_ids[k];
+    }
+    Database::Transaction transaction(database);
+    database->ReplaceCameras(assignment.cameras, image_cameras);
+    const size_t num_discarded = DiscardGeometriesOfChangedCameras(before, after, database);
+    transaction.Commit();
+    for (size_t k = 0; k < registered.size(); ++k) {
+      registered[k]->camera_id = assignment.image_camera_ids[k];
+    }
+    spdlog::info(
+        "extract: {}; re-created the cameras of {} images as {}; {} two-view geometries that "
+        "used the old intrinsics discarded, to be verified again from their matches",
+        WhyCamerasChanged(stored, record), registered.size(), DescribeCameras(assignment.cameras),
+        num_discarded);
+  } else if (stored) {
+    spdlog::info("extract: {}; the cameras they make are the workspace's, kept",
+                 WhyCamerasChanged(stored, record));
+  }
+  database->WriteStageProvenance(Database::kCamerasStage, record);
+}
+
 // Stores each image's EXIF metadata for pair selectors, so that matching needs no
 // image folder. Rewritten on every run: cheap, and a re-tagged image is seen.
 void WriteImageMetadata(const ImageScan& scan, const std::vector<Image>& images,
@@ -387,7 +540,8 @@ ExtractionSummary ExtractFeatures(const Workspace& workspace, const ExtractSetti
   RecordProvenance(settings, masks, database);
   const std::map<std::string, std::string> skipped_before =
       ReconcileImages(scan, database, &summary);
-  const std::vector<Image> images = RegisterImages(scan, settings.camera, skipped_before, database);
+  std::vector<Image> images = RegisterImages(scan, settings.camera, skipped_before, database);
+  UpdateCameras(scan, settings.camera, &images, database);
   WriteImageMetadata(scan, images, database);
   const std::vector<size_t> todo =
       PlanDetection(workspace, settings, scope, scan, images, skipped_before, &summary);

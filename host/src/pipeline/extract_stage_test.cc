@@ -2,6 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
+#include <string>
+#include <utility>
+#include <vector>
+
 #include "pipeline/stage_test_util.h"
 
 namespace tessera {
@@ -116,6 +121,83 @@ TEST(ExtractStage, NoKeypointLiesUnderTheBlackHalfOfAMask) {
       ExtractFeatures(*workspace, plugins.Extract(dir.path() / "images", manifest));
   EXPECT_EQ(again.num_detected, 3u);
   EXPECT_GT(count_right("0001.jpg", &total), 200u);
+}
+
+// Each image's camera as "name: model WxH params prior source", and the grouping.
+std::vector<std::string> CamerasOfImages(const Database& database) {
+  std::map<camera_t, Camera> cameras;
+  for (const Camera& camera : database.ReadAllCameras()) cameras[camera.camera_id] = camera;
+  std::vector<std::string> lines;
+  for (const Image& image : database.ReadAllImages()) {
+    const Camera& camera = cameras.at(image.camera_id);
+    std::string line = image.name + ": camera " + std::to_string(camera.camera_id) + " " +
+                       camera.ModelName() + " " + std::to_string(camera.width) + "x" +
+                       std::to_string(camera.height);
+    for (const double param : camera.params) line += " " + std::to_string(param);
+    line += camera.has_prior_focal_length ? " prior " : " ";
+    lines.push_back(line + CalibrationSourceName(camera.calibration_source));
+  }
+  return lines;
+}
+
+// Camera settings changed for a finished workspace: the cameras are made again as a new
+// workspace makes them; features and matches stay, and the geometries whose estimation
+// used a changed camera's intrinsics (both cameras with a focal length prior, before or
+// after) are verified again from their matches.
+TEST(ExtractStage, ChangedCameraSettingsRecreateTheCamerasAndWhatUsedThem) {
+  const testing::TemporaryDir dir;
+  testing::WriteSampleImages(dir.path() / "images", 3);  // 400x266, no EXIF
+  const testing::CheapPlugins plugins;
+  const auto workspace = Workspace::Open(dir.path() / "out");
+  const Database& database = workspace->database();
+  const auto run = [&](const Workspace& into, const Manifest& manifest) {
+    const ExtractionSummary extracted =
+        ExtractFeatures(into, plugins.Extract(dir.path() / "images", manifest));
+    const MatchingSummary matched = MatchFeatures(into, plugins.Match(manifest));
+    return std::make_pair(extracted.num_detected, matched.num_matched);  // done now
+  };
+  const std::pair<size_t, size_t> nothing_again(0, 0);
+  Manifest manifest = testing::CheapManifest(2);
+  EXPECT_EQ(run(*workspace, manifest), std::make_pair(size_t{3}, size_t{3}));
+  EXPECT_EQ(run(*workspace, manifest), nothing_again);
+  ASSERT_EQ(database.NumCameras(), 1u);
+  EXPECT_FALSE(database.ReadAllCameras()[0].has_prior_focal_length);
+
+  // camera.K (or --camera-K): the known focal length, so verification uses it.
+  manifest.camera.known_intrinsics = Eigen::Vector4d(330, 330, 200, 130);
+  manifest.camera.known_intrinsics_source = "camera.K";
+  EXPECT_EQ(run(*workspace, manifest), std::make_pair(size_t{0}, size_t{3}));
+  std::vector<Camera> cameras = database.ReadAllCameras();
+  ASSERT_EQ(cameras.size(), 1u);
+  EXPECT_EQ(cameras[0].calibration_source, CalibrationSource::kUser);
+  EXPECT_DOUBLE_EQ(cameras[0].MeanFocalLength(), 330);
+  EXPECT_EQ(run(*workspace, manifest), nothing_again);
+
+  // single_camera false: a camera per image with the same intrinsics; nothing to verify.
+  manifest.camera.single_camera = false;
+  EXPECT_EQ(run(*workspace, manifest), nothing_again);
+  EXPECT_EQ(database.NumCameras(), 3u);
+  const std::vector<std::string> per_image = CamerasOfImages(database);
+  // default_focal_length_factor is not used while K is known: the cameras stay.
+  manifest.camera.default_focal_length_factor = 2.0;
+  EXPECT_EQ(run(*workspace, manifest), nothing_again);
+  EXPECT_EQ(CamerasOfImages(database), per_image);
+
+  // camera.model without K: the default focal length (2.0 x 400 px), no prior; the
+  // geometries that used the intrinsics of K are verified again.
+  manifest.camera.known_intrinsics.reset();
+  manifest.camera.model = "PINHOLE";
+  EXPECT_EQ(run(*workspace, manifest), std::make_pair(size_t{0}, size_t{3}));
+  cameras = database.ReadAllCameras();
+  ASSERT_EQ(cameras.size(), 3u);
+  EXPECT_EQ(cameras[0].ModelName(), "PINHOLE");
+  EXPECT_DOUBLE_EQ(cameras[0].MeanFocalLength(), 800);
+  EXPECT_EQ(cameras[0].calibration_source, CalibrationSource::kDefault);
+
+  // The cameras of a new workspace with these settings.
+  const auto fresh = Workspace::Open(dir.path() / "fresh");
+  run(*fresh, manifest);
+  EXPECT_EQ(CamerasOfImages(database), CamerasOfImages(fresh->database()));
 }
 
 }  // namespace

@@ -376,6 +376,22 @@ std::string DescribeChosenPairs(const MatchPlan& plan) {
   return chosen;
 }
 
+// Records every pair the selectors chose (a shard records them all too, for the merge):
+// mapping uses these, while pairs of earlier selections stay cached for reuse.
+void RecordSelectedPairs(const MatchSettings& settings, const MatchPlan& plan, Database* database) {
+  std::vector<image_pair_t> pair_ids;
+  pair_ids.reserve(plan.pairs.size());
+  for (const auto& [i, j] : plan.pairs) {
+    pair_ids.push_back(ImagePairToPairId(plan.images[i].image_id, plan.images[j].image_id));
+  }
+  nlohmann::json selectors = nlohmann::json::array();
+  for (const PluginInstance<PairSelector>& selector : *settings.pair_selectors) {
+    selectors.push_back(selector.Provenance());
+  }
+  database->WriteSelectedPairs(pair_ids,
+                               {{"selectors", selectors}, {"num_pairs", pair_ids.size()}});
+}
+
 }  // namespace
 
 MatchingSummary MatchFeatures(const Workspace& workspace, const MatchSettings& settings,
@@ -394,6 +410,7 @@ MatchingSummary MatchFeatures(const Workspace& workspace, const MatchSettings& s
   // A shard's database is made for one provenance (its record); the merge invalidates.
   if (scope.source == nullptr) InvalidateStaleResults(settings, descriptors, results);
   const MatchPlan plan = PlanMatching(workspace, settings, descriptors, provenance, scope);
+  RecordSelectedPairs(settings, plan, results);
   summary.pairs_per_selector = plan.pairs_per_selector;
   summary.num_pairs = plan.num_in_scope;
   summary.num_reused = plan.num_reused;

@@ -64,7 +64,9 @@ MatchProvenance MakeMatchProvenance(const MatchSettings& settings,
 // the matches, the verification settings (all of VerificationSettings::ToJson, so a
 // field added there is covered) and the seed. Stored results made otherwise are
 // discarded; the provenance of what this run makes is recorded. Pair selection itself
-// only decides which pairs exist, so changing it keeps every pair already matched.
+// only decides which pairs exist, so changing it keeps every pair already matched, and
+// MatchFeatures records the pairs chosen (Database::WriteSelectedPairs): mapping uses
+// those only.
 void InvalidateStaleResults(const MatchSettings& settings, const WorkspaceDescriptors& descriptors,
                             Database* database);
 

@@ -2,8 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include "pipeline/extract_stage.h"
 #include "pipeline/stage_test_util.h"
+#include "sfm/mapper_input.h"
 
 namespace tessera {
 namespace {
@@ -113,6 +116,44 @@ TEST_F(MatchStageTest, AnyChangedVerificationFieldRecomputesTheGeometries) {
     EXPECT_EQ(Match(testing::CheapManifest(2)).num_reused, 0u) << key;
   }
   EXPECT_EQ(Match(testing::CheapManifest(2)).num_reused, 6u);
+}
+
+// Exhaustive, then `window` 1: mapping uses the three neighbouring pairs only, while
+// the others stay cached, so that going back to exhaustive matches nothing again.
+TEST_F(MatchStageTest, MappingUsesOnlyThePairsTheCurrentSelectionChose) {
+  EXPECT_EQ(Match(testing::CheapManifest(2)).num_matched, 6u);
+  std::map<image_t, int> index;  // 0000.jpg is 0
+  for (const Image& image : database_->ReadAllImages())
+    index[image.image_id] = std::stoi(image.name);
+  const auto mapped_gaps = [&] {  // the index distance of each pair mapping gets
+    std::multiset<int> gaps;
+    for (const MapperInput::Pair& pair : LoadMapperInput(*database_).pairs) {
+      gaps.insert(std::abs(index.at(pair.image_id1) - index.at(pair.image_id2)));
+    }
+    return gaps;
+  };
+  const std::multiset<int> exhaustive = mapped_gaps();
+  ASSERT_GT(exhaustive.count(2) + exhaustive.count(3), 0u) << "no pair beyond neighbours verified";
+
+  std::vector<PluginInstance<PairSelector>> window;
+  window.push_back(testing::LoadBundledPlugin<PairSelector>(
+      "pair_selector", "window", {{"window", 1}}, "pipeline.pair_selector"));
+  MatchSettings settings = plugins_.Match(testing::CheapManifest(2));
+  settings.pair_selectors = &window;
+  const MatchingSummary windowed = MatchFeatures(*workspace_, settings);
+  EXPECT_EQ(windowed.num_pairs, 3u);
+  EXPECT_EQ(windowed.num_reused, 3u);
+  EXPECT_EQ(windowed.num_matched, 0u);
+  EXPECT_EQ(mapped_gaps(),
+            std::multiset<int>(exhaustive.lower_bound(1), exhaustive.upper_bound(1)));
+  EXPECT_EQ(database_->NumMatchedPairs(), 6u);  // the others stay cached
+  EXPECT_EQ(database_->ReadAllTwoViewGeometries().size(), 6u);
+  EXPECT_EQ(database_->ReadSelectedPairs()->size(), 3u);
+
+  const MatchingSummary again = Match(testing::CheapManifest(2));
+  EXPECT_EQ(again.num_reused, 6u);
+  EXPECT_EQ(again.num_matched, 0u);
+  EXPECT_EQ(mapped_gaps(), exhaustive);
 }
 
 }  // namespace

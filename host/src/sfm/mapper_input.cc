@@ -1,5 +1,9 @@
 #include "sfm/mapper_input.h"
 
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
 #include "tessera/errors.h"
 
 namespace tessera {
@@ -24,14 +28,27 @@ MapperInput LoadMapperInput(const Database& database) {
   if (input.images.empty()) {
     throw InputError(database.path().string() + ": the workspace has no images; run extract first");
   }
+  // Pairs of an earlier pair selection stay cached in the database, out of the input.
+  const std::optional<std::vector<image_pair_t>> selected = database.ReadSelectedPairs();
+  size_t num_unselected = 0;
   for (auto& [pair_id, geometry] : database.ReadAllTwoViewGeometries()) {
     if (geometry.inlier_matches.empty()) continue;
+    if (selected && !std::binary_search(selected->begin(), selected->end(), pair_id)) {
+      ++num_unselected;
+      continue;
+    }
     MapperInput::Pair pair;
     const auto [image_id1, image_id2] = PairIdToImagePair(pair_id);
     pair.image_id1 = image_id1;
     pair.image_id2 = image_id2;
     pair.geometry = std::move(geometry);
     input.pairs.push_back(std::move(pair));
+  }
+  if (num_unselected > 0) {
+    spdlog::info(
+        "map: {} verified pairs are left out: the current pair selection did not choose them "
+        "(they stay cached in {}); {} pairs are used",
+        num_unselected, database.path().string(), input.pairs.size());
   }
   return input;
 }

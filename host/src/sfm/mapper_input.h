@@ -22,9 +22,10 @@ struct MapperInput {
   std::vector<Pair> pairs;
 };
 
-// Cameras, images with their keypoints, and every verified pair of a workspace
-// database (Tessera's or COLMAP's). Throws InputError naming the database when it
-// holds no images.
+// Cameras, images with their keypoints, and the verified pairs of a workspace
+// database (Tessera's or COLMAP's): those the last pair selection chose
+// (Database::ReadSelectedPairs) when one was recorded, every one otherwise. Throws
+// InputError naming the database when it holds no images.
 MapperInput LoadMapperInput(const Database& database);
 
 }  // namespace tessera

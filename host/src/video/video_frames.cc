@@ -1,11 +1,14 @@
 #include "video/video_frames.h"
 
 #include <spdlog/spdlog.h>
+#include <xxhash.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <map>
+#include <memory>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
@@ -59,6 +62,27 @@ double FrameTime(int index, double fps, const VideoDecoder& decoder) {
   return decoder.PositionSeconds();
 }
 
+// XXH3-128 of the file's bytes, 32 hex digits as the images' content hashes, read in
+// blocks (a video need not fit in memory); "" when it cannot be read.
+std::string FileContentHash(const fs::path& file) {
+  std::ifstream stream(file, std::ios::binary);
+  if (!stream) return "";
+  std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state(XXH3_createState(),
+                                                                 &XXH3_freeState);
+  XXH3_128bits_reset(state.get());
+  std::vector<char> block(size_t{1} << 20);
+  while (stream) {
+    stream.read(block.data(), static_cast<std::streamsize>(block.size()));
+    XXH3_128bits_update(state.get(), block.data(), static_cast<size_t>(stream.gcount()));
+  }
+  if (stream.bad()) return "";
+  const XXH128_hash_t hash = XXH3_128bits_digest(state.get());
+  char text[33];
+  std::snprintf(text, sizeof(text), "%016llx%016llx", static_cast<unsigned long long>(hash.high64),
+                static_cast<unsigned long long>(hash.low64));
+  return text;
+}
+
 nlohmann::json Record(const VideoFrames& result, const VideoFrameOptions& options) {
   std::error_code error;
   nlohmann::json frames = nlohmann::json::array();
@@ -80,8 +104,7 @@ nlohmann::json Record(const VideoFrames& result, const VideoFrameOptions& option
   const fs::path absolute = fs::absolute(result.video).lexically_normal();
   return {{"file", absolute.string()},
           {"size", static_cast<uint64_t>(fs::file_size(result.video, error))},
-          {"modified", static_cast<int64_t>(
-                           fs::last_write_time(result.video, error).time_since_epoch().count())},
+          {"content_hash", result.content_hash},
           {"options", options.ToJson()},
           {"folder", result.folder},
           {"fps", result.fps},
@@ -94,14 +117,17 @@ nlohmann::json Record(const VideoFrames& result, const VideoFrameOptions& option
           {"frames", frames}};
 }
 
-// The earlier run's selection of this video, when nothing it depends on changed.
+// The earlier run's selection of this video, when nothing it depends on changed: the
+// same file with the same content (its hash: a file replaced by another of the same size
+// and modification time is decoded again) and options.
 std::optional<VideoFrames> Reuse(const nlohmann::json& recorded, const VideoFrames& probe,
                                  const VideoFrameOptions& options, const fs::path& frames_dir) {
+  if (probe.content_hash.empty()) return std::nullopt;  // unreadable: decoding says why
   const nlohmann::json now = Record(probe, options);
   for (const nlohmann::json& video : recorded.value("videos", nlohmann::json::array())) {
     if (!video.is_object() || video.value("file", "") != now["file"] ||
         video.value("size", nlohmann::json()) != now["size"] ||
-        video.value("modified", nlohmann::json()) != now["modified"] ||
+        video.value("content_hash", "") != probe.content_hash ||
         video.value("options", nlohmann::json()) != now["options"] ||
         video.value("folder", "") != probe.folder) {
       continue;
@@ -286,7 +312,10 @@ fs::path IngestVideos(const std::vector<fs::path>& videos, const fs::path& outpu
     probe.video = video;
     probe.folder = folder;
     std::optional<VideoFrames> reused;
-    if (fs::is_regular_file(video, error)) reused = Reuse(recorded, probe, options, frames_dir);
+    if (fs::is_regular_file(video, error)) {
+      probe.content_hash = FileContentHash(video);
+      reused = Reuse(recorded, probe, options, frames_dir);
+    }
     VideoFrames result;
     if (reused) {
       result = *reused;
@@ -294,6 +323,7 @@ fs::path IngestVideos(const std::vector<fs::path>& videos, const fs::path& outpu
                    video.string(), result.images.size());
     } else {
       result = ExtractVideoFrames(video, folder, frames_dir, options);
+      result.content_hash = probe.content_hash;  // of the bytes before decoding
       spdlog::info(
           "video: {}: {} frames decoded ({}x{}, {:.2f} fps), accumulated motion {:.0f} px, {} "
           "kept in {} segments, into {}; {:.1f} frames/s decoded, selection {:.2f} ms per "

@@ -34,6 +34,7 @@ struct VideoFrames {
   double decode_seconds = 0;  // reading and decoding every frame, both passes
   double select_seconds = 0;  // scoring (sharpness, optical flow) and selection
   bool reused = false;        // taken from an earlier run's frames.json
+  std::string content_hash;   // XXH3-128 of the video file, as images' (IngestVideos)
 };
 
 // The file name of frame `index` at `time_s`: frame_000123_4.100s.jpg (the 0-based frame
@@ -52,8 +53,9 @@ VideoFrames ExtractVideoFrames(const std::filesystem::path& video, const std::st
 // Every video of a run into OUTPUT/video_frames/<stem>/, with OUTPUT/frames.json: per
 // video its file, size, options and every frame's index, time, sharpness, motion,
 // segment and whether it was kept (with its image name). A video whose file, size,
-// modification time and options equal those recorded in frames.json, and whose frames
-// are all still there, is not decoded again. Returns the frames folder.
+// content hash (as images are keyed: a file replaced by another of the same size and
+// modification time is decoded again) and options equal those recorded in frames.json,
+// and whose frames are all still there, is not decoded again. Returns the frames folder.
 std::filesystem::path IngestVideos(const std::vector<std::filesystem::path>& videos,
                                    const std::filesystem::path& output_dir,
                                    const VideoFrameOptions& options,

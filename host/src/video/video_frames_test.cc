@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <map>
@@ -29,7 +30,7 @@ struct TestFrame {
 // A pan across a sample photo: a 320x240 window moving kStep px per frame, with a
 // blurred copy after every third frame and the camera held still for 10 frames twice.
 // H.264 in MP4 (fourcc avc1), as phones write it.
-std::vector<TestFrame> WritePanVideo(const fs::path& file, int num_positions) {
+std::vector<TestFrame> WritePanVideo(const fs::path& file, int num_positions, int top = 200) {
   const cv::Mat photo = cv::imread(
       (testing::SourceDir() / "examples" / "fountain-P11-small" / "images" / "0005.jpg").string());
   std::vector<TestFrame> frames;
@@ -37,7 +38,7 @@ std::vector<TestFrame> WritePanVideo(const fs::path& file, int num_positions) {
                          cv::Size(320, 240));
   EXPECT_TRUE(writer.isOpened());
   for (int p = 0; p < num_positions; ++p) {
-    const cv::Mat window = photo(cv::Rect(p * kStep, 200, 320, 240)).clone();
+    const cv::Mat window = photo(cv::Rect(p * kStep, top, 320, 240)).clone();
     writer << window;
     frames.push_back({p, false});
     if (p % 3 == 1) {
@@ -142,6 +143,51 @@ TEST(VideoFrames, KeepsNoBlurredFrameAndCoversThePan) {
   for (const auto& entry : fs::directory_iterator(frames_dir / "pan"))
     num_files += entry.is_regular_file();
   EXPECT_EQ(num_files, 12u);
+}
+
+// A camera's files copied with their times kept: a video replaced by another of the same
+// size and modification time is decoded again, as videos are keyed by their content.
+TEST(VideoFrames, AVideoReplacedByAnotherOfTheSameSizeAndTimeIsDecodedAgain) {
+  const testing::TemporaryDir dir;
+  const fs::path first = dir.path() / "first.mp4", second = dir.path() / "second.mp4";
+  WritePanVideo(first, 30, 200);
+  WritePanVideo(second, 30, 0);  // the same pan, higher up the photo
+  // The same size: the shorter one padded at its end, which the demuxer ignores.
+  const uintmax_t size = std::max(fs::file_size(first), fs::file_size(second));
+  fs::resize_file(first, size);
+  fs::resize_file(second, size);
+  const fs::file_time_type time = fs::last_write_time(first);
+  const fs::path video = dir.path() / "in" / "pan.mp4";
+  fs::create_directories(video.parent_path());
+  const auto ingest = [&](const fs::path& from) {
+    if (!from.empty()) {
+      fs::copy_file(from, video, fs::copy_options::overwrite_existing);
+      fs::last_write_time(video, time);
+    }
+    std::vector<VideoFrames> results;
+    IngestVideos({video}, dir.path() / "out", {}, &results);
+    EXPECT_EQ(results.size(), 1u);
+    return results.at(0);
+  };
+  const auto first_pixels = [&](const VideoFrames& frames) {
+    return cv::imread((dir.path() / "out" / "video_frames" / frames.images.at(0)).string());
+  };
+  const VideoFrames before = ingest(first);
+  EXPECT_FALSE(before.reused);
+  const cv::Mat before_pixels = first_pixels(before);
+  EXPECT_TRUE(ingest({}).reused);  // unchanged: not decoded again
+
+  const VideoFrames after = ingest(second);
+  EXPECT_FALSE(after.reused);
+  EXPECT_NE(after.content_hash, before.content_hash);
+  const cv::Mat after_pixels = first_pixels(after);
+  ASSERT_EQ(after_pixels.size(), before_pixels.size());
+  EXPECT_GT(cv::norm(after_pixels, before_pixels, cv::NORM_L1) / after_pixels.total(), 10.0)
+      << "the first video's frames were kept";
+  const nlohmann::json record =
+      nlohmann::json::parse(ReadFileContents(dir.path() / "out" / "frames.json"));
+  EXPECT_EQ(record["videos"][0]["content_hash"], after.content_hash);
+  EXPECT_EQ(after.content_hash.size(), 32u);
 }
 
 TEST(VideoFrames, AShortVideoKeepsEveryFrame) {
