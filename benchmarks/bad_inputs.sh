@@ -266,6 +266,52 @@ else
   echo "(the failing test plugins are not built: $failing; plugin cases skipped)"
 fi
 
+# Names from outside: image names of models, databases and videos become paths; Slurm
+# values are written into batch scripts.
+t export --model "$work/w_out/sparse/0" --format colmap_text --output "$work/text_model" > /dev/null 2>&1
+bad_name_model() {  # DIR NAME: the text model with image 0001.jpg renamed NAME
+  mkdir -p "$1"; cp "$work/text_model"/*.txt "$1/"
+  NAME="$2" python3 -c 'import os, sys
+p = sys.argv[1] + "/images.txt"; lines = open(p).read().split("\n")
+lines = [l[:-len("0001.jpg")] + os.environ["NAME"] if l.endswith(" 0001.jpg") else l for l in lines]
+open(p, "w").write("\n".join(lines))' "$1"
+}
+cp "$work/w/0003.jpg" "$work/victim.jpg"
+bad_name_model "$work/abs_model" "$work/victim.jpg"
+check "model image name absolute (3DGS export)" 2 "abs_model/images.txt line [0-9]+: image [0-9]+: the image name '$work/victim.jpg' is an absolute path" \
+  'cmp -s "$work/victim.jpg" "$work/w/0003.jpg"' -- \
+  t export --model "$work/abs_model" --format gaussian_splatting --images "$work/w" --output "$work/abs_out"
+mkdir -p "$work/deep/er"; cp "$work/w/0003.jpg" "$work/deep/escaped.jpg"
+bad_name_model "$work/dotdot_model" "../escaped.jpg"
+check "model image name ../ (3DGS export)" 2 "dotdot_model/images.txt line [0-9]+: image [0-9]+: the image name '../escaped.jpg' has a '..' component" \
+  '[ ! -e "$work/deep/out/gaussian_splatting/escaped.jpg" ] && [ ! -e "$work/deep/out/escaped.jpg" ]' -- \
+  t export --model "$work/dotdot_model" --format gaussian_splatting --images "$work/deep/er" --output "$work/deep/out"
+cp -r "$work/w_out" "$work/nl_db"
+sqlite3 "$work/nl_db/database.db" "UPDATE images SET name = 'a' || char(10) || 'b.jpg' WHERE name = '0001.jpg'"
+check "database image name with a line break" 2 "nl_db/database.db': image [0-9]+: the image name 'a\\\\nb.jpg' contains a line break" "" -- \
+  t map --output "$work/nl_db" --manifest "$work/m.json"
+echo "not a video" > "$work/clip
+rm.mp4"
+check "video name with a line break" 2 "video '$work/clip\\\\nrm.mp4': the image name 'clip\\\\nrm/frame_" \
+  '[ ! -e "$work/v_out/video_frames" ]' -- \
+  run_m --video "$work/clip
+rm.mp4" --output "$work/v_out"
+for option in --partition --sbatch-arg --time; do
+  check "slurm $option with a line break" 2 "$option 'x\\\\ntouch .*pwned': holds a control character" \
+    '[ ! -e "$work/s_out" ] && [ ! -e "$work/pwned" ]' -- \
+    t slurm --images "$work/w" --output "$work/s_out" --workers 2 --dry-run --manifest "$work/m.json" \
+      "$option" "x
+touch $work/pwned"
+done
+check "slurm --output with a line break" 2 "--output '$work/s_out\\\\ntouch .*pwned': holds a control character" \
+  '[ ! -e "$work/s_out" ] && [ ! -e "$work/pwned" ]' -- \
+  t slurm --images "$work/w" --output "$work/s_out
+touch $work/pwned" --workers 2 --dry-run --manifest "$work/m.json"
+odd="$work/it's \$HOME \`id\` \"q\" #1 100%"
+check "slurm --output with quotes, \$, \` and #" 0 "slurm: wrote" \
+  '[ "$(sed -n "s/^exec [^ ]* /printf \"%s\\\\n\" /p" "$odd/slurm/map.sh" | bash | sed -n "/^--output$/{n;p}")" = "$odd" ] && grep -q "^#SBATCH --output=\"" "$odd/slurm/map.sh"' -- \
+  t slurm --images "$work/w" --output "$odd" --workers 2 --dry-run --manifest "$work/m.json"
+
 echo
 echo "inputs tried: $tried"
 echo "crashes: $crashes"

@@ -137,6 +137,7 @@ CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions&) {
             slurm.partition = options->partition;
             slurm.time = options->time;
             slurm.sbatch_args = options->sbatch_args;
+            CheckSlurmOptions(slurm);  // before anything is read or written
             // The whole manifest and every plugin are checked here, not on the cluster.
             PipelineContext context = PipelineContext::Create(slurm.manifest);
             if (!options->camera_K.empty()) {

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "database/database.h"
+#include "io/names.h"
 #include "tessera/errors.h"
 
 namespace tessera {
@@ -68,7 +69,10 @@ Image ImageFromRow(const SqliteStatement::Use& row) {
     throw InputError("Database '" + row.path().string() + "': image " +
                      std::to_string(image.image_id) + " has no name.");
   }
-  image.name = name;
+  // Every byte, so that a NUL inside the name is refused, not cut off.
+  image.name.assign(name, row.ColumnBytes(1));
+  CheckImageName(image.name,
+                 "Database '" + row.path().string() + "': image " + std::to_string(image.image_id));
   image.camera_id = static_cast<camera_t>(row.ColumnInt64(2));
   return image;
 }

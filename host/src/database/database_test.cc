@@ -539,6 +539,38 @@ TEST_F(DatabaseTest, CorruptRowsAreInputErrors) {
   EXPECT_THROW(database.ReadMatches(4, 5), InputError);
 }
 
+// A COLMAP database from elsewhere may hold any text as an image name; the names become
+// paths (image files, exports), so the unsafe ones are refused on every read, naming the
+// database, the image and the name with its control characters escaped.
+TEST_F(DatabaseTest, UnsafeImageNamesAreInputErrors) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"'/etc/passwd'", "'/etc/passwd' is an absolute path"},
+      {"'../../outside.jpg'", "'../../outside.jpg' has a '..' component"},
+      {"'a' || char(10) || 'b.jpg'", "'a\\nb.jpg' contains a line break"},
+      // A NUL inside the text: cut there, the name would read as plain 'a'.
+      {"CAST(X'610062' AS TEXT)", "'a\\0b' contains the control character \\0"},
+  };
+  {
+    Database database(DatabasePath());
+    AddCamerasAndImages(&database);
+  }
+  for (const auto& [sql_name, message] : cases) {
+    RawDatabase(DatabasePath())
+        .Exec("INSERT INTO images(image_id, name, camera_id) VALUES(9, " + sql_name + ", 1);");
+    Database database(DatabasePath());
+    const std::string expected =
+        "Database '" + DatabasePath().string() + "': image 9: the image name " + message;
+    try {
+      database.ReadAllImages();
+      ADD_FAILURE() << "expected an error for " << sql_name;
+    } catch (const InputError& error) {
+      EXPECT_EQ(std::string(error.what()).substr(0, expected.size()), expected);
+    }
+    EXPECT_EQ(database.ReadImageWithName("a.jpg")->image_id, 1u);  // the others still read
+    RawDatabase(DatabasePath()).Exec("DELETE FROM images WHERE image_id = 9;");
+  }
+}
+
 TEST_F(DatabaseTest, ImageFilesRoundTripAndDeleteImageRemovesAllItsRows) {
   Database database(DatabasePath());
   AddCamerasAndImages(&database);  // a, b on camera 1; c on camera 2

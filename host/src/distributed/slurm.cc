@@ -11,21 +11,34 @@
 #include <memory>
 #include <sstream>
 
+#include "io/names.h"
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
 
 namespace tessera {
 namespace {
 
+// `path` in a Slurm filename pattern, where % starts a replacement (%j, %a): %% is a %.
+std::string PercentEscaped(const std::string& path) {
+  std::string escaped;
+  for (const char c : path) escaped += c == '%' ? std::string("%%") : std::string(1, c);
+  return escaped;
+}
+
 std::string Header(const SlurmOptions& options, const std::string& name, bool array) {
   const std::filesystem::path logs = options.output_dir / "slurm" / "logs";
   std::string text = "#!/bin/bash\n";
   text += "#SBATCH --job-name=tessera-" + name + "\n";
-  text += "#SBATCH --output=" + (logs / (name + (array ? "-%a" : "") + "-%j.log")).string() + "\n";
+  text +=
+      "#SBATCH --output=" +
+      SbatchQuote(PercentEscaped(logs.string()) + "/" + name + (array ? "-%a" : "") + "-%j.log") +
+      "\n";
   if (options.threads > 0)
     text += "#SBATCH --cpus-per-task=" + std::to_string(options.threads) + "\n";
-  if (!options.partition.empty()) text += "#SBATCH --partition=" + options.partition + "\n";
-  if (!options.time.empty()) text += "#SBATCH --time=" + options.time + "\n";
+  if (!options.partition.empty()) {
+    text += "#SBATCH --partition=" + SbatchQuote(options.partition) + "\n";
+  }
+  if (!options.time.empty()) text += "#SBATCH --time=" + SbatchQuote(options.time) + "\n";
   // A job whose dependency failed is cancelled instead of waiting for ever.
   text += "#SBATCH --kill-on-invalid-dep=yes\n";
   for (const std::string& arg : options.sbatch_args) text += "#SBATCH " + arg + "\n";
@@ -40,7 +53,35 @@ std::string CommonArgs(const SlurmOptions& options) {
   return args;
 }
 
+void CheckScriptValue(const std::string& option, const std::string& value) {
+  if (!HasControlCharacter(value)) return;
+  throw InputError(option + " '" + EscapeControlCharacters(value) +
+                   "': holds a control character; a value written into the Slurm batch "
+                   "scripts must be one line of text.");
+}
+
 }  // namespace
+
+void CheckSlurmOptions(const SlurmOptions& options) {
+  CheckScriptValue("the tessera executable", options.tessera.string());
+  CheckScriptValue("--images", options.image_dir.string());
+  CheckScriptValue("--output", options.output_dir.string());
+  CheckScriptValue("--manifest", options.manifest.string());
+  CheckScriptValue("--camera-K", options.camera_K.string());
+  CheckScriptValue("--partition", options.partition);
+  CheckScriptValue("--time", options.time);
+  for (const std::string& arg : options.sbatch_args) CheckScriptValue("--sbatch-arg", arg);
+}
+
+std::string SbatchQuote(const std::string& word) {
+  if (!word.empty() && word.find_first_of(" \t\v\f\"'\\#") == std::string::npos) return word;
+  std::string quoted = "\"";
+  for (const char c : word) {
+    if (c == '"' || c == '\\') quoted += '\\';
+    quoted += c;
+  }
+  return quoted + "\"";
+}
 
 std::string ShellQuote(const std::string& word) {
   std::string quoted = "'";
@@ -60,6 +101,7 @@ std::string ArraySpec(const std::vector<int>& indices) {
 }
 
 std::vector<SlurmScript> MakeSlurmScripts(const SlurmOptions& options, const SlurmPlan& plan) {
+  CheckSlurmOptions(options);
   const std::string tessera = ShellQuote(options.tessera.string());
   const std::string images = ShellQuote(options.image_dir.string());
   const std::string n = std::to_string(options.workers);

@@ -39,7 +39,14 @@ struct SlurmScript {
   std::string text;
 };
 
-// The scripts for `plan` (the absolute paths of options are used as given).
+// Throws InputError naming the option (--output, --partition, --sbatch-arg, ...) and its
+// value, control characters escaped, when a value written into the batch scripts holds a
+// control character: a line break would end its #SBATCH line, and what follows would run
+// as shell lines or stop sbatch reading the #SBATCH lines after it.
+void CheckSlurmOptions(const SlurmOptions& options);
+
+// The scripts for `plan` (the absolute paths of options are used as given). Calls
+// CheckSlurmOptions first.
 std::vector<SlurmScript> MakeSlurmScripts(const SlurmOptions& options, const SlurmPlan& plan);
 
 // "0-3", or "0,2,5" for a rerun.
@@ -47,6 +54,11 @@ std::string ArraySpec(const std::vector<int>& indices);
 
 // Quotes a word for bash.
 std::string ShellQuote(const std::string& word);
+
+// Quotes a word for an #SBATCH line as sbatch splits it (whitespace between arguments,
+// quotes group, a backslash escapes, an unquoted # starts a comment): as it is when it
+// holds none of those, else in double quotes with \ and " escaped.
+std::string SbatchQuote(const std::string& word);
 
 // Writes the scripts (executable) into OUTPUT/slurm/ and creates OUTPUT/slurm/logs/.
 // Throws InputError naming the path it cannot write.

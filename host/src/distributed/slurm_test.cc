@@ -3,8 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <functional>
 
 #include "pipeline/stage_test_util.h"
+#include "tessera/errors.h"
 
 namespace tessera {
 namespace {
@@ -43,6 +45,73 @@ TEST(Slurm, ArraySpecs) {
 TEST(Slurm, ShellQuoting) {
   EXPECT_EQ(ShellQuote("/a b/c"), "'/a b/c'");
   EXPECT_EQ(ShellQuote("it's"), "'it'\\''s'");
+}
+
+// A line break in any value would end its #SBATCH line: what follows would run as a
+// shell line, and the #SBATCH lines after it (--kill-on-invalid-dep) would not count.
+TEST(Slurm, ControlCharactersInAnyScriptValueAreRefusedNamingTheOption) {
+  struct Case {
+    std::string option;
+    std::function<void(SlurmOptions*)> change;
+    std::string shown;  // the value in the message
+  };
+  const std::vector<Case> cases = {
+      {"--partition", [](SlurmOptions* o) { o->partition = "cpu\ntouch /tmp/pwned"; },
+       "'cpu\\ntouch /tmp/pwned'"},
+      {"--time", [](SlurmOptions* o) { o->time = "01:00:00\r"; }, "'01:00:00\\r'"},
+      {"--sbatch-arg", [](SlurmOptions* o) { o->sbatch_args.push_back("--qos=x\ntouch y"); },
+       "'--qos=x\\ntouch y'"},
+      {"--output", [](SlurmOptions* o) { o->output_dir = "/shared/out\ntouch y"; },
+       "'/shared/out\\ntouch y'"},
+      {"--images", [](SlurmOptions* o) { o->image_dir = "/shared/\x1b[2J"; }, "'/shared/\\x1b[2J'"},
+      {"--manifest", [](SlurmOptions* o) { o->manifest = "/shared/m\t.json"; },
+       "'/shared/m\\t.json'"},
+      {"--camera-K", [](SlurmOptions* o) { o->camera_K = "/shared/K\n.txt"; },
+       "'/shared/K\\n.txt'"},
+      {"the tessera executable", [](SlurmOptions* o) { o->tessera = "/opt/t\nessera"; },
+       "'/opt/t\\nessera'"},
+  };
+  for (const Case& c : cases) {
+    SlurmOptions options = Options();
+    c.change(&options);
+    try {
+      MakeSlurmScripts(options, {{0}, {0}});
+      ADD_FAILURE() << "expected InputError for " << c.option;
+    } catch (const InputError& error) {
+      EXPECT_EQ(std::string(error.what()),
+                c.option + " " + c.shown +
+                    ": holds a control character; a value written into the Slurm batch scripts "
+                    "must be one line of text.");
+    }
+  }
+}
+
+// Paths are one word however they are spelt: in the shell lines (bash runs them here,
+// printing its arguments) and in the #SBATCH --output line (sbatch's own quoting, and
+// %% for a % of the path, which Slurm would take for a replacement).
+TEST(Slurm, PathsWithSpacesQuotesAndDollarsStayOneWord) {
+  SlurmOptions options = Options();
+  options.image_dir = "/shared/my photos/it's $HOME `id` \"q\" \\ #1";
+  options.output_dir = "/shared/out $(id) 100%";
+  options.camera_K = "/shared/K file.txt";
+  const std::string extract = Named(MakeSlurmScripts(options, {{0, 1}, {0, 1}}), "extract").text;
+  EXPECT_TRUE(
+      Has(extract, "#SBATCH --output=\"/shared/out $(id) 100%%/slurm/logs/extract-%a-%j.log\"\n"))
+      << extract;
+  const std::string exec = "exec '/opt/tessera/bin/tessera' ";
+  const size_t begin = extract.find(exec);
+  ASSERT_NE(begin, std::string::npos) << extract;
+  const std::string command =
+      "SLURM_ARRAY_TASK_ID=1; printf '%s\\n' " + extract.substr(begin + exec.size());
+  const testing::CommandResult printed = testing::RunCommand("bash -c", ShellQuote(command));
+  EXPECT_EQ(printed.exit_code, 0) << printed.output;
+  EXPECT_EQ(printed.output, "extract\n--images\n" + options.image_dir.string() + "\n--output\n" +
+                                options.output_dir.string() +
+                                "\n--manifest\n/shared/m.json\n--threads\n8\n--camera-K\n"
+                                "/shared/K file.txt\n--shard\n1/4\n");
+  EXPECT_EQ(SbatchQuote("cpu"), "cpu");
+  EXPECT_EQ(SbatchQuote("a b\"c\\d#"), "\"a b\\\"c\\\\d#\"");
+  EXPECT_EQ(SbatchQuote(""), "\"\"");
 }
 
 TEST(Slurm, FiveScriptsInOrderWithArraysAndOptions) {
@@ -126,6 +195,25 @@ TEST_F(DistributedArguments, AShardOutsideTheRangeIsExit2) {
   EXPECT_FALSE(std::filesystem::exists(dir_.path() / "out" / "shards"));
   const auto workers = Tessera("slurm --images " + images + " --output " + out + " --workers 0");
   EXPECT_EQ(workers.exit_code, 2) << workers.output;
+}
+
+TEST_F(DistributedArguments, ALineBreakInAnOptionIsExit2BeforeAnythingIsWritten) {
+  const std::string images = (dir_.path() / "images").string();
+  const std::string out = (dir_.path() / "out").string();
+  for (const std::string option : {"--partition", "--sbatch-arg", "--time"}) {
+    const auto result =
+        Tessera("slurm --images " + images + " --output " + out + " --workers 2 --dry-run " +
+                option + " " + ShellQuote("x\ntouch " + (dir_.path() / "pwned").string()));
+    EXPECT_EQ(result.exit_code, 2) << result.output;
+    EXPECT_TRUE(Has(result.output, option + " 'x\\ntouch ")) << result.output;
+  }
+  const auto output = Tessera("slurm --images " + images + " --output " + ShellQuote(out + "\nx") +
+                              " --workers 2 --dry-run");
+  EXPECT_EQ(output.exit_code, 2) << output.output;
+  EXPECT_TRUE(Has(output.output, "--output '" + out + "\\nx': holds a control character"))
+      << output.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_.path() / "out"));
+  EXPECT_FALSE(std::filesystem::exists(dir_.path() / "pwned"));
 }
 
 TEST_F(DistributedArguments, SbatchMissingIsExit2SuggestingDryRun) {

@@ -14,6 +14,7 @@
 #include <optional>
 #include <system_error>
 
+#include "io/names.h"
 #include "tessera/errors.h"
 #include "tessera/io/image_io.h"
 #include "util/strings.h"
@@ -33,13 +34,6 @@ bool HasImageExtension(const fs::path& path) {
 bool IsHidden(const fs::path& path) {
   const std::string name = path.filename().string();
   return !name.empty() && name[0] == '.';
-}
-
-// A name on one line: its line breaks written as \n and \r.
-std::string OneLine(const std::string& name) {
-  std::string shown;
-  for (const char c : name) shown += c == '\n' ? "\\n" : c == '\r' ? "\\r" : std::string(1, c);
-  return shown;
 }
 
 std::string ContentHash(const Bytes& bytes) {
@@ -189,7 +183,7 @@ using SkippedEntries = std::vector<std::pair<std::string, std::string>>;  // nam
 bool SkipFolder(const fs::directory_entry& entry, const std::string& name,
                 const ScanExclusions& exclusions, ImageScan* scan, SkippedEntries* skipped) {
   const fs::path& path = entry.path();
-  const std::string folder = "Skipped the folder '" + OneLine(name) + "': ";
+  const std::string folder = "Skipped the folder '" + EscapeControlCharacters(name) + "': ";
   std::error_code error;
   const fs::path canonical = fs::weakly_canonical(path, error);
   const auto& excluded = exclusions.excluded;
@@ -227,8 +221,9 @@ bool SkipFolder(const fs::directory_entry& entry, const std::string& name,
 // not used.
 std::optional<ImageEntry> ReadImageEntry(const std::string& name, const fs::path& path,
                                          int64_t max_image_pixels, std::string* problem) {
-  if (name.find_first_of("\r\n") != std::string::npos) {
-    *problem = "the name contains a line break, which a COLMAP text model cannot hold";
+  // The check every image name from outside passes (models, databases, videos).
+  if (const std::string why = ImageNameProblem(name); !why.empty()) {
+    *problem = "the name " + why;
     return std::nullopt;
   }
   const std::optional<Bytes> bytes = ReadRegularFile(path, problem);
@@ -309,7 +304,7 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
   std::stable_sort(skipped.begin(), skipped.end(),
                    [](const auto& a, const auto& b) { return NaturalLess(a.first, b.first); });
   for (const auto& [name, why] : skipped) {
-    scan.warnings.push_back("Skipped '" + OneLine(name) + "': " + why + ".");
+    scan.warnings.push_back("Skipped '" + EscapeControlCharacters(name) + "': " + why + ".");
   }
   return scan;
 }

@@ -339,6 +339,8 @@ TEST(ScanImageFolder, RecordsSizeAndContentHashAndRefusesOversizedOrLineBrokenNa
   fs::copy_file(dir.path() / "a.png", dir.path() / "b.png");
   Write(dir.path() / "c.png", Pattern(40, 30));
   fs::copy_file(dir.path() / "a.png", dir.path() / "line\nbreak.png");
+  // Any control character: the model and database readers refuse such names.
+  fs::copy_file(dir.path() / "a.png", dir.path() / "escape\x1b.png");
   Write(dir.path() / "big.png", Pattern(50, 30));
   ImageScanOptions options;
   options.max_image_pixels = 1200;  // 40x30 passes, 50x30 does not
@@ -348,10 +350,12 @@ TEST(ScanImageFolder, RecordsSizeAndContentHashAndRefusesOversizedOrLineBrokenNa
   EXPECT_EQ(scan.images[0].content_hash.size(), 32u);
   EXPECT_EQ(scan.images[0].content_hash, scan.images[1].content_hash);  // same bytes
   EXPECT_NE(scan.images[0].content_hash, scan.images[2].content_hash);
-  ASSERT_EQ(scan.warnings.size(), 2u);
+  ASSERT_EQ(scan.warnings.size(), 3u);
   EXPECT_EQ(scan.warnings[0],
             "Skipped 'big.png': 50x30 pixels is over the limit of 1200 (max_image_pixels).");
   EXPECT_EQ(scan.warnings[1],
+            "Skipped 'escape\\x1b.png': the name contains the control character \\x1b.");
+  EXPECT_EQ(scan.warnings[2],
             "Skipped 'line\\nbreak.png': the name contains a line break, which a COLMAP text "
             "model cannot hold.");
 }

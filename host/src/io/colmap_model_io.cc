@@ -12,6 +12,7 @@
 #include <system_error>
 #include <type_traits>
 
+#include "names.h"
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
 
@@ -165,6 +166,7 @@ void ReadImagesBinary(const fs::path& path, Reconstruction* reconstruction,
     }
     image.camera_id = reader.Read<camera_t>("the camera id of " + what);
     image.name = reader.ReadString("the name of " + what);
+    CheckImageName(image.name, path.string() + ": " + what);
     image.registered = true;
     const uint64_t num_points2D =
         reader.ReadCount(kPoint2DBinaryBytes, "2D points of " + what + " (" + image.name + ")");
@@ -349,6 +351,8 @@ void ReadImagesText(const fs::path& path, Reconstruction* reconstruction,
     image.camera_id = line.Parse<camera_t>(8, "camera id");
     if (line.NumFields() < 10) line.Fail("missing image name");
     image.name = line.Rest(9);
+    CheckImageName(image.name, path.string() + " line " + std::to_string(reader.line_number()) +
+                                   ": image " + std::to_string(image.image_id));
     image.registered = true;
 
     if (!reader.NextRaw()) {

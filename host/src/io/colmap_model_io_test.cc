@@ -519,6 +519,44 @@ TEST(ColmapModelIo, NonFiniteNumbersAndZeroRotationsAreRefusedNamingBinaryRecord
                  ": the error of 3D point 1000: nan is not a finite number.");
 }
 
+// Image names become paths below the image and output folders (the gaussian_splatting
+// exporter writes images/<name>): absolute names, '..' and control characters are
+// refused, naming the file, the image and the name with its control characters escaped.
+TEST(ColmapModelIo, UnsafeImageNamesAreRefusedInBothFormats) {
+  const std::pair<std::string, std::string> cases[] = {
+      {"/tmp/overwritten.jpg",
+       "'/tmp/overwritten.jpg' is an absolute path; image names are relative to the image "
+       "folder."},
+      {"../../outside.jpg",
+       "'../../outside.jpg' has a '..' component, which leads out of the image folder."},
+      {"sub/../../outside.jpg",
+       "'sub/../../outside.jpg' has a '..' component, which leads out of the image folder."},
+      {"bell\x07.jpg", "'bell\\x07.jpg' contains the control character \\x07."},
+      {"line\nbreak.jpg",
+       "'line\\nbreak.jpg' contains a line break, which a COLMAP text model cannot hold."},
+  };
+  for (const auto& [name, message] : cases) {
+    Reconstruction reconstruction = RegisteredOnly(SyntheticReconstruction());
+    reconstruction.images.at(2).name = name;
+    for (const ColmapModelFormat format : {ColmapModelFormat::kBinary, ColmapModelFormat::kText}) {
+      // A line break cannot be written into a text model: the name ends its line there.
+      if (format == ColmapModelFormat::kText && name.find('\n') != std::string::npos) continue;
+      TemporaryDir dir;
+      WriteColmapModel(reconstruction, dir.path(), format);
+      const bool binary = format == ColmapModelFormat::kBinary;
+      // The text model writes image 1 on lines 5 and 6, image 2 on line 7.
+      const std::string where = binary ? (dir.path() / "images.bin").string() + ": image 2"
+                                       : (dir.path() / "images.txt").string() + " line 7: image 2";
+      try {
+        ReadColmapModel(dir.path());
+        ADD_FAILURE() << "expected InputError for " << name;
+      } catch (const InputError& error) {
+        EXPECT_EQ(std::string(error.what()), where + ": the image name " + message);
+      }
+    }
+  }
+}
+
 // --- COLMAP's own files -----------------------------------------------------------
 
 class ColmapAnchorTest : public ::testing::TestWithParam<std::string> {

@@ -15,6 +15,7 @@
 #include <optional>
 #include <set>
 
+#include "io/names.h"
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
 #include "tessera/options.h"
@@ -148,6 +149,7 @@ std::optional<VideoFrames> Reuse(const nlohmann::json& recorded, const VideoFram
         if (frame.at("selected").get<bool>()) {
           result.selection.selected.push_back(result.frames.size() - 1);
           result.images.push_back(frame.at("image").get<std::string>());
+          CheckImageName(result.images.back(), (frames_dir.parent_path() / "frames.json").string());
           std::error_code error;
           if (!fs::is_regular_file(frames_dir / result.images.back(), error)) return std::nullopt;
         }
@@ -308,6 +310,10 @@ fs::path IngestVideos(const std::vector<fs::path>& videos, const fs::path& outpu
     for (int k = 2; folders.count(folder); ++k)
       folder = video.stem().string() + "_" + std::to_string(k);
     folders.insert(folder);
+    // Its frames are images named <folder>/frame_...jpg: a control character in the
+    // video's name would be in every one of them.
+    CheckImageName(folder + "/" + VideoFrameName(0, 0),
+                   "video '" + EscapeControlCharacters(video.string()) + "'");
     VideoFrames probe;
     probe.video = video;
     probe.folder = folder;

@@ -220,6 +220,43 @@ TEST(VideoFrames, AnUnreadableOrEmptyVideoIsAnInputErrorNamingTheFile) {
             0u);
 }
 
+// A video's frames are images named <video stem>/frame_...jpg: a line break in the
+// video's name would be in each of them (a COLMAP text model cannot hold it).
+TEST(VideoFrames, AControlCharacterInAVideoNameIsAnInputError) {
+  const testing::TemporaryDir dir;
+  const fs::path video = dir.path() / "pan\nrm.mp4";
+  try {
+    IngestVideos({video}, dir.path() / "out", {});
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "video '" + dir.path().string() +
+                  "/pan\\nrm.mp4': the image name 'pan\\nrm/frame_000000_0.000s.jpg' contains "
+                  "a line break, which a COLMAP text model cannot hold.");
+  }
+}
+
+// frames.json is read back to reuse a selection: the image names it holds are checked as
+// every image name from outside is.
+TEST(VideoFrames, AnUnsafeImageNameInFramesJsonIsAnInputError) {
+  const testing::TemporaryDir dir;
+  WritePanVideo(dir.path() / "short.mp4", 4);
+  IngestVideos({dir.path() / "short.mp4"}, dir.path(), {});
+  const fs::path record_file = dir.path() / "frames.json";
+  nlohmann::json record = nlohmann::json::parse(ReadFileContents(record_file));
+  record["videos"][0]["frames"][0]["image"] = "../../outside.jpg";
+  WriteFileAtomically(record_file, record.dump(2));
+  try {
+    IngestVideos({dir.path() / "short.mp4"}, dir.path(), {});
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              record_file.string() +
+                  ": the image name '../../outside.jpg' has a '..' component, which leads out "
+                  "of the image folder.");
+  }
+}
+
 TEST(VideoFrames, OptionsComeFromTheManifestsVideoObject) {
   const VideoFrameOptions options = VideoFrameOptions::FromJson(
       {{"min_frames", 5}, {"max_frames", 50}, {"target_frames", 20}, {"analysis_size", 320}});

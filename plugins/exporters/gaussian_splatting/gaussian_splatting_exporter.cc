@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -188,6 +189,55 @@ std::filesystem::path FindMask(const std::filesystem::path& dir, const std::stri
   return {};
 }
 
+// `name` with its control characters escaped (\n, \r, \t, \0, else \xHH), for a
+// message on one line.
+std::string Printable(const std::string& name) {
+  std::string printable;
+  for (const char c : name) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte != 0x7f) {
+      printable += c;
+    } else if (c == '\n' || c == '\r' || c == '\t' || c == '\0') {
+      printable += c == '\n' ? "\\n" : c == '\r' ? "\\r" : c == '\t' ? "\\t" : "\\0";
+    } else {
+      char escaped[5];
+      std::snprintf(escaped, sizeof(escaped), "\\x%02x", byte);
+      printable += escaped;
+    }
+  }
+  return printable;
+}
+
+// Why the image name `name` cannot be a path below a folder; empty when it can. It may
+// not resolve outside the folder (absolute, more '..' than folders), hold a NUL (which
+// cuts the path short) or name the folder itself.
+std::string WhyNotBelowFolder(const std::string& name) {
+  const std::filesystem::path path(name);
+  const std::filesystem::path normal = path.lexically_normal();
+  if (name.find('\0') != std::string::npos) return "holds a NUL, which cuts the path short";
+  if (path.has_root_path() || (!normal.empty() && *normal.begin() == "..")) {
+    return "would be written outside this folder";
+  }
+  if (normal.empty() || normal.filename().empty() || normal.filename() == ".") {
+    return "names no file";
+  }
+  return "";
+}
+
+// Image names become paths below OUTPUT/<folder>/images and masks: each is checked before
+// anything is written. The model readers refuse unsafe names already; this guards
+// models that reach the exporter by another way.
+void CheckImageNames(const Reconstruction& reconstruction, const std::filesystem::path& root) {
+  for (const auto& [image_id, image] : reconstruction.images) {
+    if (!image.registered) continue;
+    const std::string why = WhyNotBelowFolder(image.name);
+    if (!why.empty()) {
+      throw InputError((root / "images").string() + ": image " + std::to_string(image_id) +
+                       " has the name '" + Printable(image.name) + "', which " + why);
+    }
+  }
+}
+
 }  // namespace
 
 class GaussianSplattingExporter : public Exporter {
@@ -224,6 +274,7 @@ class GaussianSplattingExporter : public Exporter {
                        ": the gaussian_splatting exporter needs the image folder to undistort "
                        "(tessera export --images DIR)");
     }
+    CheckImageNames(reconstruction, root);
     Reconstruction undistorted = reconstruction;
     for (auto& [camera_id, camera] : undistorted.cameras) {
       // A camera without distortion loses nothing: it is kept as it is in both modes.

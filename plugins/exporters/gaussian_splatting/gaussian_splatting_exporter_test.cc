@@ -181,12 +181,17 @@ TEST(GaussianSplattingExporter, FullFieldKeepsEveryPixelOfAFisheyeImageCircle) {
   ExportContext context;
   context.output_dir = output.path();
   context.image_dir = images.path();
-  testing::Unguarded(testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting",
-                                       {{"folder", "full"}, {"field_of_view", "full"}})).Export(model, context);
-  testing::Unguarded(testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting", {{"folder", "crop"}})).Export(model, context);
+  testing::Unguarded(
+      testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting",
+                                           {{"folder", "full"}, {"field_of_view", "full"}}))
+      .Export(model, context);
+  testing::Unguarded(
+      testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting", {{"folder", "crop"}}))
+      .Export(model, context);
   testing::Unguarded(testing::LoadBundledPlugin<Exporter>(
-      "exporter", "gaussian_splatting",
-      {{"folder", "circle"}, {"field_of_view", "full"}, {"max_ray_angle", 75}})).Export(model, context);
+                         "exporter", "gaussian_splatting",
+                         {{"folder", "circle"}, {"field_of_view", "full"}, {"max_ray_angle", 75}}))
+      .Export(model, context);
 
   // How many circle pixels land outside `pinhole`'s image, or (with a mask) on black.
   const auto count_lost = [&](const Camera& pinhole, const cv::Mat& mask) {
@@ -353,6 +358,47 @@ TEST(GaussianSplattingExporter, FolderOptionAndErrorsNameTheFile) {
   EXPECT_TRUE(fs::is_regular_file(output.path() / "3dgs_1" / "images" / "img_2.png"));
   EXPECT_EQ(ReadColmapModel(output.path() / "3dgs_1" / "sparse" / "0").cameras.at(1).params,
             (std::vector<double>{50, 50, 20, 15}));
+}
+
+// Image names are paths below OUTPUT/<folder>/images: an absolute name would overwrite
+// that file (here the source image itself), a '../' name would write outside the output
+// folder. Each is refused naming the image, before anything is written.
+TEST(GaussianSplattingExporter, ImageNamesOutsideTheFolderAreRefused) {
+  const Camera camera = Camera::Create(1, CameraModelId::kSimplePinhole, 50, 40, 30);
+  testing::TemporaryDir dir;
+  const fs::path images = dir.path() / "in" / "images", output = dir.path() / "out";
+  fs::create_directories(images);
+  const cv::Mat pixels(30, 40, CV_8UC3, cv::Scalar(9));
+  cv::imwrite((images / "img_1.png").string(), pixels);
+  cv::imwrite((dir.path() / "escaped.png").string(), pixels);  // images/../../escaped.png
+  cv::imwrite((dir.path() / "absolute.png").string(), pixels);
+  const auto absolute_time = fs::last_write_time(dir.path() / "absolute.png");
+  auto exporter = testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting");
+  ExportContext context;
+  context.output_dir = output;
+  context.image_dir = images;
+  const std::pair<std::string, std::string> cases[] = {
+      {"../../escaped.png", "'../../escaped.png', which would be written outside this folder"},
+      {(dir.path() / "absolute.png").string(), "'" + (dir.path() / "absolute.png").string() +
+                                                   "', which would be written outside this folder"},
+      {"sub/..", "'sub/..', which names no file"},
+      {std::string("img_1.png\0/../../x", 18),
+       "'img_1.png\\0/../../x', which holds a NUL, which cuts the path short"},
+  };
+  for (const auto& [name, message] : cases) {
+    Reconstruction model = testing::MakeSyntheticModel(camera, 2, 40);
+    model.images.at(2).name = name;
+    try {
+      testing::Unguarded(exporter).Export(model, context);
+      ADD_FAILURE() << "expected InputError for " << name;
+    } catch (const InputError& error) {
+      EXPECT_EQ(std::string(error.what()), (output / "gaussian_splatting" / "images").string() +
+                                               ": image 2 has the name " + message);
+    }
+  }
+  EXPECT_FALSE(fs::exists(output / "escaped.png"));
+  EXPECT_FALSE(fs::exists(output / "gaussian_splatting"));                     // nothing written
+  EXPECT_EQ(fs::last_write_time(dir.path() / "absolute.png"), absolute_time);  // not replaced
 }
 
 // COLMAP's model of fountain-P11 (SIMPLE_RADIAL) and the full-resolution images.
