@@ -98,7 +98,7 @@ GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
   model_panel_ = std::make_unique<ModelPanel>(view_.get(), options.model);
   // A run's models replace the ones opened.
   setup_ =
-      std::make_unique<SetupPanel>(RunRequest{options.images, options.output, options.manifest},
+      std::make_unique<SetupPanel>(RunRequest{options.images, options.output, options.manifest, {}},
                                    options.follow_run, controller_.get(), [this]() {
                                      view_->ForgetPicks();
                                      model_panel_->ForgetModels();

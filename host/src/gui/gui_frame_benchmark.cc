@@ -105,7 +105,7 @@ void BM_CancelDuringMatching(benchmark::State& state) {
   };
   for (auto _ : state) {
     controller.Start({dir.path() / "images", dir.path() / ("out" + std::to_string(runs++)),
-                      dir.path() / "manifest.json"});
+                      dir.path() / "manifest.json", {}});
     while (controller.Running() && !matching()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }

@@ -27,7 +27,9 @@ void ManifestEditorPanel::SetText(const std::string& text) {
 
 bool ManifestEditorPanel::Load() {
   error_.clear();
+  status_.clear();
   const PathField& manifest = *manifest_field_;
+  loaded_from_ = manifest.data();
   const fs::path file = manifest[0] != '\0' ? fs::path(manifest.data()) : DefaultManifestFile();
   try {
     const std::string text = ReadFileContents(file);
@@ -77,8 +79,13 @@ bool ManifestEditorPanel::Save(const fs::path& file) {
     return false;
   }
   SetPathField(file, manifest_field_);
-  status_ = "saved " + file.string() + "; Run uses it";
+  loaded_from_ = manifest_field_->data();
+  status_ = "saved " + file.string();
   return true;
+}
+
+void ManifestEditorPanel::FollowManifestField() {
+  if (Loaded() && loaded_from_ != manifest_field_->data()) Load();
 }
 
 bool ManifestEditorPanel::SetPlugin(const std::string& slot, const std::string& plugin) {
@@ -109,7 +116,7 @@ void ManifestEditorPanel::FindPlugins() {
 void ManifestEditorPanel::Draw(WidgetRects* widgets) {
   if (!ImGui::CollapsingHeader("Pipeline: plugins and options (manifest editor)")) return;
   widgets->RecordLastItem("manifest editor");
-  if (text_[0] == '\0') Load();
+  if (!Loaded()) Load();
   if (plugins_by_kind_.empty()) FindPlugins();
   // One plugin per slot, from the plugins found on the plugin path.
   for (const auto& [kind, names] : plugins_by_kind_) {
@@ -121,8 +128,12 @@ void ManifestEditorPanel::Draw(WidgetRects* widgets) {
       ImGui::EndCombo();
     }
   }
-  ImGui::InputTextMultiline("##manifest json", text_.data(), text_.size(),
-                            ImVec2(-1, ImGui::GetTextLineHeight() * 12));
+  if (ImGui::InputTextMultiline("##manifest json", text_.data(), text_.size(),
+                                ImVec2(-1, ImGui::GetTextLineHeight() * 12))) {
+    status_.clear();  // a "valid" or "saved" no longer describes the text
+    error_.clear();
+  }
+  ImGui::TextDisabled("Run uses this text; saving is optional");
   if (ImGui::Button("Check")) Check();
   ImGui::SameLine();
   if (ImGui::Button("Reload")) Load();

@@ -4,7 +4,8 @@
 // a text box (loaded from the manifest field's file, or the default manifest), one plugin
 // per slot chosen from the plugins found on the plugin path, Check (as `tessera run`
 // does: parsed, every plugin created with its options), Reload, and Save as, which makes
-// the saved file the run's manifest.
+// the saved file the manifest field's. Once loaded, the editor's text is what Run runs;
+// it is reloaded when the manifest field names another file.
 
 #include <filesystem>
 #include <map>
@@ -27,11 +28,17 @@ class ManifestEditorPanel {
   bool Load();
   // Checks the editor's JSON as `tessera run` does.
   bool Check();
-  // Saves the editor's JSON to `file` (after checking) and makes it the run's manifest.
+  // Saves the editor's JSON to `file` (after checking) and sets the manifest field to it.
   bool Save(const std::filesystem::path& file);
   // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "bundle_adjuster")
   // in the editor's JSON, with no options.
   bool SetPlugin(const std::string& slot, const std::string& plugin);
+
+  // Reloads the editor when the manifest field no longer names the file it was loaded
+  // from, clearing the messages of the old file.
+  void FollowManifestField();
+  // Whether the editor holds a manifest (it is loaded when first opened).
+  bool Loaded() const { return text_[0] != '\0'; }
 
   void SetText(const std::string& text);
   std::string Text() const { return text_.data(); }
@@ -49,6 +56,7 @@ class ManifestEditorPanel {
   std::vector<char> text_ = std::vector<char>(1 << 16, '\0');
   PathField save_path_{};
   std::string error_, status_;
+  std::string loaded_from_;  // the manifest field's value when last loaded or saved
   std::map<std::string, std::vector<std::string>> plugins_by_kind_;
 };
 

@@ -8,13 +8,35 @@
 #include <algorithm>
 #include <cerrno>
 
+#include <nlohmann/json.hpp>
+
+#include "manifest/manifest.h"
 #include "pipeline/pipeline_context.h"
 #include "pipeline/run_pipeline.h"
 #include "plugin/plugin_call.h"
 #include "tessera/errors.h"
 #include "util/exit_codes.h"
+#include "util/paths.h"
 
 namespace tessera::gui {
+namespace {
+
+// The request's manifest: the editor's JSON when given, else the manifest file.
+PipelineContext CreateContext(const RunRequest& request) {
+  if (request.manifest_json.empty()) return PipelineContext::Create(request.manifest_file);
+  const std::filesystem::path file =
+      request.manifest_file.empty() ? DefaultManifestFile() : request.manifest_file;
+  nlohmann::json json;
+  try {
+    json = nlohmann::json::parse(request.manifest_json);
+  } catch (const nlohmann::json::parse_error& error) {
+    throw InputError(std::string("the manifest editor: invalid JSON: ") + error.what());
+  }
+  return PipelineContext::Create(
+      Manifest::FromJson(json, file.parent_path(), "the manifest editor"));
+}
+
+}  // namespace
 
 const char* RunStateName(RunState state) {
   switch (state) {
@@ -144,7 +166,7 @@ void RunController::Work(RunRequest request) {
   size_t num_models = 0;
   int exit_code = kExitInternalError;
   try {
-    const PipelineContext context = PipelineContext::Create(request.manifest_file);
+    const PipelineContext context = CreateContext(request);
     context.LimitLibraryThreads();
     const RunResult result = RunPipeline(context, {request.image_dir, request.output_dir}, control);
     num_models = result.summary.map.num_models;

@@ -24,6 +24,9 @@ struct RunRequest {
   std::filesystem::path image_dir;
   std::filesystem::path output_dir;
   std::filesystem::path manifest_file;  // empty: the default manifest
+  // Not empty: the manifest editor's JSON, run in place of manifest_file's contents
+  // (whose folder still resolves the manifest's relative paths).
+  std::string manifest_json;
 };
 
 struct StageProgress {

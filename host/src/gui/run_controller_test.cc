@@ -29,7 +29,7 @@ TEST(RunController, RunsThePipelineBelowTheWindowsPriority) {
     worker_niceness = ThreadNiceness();
     ++num_worker_calls;
   });
-  ASSERT_TRUE(controller.Start({dir.path() / "no such folder", dir.path() / "out", {}}));
+  ASSERT_TRUE(controller.Start({dir.path() / "no such folder", dir.path() / "out", {}, {}}));
   controller.Join();
   EXPECT_EQ(controller.Status().state, RunState::kFailed);
   ASSERT_GT(num_worker_calls.load(), 0);

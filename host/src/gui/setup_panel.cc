@@ -82,7 +82,10 @@ bool SetupPanel::CheckFields() {
     images_error_ = images.string() + ": no images in this folder (JPEG, PNG, TIFF, BMP, WebP)";
   }
   if (output_[0] == '\0') error_ = "choose an output folder (the workspace)";
-  if (!manifest.empty()) {
+  if (editor_.Loaded()) {
+    // The editor's text is the run's manifest: checked as `tessera run` would.
+    if (!editor_.Check()) manifest_error_ = editor_.Error();
+  } else if (!manifest.empty()) {
     try {
       Manifest::Load(manifest);
     } catch (const InputError& exception) {
@@ -102,8 +105,10 @@ bool SetupPanel::Run() {
     return false;
   }
   before_start_();
-  if (!controller_->Start(
-          {fs::path(images_.data()), fs::path(output_.data()), fs::path(manifest_.data())})) {
+  RunRequest request{fs::path(images_.data()), fs::path(output_.data()),
+                     fs::path(manifest_.data()), {}};
+  if (editor_.Loaded()) request.manifest_json = editor_.Text();
+  if (!controller_->Start(request)) {
     error_ = "a run is going on";
     return false;
   }
@@ -121,17 +126,28 @@ void SetupPanel::Draw(const RunStatus& status, WidgetRects* widgets) {
 
 void SetupPanel::DrawFields(WidgetRects* widgets) {
   ImGui::PushItemWidth(-110);
-  ImGui::InputTextWithHint("Images", "folder of photographs", images_.data(), images_.size());
+  // A field's message is about the text that was checked: editing the field clears it.
+  if (ImGui::InputTextWithHint("Images", "folder of photographs", images_.data(),
+                               images_.size())) {
+    images_error_.clear();
+  }
   widgets->RecordLastItem("images");
   ImGui::SameLine();
   browser_.Draw("images", &images_, widgets);
   ErrorText(images_error_);
-  ImGui::InputTextWithHint("Output", "workspace folder", output_.data(), output_.size());
+  if (ImGui::InputTextWithHint("Output", "workspace folder", output_.data(), output_.size())) {
+    error_.clear();
+  }
   widgets->RecordLastItem("output");
   ImGui::SameLine();
   browser_.Draw("output", &output_, widgets);
-  ImGui::InputTextWithHint("Manifest", "default manifest", manifest_.data(), manifest_.size());
+  if (ImGui::InputTextWithHint("Manifest", "default manifest", manifest_.data(),
+                               manifest_.size())) {
+    manifest_error_.clear();
+    error_.clear();
+  }
   widgets->RecordLastItem("manifest");
+  editor_.FollowManifestField();
   ErrorText(manifest_error_);
   ImGui::PopItemWidth();
 }
