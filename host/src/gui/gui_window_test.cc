@@ -17,6 +17,7 @@
 #include "manifest/manifest.h"
 #include "pipeline/stage_test_util.h"
 #include "tessera/errors.h"
+#include "tessera/io/file_io.h"
 #include "test_support.h"
 
 namespace tessera::gui {
@@ -399,6 +400,44 @@ TEST_F(GuiWindowTest, ManifestEditorChecksAsTheCliAndSaves) {
   const Manifest manifest = Manifest::Load(saved);
   ASSERT_TRUE(manifest.detector.has_value());
   EXPECT_EQ(manifest.detector->plugin, "orb");
+  app.Frame();
+}
+
+// Once the editor is open, Run runs its text, saved or not: a bad manifest file fixed in
+// the editor runs without saving, and the file stays as it was.
+TEST_F(GuiWindowTest, RunUsesTheEditorsTextWithoutSaving) {
+  tessera::testing::WriteSampleImages(dir_.path() / "images", 2);
+  const fs::path bad_manifest = dir_.path() / "bad.json";
+  const std::string bad_text = R"({"pipeline": {"detector": {"plugin": "orb", "options": []}}})";
+  std::ofstream(bad_manifest) << bad_text;
+  GuiOptions options;
+  options.images = dir_.path() / "images";
+  options.output = dir_.path() / "out";
+  options.manifest = bad_manifest;
+  GuiApp app(options);
+  app.Frame();
+  ASSERT_TRUE(app.LoadManifestIntoEditor()) << app.EditorError();
+  EXPECT_EQ(app.EditorText(), bad_text);
+  EXPECT_FALSE(app.Run());
+  EXPECT_NE(app.SetupError().find("pipeline.detector.options"), std::string::npos)
+      << app.SetupError();
+  // The editor's text names a plugin whose factory throws: the run that starts is the
+  // editor's (the file would not start), and fails naming what the plugin said.
+  app.SetEditorText(R"({"plugin_paths": [")" +
+                    (tessera::testing::BinaryDir() / "test_plugins" / "factory_throws").string() +
+                    R"("], "pipeline": {"pair_selector": {"plugin": "throws"}}})");
+  ASSERT_TRUE(app.Run()) << app.SetupError();
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return !app.controller().Running(); }, 30));
+  const RunStatus status = app.controller().Status();
+  EXPECT_EQ(status.state, RunState::kFailed);
+  EXPECT_NE(status.error.find("cannot reach the license server"), std::string::npos)
+      << status.error;
+  EXPECT_EQ(tessera::ReadFileContents(bad_manifest), bad_text);
+  // Invalid JSON in the editor is refused before a run starts, naming the editor.
+  app.SetEditorText("{\"pipeline\": ");
+  EXPECT_FALSE(app.Run());
+  EXPECT_NE(app.SetupError().find("invalid JSON"), std::string::npos) << app.SetupError();
   app.Frame();
 }
 
