@@ -79,6 +79,56 @@ double MedianOf(std::vector<double> values) {
   return values.size() % 2 == 1 ? values[mid] : (values[mid - 1] + values[mid]) / 2;
 }
 
+// Which images a known K applies to: those whose size holds its principal point. A K
+// that fits none of the images is refused (it was given for another resolution). Each
+// size it does not fit is named in a warning, and those images get the camera their EXIF
+// or the default focal length gives; each size whose centre lies more than 10% of the
+// image's size from the principal point is named in a warning too.
+std::vector<bool> ImagesKnownIntrinsicsFit(const std::vector<ImageEntry>& images,
+                                           const CameraSettings& settings,
+                                           std::vector<std::string>* warnings) {
+  if (!settings.known_intrinsics) return std::vector<bool>(images.size(), false);
+  const Eigen::Vector4d& K = *settings.known_intrinsics;
+  const std::string point =
+      "the principal point (" + FormatNumber(K(2)) + ", " + FormatNumber(K(3)) + ")";
+  std::vector<bool> fits(images.size());
+  std::map<std::pair<int, int>, std::vector<size_t>> images_by_size;
+  for (size_t i = 0; i < images.size(); ++i) {
+    fits[i] = K(2) > 0 && K(2) < images[i].width && K(3) > 0 && K(3) < images[i].height;
+    images_by_size[{images[i].width, images[i].height}].push_back(i);
+  }
+  if (!images.empty() && std::find(fits.begin(), fits.end(), true) == fits.end()) {
+    const ImageEntry& first = images.front();
+    throw InputError(settings.known_intrinsics_source + ": " + point + " lies outside image '" +
+                     first.name + "' (" + std::to_string(first.width) + "x" +
+                     std::to_string(first.height) +
+                     "); the intrinsics must be given for the images' resolution");
+  }
+  for (const auto& [size, indices] : images_by_size) {
+    const auto [width, height] = size;
+    const std::string dimensions = std::to_string(width) + "x" + std::to_string(height);
+    const std::string& name = images[indices.front()].name;
+    const std::string these = indices.size() == 1
+                                  ? "the " + dimensions + " image '" + name + "'"
+                                  : "the " + std::to_string(indices.size()) + " images of " +
+                                        dimensions + " (the first '" + name + "')";
+    const double dx = K(2) - width / 2.0, dy = K(3) - height / 2.0;
+    if (!fits[indices.front()]) {
+      warnings->push_back(settings.known_intrinsics_source + ": " + point + " lies outside " +
+                          these +
+                          "; K is not used there: the EXIF or the default "
+                          "focal length gives the camera");
+    } else if (std::abs(dx) > 0.1 * width || std::abs(dy) > 0.1 * height) {
+      warnings->push_back(
+          settings.known_intrinsics_source + ": " + point + " lies " +
+          FormatNumber(std::round(std::hypot(dx, dy))) + " px from the centre of " + these +
+          ", more than 10% of the image size: were the intrinsics given for another "
+          "resolution?");
+    }
+  }
+  return fits;
+}
+
 }  // namespace
 
 std::optional<FocalLengthPrior> EstimateFocalLengthPrior(const ImageEntry& image,
@@ -160,14 +210,20 @@ CameraAssignment AssignCameras(const std::vector<ImageEntry>& images,
   const std::string hint = FisheyeLensHint(images, settings);
   if (!hint.empty()) assignment.notes.push_back(hint);
 
-  // The intrinsics each image would get on its own.
-  std::vector<ImagePrior> priors;
-  priors.reserve(images.size());
   for (const ImageEntry& image : images) {
     if (image.width <= 0 || image.height <= 0) {
       throw InputError(image.name + ": the image has no size");
     }
-    if (settings.known_intrinsics) {
+  }
+  const std::vector<bool> uses_known =
+      ImagesKnownIntrinsicsFit(images, settings, &assignment.warnings);
+
+  // The intrinsics each image would get on its own.
+  std::vector<ImagePrior> priors;
+  priors.reserve(images.size());
+  for (size_t i = 0; i < images.size(); ++i) {
+    const ImageEntry& image = images[i];
+    if (uses_known[i]) {
       priors.push_back({0, CalibrationSource::kUser, true});
       continue;
     }
@@ -190,7 +246,7 @@ CameraAssignment AssignCameras(const std::vector<ImageEntry>& images,
       continue;
     }
     // Known intrinsics describe one physical camera whatever the EXIF says.
-    const bool by_make = !settings.known_intrinsics;
+    const bool by_make = !uses_known[i];
     const GroupKey key(image.width, image.height, by_make ? image.exif.make : "",
                        by_make ? image.exif.model : "");
     const auto [it, inserted] = group_of_key.emplace(key, groups.size());
@@ -203,15 +259,8 @@ CameraAssignment AssignCameras(const std::vector<ImageEntry>& images,
     const ImageEntry& first = images[group.front()];
     const camera_t camera_id = static_cast<camera_t>(assignment.cameras.size() + 1);
     Camera camera;
-    if (settings.known_intrinsics) {
+    if (uses_known[group.front()]) {
       const Eigen::Vector4d& K = *settings.known_intrinsics;
-      if (!(K(2) > 0 && K(2) < first.width && K(3) > 0 && K(3) < first.height)) {
-        throw InputError(settings.known_intrinsics_source + ": the principal point (" +
-                         FormatNumber(K(2)) + ", " + FormatNumber(K(3)) + ") lies outside image '" +
-                         first.name + "' (" + std::to_string(first.width) + "x" +
-                         std::to_string(first.height) +
-                         "); the intrinsics must be given for the images' resolution");
-      }
       camera = Camera::Create(camera_id, model_id, (K(0) + K(1)) / 2, first.width, first.height);
       const std::vector<int> focal_idx = camera.FocalIdx();
       if (focal_idx.size() == 2) {

@@ -256,6 +256,40 @@ TEST(AssignCameras, KnownIntrinsicsOverrideExif) {
   }
 }
 
+// The sample's 1024 px K on 768 px copies: the principal point 128 px off centre.
+TEST(AssignCameras, AKnownPrincipalPointFarFromTheCentreIsNamedInAWarning) {
+  CameraSettings settings;
+  settings.known_intrinsics = Eigen::Vector4d(919.8, 921.8, 507.1, 335.9);
+  settings.known_intrinsics_source = "K.txt";
+  CameraAssignment assignment = AssignCameras({Entry("a.jpg", 1024, 683)}, settings);
+  EXPECT_TRUE(assignment.warnings.empty());
+  assignment = AssignCameras({Entry("a.jpg", 768, 512), Entry("b.jpg", 768, 512)}, settings);
+  ASSERT_EQ(assignment.warnings.size(), 1u);
+  EXPECT_EQ(assignment.warnings[0],
+            "K.txt: the principal point (507.1, 335.9) lies 147 px from the centre of the 2 "
+            "images of 768x512 (the first 'a.jpg'), more than 10% of the image size: were the "
+            "intrinsics given for another resolution?");
+  EXPECT_EQ(assignment.cameras.at(0).calibration_source, CalibrationSource::kUser);
+}
+
+// Images of two sizes: K applies to those it fits; the others keep their own camera.
+TEST(AssignCameras, AKnownKAppliesToTheImagesItFitsAndNamesTheOthers) {
+  CameraSettings settings;
+  settings.known_intrinsics = Eigen::Vector4d(919.8, 921.8, 507.1, 335.9);
+  settings.known_intrinsics_source = "K.txt";
+  const CameraAssignment assignment =
+      AssignCameras({Entry("big.jpg", 1024, 683), Entry("small.jpg", 320, 240)}, settings);
+  ASSERT_EQ(assignment.cameras.size(), 2u);
+  EXPECT_EQ(assignment.cameras[0].calibration_source, CalibrationSource::kUser);
+  EXPECT_EQ(assignment.cameras[1].calibration_source, CalibrationSource::kDefault);
+  EXPECT_DOUBLE_EQ(assignment.cameras[1].params[1], 160.0);  // its own centre
+  ASSERT_EQ(assignment.warnings.size(), 1u);
+  EXPECT_EQ(assignment.warnings[0],
+            "K.txt: the principal point (507.1, 335.9) lies outside the 320x240 image "
+            "'small.jpg'; K is not used there: the EXIF or the default focal length gives "
+            "the camera");
+}
+
 TEST(AssignCameras, RejectsAnUnknownModel) {
   CameraSettings settings;
   settings.model = "FISHEYE";
