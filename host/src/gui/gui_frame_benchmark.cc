@@ -74,7 +74,7 @@ void FrameTime(benchmark::State& state, bool while_running) {
     if (while_running && !app.controller().Running()) {
       app.controller().Join();
       app.controller().Start(
-          {options.images, dir.path() / ("out" + std::to_string(runs++)), options.manifest});
+          {options.images, dir.path() / ("out" + std::to_string(runs++)), options.manifest, {}});
     }
     app.Frame();
     glFinish();
