@@ -61,6 +61,15 @@ assert rows[0]["pairs_per_selector"] == [
 assert [(s["plugin"], s["json_path"], s["num_pairs"]) for s in rows[1]["pairs_per_selector"]] == [
     ("window", "pipeline.pair_selector[0]", 40), ("sequential", "pipeline.pair_selector[1]", 19)], rows[1]
 for r in rows:
+    if r["manifest"] == "colmap":
+        continue
+    # Every plugin with its version, exporters included (fast.json's colmap_binary and ply).
+    used = [(p["slot"], p["plugin"]) for p in r["plugins_used"]]
+    assert used[-2:] == [("exporter", "colmap_binary"), ("exporter", "ply")], r
+    assert all(p["version"] for p in r["plugins_used"]), r
+    assert r["plugins"].endswith("colmap_binary %s+ply %s" % (
+        r["plugins_used"][-2]["version"], r["plugins_used"][-1]["version"])), r
+for r in rows:
     assert r["exit_code"] == 0 and r["num_registered"] == 11, r
     assert r["position_error_mean_relative"] is not None and r["position_error_mean_relative"] < 0.01, r
     assert r["num_wrongly_registered"] == 0, r

@@ -53,7 +53,10 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // One system on the images: a manifest, or COLMAP.
 struct BenchRow {
   std::string name;     // the manifest's file stem, or "colmap"
-  std::string plugins;  // detector / pair_selector / matcher / bundle_adjuster
+  // detector / pair_selector / matcher / bundle_adjuster / exporters, each with its
+  // version once the run has said it (plugins_used)
+  std::string plugins;
+  std::vector<PluginUsed> plugins_used;  // from run_summary.json
   std::string workspace;
   int exit_code = 0;
   std::string extract_shared_with;  // the row whose features this one started from
@@ -178,6 +181,17 @@ std::string SlotPlugin(const nlohmann::json& manifest, const std::string& slot) 
   return names.empty() ? "-" : names;
 }
 
+// "orb 1.0.0 / exhaustive 1.0.0 / brute_force 1.0.0 / ceres 1.0.0 / colmap_binary 1.0.0+ply
+// 1.0.0": the plugins of each slot in pipeline order, joined by "+".
+std::string DescribePlugins(const std::vector<PluginUsed>& plugins) {
+  std::string text;
+  for (size_t k = 0; k < plugins.size(); ++k) {
+    if (k > 0) text += plugins[k].slot == plugins[k - 1].slot ? "+" : " / ";
+    text += plugins[k].plugin + " " + plugins[k].version;
+  }
+  return text;
+}
+
 // "window 40", or "sequential 497 + retrieval 300 = 720" for several selectors.
 std::string PairsBySelector(const BenchRow& row) {
   if (row.pairs_per_selector.empty()) return "-";
@@ -228,7 +242,7 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
   row.workspace = workspace.string();
   row.plugins = SlotPlugin(manifest, "detector") + " / " + SlotPlugin(manifest, "pair_selector") +
                 " / " + SlotPlugin(manifest, "matcher") + " / " +
-                SlotPlugin(manifest, "bundle_adjuster");
+                SlotPlugin(manifest, "bundle_adjuster") + " / " + SlotPlugin(manifest, "exporters");
   ResetBenchWorkspace(workspace);
   if (!shared_from.empty()) {
     fs::copy_file(fs::path(options.output) / shared_from / "database.db",
@@ -261,6 +275,10 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
   row.num_models = run.map.num_models;
   row.num_selected_pairs = run.match.num_pairs;
   row.pairs_per_selector = run.match.pairs_per_selector;
+  if (!run.plugins.empty()) {
+    row.plugins_used = run.plugins;
+    row.plugins = DescribePlugins(run.plugins);
+  }
   ReadMatchingFigures(workspace / "database.db", &row);
   const MappingSummary mapping =
       MappingSummary::FromJson(ReadJsonFile(workspace / "mapping_summary.json"));
@@ -393,6 +411,7 @@ nlohmann::json ToJson(const BenchRow& row) {
   };
   return {{"manifest", row.name},
           {"plugins", row.plugins},
+          {"plugins_used", row.plugins_used},
           {"workspace", row.workspace},
           {"exit_code", row.exit_code},
           {"extract_shared_with", row.extract_shared_with},

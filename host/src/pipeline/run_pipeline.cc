@@ -23,6 +23,22 @@ std::filesystem::path InputImages(const PipelineContext& context, const RunOptio
   return IngestVideos(options.videos, options.output_dir, context.video_options);
 }
 
+// Every plugin of the run with its version, in pipeline order.
+std::vector<PluginUsed> PluginsUsed(const PipelineContext& context) {
+  std::vector<PluginUsed> plugins = {
+      {"detector", context.detector.name(), context.detector.version()}};
+  for (const auto& selector : context.pair_selectors) {
+    plugins.push_back({"pair_selector", selector.name(), selector.version()});
+  }
+  plugins.push_back({"matcher", context.matcher.name(), context.matcher.version()});
+  plugins.push_back(
+      {"bundle_adjuster", context.bundle_adjuster.name(), context.bundle_adjuster.version()});
+  for (const auto& exporter : context.exporters) {
+    plugins.push_back({"exporter", exporter.name(), exporter.version()});
+  }
+  return plugins;
+}
+
 }  // namespace
 
 ExtractionSummary RunExtract(const PipelineContext& context, const RunOptions& options,
@@ -93,6 +109,7 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
     return run;
   }
   summary.total_seconds = timer.ElapsedSeconds();
+  summary.plugins = PluginsUsed(context);
   spdlog::info("run: extract {:.2f} s, match {:.2f} s, map {:.2f} s, total {:.2f} s",
                summary.extract.seconds, summary.match.seconds, summary.map.seconds,
                summary.total_seconds);

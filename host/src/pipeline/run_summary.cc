@@ -12,6 +12,16 @@ void from_json(const nlohmann::json& json, SelectorPairs& pairs) {
   pairs.num_pairs = json.at("num_pairs").get<size_t>();
 }
 
+void to_json(nlohmann::json& json, const PluginUsed& plugin) {
+  json = {{"slot", plugin.slot}, {"plugin", plugin.plugin}, {"version", plugin.version}};
+}
+
+void from_json(const nlohmann::json& json, PluginUsed& plugin) {
+  plugin.slot = json.at("slot").get<std::string>();
+  plugin.plugin = json.at("plugin").get<std::string>();
+  plugin.version = json.at("version").get<std::string>();
+}
+
 nlohmann::json RunSummary::ToJson() const {
   nlohmann::json selectors = nlohmann::json::array();
   for (const SelectorPairs& selector : match.pairs_per_selector) selectors.push_back(selector);
@@ -36,7 +46,8 @@ nlohmann::json RunSummary::ToJson() const {
             {"num_registered", map.num_registered},
             {"num_images", map.num_images},
             {"images_per_model", map.images_per_model}}},
-          {"total_seconds", total_seconds}};
+          {"total_seconds", total_seconds},
+          {"plugins", plugins}};
 }
 
 RunSummary RunSummary::FromJson(const nlohmann::json& json) {
@@ -67,6 +78,8 @@ RunSummary RunSummary::FromJson(const nlohmann::json& json) {
   summary.map.images_per_model =
       map.value("images_per_model", nlohmann::json::array()).get<std::vector<size_t>>();
   summary.total_seconds = json.at("total_seconds").get<double>();
+  summary.plugins =
+      json.value("plugins", nlohmann::json::array()).get<std::vector<PluginUsed>>();
   return summary;
 }
 

@@ -35,6 +35,17 @@ struct SelectorPairs {
 void to_json(nlohmann::json& json, const SelectorPairs& pairs);
 void from_json(const nlohmann::json& json, SelectorPairs& pairs);
 
+// A plugin a run used: its slot ("detector", "pair_selector", "matcher",
+// "bundle_adjuster" or "exporter"), name and version.
+struct PluginUsed {
+  std::string slot;
+  std::string plugin;
+  std::string version;
+};
+// {"slot", "plugin", "version"}.
+void to_json(nlohmann::json& json, const PluginUsed& plugin);
+void from_json(const nlohmann::json& json, PluginUsed& plugin);
+
 struct MatchingSummary {
   StageStatus status = StageStatus::kCompleted;
   size_t num_pairs = 0;                           // pairs chosen by the pair selectors, united
@@ -61,13 +72,14 @@ struct MapStageSummary {
 // run_summary.json. ToJson writes, of each stage, the fields listed there (the status
 // is not written: the file exists only for a run that went to its end); FromJson reads
 // them back and leaves the others at their defaults. FromJson throws
-// nlohmann::json::exception for a missing or mistyped field; `pairs_per_selector` and
-// `images_per_model`, absent from files of older versions, may be missing.
+// nlohmann::json::exception for a missing or mistyped field; `pairs_per_selector`,
+// `images_per_model` and `plugins`, absent from files of older versions, may be missing.
 struct RunSummary {
   ExtractionSummary extract;
   MatchingSummary match;
   MapStageSummary map;
   double total_seconds = 0;
+  std::vector<PluginUsed> plugins;  // in pipeline order, exporters last
 
   nlohmann::json ToJson() const;
   static RunSummary FromJson(const nlohmann::json& json);
