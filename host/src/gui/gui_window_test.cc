@@ -11,6 +11,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <regex>
 
+#include "database/database.h"
 #include "gui/gui_app.h"
 #include "gui/renderer.h"
 #include "gui/xvfb.h"
@@ -421,18 +422,20 @@ TEST_F(GuiWindowTest, RunUsesTheEditorsTextWithoutSaving) {
   EXPECT_FALSE(app.Run());
   EXPECT_NE(app.SetupError().find("pipeline.detector.options"), std::string::npos)
       << app.SetupError();
-  // The editor's text names a plugin whose factory throws: the run that starts is the
-  // editor's (the file would not start), and fails naming what the plugin said.
-  app.SetEditorText(R"({"plugin_paths": [")" +
-                    (tessera::testing::BinaryDir() / "test_plugins" / "factory_throws").string() +
-                    R"("], "pipeline": {"pair_selector": {"plugin": "throws"}}})");
+  // The editor's text, fixed: the run that starts is the editor's (the file would not
+  // start), and its detector options are what the workspace records.
+  app.SetEditorText(R"({"pipeline": {
+      "detector": {"plugin": "orb", "options": {"max_num_features": 77}},
+      "pair_selector": {"plugin": "exhaustive"}, "matcher": {"plugin": "brute_force"},
+      "bundle_adjuster": {"plugin": "ceres"}}})");
   ASSERT_TRUE(app.Run()) << app.SetupError();
   ASSERT_TRUE(WaitFor(
-      &app, [&] { return !app.controller().Running(); }, 30));
-  const RunStatus status = app.controller().Status();
-  EXPECT_EQ(status.state, RunState::kFailed);
-  EXPECT_NE(status.error.find("cannot reach the license server"), std::string::npos)
-      << status.error;
+      &app, [&] { return !app.controller().Running(); }, 120));
+  const std::optional<nlohmann::json> features =
+      Database(options.output / "database.db").ReadStageProvenance(Database::kFeaturesStage);
+  ASSERT_TRUE(features.has_value());
+  EXPECT_NE(features->dump().find("\"max_num_features\":77"), std::string::npos)
+      << features->dump();
   EXPECT_EQ(tessera::ReadFileContents(bad_manifest), bad_text);
   // Invalid JSON in the editor is refused before a run starts, naming the editor.
   app.SetEditorText("{\"pipeline\": ");
