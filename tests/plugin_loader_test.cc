@@ -2,8 +2,11 @@
 // never crashing on a broken plugin.
 
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
 
 #include <fstream>
+#include <sstream>
 
 #include "plugin/plugin_registry.h"
 #include "test_support.h"
@@ -62,12 +65,86 @@ TEST(PluginLoader, RefusesAnotherAbiVersionNamingBothNumbers) {
 }
 
 TEST(PluginLoader, RefusesAPluginBuiltAgainstAbiOne) {
-  ASSERT_EQ(kPluginAbiVersion, 4u);
+  ASSERT_EQ(kPluginAbiVersion, 5u);
   const auto file = File("abi_one", "abi_one");
   EXPECT_EQ(InspectPluginFile(file).refusal,
-            file.string() + ": wrong plugin ABI version: got version 1, supported version is 4");
+            file.string() + ": wrong plugin ABI version: got version 1, supported version is 5");
   const PluginRegistry registry = PluginRegistry::Discover({kRoot / "abi_one"});
   EXPECT_TRUE(registry.NamesOfKind("pair_selector").empty());
+}
+
+// Built with -D_GLIBCXX_USE_CXX11_ABI=0, it used to be listed as usable and then fail
+// with std::bad_alloc naming no plugin.
+TEST(PluginLoader, RefusesAPluginBuiltWithAnotherStringAbiNamingTheSetting) {
+  const auto file = File("old_string_abi", "old_string_abi");
+  EXPECT_EQ(InspectPluginFile(file).refusal,
+            file.string() +
+                ": plugin 'old_string_abi' built with -D_GLIBCXX_USE_CXX11_ABI=0 (the C++ "
+                "library's string ABI), the host with 1; a plugin must be built as the host is, "
+                "since C++ objects cross the boundary");
+  const PluginRegistry registry = PluginRegistry::Discover({kRoot / "old_string_abi"});
+  EXPECT_TRUE(registry.NamesOfKind("pair_selector").empty());
+}
+
+TEST(PluginLoader, BuildMismatchNamesTheFirstSettingThatDiffers) {
+  const TesseraBuildRecord host = HostBuildRecord();
+  EXPECT_EQ(BuildMismatch(host, host), "");
+  TesseraBuildRecord other = host;
+  other.compiler = host.compiler == 1 ? 2 : 1;
+  other.compiler_major = 99;
+  EXPECT_EQ(BuildMismatch(other, host)
+                .rfind(std::string("built with ") + (other.compiler == 1 ? "GCC 99" : "Clang 99") +
+                           ", the host with ",
+                       0),
+            0u)
+      << BuildMismatch(other, host);
+  other = host;
+  other.sizeof_json += 8;
+  EXPECT_EQ(BuildMismatch(other, host)
+                .rfind("built with a nlohmann::json of " + std::to_string(host.sizeof_json + 8) +
+                           " bytes, the host's has " + std::to_string(host.sizeof_json),
+                       0),
+            0u)
+      << BuildMismatch(other, host);
+  other = host;
+  other.standard_library = 2;
+  other.string_abi = 0;
+  EXPECT_EQ(BuildMismatch(other, host).rfind("built against libc++, the host against libstdc++", 0),
+            0u)
+      << BuildMismatch(other, host);
+}
+
+// A plugin's Logger writes through the host's log, named, and honours -q.
+TEST(PluginLog, LinesGoToTheHostsLogWithThePluginsNameAndSubject) {
+  std::ostringstream out;
+  const auto previous = spdlog::default_logger();
+  const auto capture = std::make_shared<spdlog::logger>(
+      "capture", std::make_shared<spdlog::sinks::ostream_sink_mt>(out));
+  capture->set_pattern("[%l] %v");
+  capture->set_level(spdlog::level::info);
+  spdlog::set_default_logger(capture);
+  const LogSink sink = PluginLogSink("sift");
+  sink(LogLevel::kInfo, "outside a call");
+  {
+    const PluginCallScope scope("sift", PluginStage::kDetect, ImageSubject("a.jpg"));
+    sink(LogLevel::kWarning, "inside");
+    sink(LogLevel::kDebug, "debug is for -v");
+  }
+  capture->set_level(spdlog::level::warn);  // -q
+  sink(LogLevel::kInfo, "quiet");
+  sink(LogLevel::kWarning, "still shown");
+  spdlog::set_default_logger(previous);
+  EXPECT_EQ(out.str(),
+            "[info] sift: outside a call\n[warning] sift (image a.jpg): inside\n"
+            "[warning] sift: still shown\n");
+  // The registry connects every plugin it makes.
+  const PluginRegistry registry = PluginRegistry::Discover({kRoot / "good"});
+  auto selector = registry.Create<PairSelector>("pair_selector", "consecutive", {}, "p");
+  out.str("");
+  spdlog::set_default_logger(capture);
+  testing::Unguarded(selector).log().Warn("from the plugin");
+  spdlog::set_default_logger(previous);
+  EXPECT_EQ(out.str(), "[warning] consecutive: from the plugin\n");
 }
 
 TEST(PluginLoader, RefusesAnUnknownKindWithASuggestion) {
@@ -170,9 +247,9 @@ TEST(PluginLoader, DiscoveryListsRefusedFilesWithoutThrowing) {
   const PluginRegistry registry = PluginRegistry::Discover(paths);
   size_t refused = 0;
   for (const auto& record : registry.records()) refused += record.usable() ? 0 : 1;
-  // no_info, wrong_abi, abi_one, unknown_kind, no_factory, the second twin, and
-  // crash_on_load, which the probe refused without this process ever loading it.
-  EXPECT_EQ(refused, 7u);
+  // no_info, wrong_abi, abi_one, old_string_abi, unknown_kind, no_factory, the second
+  // twin, and crash_on_load, which the probe refused without this process ever loading it.
+  EXPECT_EQ(refused, 8u);
   EXPECT_EQ(registry.NamesOfKind("pair_selector"),
             (std::vector<std::string>{"consecutive", "failing_pair_selector", "float_only",
                                       "throws", "twin"}));

@@ -209,8 +209,9 @@ extern "C" __attribute__((visibility("default"))) int tessera_unrelated_symbol()
 
 #elif defined(TESSERA_TEST_CASE_WRONG_ABI)
 extern "C" {
+// Its build record is empty: a host reads nothing past abi_version of another version.
 const TesseraPluginInfo wrong_abi_info = {999, "pair_selector", "future", "9.0.0",
-                                          "From the future"};
+                                          "From the future", TesseraBuildRecord{}};
 }
 static std::unique_ptr<tessera::Plugin> wrong_abi_create(const nlohmann::json& options) {
   return std::make_unique<TestPairSelector>(options);
@@ -222,7 +223,7 @@ BOOST_DLL_ALIAS(wrong_abi_create, tessera_plugin_create)
 // A plugin built against ABI 1 (pair selectors saw only file names): its record says 1.
 extern "C" {
 const TesseraPluginInfo abi_one_info = {1, "pair_selector", "names_only", "1.0.0",
-                                        "Built against ABI 1"};
+                                        "Built against ABI 1", TesseraBuildRecord{}};
 }
 static std::unique_ptr<tessera::Plugin> abi_one_create(const nlohmann::json& options) {
   return std::make_unique<TestPairSelector>(options);
@@ -233,7 +234,7 @@ BOOST_DLL_ALIAS(abi_one_create, tessera_plugin_create)
 #elif defined(TESSERA_TEST_CASE_UNKNOWN_KIND)
 extern "C" {
 const TesseraPluginInfo unknown_kind_info = {TESSERA_PLUGIN_ABI_VERSION, "detectr", "typo_kind",
-                                             "1.0.0", "A kind with a typo"};
+                                             "1.0.0", "A kind with a typo", TESSERA_BUILD_RECORD};
 }
 static std::unique_ptr<tessera::Plugin> unknown_kind_create(const nlohmann::json& options) {
   return std::make_unique<TestPairSelector>(options);
@@ -244,9 +245,15 @@ BOOST_DLL_ALIAS(unknown_kind_create, tessera_plugin_create)
 #elif defined(TESSERA_TEST_CASE_NO_FACTORY)
 extern "C" {
 const TesseraPluginInfo no_factory_info = {TESSERA_PLUGIN_ABI_VERSION, "pair_selector",
-                                           "no_factory", "1.0.0", "Info but no factory"};
+                                           "no_factory",  "1.0.0", "Info but no factory",
+                                           TESSERA_BUILD_RECORD};
 }
 BOOST_DLL_ALIAS(no_factory_info, tessera_plugin_info)
+
+#elif defined(TESSERA_TEST_CASE_OLD_STRING_ABI)
+// Compiled with -D_GLIBCXX_USE_CXX11_ABI=0: its std::string is not the host's.
+TESSERA_PLUGIN(pair_selector, TestPairSelector, "old_string_abi", "1.0.0",
+               "Built with the old libstdc++ string ABI")
 
 #elif defined(TESSERA_TEST_CASE_FACTORY_THROWS)
 TESSERA_PLUGIN(pair_selector, TestPairSelector, "throws", "1.0.0", "Its factory throws")

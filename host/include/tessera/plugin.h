@@ -8,22 +8,42 @@
 // compiler and standard library, since C++ objects cross the boundary.
 
 #include <cstdint>
+#include <filesystem>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "tessera/export.h"
+#include "tessera/log.h"
 
 // Bumped whenever TesseraPluginInfo, a plugin interface, a type that crosses the
 // boundary or the API of Tessera::io (tessera/io/) changes; the host refuses a plugin
 // built against another version. libtessera_io's SONAME carries this number
-// (libtessera_io.so.4), so a plugin linked against another Tessera::io does not load.
+// (libtessera_io.so.N), so a plugin linked against another Tessera::io does not load.
 // abi_headers.sha256 records it with a hash of every header here, comments and whitespace
 // excluded: the test sdk_abi_check fails when a header changes without a bump (bump it,
 // then run scripts/sdk_abi_check.py --update).
-#define TESSERA_PLUGIN_ABI_VERSION 4
+#define TESSERA_PLUGIN_ABI_VERSION 5
 
 extern "C" {
+// How a binary was built, as far as the C++ objects that cross the plugin boundary
+// depend on it. The host refuses a plugin whose record differs from its own, naming the
+// setting (a plugin built with -D_GLIBCXX_USE_CXX11_ABI=0 would otherwise load and then
+// fail with std::bad_alloc on its first std::string).
+struct TesseraBuildRecord {
+  uint32_t compiler;          // 1 GCC, 2 Clang, 0 another
+  uint32_t compiler_major;    // __GNUC__ or __clang_major__
+  uint32_t standard_library;  // 1 libstdc++, 2 libc++, 0 another
+  uint32_t string_abi;        // libstdc++'s _GLIBCXX_USE_CXX11_ABI (1 or 0); 0 for others
+  uint32_t sizeof_string;     // sizeof(std::string)
+  uint32_t sizeof_vector;     // sizeof(std::vector<int>)
+  uint32_t sizeof_function;   // sizeof(std::function<void()>)
+  uint32_t sizeof_json;       // sizeof(nlohmann::json)
+  uint32_t sizeof_path;       // sizeof(std::filesystem::path)
+};
+
 // The info record. `abi_version` stays the first member in every version so that
 // any host can read it.
 struct TesseraPluginInfo {
@@ -32,8 +52,34 @@ struct TesseraPluginInfo {
   const char* name;
   const char* version;
   const char* description;
+  TesseraBuildRecord build;  // TESSERA_BUILD_RECORD where the plugin was compiled
 };
 }
+
+#if defined(__clang__)
+#define TESSERA_BUILD_COMPILER 2u, static_cast<uint32_t>(__clang_major__)
+#elif defined(__GNUC__)
+#define TESSERA_BUILD_COMPILER 1u, static_cast<uint32_t>(__GNUC__)
+#else
+#define TESSERA_BUILD_COMPILER 0u, 0u
+#endif
+#if defined(__GLIBCXX__)
+#define TESSERA_BUILD_STANDARD_LIBRARY 1u, static_cast<uint32_t>(_GLIBCXX_USE_CXX11_ABI)
+#elif defined(_LIBCPP_VERSION)
+#define TESSERA_BUILD_STANDARD_LIBRARY 2u, 0u
+#else
+#define TESSERA_BUILD_STANDARD_LIBRARY 0u, 0u
+#endif
+// The build record of the translation unit that expands it.
+#define TESSERA_BUILD_RECORD                                  \
+  TesseraBuildRecord {                                        \
+    TESSERA_BUILD_COMPILER, TESSERA_BUILD_STANDARD_LIBRARY,   \
+        static_cast<uint32_t>(sizeof(std::string)),           \
+        static_cast<uint32_t>(sizeof(std::vector<int>)),      \
+        static_cast<uint32_t>(sizeof(std::function<void()>)), \
+        static_cast<uint32_t>(sizeof(nlohmann::json)),        \
+        static_cast<uint32_t>(sizeof(std::filesystem::path))  \
+  }
 
 namespace tessera {
 
@@ -48,8 +94,18 @@ class TESSERA_API Plugin {
   // results this plugin produced, so that a change invalidates those results.
   const nlohmann::json& EffectiveOptions() const { return effective_options_; }
 
+  // The plugin's logger (tessera/log.h): lines go to the host's log with the plugin's
+  // name. The host connects it right after the factory returns, so a constructor's
+  // lines go to stderr.
+  const Logger& log() const { return log_; }
+  // For the host: connects log() to the host's log.
+  void SetLogSink(LogSink sink) { log_.SetSink(std::move(sink)); }
+
  protected:
   nlohmann::json effective_options_ = nlohmann::json::object();
+
+ private:
+  Logger log_;
 };
 
 // Makes a plugin from its options. Throws tessera::OptionError for invalid options.
@@ -62,16 +118,16 @@ using PluginFactory = std::unique_ptr<Plugin>(const nlohmann::json& options);
 // interface and has a constructor taking `const nlohmann::json& options`.
 //
 //   TESSERA_PLUGIN(detector, SiftDetector, "sift", "1.0.0", "SIFT (OpenCV)")
-#define TESSERA_PLUGIN(KIND, CLASS, NAME, VERSION, DESCRIPTION)                                  \
-  static_assert(std::is_base_of_v<::tessera::plugin_kinds::KIND, CLASS>,                         \
-                #CLASS " must derive from the " #KIND " interface");                             \
-  extern "C" {                                                                                   \
-  const TesseraPluginInfo tessera_plugin_info_record = {TESSERA_PLUGIN_ABI_VERSION, #KIND, NAME, \
-                                                        VERSION, DESCRIPTION};                   \
-  }                                                                                              \
-  static std::unique_ptr<::tessera::Plugin> tessera_plugin_create_impl(                          \
-      const nlohmann::json& options) {                                                           \
-    return std::make_unique<CLASS>(options);                                                     \
-  }                                                                                              \
-  BOOST_DLL_ALIAS(tessera_plugin_info_record, tessera_plugin_info)                               \
+#define TESSERA_PLUGIN(KIND, CLASS, NAME, VERSION, DESCRIPTION)                             \
+  static_assert(std::is_base_of_v<::tessera::plugin_kinds::KIND, CLASS>,                    \
+                #CLASS " must derive from the " #KIND " interface");                        \
+  extern "C" {                                                                              \
+  const TesseraPluginInfo tessera_plugin_info_record = {                                    \
+      TESSERA_PLUGIN_ABI_VERSION, #KIND, NAME, VERSION, DESCRIPTION, TESSERA_BUILD_RECORD}; \
+  }                                                                                         \
+  static std::unique_ptr<::tessera::Plugin> tessera_plugin_create_impl(                     \
+      const nlohmann::json& options) {                                                      \
+    return std::make_unique<CLASS>(options);                                                \
+  }                                                                                         \
+  BOOST_DLL_ALIAS(tessera_plugin_info_record, tessera_plugin_info)                          \
   BOOST_DLL_ALIAS(tessera_plugin_create_impl, tessera_plugin_create)

@@ -26,6 +26,7 @@ CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions&) {
     std::string format;
     std::string output;
     std::string images;
+    std::string masks;
     std::string options = "{}";
     int model_index = 0;
   };
@@ -42,6 +43,9 @@ CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions&) {
       ->required();
   sub->add_option("--images", options->images,
                   "Folder of the images named in the model (for exporters that read them)");
+  sub->add_option("--masks", options->masks,
+                  "Folder of the images' masks, as extract takes it (for exporters that write "
+                  "masks: gaussian_splatting)");
   sub->add_option("--options", options->options, "The exporter's options as a JSON object");
   sub->add_option("--model-index", options->model_index,
                   "Model number, for exporters that write per model (sparse/N)")
@@ -69,10 +73,12 @@ CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions&) {
     CreateFolder(options->output);
     OutputTransaction outputs(options->output, OutputTransaction::Mode::kAddToSet);
     outputs.Protect(options->images);
+    outputs.Protect(options->masks);
     ExportContext context;
     context.output_dir = outputs.StageFor(exporter.name());
     context.image_dir = options->images;
     context.model_index = options->model_index;
+    context.mask_dir = options->masks;
     try {
       exporter.Call(PluginStage::kExport, "model " + std::to_string(context.model_index),
                     [&](auto& plugin) { plugin.Export(reconstruction, context); });

@@ -82,7 +82,7 @@ void ExportModel(const Reconstruction& model, size_t index, const MapSettings& s
     const std::filesystem::path staged = outputs->StageFor(exporter.name(), k);
     try {
       exporter.Call(PluginStage::kExport, subject, [&](auto& plugin) {
-        plugin.Export(model, {staged, image_dir, static_cast<int>(index)});
+        plugin.Export(model, {staged, image_dir, static_cast<int>(index), settings.mask_dir});
       });
     } catch (const PluginError& error) {
       outputs->Keep();

@@ -2,6 +2,7 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -276,6 +277,23 @@ PluginCallScope::PluginCallScope(const std::string& plugin, PluginStage stage,
   std::atomic_signal_fence(std::memory_order_seq_cst);
   record.active = 1;
   g_last_started.store(&record);
+}
+
+std::string CurrentPluginSubject() {
+  const CallRecord& record = t_record;
+  return record.active ? std::string(record.subject) : std::string();
+}
+
+LogSink PluginLogSink(const std::string& plugin) {
+  return [plugin](LogLevel level, const std::string& text) {
+    const std::string subject = CurrentPluginSubject();
+    const std::string who =
+        subject.empty() || subject.rfind("from ", 0) == 0 ? plugin : plugin + " (" + subject + ")";
+    const spdlog::level::level_enum spdlog_level = level == LogLevel::kDebug  ? spdlog::level::debug
+                                                   : level == LogLevel::kInfo ? spdlog::level::info
+                                                                              : spdlog::level::warn;
+    spdlog::log(spdlog_level, "{}: {}", who, text);
+  };
 }
 
 PluginCallScope::~PluginCallScope() {

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "tessera/errors.h"
+#include "tessera/log.h"
 
 namespace tessera {
 
@@ -91,6 +92,14 @@ class PluginCallScope {
  private:
   bool outermost_;
 };
+
+// The subject of the plugin call the current thread is in ("image a.jpg"), empty
+// outside one.
+std::string CurrentPluginSubject();
+// Where the Logger of the plugin `plugin` writes (Plugin::SetLogSink): the host's log,
+// as "PLUGIN: text", or "PLUGIN (image a.jpg): text" during a call about an image or
+// pair; -v and -q apply as to the host's own lines.
+LogSink PluginLogSink(const std::string& plugin);
 
 // Calls `fn` (which calls into the plugin `plugin`) and returns its result. Anything it
 // throws is rethrown as a PluginError whose message names the plugin, what it was doing

@@ -17,7 +17,53 @@ bool IsSharedObject(const std::filesystem::path& path) { return path.extension()
 
 std::string Quote(const std::string& text) { return "'" + text + "'"; }
 
+std::string CompilerName(uint32_t compiler, uint32_t major) {
+  const char* family = compiler == 1 ? "GCC" : compiler == 2 ? "Clang" : "an unknown compiler";
+  return std::string(family) + (compiler == 1 || compiler == 2 ? " " + std::to_string(major) : "");
+}
+
+std::string LibraryName(uint32_t library) {
+  return library == 1 ? "libstdc++" : library == 2 ? "libc++" : "an unknown standard library";
+}
+
 }  // namespace
+
+std::string BuildMismatch(const TesseraBuildRecord& plugin, const TesseraBuildRecord& host) {
+  const std::string tail =
+      "; a plugin must be built as the host is, since C++ objects cross "
+      "the boundary";
+  if (plugin.standard_library != host.standard_library) {
+    return "built against " + LibraryName(plugin.standard_library) + ", the host against " +
+           LibraryName(host.standard_library) + tail;
+  }
+  if (plugin.string_abi != host.string_abi) {
+    return "built with -D_GLIBCXX_USE_CXX11_ABI=" + std::to_string(plugin.string_abi) +
+           " (the C++ library's string ABI), the host with " + std::to_string(host.string_abi) +
+           tail;
+  }
+  if (plugin.compiler != host.compiler || plugin.compiler_major != host.compiler_major) {
+    return "built with " + CompilerName(plugin.compiler, plugin.compiler_major) +
+           ", the host with " + CompilerName(host.compiler, host.compiler_major) + tail;
+  }
+  const std::pair<const char*, std::pair<uint32_t, uint32_t>> sizes[] = {
+      {"std::string", {plugin.sizeof_string, host.sizeof_string}},
+      {"std::vector", {plugin.sizeof_vector, host.sizeof_vector}},
+      {"std::function", {plugin.sizeof_function, host.sizeof_function}},
+      {"nlohmann::json", {plugin.sizeof_json, host.sizeof_json}},
+      {"std::filesystem::path", {plugin.sizeof_path, host.sizeof_path}}};
+  for (const auto& [type, size] : sizes) {
+    if (size.first != size.second) {
+      return std::string("built with a ") + type + " of " + std::to_string(size.first) +
+             " bytes, the host's has " + std::to_string(size.second) + tail;
+    }
+  }
+  return "";
+}
+
+const TesseraBuildRecord& HostBuildRecord() {
+  static const TesseraBuildRecord record = TESSERA_BUILD_RECORD;
+  return record;
+}
 
 const std::vector<std::string>& PluginKindNames() {
   static const std::vector<std::string> kinds = {"detector", "matcher", "pair_selector",
@@ -66,6 +112,12 @@ PluginRecord InspectPluginFile(const std::filesystem::path& file) {
     record.refusal = where + "wrong plugin ABI version: got version " +
                      std::to_string(info.abi_version) + ", supported version is " +
                      std::to_string(kPluginAbiVersion);
+    return record;
+  }
+  if (const std::string mismatch = BuildMismatch(info.build, HostBuildRecord());
+      !mismatch.empty()) {
+    const std::string name = info.name != nullptr ? Quote(info.name) + " " : "";
+    record.refusal = where + "plugin " + name + mismatch;
     return record;
   }
   if (info.kind == nullptr || info.name == nullptr || info.version == nullptr) {
@@ -205,6 +257,7 @@ std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
     throw InputError(record.file.string() + ": plugin " + Quote(record.name) +
                      " failed to start: its factory returned nothing");
   }
+  plugin->SetLogSink(PluginLogSink(record.name));
   return plugin;
 }
 

@@ -90,6 +90,13 @@ class PluginInstance {
   std::filesystem::path file_;
 };
 
+// Why a plugin built as `plugin` says cannot run in a host built as `host`, as the end
+// of a sentence ("built with -D_GLIBCXX_USE_CXX11_ABI=0 (...), the host with 1; ..."),
+// naming the first setting that differs; empty when none does.
+std::string BuildMismatch(const TesseraBuildRecord& plugin, const TesseraBuildRecord& host);
+// This host's build record.
+const TesseraBuildRecord& HostBuildRecord();
+
 // Reads the info record of one file and checks it: opens, has the record, ABI version
 // equal to the host's, known kind, has a factory. Never throws; a failure is
 // recorded in `refusal` as one sentence naming the file.

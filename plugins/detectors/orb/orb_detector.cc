@@ -33,6 +33,10 @@ struct OrbOptions {
   int fast_threshold = 20;
   // Border in pixels, at each level, where no keypoint is detected.
   int edge_threshold = 31;
+  // Detection that adapts to weak texture: an image with fewer keypoints than this is
+  // detected again with the FAST threshold halved, down to min_fast_threshold. 0: off.
+  int min_num_features = 0;
+  int min_fast_threshold = 2;
 };
 
 // Where a keypoint of OpenCV's ORB lies, in pixels of the image ORB was given, in
@@ -64,21 +68,49 @@ class OrbDetector : public Detector {
     options_.num_levels = reader.Get<int>("num_levels", options_.num_levels, 1, 32);
     options_.fast_threshold = reader.Get<int>("fast_threshold", options_.fast_threshold, 1, 255);
     options_.edge_threshold = reader.Get<int>("edge_threshold", options_.edge_threshold, 0, 256);
+    options_.min_num_features =
+        reader.Get<int>("min_num_features", options_.min_num_features, 0, 1000000);
+    options_.min_fast_threshold =
+        reader.Get<int>("min_fast_threshold", options_.min_fast_threshold, 1, 255);
     reader.Finish();
     effective_options_ = reader.Effective();
+    if (options_.min_num_features == 0) {
+      // Off: the features are those of a detector without the option, and so is the
+      // record of the options that produced them.
+      if (reader.Has("min_fast_threshold")) {
+        throw OptionError("min_fast_threshold", "is used only with min_num_features above 0");
+      }
+      effective_options_.erase("min_num_features");
+      effective_options_.erase("min_fast_threshold");
+    }
   }
 
   FeatureSet Detect(const ImageView& view) const override {
     const ScaledImage scaled = ScaleToMaxSize(view, options_.max_image_size, "orb");
 
-    // A detector per call: sharing one cv::ORB across threads is not documented as safe.
-    const cv::Ptr<cv::ORB> orb = cv::ORB::create(
-        options_.max_num_features, static_cast<float>(options_.scale_factor), options_.num_levels,
-        options_.edge_threshold, /*firstLevel=*/0, /*WTA_K=*/2, cv::ORB::HARRIS_SCORE,
-        /*patchSize=*/31, options_.fast_threshold);
     std::vector<cv::KeyPoint> cv_keypoints;
     cv::Mat cv_descriptors;
-    orb->detectAndCompute(scaled.image, cv::noArray(), cv_keypoints, cv_descriptors);
+    int threshold = options_.fast_threshold;
+    DetectAt(scaled.image, threshold, &cv_keypoints, &cv_descriptors);
+    const int wanted = options_.min_num_features;
+    if (static_cast<int>(cv_keypoints.size()) < wanted) {
+      const size_t first_count = cv_keypoints.size();
+      const int first_threshold = threshold;
+      while (static_cast<int>(cv_keypoints.size()) < wanted &&
+             threshold > options_.min_fast_threshold) {
+        threshold = std::max(threshold / 2, options_.min_fast_threshold);
+        DetectAt(scaled.image, threshold, &cv_keypoints, &cv_descriptors);
+      }
+      const std::string text = std::to_string(first_count) + " features at FAST threshold " +
+                               std::to_string(first_threshold) + ", fewer than min_num_features " +
+                               std::to_string(wanted) + ": " + std::to_string(cv_keypoints.size()) +
+                               " at " + std::to_string(threshold);
+      if (static_cast<int>(cv_keypoints.size()) < wanted) {
+        log().Warn(text + ", the floor min_fast_threshold");
+      } else {
+        log().Info(text);
+      }
+    }
     // ORB fills its quota level by level and may keep ties beyond it.
     const std::vector<int> order = StrongestFirst(cv_keypoints, options_.max_num_features);
 
@@ -104,6 +136,18 @@ class OrbDetector : public Detector {
   DescriptorMetric Metric() const override { return DescriptorMetric::kHamming; }
 
  private:
+  // ORB on `image` at the FAST threshold `threshold`.
+  void DetectAt(const cv::Mat& image, int threshold, std::vector<cv::KeyPoint>* keypoints,
+                cv::Mat* descriptors) const {
+    // A detector per call: sharing one cv::ORB across threads is not documented as safe.
+    const cv::Ptr<cv::ORB> orb = cv::ORB::create(
+        options_.max_num_features, static_cast<float>(options_.scale_factor), options_.num_levels,
+        options_.edge_threshold, /*firstLevel=*/0, /*WTA_K=*/2, cv::ORB::HARRIS_SCORE,
+        /*patchSize=*/31, threshold);
+    keypoints->clear();
+    orb->detectAndCompute(image, cv::noArray(), *keypoints, *descriptors);
+  }
+
   OrbOptions options_;
 };
 

@@ -306,6 +306,54 @@ TEST(OrbDetector, RejectsInvalidOptions) {
       << text;
 }
 
+// Weak texture: the same scene at 6% of its contrast.
+cv::Mat LowContrast(const cv::Mat& image) {
+  cv::Mat low;
+  image.convertTo(low, CV_8U, 0.06, 120);
+  return low;
+}
+
+TEST(OrbDetector, MinNumFeaturesLowersTheThresholdOnWeakTextureAndSaysSo) {
+  const cv::Mat image = LowContrast(MakeTexturedImage());
+  const size_t plain = Detect({}, image).keypoints.size();
+  ASSERT_LT(plain, 1000u);
+  const auto detector =
+      testing::LoadBundledPlugin<Detector>("detector", "orb", {{"min_num_features", 1000}});
+  std::vector<std::string> lines;
+  testing::Unguarded(detector).SetLogSink([&](LogLevel level, const std::string& text) {
+    lines.push_back((level == LogLevel::kInfo ? "info: " : "other: ") + text);
+  });
+  const FeatureSet adapted = testing::Unguarded(detector).Detect(View(image));
+  EXPECT_GE(adapted.keypoints.size(), 1000u);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_TRUE(StartsWith(lines[0], "info: " + std::to_string(plain) +
+                                       " features at FAST threshold 20, fewer than "
+                                       "min_num_features 1000: " +
+                                       std::to_string(adapted.keypoints.size()) + " at "))
+      << lines[0];
+  // A well-textured image is detected once, as without the option, and says nothing.
+  lines.clear();
+  const cv::Mat textured = MakeTexturedImage();
+  EXPECT_TRUE(testing::Unguarded(detector).Detect(View(textured)).descriptors.data ==
+              Detect({}, textured).descriptors.data);
+  EXPECT_TRUE(lines.empty());
+  // The floor stops it: a warning names it.
+  const auto floored = testing::LoadBundledPlugin<Detector>(
+      "detector", "orb", {{"min_num_features", 1000000}, {"min_fast_threshold", 15}});
+  testing::Unguarded(floored).SetLogSink([&](LogLevel level, const std::string& text) {
+    lines.push_back((level == LogLevel::kWarning ? "warning: " : "other: ") + text);
+  });
+  testing::Unguarded(floored).Detect(View(image));
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_NE(lines[0].find(" at 15, the floor min_fast_threshold"), std::string::npos) << lines[0];
+  EXPECT_TRUE(StartsWith(lines[0], "warning: ")) << lines[0];
+  // Off, its floor is a mistake worth naming; on, both are recorded with the features.
+  EXPECT_TRUE(StartsWith(OptionErrorText({{"min_fast_threshold", 5}}),
+                         "pipeline.test.options.min_fast_threshold: is used only with "
+                         "min_num_features above 0"));
+  EXPECT_EQ(testing::Unguarded(detector).EffectiveOptions().at("min_fast_threshold"), 2);
+}
+
 TEST(OrbDetector, RejectsAnEmptyImage) {
   const auto detector = testing::LoadBundledPlugin<Detector>("detector", "orb");
   EXPECT_THROW(testing::Unguarded(detector).Detect(ImageView()), InputError);

@@ -9,6 +9,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -42,6 +43,11 @@ struct SiftOptions {
   double sigma = 1.6;
   // RootSIFT descriptors (L1-normalise, then square root), as COLMAP's default.
   bool root_sift = true;
+  // Detection that adapts to weak texture: an image with fewer keypoints than this is
+  // detected again with the contrast threshold halved, down to min_contrast_threshold.
+  // 0: off.
+  int min_num_features = 0;
+  double min_contrast_threshold = 0.0025;
 };
 
 class SiftDetector : public Detector {
@@ -60,20 +66,49 @@ class SiftDetector : public Detector {
         reader.Get<int>("num_octave_layers", options_.num_octave_layers, 1, 10);
     options_.sigma = reader.Get<double>("sigma", options_.sigma, 0.5, 10.0);
     options_.root_sift = reader.GetBool("root_sift", options_.root_sift);
+    options_.min_num_features =
+        reader.Get<int>("min_num_features", options_.min_num_features, 0, 1000000);
+    options_.min_contrast_threshold =
+        reader.Get<double>("min_contrast_threshold", options_.min_contrast_threshold, 1e-6, 1.0);
     reader.Finish();
     effective_options_ = reader.Effective();
+    if (options_.min_num_features == 0) {
+      // Off: the features are those of a detector without the option, and so is the
+      // record of the options that produced them.
+      if (reader.Has("min_contrast_threshold")) {
+        throw OptionError("min_contrast_threshold", "is used only with min_num_features above 0");
+      }
+      effective_options_.erase("min_num_features");
+      effective_options_.erase("min_contrast_threshold");
+    }
   }
 
   FeatureSet Detect(const ImageView& view) const override {
     const ScaledImage scaled = ScaleToMaxSize(view, options_.max_image_size, "sift");
 
-    // A detector per call: sharing one cv::SIFT across threads is not documented as safe.
-    const cv::Ptr<cv::SIFT> sift =
-        cv::SIFT::create(options_.max_num_features, options_.num_octave_layers,
-                         options_.contrast_threshold, options_.edge_threshold, options_.sigma);
     std::vector<cv::KeyPoint> cv_keypoints;
     cv::Mat cv_descriptors;
-    sift->detectAndCompute(scaled.image, cv::noArray(), cv_keypoints, cv_descriptors);
+    double threshold = options_.contrast_threshold;
+    DetectAt(scaled.image, threshold, &cv_keypoints, &cv_descriptors);
+    const int wanted = options_.min_num_features;
+    if (static_cast<int>(cv_keypoints.size()) < wanted) {
+      const size_t first_count = cv_keypoints.size();
+      const double first_threshold = threshold;
+      while (static_cast<int>(cv_keypoints.size()) < wanted &&
+             threshold > options_.min_contrast_threshold) {
+        threshold = std::max(threshold / 2, options_.min_contrast_threshold);
+        DetectAt(scaled.image, threshold, &cv_keypoints, &cv_descriptors);
+      }
+      const std::string text = std::to_string(first_count) + " features at contrast threshold " +
+                               FormatThreshold(first_threshold) + ", fewer than min_num_features " +
+                               std::to_string(wanted) + ": " + std::to_string(cv_keypoints.size()) +
+                               " at " + FormatThreshold(threshold);
+      if (static_cast<int>(cv_keypoints.size()) < wanted) {
+        log().Warn(text + ", the floor min_contrast_threshold");
+      } else {
+        log().Info(text);
+      }
+    }
     // OpenCV keeps every keypoint whose response ties with the last one kept.
     const std::vector<int> order = StrongestFirst(cv_keypoints, options_.max_num_features);
 
@@ -101,6 +136,23 @@ class SiftDetector : public Detector {
   DescriptorMetric Metric() const override { return DescriptorMetric::kL2; }
 
  private:
+  // SIFT on `image` at the contrast threshold `threshold`.
+  void DetectAt(const cv::Mat& image, double threshold, std::vector<cv::KeyPoint>* keypoints,
+                cv::Mat* descriptors) const {
+    // A detector per call: sharing one cv::SIFT across threads is not documented as safe.
+    const cv::Ptr<cv::SIFT> sift =
+        cv::SIFT::create(options_.max_num_features, options_.num_octave_layers, threshold,
+                         options_.edge_threshold, options_.sigma);
+    keypoints->clear();
+    sift->detectAndCompute(image, cv::noArray(), *keypoints, *descriptors);
+  }
+
+  static std::string FormatThreshold(double threshold) {
+    std::ostringstream text;
+    text << threshold;
+    return text.str();
+  }
+
   // COLMAP's conversion: normalise (L2, or L1 then square root for RootSIFT), then
   // 512 times the value, rounded and clamped to [0, 255].
   Eigen::Matrix<uint8_t, 1, kDescriptorDimension> ToUnsignedByte(

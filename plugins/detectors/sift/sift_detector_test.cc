@@ -306,6 +306,37 @@ TEST(SiftDetector, RejectsInvalidOptions) {
       << text;
 }
 
+// Weak texture: the same scene at 4% of its contrast.
+cv::Mat LowContrast(const cv::Mat& image) {
+  cv::Mat low;
+  image.convertTo(low, CV_8U, 0.04, 122);
+  return low;
+}
+
+TEST(SiftDetector, MinNumFeaturesLowersTheContrastThresholdOnWeakTextureAndSaysSo) {
+  const cv::Mat image = LowContrast(MakeTexturedImage());
+  const size_t plain = Detect({}, image).keypoints.size();
+  ASSERT_LT(plain, 500u);
+  const auto detector =
+      testing::LoadBundledPlugin<Detector>("detector", "sift", {{"min_num_features", 500}});
+  std::vector<std::string> lines;
+  testing::Unguarded(detector).SetLogSink([&](LogLevel level, const std::string& text) {
+    lines.push_back((level == LogLevel::kInfo ? "info: " : "other: ") + text);
+  });
+  const FeatureSet adapted = testing::Unguarded(detector).Detect(View(image));
+  EXPECT_GE(adapted.keypoints.size(), 500u);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_TRUE(StartsWith(lines[0], "info: " + std::to_string(plain) +
+                                       " features at contrast threshold 0.02, fewer than "
+                                       "min_num_features 500: " +
+                                       std::to_string(adapted.keypoints.size()) + " at "))
+      << lines[0];
+  EXPECT_TRUE(StartsWith(OptionErrorText({{"min_contrast_threshold", 0.01}}),
+                         "pipeline.test.options.min_contrast_threshold: is used only with "
+                         "min_num_features above 0"));
+  EXPECT_EQ(testing::Unguarded(detector).EffectiveOptions().at("min_num_features"), 500);
+}
+
 TEST(SiftDetector, RejectsAnEmptyImage) {
   const auto detector = testing::LoadBundledPlugin<Detector>("detector", "sift");
   EXPECT_THROW(testing::Unguarded(detector).Detect(ImageView()), InputError);

@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "common/synthetic_model_test_util.h"
+#include "tessera/testing/synthetic_model.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
 #include "test_support.h"

@@ -2,7 +2,7 @@
 // read as it is (the reference trainer accepts only PINHOLE and SIMPLE_PINHOLE cameras):
 //   OUTPUT/<folder>/images/<name>                         undistorted images
 //   OUTPUT/<folder>/sparse/0/{cameras,images,points3D}.bin the model of those images
-//   OUTPUT/<folder>/masks/<name>.png                      with mask_path: their masks
+//   OUTPUT/<folder>/masks/<name>.png                      with masks: theirs
 // With field_of_view "full" the images are larger and hold the whole field of a wide
 // lens; every image then gets a mask, black on the blank border.
 
@@ -313,8 +313,11 @@ class GaussianSplattingExporter : public Exporter {
       CreateFolder(target.parent_path());
       WriteFileAtomically(target, EncodeImage(pixels, target, jpeg_quality_));
       cv::Mat mask;  // of the written image; empty: none written
-      if (!mask_path_.empty()) {
-        const std::filesystem::path mask_file = FindMask(mask_path_, image.name);
+      // The option names a folder for this exporter only; else the run's masks.
+      const std::filesystem::path mask_dir =
+          !mask_path_.empty() ? std::filesystem::path(mask_path_) : context.mask_dir;
+      if (!mask_dir.empty()) {
+        const std::filesystem::path mask_file = FindMask(mask_dir, image.name);
         if (!mask_file.empty()) mask = cv::imread(mask_file.string(), cv::IMREAD_GRAYSCALE);
         // No mask, or one of another size: none from mask_path (the extract stage warned).
         if (mask.cols != static_cast<int>(camera.width) ||

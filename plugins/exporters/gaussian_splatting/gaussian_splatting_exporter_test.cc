@@ -5,7 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "common/synthetic_model_test_util.h"
+#include "tessera/testing/synthetic_model.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/model_statistics.h"
 #include "test_support.h"
@@ -143,6 +143,19 @@ TEST(GaussianSplattingExporter, UndistortsAnOpenCVFisheyeCameraToPinholeWithItsM
   EXPECT_EQ(written_mask.at<uchar>(60, 120), 255);
   EXPECT_EQ(cv::countNonZero(written_mask(cv::Rect(0, 0, 79, 120))), 0);
   EXPECT_FALSE(fs::exists(root / "masks" / "img_2.png.png"));  // no mask given
+
+  // Masks given once: the run's mask folder (ExportContext::mask_dir) is used when the
+  // exporter's own mask_path is not set, with the same result.
+  testing::TemporaryDir output_from_run;
+  auto plain = testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting");
+  context.output_dir = output_from_run.path();
+  context.mask_dir = masks.path();
+  testing::Unguarded(plain).Export(model, context);
+  const cv::Mat run_mask = cv::imread(
+      (output_from_run.path() / "gaussian_splatting" / "masks" / "img_1.png.png").string(),
+      cv::IMREAD_GRAYSCALE);
+  ASSERT_EQ(run_mask.size(), mask.size());
+  EXPECT_EQ(cv::countNonZero(run_mask != written_mask), 0);
 }
 
 // An equidistant fisheye (OPENCV_FISHEYE, k = 0) whose image circle, 150 degrees across,

@@ -6,7 +6,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <sstream>
 
-#include "common/synthetic_model_test_util.h"
+#include "tessera/testing/synthetic_model.h"
 #include "test_support.h"
 
 namespace tessera {

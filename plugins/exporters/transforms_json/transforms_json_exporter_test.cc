@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <fstream>
 
-#include "common/synthetic_model_test_util.h"
+#include "tessera/testing/synthetic_model.h"
 #include "test_support.h"
 
 namespace tessera {

@@ -1,9 +1,17 @@
 #pragma once
 
-// Test scenes for the exporter tests: cameras on an arc looking at a cloud of points,
-// with keypoints that are the exact projections, so that a test asserts on errors.
+// Test scenes for plugins' unit tests (installed with the SDK; the bundled exporters'
+// tests use it): cameras on an arc looking at a cloud of points, with keypoints that are
+// the exact projections, so that a test asserts on errors. Header-only, needs Eigen.
+//
+//   #include "tessera/testing/synthetic_model.h"
+//   const tessera::Camera camera =
+//       tessera::Camera::Create(1, tessera::CameraModelId::kSimpleRadial, 500, 640, 480);
+//   const tessera::Reconstruction model = tessera::testing::MakeSyntheticModel(camera, 5, 200);
 
 #include <Eigen/Geometry>
+#include <cmath>
+#include <cstdint>
 #include <random>
 #include <string>
 
