@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "tessera/adaptive_threshold.h"
 #include "tessera/keypoint_selection.h"
 #include "tessera/scaled_image.h"
 #include "tessera/sdk.h"
@@ -90,27 +91,14 @@ class OrbDetector : public Detector {
 
     std::vector<cv::KeyPoint> cv_keypoints;
     cv::Mat cv_descriptors;
-    int threshold = options_.fast_threshold;
-    DetectAt(scaled.image, threshold, &cv_keypoints, &cv_descriptors);
-    const int wanted = options_.min_num_features;
-    if (static_cast<int>(cv_keypoints.size()) < wanted) {
-      const size_t first_count = cv_keypoints.size();
-      const int first_threshold = threshold;
-      while (static_cast<int>(cv_keypoints.size()) < wanted &&
-             threshold > options_.min_fast_threshold) {
-        threshold = std::max(threshold / 2, options_.min_fast_threshold);
-        DetectAt(scaled.image, threshold, &cv_keypoints, &cv_descriptors);
-      }
-      const std::string text = std::to_string(first_count) + " features at FAST threshold " +
-                               std::to_string(first_threshold) + ", fewer than min_num_features " +
-                               std::to_string(wanted) + ": " + std::to_string(cv_keypoints.size()) +
-                               " at " + std::to_string(threshold);
-      if (static_cast<int>(cv_keypoints.size()) < wanted) {
-        log().Warn(text + ", the floor min_fast_threshold");
-      } else {
-        log().Info(text);
-      }
-    }
+    DetectWithAdaptiveThreshold(
+        static_cast<size_t>(options_.min_num_features), options_.fast_threshold,
+        options_.min_fast_threshold,
+        [&](int threshold) {
+          DetectAt(scaled.image, threshold, &cv_keypoints, &cv_descriptors);
+          return cv_keypoints.size();
+        },
+        log(), "FAST threshold", "min_fast_threshold");
     // ORB fills its quota level by level and may keep ties beyond it.
     const std::vector<int> order = StrongestFirst(cv_keypoints, options_.max_num_features);
 

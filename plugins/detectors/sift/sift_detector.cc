@@ -9,10 +9,10 @@
 #include <opencv2/core.hpp>
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgproc.hpp>
-#include <sstream>
 #include <string>
 #include <vector>
 
+#include "tessera/adaptive_threshold.h"
 #include "tessera/keypoint_selection.h"
 #include "tessera/scaled_image.h"
 #include "tessera/sdk.h"
@@ -88,27 +88,14 @@ class SiftDetector : public Detector {
 
     std::vector<cv::KeyPoint> cv_keypoints;
     cv::Mat cv_descriptors;
-    double threshold = options_.contrast_threshold;
-    DetectAt(scaled.image, threshold, &cv_keypoints, &cv_descriptors);
-    const int wanted = options_.min_num_features;
-    if (static_cast<int>(cv_keypoints.size()) < wanted) {
-      const size_t first_count = cv_keypoints.size();
-      const double first_threshold = threshold;
-      while (static_cast<int>(cv_keypoints.size()) < wanted &&
-             threshold > options_.min_contrast_threshold) {
-        threshold = std::max(threshold / 2, options_.min_contrast_threshold);
-        DetectAt(scaled.image, threshold, &cv_keypoints, &cv_descriptors);
-      }
-      const std::string text = std::to_string(first_count) + " features at contrast threshold " +
-                               FormatThreshold(first_threshold) + ", fewer than min_num_features " +
-                               std::to_string(wanted) + ": " + std::to_string(cv_keypoints.size()) +
-                               " at " + FormatThreshold(threshold);
-      if (static_cast<int>(cv_keypoints.size()) < wanted) {
-        log().Warn(text + ", the floor min_contrast_threshold");
-      } else {
-        log().Info(text);
-      }
-    }
+    DetectWithAdaptiveThreshold(
+        static_cast<size_t>(options_.min_num_features), options_.contrast_threshold,
+        options_.min_contrast_threshold,
+        [&](double threshold) {
+          DetectAt(scaled.image, threshold, &cv_keypoints, &cv_descriptors);
+          return cv_keypoints.size();
+        },
+        log(), "contrast threshold", "min_contrast_threshold");
     // OpenCV keeps every keypoint whose response ties with the last one kept.
     const std::vector<int> order = StrongestFirst(cv_keypoints, options_.max_num_features);
 
@@ -145,12 +132,6 @@ class SiftDetector : public Detector {
                          options_.edge_threshold, options_.sigma);
     keypoints->clear();
     sift->detectAndCompute(image, cv::noArray(), *keypoints, *descriptors);
-  }
-
-  static std::string FormatThreshold(double threshold) {
-    std::ostringstream text;
-    text << threshold;
-    return text.str();
   }
 
   // COLMAP's conversion: normalise (L2, or L1 then square root for RootSIFT), then
