@@ -167,6 +167,12 @@ fresh "$work/pairs"
 PAIRS='{"plugin": "window", "options": {"window": 1}}' manifest "$work/window.json" '[{"plugin": "colmap_binary"}]'
 check "pair selection narrowed: earlier pairs not mapped" 0 'grep -q "map: 5 images, [1-4] verified pairs" "$work/case.log"' "" -- \
   t run --images "$work/d" --output "$work/pairs" --manifest "$work/window.json"
+# A 3DGS re-export of a smaller model (4 of the 5 images): no image of the old one left.
+mkdir -p "$work/d4"; cp "$work"/d/000[3456].jpg "$work/d4/"
+t run --images "$work/d4" --output "$work/small" --manifest "$work/bin.json" > /dev/null 2>&1
+"$tessera" export --model "$work/base/sparse/0" --format gaussian_splatting --images "$work/d" --output "$work/gs" > /dev/null 2>&1
+check "3DGS re-export of a smaller model: no old image left" 0 '[ "$(ls "$work/gs/gaussian_splatting/images" | wc -l)" = 4 ] && [ ! -e "$work/gs/gaussian_splatting/images/0007.jpg" ]' "" -- \
+  "$tessera" export --model "$work/small/sparse/0" --format gaussian_splatting --images "$work/d4" --output "$work/gs"
 check "--threads 65537" 2 "" "" -- \
   "$tessera" run --images "$work/d" --output "$work/thr" --manifest "$work/bin.json" --threads 65537
 

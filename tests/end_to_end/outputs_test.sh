@@ -11,7 +11,8 @@
 #  6. exporter options naming workspace files, or two exporters writing one path: exit 2
 #     before anything is replaced, the database intact;
 #  7. a failing exporter stops the ones after it; the earlier set stays whole;
-#  8. a rerun that builds no model (exit 3) leaves no model of an earlier run.
+#  8. a rerun that builds no model (exit 3) leaves no model of an earlier run;
+#  9. a gaussian_splatting re-export of a smaller model leaves none of the old images.
 # usage: outputs_test.sh TESSERA DOWNSCALE SOURCE_DIR FAILING_PLUGIN_DIR
 set -uo pipefail
 tessera=$1
@@ -175,4 +176,18 @@ code=$?
 python3 -c 'import json,sys; assert json.load(open(sys.argv[1]))["models"] == []' "$work/n/mapping_summary.json" ||
   fail "no model: mapping_summary.json still lists the earlier models"
 echo "no model: the earlier models removed, mapping_summary.json lists none"
+
+# 9. A 3DGS re-export of a model of 4 of the 5 images into the same folder.
+mkdir -p "$work/d4"
+cp "$work"/d/000[3456].jpg "$work/d4/"
+tess "$work/small.log" "$work/bin.json" run --images "$work/d4" --output "$work/small" ||
+  { cat "$work/small.log"; fail "the run on 4 images"; }
+"$tessera" export --model "$work/base/sparse/0" --format gaussian_splatting --images "$work/d" \
+  --output "$work/gs" > "$work/gs1.log" 2>&1 || { cat "$work/gs1.log"; fail "the first 3DGS export"; }
+[ "$(ls "$work/gs/gaussian_splatting/images" | wc -l)" = 5 ] || fail "the first 3DGS export has not 5 images"
+"$tessera" export --model "$work/small/sparse/0" --format gaussian_splatting --images "$work/d4" \
+  --output "$work/gs" > "$work/gs2.log" 2>&1 || { cat "$work/gs2.log"; fail "the second 3DGS export"; }
+[ "$(ls "$work/gs/gaussian_splatting/images" | wc -l)" = 4 ] && [ ! -e "$work/gs/gaussian_splatting/images/0007.jpg" ] ||
+  fail "the re-export of a smaller model left old images: $(ls "$work/gs/gaussian_splatting/images")"
+echo "3DGS re-export of a smaller model: the old images gone"
 echo "PASS"
