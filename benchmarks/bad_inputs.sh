@@ -268,26 +268,27 @@ fi
 
 # Names from outside: image names of models, databases and videos become paths; Slurm
 # values are written into batch scripts.
-t export --model "$work/w_out/sparse/0" --format colmap_text --output "$work/text_model" > /dev/null 2>&1
-bad_name_model() {  # DIR NAME: the text model with image 0001.jpg renamed NAME
-  mkdir -p "$1"; cp "$work/text_model"/*.txt "$1/"
+"$tessera" export --model "$work/w_out/sparse/0" --format colmap_text --output "$work/text_model" > /dev/null 2>&1
+bad_name_model() {  # DIR NAME: the text model with its first image renamed NAME
+  mkdir -p "$1"; cp "$work/text_model/sparse/0"/*.txt "$1/"
   NAME="$2" python3 -c 'import os, sys
 p = sys.argv[1] + "/images.txt"; lines = open(p).read().split("\n")
-lines = [l[:-len("0001.jpg")] + os.environ["NAME"] if l.endswith(" 0001.jpg") else l for l in lines]
+first = next(i for i, l in enumerate(lines) if l and not l.startswith("#"))
+lines[first] = " ".join(lines[first].split(" ")[:9] + [os.environ["NAME"]])
 open(p, "w").write("\n".join(lines))' "$1"
 }
 cp "$work/w/0003.jpg" "$work/victim.jpg"
 bad_name_model "$work/abs_model" "$work/victim.jpg"
 check "model image name absolute (3DGS export)" 2 "abs_model/images.txt line [0-9]+: image [0-9]+: the image name '$work/victim.jpg' is an absolute path" \
   'cmp -s "$work/victim.jpg" "$work/w/0003.jpg"' -- \
-  t export --model "$work/abs_model" --format gaussian_splatting --images "$work/w" --output "$work/abs_out"
+  "$tessera" export --model "$work/abs_model" --format gaussian_splatting --images "$work/w" --output "$work/abs_out"
 mkdir -p "$work/deep/er"; cp "$work/w/0003.jpg" "$work/deep/escaped.jpg"
 bad_name_model "$work/dotdot_model" "../escaped.jpg"
 check "model image name ../ (3DGS export)" 2 "dotdot_model/images.txt line [0-9]+: image [0-9]+: the image name '../escaped.jpg' has a '..' component" \
   '[ ! -e "$work/deep/out/gaussian_splatting/escaped.jpg" ] && [ ! -e "$work/deep/out/escaped.jpg" ]' -- \
-  t export --model "$work/dotdot_model" --format gaussian_splatting --images "$work/deep/er" --output "$work/deep/out"
+  "$tessera" export --model "$work/dotdot_model" --format gaussian_splatting --images "$work/deep/er" --output "$work/deep/out"
 cp -r "$work/w_out" "$work/nl_db"
-sqlite3 "$work/nl_db/database.db" "UPDATE images SET name = 'a' || char(10) || 'b.jpg' WHERE name = '0001.jpg'"
+sqlite3 "$work/nl_db/database.db" "UPDATE images SET name = 'a' || char(10) || 'b.jpg' WHERE image_id = (SELECT MIN(image_id) FROM images)"
 check "database image name with a line break" 2 "nl_db/database.db': image [0-9]+: the image name 'a\\\\nb.jpg' contains a line break" "" -- \
   t map --output "$work/nl_db" --manifest "$work/m.json"
 echo "not a video" > "$work/clip

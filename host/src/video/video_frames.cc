@@ -288,6 +288,29 @@ VideoFrames ExtractVideoFrames(const fs::path& video, const std::string& folder,
   return result;
 }
 
+namespace {
+
+// The folder below video_frames/ of each video: its name's stem, made unique. Its frames
+// are images named <folder>/frame_...jpg, so each name is checked as an image name: a
+// control character in a video's name would be in every one of them.
+std::vector<std::string> VideoFolders(const std::vector<fs::path>& videos) {
+  std::vector<std::string> folders;
+  std::set<std::string> taken;
+  for (const fs::path& video : videos) {
+    std::string folder = video.stem().string();
+    if (folder.empty() || folder[0] == '.') folder = "video" + folder;
+    for (int k = 2; taken.count(folder); ++k)
+      folder = video.stem().string() + "_" + std::to_string(k);
+    taken.insert(folder);
+    CheckImageName(folder + "/" + VideoFrameName(0, 0),
+                   "video '" + EscapeControlCharacters(video.string()) + "'");
+    folders.push_back(folder);
+  }
+  return folders;
+}
+
+}  // namespace
+
 fs::path IngestVideos(const std::vector<fs::path>& videos, const fs::path& output_dir,
                       const VideoFrameOptions& options, std::vector<VideoFrames>* results) {
   const fs::path frames_dir = output_dir / "video_frames";
@@ -301,19 +324,12 @@ fs::path IngestVideos(const std::vector<fs::path>& videos, const fs::path& outpu
       recorded = nlohmann::json::object();  // damaged: every video is decoded again
     }
   }
+  const std::vector<std::string> folders = VideoFolders(videos);  // before anything is written
   CreateFolder(frames_dir);
   nlohmann::json record = {{"videos", nlohmann::json::array()}};
-  std::set<std::string> folders;
-  for (const fs::path& video : videos) {
-    std::string folder = video.stem().string();
-    if (folder.empty() || folder[0] == '.') folder = "video" + folder;
-    for (int k = 2; folders.count(folder); ++k)
-      folder = video.stem().string() + "_" + std::to_string(k);
-    folders.insert(folder);
-    // Its frames are images named <folder>/frame_...jpg: a control character in the
-    // video's name would be in every one of them.
-    CheckImageName(folder + "/" + VideoFrameName(0, 0),
-                   "video '" + EscapeControlCharacters(video.string()) + "'");
+  for (size_t index = 0; index < videos.size(); ++index) {
+    const fs::path& video = videos[index];
+    const std::string& folder = folders[index];
     VideoFrames probe;
     probe.video = video;
     probe.folder = folder;
@@ -345,7 +361,8 @@ fs::path IngestVideos(const std::vector<fs::path>& videos, const fs::path& outpu
   }
   // Folders of videos no longer given: their frames would be scanned as images.
   for (const auto& entry : fs::directory_iterator(frames_dir, error)) {
-    if (entry.is_directory() && !folders.count(entry.path().filename().string())) {
+    if (entry.is_directory() && std::find(folders.begin(), folders.end(),
+                                          entry.path().filename().string()) == folders.end()) {
       spdlog::info("video: removing {}: its video is not among this run's", entry.path().string());
       fs::remove_all(entry.path(), error);
     }

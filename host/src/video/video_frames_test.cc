@@ -234,6 +234,8 @@ TEST(VideoFrames, AControlCharacterInAVideoNameIsAnInputError) {
                   "/pan\\nrm.mp4': the image name 'pan\\nrm/frame_000000_0.000s.jpg' contains "
                   "a line break, which a COLMAP text model cannot hold.");
   }
+  // Refused before anything is written.
+  EXPECT_FALSE(fs::exists(dir.path() / "out" / "video_frames"));
 }
 
 // frames.json is read back to reuse a selection: the image names it holds are checked as
