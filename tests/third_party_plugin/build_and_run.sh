@@ -17,8 +17,20 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 cmake --install "$build_dir" --prefix "$work/prefix" > "$work/install.log"
-# Only the installed tree: no path into the Tessera sources or build.
-cmake -S "$source_dir" -B "$work/build" -DCMAKE_BUILD_TYPE=Release \
+# Only the installed tree: no path into the Tessera sources or build. The examples are
+# built from the copy installed with the documentation, as the guide says, beside the
+# guide and one page per plugin kind.
+docs="$work/prefix/share/doc/tessera"
+for page in plugin_authors_guide.md manifest_reference.md plugins/detector.md plugins/matcher.md \
+    plugins/pair_selector.md plugins/bundle_adjuster.md plugins/exporter.md; do
+  [ -s "$docs/$page" ] || { echo "FAIL: $docs/$page is not installed"; exit 1; }
+done
+for example in "$source_dir"/*.cc "$source_dir"/CMakeLists.txt; do
+  cmp -s "$example" "$docs/examples/$(basename "$example")" ||
+    { echo "FAIL: $docs/examples/$(basename "$example") is not the installed copy of $example"; exit 1; }
+done
+cp -r "$docs/examples" "$work/examples"
+cmake -S "$work/examples" -B "$work/build" -DCMAKE_BUILD_TYPE=Release \
       -DCMAKE_PREFIX_PATH="$work/prefix" > "$work/configure.log"
 cmake --build "$work/build" -j2 > "$work/build.log"
 

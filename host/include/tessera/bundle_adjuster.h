@@ -53,6 +53,31 @@ inline std::string BundleAdjustmentSummary::BriefReport() const {
 
 // Refines cameras, poses and points of a reconstruction by minimizing reprojection
 // error.
+//
+// The contract in short (the full one: PREFIX/share/doc/tessera/plugins/bundle_adjuster.md),
+// as the bundled `ceres` adjuster keeps it:
+// - The mapper calls Adjust one call at a time. A local adjustment gets a sub-model: the
+//   local images, the other images that see their points (in constant_poses) and only
+//   the local images' points, so an image's points2D may name points that are not in
+//   it: go from the points' tracks. A global adjustment gets the model itself.
+// - One residual per Point3D::track element whose image is in config.images (empty:
+//   every registered image); observations in other images are not added.
+// - A point with fewer than 2 observations in the problem stays in it, constant; so do
+//   config.constant_points and the poses of config.constant_poses.
+// - Gauge: with fix_gauge and no constant pose in the problem, hold the pose of the
+//   lowest image id with observations and the largest-magnitude translation
+//   coordinate of the next one; with a constant pose, fix nothing else.
+// - Intrinsics move only as the refine_* flags say; max_num_iterations > 0 caps the
+//   adjuster's own, function_tolerance >= 0 replaces it.
+// - Write back only a usable result, and only what could move (constant values stay
+//   bit-identical); then set Point3D::error of every point of the problem to its mean
+//   reprojection error over the track's registered images (PointReprojectionError,
+//   tessera/io/model_statistics.h). Change values only: poses, camera params, xyz, error.
+// - An invalid problem (no registered image, unknown image or camera, no observation,
+//   nothing variable) is usable = false with a sentence in message, the model untouched.
+// - A throw ends the map stage (InputError: exit code 2, else 1); a crash ends the run
+//   (exit code 4), and a bundle that crashed the adjuster twice is refused (exit code 2).
+// - Log with log() (tessera/log.h), never to stdout or stderr; never call exit().
 class TESSERA_API BundleAdjuster : public Plugin {
  public:
   virtual BundleAdjustmentSummary Adjust(const BundleAdjustmentConfig& config,

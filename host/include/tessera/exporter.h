@@ -22,6 +22,22 @@ struct ExportContext {
 // an exporter writes the registered ones only. It writes below context.output_dir only
 // (the host runs each exporter in a staging folder and places its files when the whole
 // set succeeded).
+//
+// The contract in short (the full one: PREFIX/share/doc/tessera/plugins/exporter.md):
+// - Export is called one call at a time: by map and run once per model and exporter
+//   (models from 0, the largest; points coloured first when the image folder is known),
+//   by `tessera export` once. context.output_dir is the same staging folder for every
+//   model of a run: name per-model files with PerModelPath or SparseModelDir
+//   (tessera/io/exporter_paths.h), and path options with OptionReader::GetRelativePath.
+// - context.image_dir may be empty (not known); context.mask_dir is empty without masks.
+//   Never write into either: the host places nothing there.
+// - A throw stops the set: later exporters are not run, earlier outputs stay whole, and
+//   what this run wrote stays in the staging folder until the next run (InputError:
+//   exit code 2, else 1). A crash ends the run (exit code 4); a model that crashed the
+//   exporter twice is skipped by it from then on, with a warning.
+// - Options: OptionReader in the constructor, Finish(), effective_options_ =
+//   reader.Effective(). An OptionError there is exit code 2, naming the key.
+// - Log with log() (tessera/log.h), never to stdout or stderr; never call exit().
 class TESSERA_API Exporter : public Plugin {
  public:
   virtual void Export(const Reconstruction& reconstruction, const ExportContext& context) const = 0;

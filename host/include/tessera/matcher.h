@@ -8,6 +8,20 @@
 namespace tessera {
 
 // Finds putative correspondences between the descriptors of two images.
+//
+// The contract in short (the full one: PREFIX/share/doc/tessera/plugins/matcher.md):
+// - Match is called once per selected pair not yet matched in the workspace, from
+//   several threads at once, with the two images' descriptors as stored (one uint8 row
+//   per keypoint, the workspace's metric and width; a set may be empty).
+// - Return indices into the two sets: an index beyond them ends the stage (exit code
+//   1). The host then verifies the matches geometrically; return putative ones.
+// - A throw from Match ends the match stage (InputError: exit code 2, else 1); pairs
+//   matched before stay in the workspace. A crash ends the run (exit code 4); a pair
+//   that crashed the matcher twice is skipped from then on.
+// - Options: OptionReader in the constructor, Finish(), effective_options_ =
+//   reader.Effective(); the host records them with the matches, and a change matches
+//   the pairs again. An OptionError there is exit code 2, naming the key.
+// - Log with log() (tessera/log.h), never to stdout or stderr; never call exit().
 class TESSERA_API Matcher : public Plugin {
  public:
   // Indices into descriptors1 and descriptors2. Both sets share one metric; a

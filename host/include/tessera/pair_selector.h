@@ -53,6 +53,20 @@ struct PairSelectionInput {
 
 // Chooses which image pairs to match, from the images' names, cameras, metadata and,
 // on demand, features.
+//
+// The contract in short (the full one: PREFIX/share/doc/tessera/plugins/pair_selector.md):
+// - SelectPairs is called once per match stage, from one thread, with every image of
+//   the workspace in capture order; it may use input.num_threads threads.
+// - Return indices into input.images, each pair once, first < second, in a
+//   deterministic order. An index out of range or a self pair ends the stage (exit
+//   code 1). With several selectors the host matches the union, each pair once.
+// - Read features on demand through input.features and drop them; never hold them all.
+// - InputError (or OptionError) from SelectPairs or CheckDescriptors ends the stage with
+//   exit code 2, naming the selector's slot; anything else exit code 1. A crash ends the
+//   run (exit code 4); a selector that crashed twice on the same images is refused them.
+// - Options: OptionReader in the constructor, Finish(), effective_options_ =
+//   reader.Effective(); the host records them with the selected pairs.
+// - Log with log() (tessera/log.h), never to stdout or stderr; never call exit().
 class TESSERA_API PairSelector : public Plugin {
  public:
   // Returns each pair once, with first < second, in a deterministic order.
