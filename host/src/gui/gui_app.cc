@@ -257,6 +257,9 @@ const std::string& GuiApp::EditorError() const { return setup_->editor().Error()
 bool GuiApp::SetEditorPlugin(const std::string& slot, const std::string& plugin) {
   return setup_->editor().SetPlugin(slot, plugin);
 }
+std::string GuiApp::EditorPlugin(const std::string& slot) const {
+  return setup_->editor().PluginOf(slot);
+}
 
 bool GuiApp::OpenMatchMatrix(const fs::path& path) { return match_matrix_->Open(path); }
 const std::string& GuiApp::MatchError() const { return match_matrix_->Error(); }

@@ -98,6 +98,9 @@ class GuiApp {
   // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "bundle_adjuster")
   // in the editor's JSON, with no options.
   bool SetEditorPlugin(const std::string& slot, const std::string& plugin);
+  // The plugin a slot's dropdown shows: the one the editor's JSON names ("(none)" when
+  // the slot is absent).
+  std::string EditorPlugin(const std::string& slot) const;
   // Opens the match matrix of the workspace `path` (its database.db); false with the
   // message in MatchError when it cannot.
   bool OpenMatchMatrix(const std::filesystem::path& path);

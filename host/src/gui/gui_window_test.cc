@@ -403,6 +403,40 @@ TEST_F(GuiWindowTest, ManifestEditorChecksAsTheCliAndSaves) {
   app.Frame();
 }
 
+// Each slot's dropdown shows the plugin the editor's text names: the loaded file's, then
+// the one picked, then the reloaded file's; an absent slot reads "(none)".
+TEST_F(GuiWindowTest, PluginDropdownsShowTheEditorsPlugins) {
+  const fs::path manifest = dir_.path() / "m.json";
+  std::ofstream(manifest) << R"({"pipeline": {"detector": {"plugin": "sift"},
+                                             "matcher": {"plugin": "flann"}}})";
+  GuiOptions options;
+  options.manifest = manifest;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  Click(&app, "manifest editor");  // opened: the dropdowns are drawn from now on
+  EXPECT_EQ(app.EditorPlugin("detector"), "sift");
+  EXPECT_EQ(app.EditorPlugin("matcher"), "flann");
+  EXPECT_EQ(app.EditorPlugin("bundle_adjuster"), "(none)");
+  ASSERT_TRUE(app.SetEditorPlugin("detector", "orb"));
+  app.Frame();
+  EXPECT_EQ(app.EditorPlugin("detector"), "orb");
+  EXPECT_EQ(app.EditorPlugin("matcher"), "flann");
+  std::ofstream(manifest) << R"({"pipeline": {"matcher": {"plugin": "brute_force"},
+                                             "pair_selector": [{"plugin": "sequential"},
+                                                               {"plugin": "exhaustive"}]}})";
+  ASSERT_TRUE(app.LoadManifestIntoEditor()) << app.EditorError();
+  app.Frame();
+  EXPECT_EQ(app.EditorPlugin("matcher"), "brute_force");
+  EXPECT_EQ(app.EditorPlugin("detector"), "(none)");
+  EXPECT_EQ(app.EditorPlugin("pair_selector"), "sequential + exhaustive");
+  ASSERT_TRUE(app.SetEditorPlugin("detector", "orb"));
+  app.Frame();
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
+  app.SetEditorText("{\"pipeline\": ");
+  EXPECT_EQ(app.EditorPlugin("matcher"), "(invalid JSON)");
+}
+
 // Once the editor is open, Run runs its text, saved or not: a bad manifest file fixed in
 // the editor runs without saving, and the file stays as it was.
 TEST_F(GuiWindowTest, RunUsesTheEditorsTextWithoutSaving) {
