@@ -247,6 +247,8 @@ const std::string& GuiApp::ModelError() const { return model_panel_->Error(); }
 const std::string& GuiApp::SetupError() const { return setup_->Error(); }
 std::string GuiApp::ImagesField() const { return setup_->ImagesField(); }
 std::string GuiApp::OutputField() const { return setup_->OutputField(); }
+std::string GuiApp::ManifestField() const { return setup_->ManifestField(); }
+bool GuiApp::ChooseRecipe(const std::string& name) { return setup_->ChooseRecipe(name); }
 
 bool GuiApp::LoadManifestIntoEditor() { return setup_->editor().Load(); }
 bool GuiApp::CheckEditedManifest() { return setup_->editor().Check(); }

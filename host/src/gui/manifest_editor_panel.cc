@@ -125,7 +125,9 @@ std::string ManifestEditorPanel::PluginOf(const std::string& slot) const {
   const nlohmann::json& value = json["pipeline"][slot];
   if (!value.is_array()) return PluginNamed(value);
   std::string names;  // pair selectors may be a list
-  for (const nlohmann::json& each : value) names += (names.empty() ? "" : " + ") + PluginNamed(each);
+  for (const nlohmann::json& each : value) {
+    names += (names.empty() ? "" : " + ") + PluginNamed(each);
+  }
   return names.empty() ? "(none)" : names;
 }
 
@@ -136,11 +138,9 @@ void ManifestEditorPanel::FindPlugins() {
       auto& plugins = plugins_by_kind_[kind];
       for (const std::string& name : registry.NamesOfKind(kind)) {
         // The first usable record of the name is the one a run would load.
-        const auto record =
-            std::find_if(registry.records().begin(), registry.records().end(),
-                         [&](const PluginRecord& r) {
-                           return r.usable() && r.kind == kind && r.name == name;
-                         });
+        const auto record = std::find_if(
+            registry.records().begin(), registry.records().end(),
+            [&](const PluginRecord& r) { return r.usable() && r.kind == kind && r.name == name; });
         plugins.emplace_back(name, record != registry.records().end() ? record->description : "");
       }
     }
@@ -156,7 +156,9 @@ void ManifestEditorPanel::DrawSlot(const std::string& kind, const std::string& c
   if (ImGui::BeginCombo(label.c_str(), current.c_str())) {
     for (const auto& [name, description] : plugins) {
       if (ImGui::Selectable(name.c_str(), name == current)) SetPlugin(kind, name);
-      if (ImGui::IsItemHovered() && !description.empty()) ImGui::SetTooltip("%s", description.c_str());
+      if (ImGui::IsItemHovered() && !description.empty()) {
+        ImGui::SetTooltip("%s", description.c_str());
+      }
     }
     ImGui::EndCombo();
   }
