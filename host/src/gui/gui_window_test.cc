@@ -513,12 +513,11 @@ TEST_F(GuiWindowTest, RecipeListChoosesARecipeThatRunUses) {
   app.Frame();
   Click(&app, "recipe");
   app.Frame();
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
   Click(&app, "recipe fast");
   EXPECT_EQ(app.ManifestField(), (recipes / "fast.json").string());
   EXPECT_EQ(app.EditorText(), ReadFileContents(recipes / "fast.json"));
   EXPECT_EQ(app.EditorPlugin("detector"), "orb");
-  app.Frame();
-  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
   ASSERT_TRUE(app.Run()) << app.SetupError();
   ASSERT_TRUE(WaitFor(
       &app, [&] { return !app.controller().Running(); }, 120));
@@ -539,6 +538,7 @@ TEST_F(GuiWindowTest, ManifestBrowserChoosesAJsonFile) {
   app.Frame();
   Click(&app, "browse manifest");
   app.Frame();
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
   EXPECT_FALSE(app.Widget("file notes.txt").has_value());
   EXPECT_FALSE(app.Widget("choose folder").has_value());
   Click(&app, "file b.json");

@@ -83,7 +83,8 @@ const Recipe* RecipeList::Draw(const std::string& manifest_field, WidgetRects* w
   const ImVec2 at = ImGui::GetCursorScreenPos();
   widgets->Set("recipe",
                {at.x, at.y, at.x + ImGui::CalcItemWidth(), at.y + ImGui::GetFrameHeight()});
-  if (ImGui::BeginCombo("Recipe", preview)) {
+  // Tall enough for the nine shipped recipes without scrolling.
+  if (ImGui::BeginCombo("Recipe", preview, ImGuiComboFlags_HeightLarge)) {
     for (const Recipe& recipe : recipes()) {
       if (ImGui::Selectable(recipe.name.c_str(), &recipe == current)) chosen = &recipe;
       widgets->RecordLastItem("recipe " + recipe.name);
