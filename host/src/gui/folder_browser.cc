@@ -8,7 +8,8 @@
 namespace tessera::gui {
 namespace fs = std::filesystem;
 
-void FolderBrowser::Draw(const std::string& name, PathField* path, WidgetRects* widgets) {
+void FolderBrowser::Draw(const std::string& name, PathField* path, WidgetRects* widgets,
+                         const std::string& file_extension) {
   const std::string popup = "browse " + name;
   if (ImGui::Button(("...##" + name).c_str())) {
     std::error_code error;
@@ -20,37 +21,58 @@ void FolderBrowser::Draw(const std::string& name, PathField* path, WidgetRects* 
   widgets->RecordLastItem(popup);
   if (!ImGui::BeginPopup(popup.c_str())) return;
   ImGui::TextUnformatted(browse_dir_.string().c_str());
-  if (ImGui::Button("Choose this folder")) {
-    SetPathField(browse_dir_, path);
-    ImGui::CloseCurrentPopup();
+  if (file_extension.empty()) {
+    if (ImGui::Button("Choose this folder")) {
+      SetPathField(browse_dir_, path);
+      ImGui::CloseCurrentPopup();
+    }
+    widgets->RecordLastItem("choose folder");
+  } else {
+    ImGui::TextDisabled("choose a %s file", file_extension.c_str());
   }
-  widgets->RecordLastItem("choose folder");
   ImGui::Separator();
   if (ImGui::Selectable("..", false, ImGuiSelectableFlags_DontClosePopups)) {
     browse_dir_ = browse_dir_.parent_path();
   }
-  const fs::path next = DrawFolderList(widgets);
-  if (!next.empty()) browse_dir_ = next;
+  const fs::path next = DrawFolderList(file_extension, widgets);
+  std::error_code error;
+  if (!next.empty() && fs::is_directory(next, error)) {
+    browse_dir_ = next;
+  } else if (!next.empty()) {  // a file: the field's value
+    SetPathField(next, path);
+    ImGui::CloseCurrentPopup();
+  }
   ImGui::EndPopup();
 }
 
-fs::path FolderBrowser::DrawFolderList(WidgetRects* widgets) {
-  // At most 1000 sub-folders, so that a huge folder costs little on the UI thread.
-  std::vector<std::string> folders;
+fs::path FolderBrowser::DrawFolderList(const std::string& file_extension, WidgetRects* widgets) {
+  // At most 1000 entries, so that a huge folder costs little on the UI thread.
+  std::vector<std::string> folders, files;
   std::error_code error;
   for (fs::directory_iterator it(browse_dir_, fs::directory_options::skip_permission_denied, error),
        end;
-       !error && it != end && folders.size() < 1000; it.increment(error)) {
+       !error && it != end && folders.size() + files.size() < 1000; it.increment(error)) {
     std::error_code type_error;
-    if (it->is_directory(type_error)) folders.push_back(it->path().filename().string());
+    if (it->is_directory(type_error)) {
+      folders.push_back(it->path().filename().string());
+    } else if (!file_extension.empty() && it->path().extension() == file_extension) {
+      files.push_back(it->path().filename().string());
+    }
   }
   std::sort(folders.begin(), folders.end());
+  std::sort(files.begin(), files.end());
   fs::path next;
   for (const std::string& folder : folders) {
     if (ImGui::Selectable((folder + "/").c_str(), false, ImGuiSelectableFlags_DontClosePopups)) {
       next = browse_dir_ / folder;
     }
     widgets->RecordLastItem("folder " + folder);
+  }
+  for (const std::string& file : files) {
+    if (ImGui::Selectable(file.c_str(), false, ImGuiSelectableFlags_DontClosePopups)) {
+      next = browse_dir_ / file;
+    }
+    widgets->RecordLastItem("file " + file);
   }
   return next;
 }

@@ -2,7 +2,9 @@
 
 // A "..." button beside a path field that opens a popup listing the sub-folders of the
 // field's folder (or of the working folder): ".." goes up, a folder goes in, "Choose this
-// folder" writes the folder into the field.
+// folder" writes the folder into the field. Given a file extension (the manifest field's
+// ".json"), it lists the files with it too, and a file clicked is written into the field
+// instead of a folder.
 
 #include <filesystem>
 #include <string>
@@ -15,12 +17,14 @@ namespace tessera::gui {
 class FolderBrowser {
  public:
   // The button and its popup "browse <name>"; records "browse <name>", "choose folder"
-  // and "folder <sub-folder>" in `widgets`.
-  void Draw(const std::string& name, PathField* path, WidgetRects* widgets);
+  // (without `file_extension`), "folder <sub-folder>" and "file <file>" in `widgets`.
+  void Draw(const std::string& name, PathField* path, WidgetRects* widgets,
+            const std::string& file_extension = "");
 
  private:
-  // The popup's list; returns the sub-folder clicked (empty when none).
-  std::filesystem::path DrawFolderList(WidgetRects* widgets);
+  // The popup's list: sub-folders, then the files with `file_extension` when it is not
+  // empty. Returns the entry clicked (empty when none).
+  std::filesystem::path DrawFolderList(const std::string& file_extension, WidgetRects* widgets);
 
   std::filesystem::path browse_dir_;  // the folder listed
 };

@@ -247,6 +247,8 @@ const std::string& GuiApp::ModelError() const { return model_panel_->Error(); }
 const std::string& GuiApp::SetupError() const { return setup_->Error(); }
 std::string GuiApp::ImagesField() const { return setup_->ImagesField(); }
 std::string GuiApp::OutputField() const { return setup_->OutputField(); }
+std::string GuiApp::ManifestField() const { return setup_->ManifestField(); }
+bool GuiApp::ChooseRecipe(const std::string& name) { return setup_->ChooseRecipe(name); }
 
 bool GuiApp::LoadManifestIntoEditor() { return setup_->editor().Load(); }
 bool GuiApp::CheckEditedManifest() { return setup_->editor().Check(); }
@@ -256,6 +258,9 @@ std::string GuiApp::EditorText() const { return setup_->editor().Text(); }
 const std::string& GuiApp::EditorError() const { return setup_->editor().Error(); }
 bool GuiApp::SetEditorPlugin(const std::string& slot, const std::string& plugin) {
   return setup_->editor().SetPlugin(slot, plugin);
+}
+std::string GuiApp::EditorPlugin(const std::string& slot) const {
+  return setup_->editor().PluginOf(slot);
 }
 
 bool GuiApp::OpenMatchMatrix(const fs::path& path) { return match_matrix_->Open(path); }

@@ -95,9 +95,17 @@ class GuiApp {
   const std::string& EditorError() const;
   std::string ImagesField() const;
   std::string OutputField() const;
+  std::string ManifestField() const;
+  // Chooses the recipe `name` (manifests/<name>.json) as the recipe list does: the
+  // manifest field names its file and the editor holds its text. False with the message
+  // in SetupError when there is no such recipe.
+  bool ChooseRecipe(const std::string& name);
   // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "bundle_adjuster")
   // in the editor's JSON, with no options.
   bool SetEditorPlugin(const std::string& slot, const std::string& plugin);
+  // The plugin a slot's dropdown shows: the one the editor's JSON names ("(none)" when
+  // the slot is absent).
+  std::string EditorPlugin(const std::string& slot) const;
   // Opens the match matrix of the workspace `path` (its database.db); false with the
   // message in MatchError when it cannot.
   bool OpenMatchMatrix(const std::filesystem::path& path);

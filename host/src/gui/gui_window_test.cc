@@ -20,6 +20,7 @@
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
 #include "test_support.h"
+#include "util/paths.h"
 
 namespace tessera::gui {
 namespace {
@@ -404,6 +405,40 @@ TEST_F(GuiWindowTest, ManifestEditorChecksAsTheCliAndSaves) {
   app.Frame();
 }
 
+// Each slot's dropdown shows the plugin the editor's text names: the loaded file's, then
+// the one picked, then the reloaded file's; an absent slot reads "(none)".
+TEST_F(GuiWindowTest, PluginDropdownsShowTheEditorsPlugins) {
+  const fs::path manifest = dir_.path() / "m.json";
+  std::ofstream(manifest) << R"({"pipeline": {"detector": {"plugin": "sift"},
+                                             "matcher": {"plugin": "flann"}}})";
+  GuiOptions options;
+  options.manifest = manifest;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  Click(&app, "manifest editor");  // opened: the dropdowns are drawn from now on
+  EXPECT_EQ(app.EditorPlugin("detector"), "sift");
+  EXPECT_EQ(app.EditorPlugin("matcher"), "flann");
+  EXPECT_EQ(app.EditorPlugin("bundle_adjuster"), "(none)");
+  ASSERT_TRUE(app.SetEditorPlugin("detector", "orb"));
+  app.Frame();
+  EXPECT_EQ(app.EditorPlugin("detector"), "orb");
+  EXPECT_EQ(app.EditorPlugin("matcher"), "flann");
+  std::ofstream(manifest) << R"({"pipeline": {"matcher": {"plugin": "brute_force"},
+                                             "pair_selector": [{"plugin": "sequential"},
+                                                               {"plugin": "exhaustive"}]}})";
+  ASSERT_TRUE(app.LoadManifestIntoEditor()) << app.EditorError();
+  app.Frame();
+  EXPECT_EQ(app.EditorPlugin("matcher"), "brute_force");
+  EXPECT_EQ(app.EditorPlugin("detector"), "(none)");
+  EXPECT_EQ(app.EditorPlugin("pair_selector"), "sequential + exhaustive");
+  ASSERT_TRUE(app.SetEditorPlugin("detector", "orb"));
+  app.Frame();
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
+  app.SetEditorText("{\"pipeline\": ");
+  EXPECT_EQ(app.EditorPlugin("matcher"), "(invalid JSON)");
+}
+
 // Once the editor is open, Run runs its text, saved or not: a bad manifest file fixed in
 // the editor runs without saving, and the file stays as it was.
 TEST_F(GuiWindowTest, RunUsesTheEditorsTextWithoutSaving) {
@@ -458,6 +493,59 @@ TEST_F(GuiWindowTest, FolderBrowserChoosesTheImageFolder) {
   app.Frame();
   Click(&app, "choose folder");
   EXPECT_EQ(app.ImagesField(), (dir_.path() / "photos").string());
+}
+
+// The recipe list: manifests/ (as copied next to the executable), each chosen one the
+// manifest field's file and the editor's text; a Run then runs it.
+TEST_F(GuiWindowTest, RecipeListChoosesARecipeThatRunUses) {
+  tessera::testing::WriteSampleImages(dir_.path() / "images", 2);
+  GuiOptions options;
+  options.images = dir_.path() / "images";
+  options.output = dir_.path() / "out";
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  EXPECT_FALSE(app.ChooseRecipe("no_such_recipe"));
+  EXPECT_NE(app.SetupError().find("no recipe 'no_such_recipe'"), std::string::npos)
+      << app.SetupError();
+  const fs::path recipes = DefaultManifestFile().parent_path();
+  ASSERT_TRUE(app.ChooseRecipe("sequential")) << app.SetupError();
+  EXPECT_EQ(app.ManifestField(), (recipes / "sequential.json").string());
+  EXPECT_EQ(app.EditorText(), ReadFileContents(recipes / "sequential.json"));
+  // Chosen in the list with the mouse: "fast" (ORB), which the run then uses.
+  app.Frame();
+  Click(&app, "recipe");
+  app.Frame();
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
+  Click(&app, "recipe fast");
+  EXPECT_EQ(app.ManifestField(), (recipes / "fast.json").string());
+  EXPECT_EQ(app.EditorText(), ReadFileContents(recipes / "fast.json"));
+  EXPECT_EQ(app.EditorPlugin("detector"), "orb");
+  ASSERT_TRUE(app.Run()) << app.SetupError();
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return !app.controller().Running(); }, 120));
+  EXPECT_TRUE(LogHas(app, std::regex(R"(extract: 2 images, 2 to detect with 'orb')")));
+}
+
+// The manifest field's browser lists .json files beside the folders; a file clicked is
+// the field's value.
+TEST_F(GuiWindowTest, ManifestBrowserChoosesAJsonFile) {
+  fs::create_directories(dir_.path() / "recipes");
+  std::ofstream(dir_.path() / "recipes" / "a.json") << "{}";
+  std::ofstream(dir_.path() / "recipes" / "b.json") << "{}";
+  std::ofstream(dir_.path() / "recipes" / "notes.txt") << "";
+  GuiOptions options;
+  options.manifest = dir_.path() / "recipes" / "a.json";
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  Click(&app, "browse manifest");
+  app.Frame();
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
+  EXPECT_FALSE(app.Widget("file notes.txt").has_value());
+  EXPECT_FALSE(app.Widget("choose folder").has_value());
+  Click(&app, "file b.json");
+  EXPECT_EQ(app.ManifestField(), (dir_.path() / "recipes" / "b.json").string());
 }
 
 TEST_F(GuiWindowTest, NoRedrawWhenNothingChanged) {

@@ -15,6 +15,20 @@
 
 namespace tessera::gui {
 namespace fs = std::filesystem;
+namespace {
+
+// The slots in pipeline order, as the dropdowns list them.
+constexpr const char* kSlots[] = {"detector", "pair_selector", "matcher", "bundle_adjuster"};
+
+// The plugin named by one slot's JSON ({"plugin": NAME, ...}); "?" when it names none.
+std::string PluginNamed(const nlohmann::json& slot) {
+  if (slot.is_object() && slot.contains("plugin") && slot["plugin"].is_string()) {
+    return slot["plugin"].get<std::string>();
+  }
+  return "?";
+}
+
+}  // namespace
 
 ManifestEditorPanel::ManifestEditorPanel(PathField* manifest_field)
     : manifest_field_(manifest_field) {}
@@ -101,11 +115,34 @@ bool ManifestEditorPanel::SetPlugin(const std::string& slot, const std::string& 
   }
 }
 
+std::string ManifestEditorPanel::PluginOf(const std::string& slot) const {
+  const nlohmann::json json = nlohmann::json::parse(text_.data(), nullptr, false);
+  if (json.is_discarded()) return "(invalid JSON)";
+  if (!json.is_object() || !json.contains("pipeline") || !json["pipeline"].is_object() ||
+      !json["pipeline"].contains(slot)) {
+    return "(none)";
+  }
+  const nlohmann::json& value = json["pipeline"][slot];
+  if (!value.is_array()) return PluginNamed(value);
+  std::string names;  // pair selectors may be a list
+  for (const nlohmann::json& each : value) {
+    names += (names.empty() ? "" : " + ") + PluginNamed(each);
+  }
+  return names.empty() ? "(none)" : names;
+}
+
 void ManifestEditorPanel::FindPlugins() {
   try {
     const PluginRegistry registry = PluginRegistry::Discover(PluginSearchPath({}));
-    for (const char* kind : {"detector", "pair_selector", "matcher", "bundle_adjuster"}) {
-      plugins_by_kind_[kind] = registry.NamesOfKind(kind);
+    for (const char* kind : kSlots) {
+      auto& plugins = plugins_by_kind_[kind];
+      for (const std::string& name : registry.NamesOfKind(kind)) {
+        // The first usable record of the name is the one a run would load.
+        const auto record = std::find_if(
+            registry.records().begin(), registry.records().end(),
+            [&](const PluginRecord& r) { return r.usable() && r.kind == kind && r.name == name; });
+        plugins.emplace_back(name, record != registry.records().end() ? record->description : "");
+      }
     }
   } catch (const std::exception& error) {
     error_ = error.what();
@@ -113,21 +150,33 @@ void ManifestEditorPanel::FindPlugins() {
   }
 }
 
+void ManifestEditorPanel::DrawSlot(const std::string& kind, const std::string& current) {
+  const auto& plugins = plugins_by_kind_[kind];
+  const std::string label = kind + "##slot";
+  if (ImGui::BeginCombo(label.c_str(), current.c_str())) {
+    for (const auto& [name, description] : plugins) {
+      if (ImGui::Selectable(name.c_str(), name == current)) SetPlugin(kind, name);
+      if (ImGui::IsItemHovered() && !description.empty()) {
+        ImGui::SetTooltip("%s", description.c_str());
+      }
+    }
+    ImGui::EndCombo();
+  }
+  // The description of the plugin now named, so that it follows a new choice.
+  for (const auto& [name, description] : plugins) {
+    if (name == current) HintText(description);
+  }
+}
+
 void ManifestEditorPanel::Draw(WidgetRects* widgets) {
-  if (!ImGui::CollapsingHeader("Pipeline: plugins and options (manifest editor)")) return;
-  widgets->RecordLastItem("manifest editor");
+  const bool open = ImGui::CollapsingHeader("Pipeline: plugins and options (manifest editor)");
+  widgets->RecordLastItem("manifest editor");  // recorded closed too, to be clicked open
+  if (!open) return;
   if (!Loaded()) Load();
   if (plugins_by_kind_.empty()) FindPlugins();
-  // One plugin per slot, from the plugins found on the plugin path.
-  for (const auto& [kind, names] : plugins_by_kind_) {
-    const std::string label = kind + "##slot";
-    if (ImGui::BeginCombo(label.c_str(), "choose...")) {
-      for (const std::string& name : names) {
-        if (ImGui::Selectable(name.c_str())) SetPlugin(kind, name);
-      }
-      ImGui::EndCombo();
-    }
-  }
+  // One plugin per slot, from the plugins found on the plugin path; each dropdown shows
+  // the plugin the text names now.
+  for (const char* kind : kSlots) DrawSlot(kind, PluginOf(kind));
   if (ImGui::InputTextMultiline("##manifest json", text_.data(), text_.size(),
                                 ImVec2(-1, ImGui::GetTextLineHeight() * 12))) {
     status_.clear();  // a "valid" or "saved" no longer describes the text

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "gui/panel_widgets.h"
@@ -33,6 +34,10 @@ class ManifestEditorPanel {
   // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "bundle_adjuster")
   // in the editor's JSON, with no options.
   bool SetPlugin(const std::string& slot, const std::string& plugin);
+  // The plugin the editor's JSON names for a slot, as its dropdown shows it: "(none)"
+  // when the slot is absent (a run then has no such stage), "(invalid JSON)" when the
+  // text does not parse; several pair selectors are joined with " + ".
+  std::string PluginOf(const std::string& slot) const;
 
   // Reloads the editor when the manifest field no longer names the file it was loaded
   // from, clearing the messages of the old file.
@@ -51,13 +56,17 @@ class ManifestEditorPanel {
  private:
   // The plugins of each slot's kind on the plugin path, found once.
   void FindPlugins();
+  // A slot's dropdown, its preview the plugin `json` names, and that plugin's
+  // description beneath it.
+  void DrawSlot(const std::string& kind, const std::string& current);
 
   PathField* manifest_field_;
   std::vector<char> text_ = std::vector<char>(1 << 16, '\0');
   PathField save_path_{};
   std::string error_, status_;
   std::string loaded_from_;  // the manifest field's value when last loaded or saved
-  std::map<std::string, std::vector<std::string>> plugins_by_kind_;
+  // Per kind: each plugin's name and description.
+  std::map<std::string, std::vector<std::pair<std::string, std::string>>> plugins_by_kind_;
 };
 
 }  // namespace tessera::gui

@@ -19,4 +19,11 @@ void ErrorText(const std::string& text) {
   ImGui::PopStyleColor();
 }
 
+void HintText(const std::string& text) {
+  if (text.empty()) return;
+  ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+  ImGui::TextWrapped("%s", text.c_str());
+  ImGui::PopStyleColor();
+}
+
 }  // namespace tessera::gui

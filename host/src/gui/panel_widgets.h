@@ -1,7 +1,7 @@
 #pragma once
 
 // Small pieces the panels share: the text buffer of a path field (ImGui edits a char
-// array in place) and a message line in red.
+// array in place), a message line in red and a greyed hint.
 
 #include <array>
 #include <filesystem>
@@ -16,5 +16,8 @@ void SetPathField(const std::filesystem::path& path, PathField* field);
 
 // Draws `text` wrapped, in red; nothing when it is empty.
 void ErrorText(const std::string& text);
+
+// Draws `text` wrapped, greyed (a description or hint); nothing when it is empty.
+void HintText(const std::string& text);
 
 }  // namespace tessera::gui

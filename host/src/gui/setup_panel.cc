@@ -105,11 +105,28 @@ bool SetupPanel::Run() {
     return false;
   }
   before_start_();
-  RunRequest request{fs::path(images_.data()), fs::path(output_.data()),
-                     fs::path(manifest_.data()), {}};
+  RunRequest request{
+      fs::path(images_.data()), fs::path(output_.data()), fs::path(manifest_.data()), {}};
   if (editor_.Loaded()) request.manifest_json = editor_.Text();
   if (!controller_->Start(request)) {
     error_ = "a run is going on";
+    return false;
+  }
+  return true;
+}
+
+bool SetupPanel::ChooseRecipe(const std::string& name) {
+  const Recipe* recipe = recipes_.Find(name);
+  if (recipe == nullptr) {
+    error_ = "no recipe '" + name + "' in " + recipes_.folder().string();
+    return false;
+  }
+  SetPathField(recipe->file, &manifest_);
+  error_.clear();
+  manifest_error_.clear();
+  // Loaded now, so that the editor (Run's manifest once loaded) holds the recipe.
+  if (!editor_.Load()) {
+    error_ = editor_.Error();
     return false;
   }
   return true;
@@ -127,8 +144,7 @@ void SetupPanel::Draw(const RunStatus& status, WidgetRects* widgets) {
 void SetupPanel::DrawFields(WidgetRects* widgets) {
   ImGui::PushItemWidth(-110);
   // A field's message is about the text that was checked: editing the field clears it.
-  if (ImGui::InputTextWithHint("Images", "folder of photographs", images_.data(),
-                               images_.size())) {
+  if (ImGui::InputTextWithHint("Images", "folder of photographs", images_.data(), images_.size())) {
     images_error_.clear();
   }
   widgets->RecordLastItem("images");
@@ -147,6 +163,9 @@ void SetupPanel::DrawFields(WidgetRects* widgets) {
     error_.clear();
   }
   widgets->RecordLastItem("manifest");
+  ImGui::SameLine();
+  browser_.Draw("manifest", &manifest_, widgets, ".json");
+  if (const Recipe* recipe = recipes_.Draw(manifest_.data(), widgets)) ChooseRecipe(recipe->name);
   editor_.FollowManifestField();
   ErrorText(manifest_error_);
   ImGui::PopItemWidth();

@@ -1,7 +1,8 @@
 #pragma once
 
 // The "Reconstruct" section of the set-up window: the image and output folders (typed, or
-// chosen in a folder browser), the manifest file and its editor, Run (the fields checked
+// chosen in a folder browser), the manifest file (typed, chosen in the browser or from the
+// recipe list) and its editor, Run (the fields checked
 // first, each wrong one with its message beside it) and Cancel, the run's state, whether
 // the view follows the growing model, and a progress bar per stage with its rate and
 // the time left.
@@ -12,6 +13,7 @@
 #include "gui/folder_browser.h"
 #include "gui/manifest_editor_panel.h"
 #include "gui/panel_widgets.h"
+#include "gui/recipe_list.h"
 #include "gui/run_controller.h"
 #include "gui/widget_rects.h"
 
@@ -29,6 +31,10 @@ class SetupPanel {
   // Starts a run of the fields (as the Run button does); false with the message in
   // Error() (also logged) when a field is wrong or a run is going on.
   bool Run();
+  // Makes the recipe `name` (manifests/<name>.json) the manifest field's file and loads
+  // it into the editor (as choosing it in the recipe list does); false with the message
+  // in Error() when there is no such recipe or it cannot be read.
+  bool ChooseRecipe(const std::string& name);
   // A failed run's message, shown in place of a field's.
   void ShowRunError(const std::string& message) { error_ = message; }
 
@@ -38,6 +44,7 @@ class SetupPanel {
   const std::string& Error() const { return error_; }
   std::string ImagesField() const { return images_.data(); }
   std::string OutputField() const { return output_.data(); }
+  std::string ManifestField() const { return manifest_.data(); }
   bool follow_run() const { return follow_run_; }
   ManifestEditorPanel& editor() { return editor_; }
 
@@ -54,6 +61,7 @@ class SetupPanel {
   std::string error_, images_error_, manifest_error_;
   bool follow_run_ = true;
   FolderBrowser browser_;
+  RecipeList recipes_;
   ManifestEditorPanel editor_{&manifest_};
 };
 
