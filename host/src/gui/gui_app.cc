@@ -190,8 +190,9 @@ void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
   widgets_.Clear();
   const WidgetRect view = ViewRect();
   if (!options_.view_only) {
-    DrawSetupWindow(status);
     const fs::path images(setup_->ImagesField());
+    CheckImageFolderOfModel(images);
+    DrawSetupWindow(status);
     picking_->DrawDetails(view, images, &widgets_);
     match_matrix_->Draw(view, images, &widgets_);
   }
@@ -210,11 +211,26 @@ void GuiApp::DrawSetupWindow(const RunStatus& status) {
   setup_->Draw(status, &widgets_);
   ImGui::Separator();
   model_panel_->Draw(&widgets_);
+  if (!folder_check_.warning.empty()) {
+    ImGui::PushTextWrapPos(0);
+    ImGui::TextColored(ImVec4(1, 0.75f, 0.3f, 1), "%s", folder_check_.warning.c_str());
+    ImGui::PopTextWrapPos();
+    widgets_.RecordLastItem("image folder warning");
+  }
   const std::string output = setup_->OutputField();
   match_matrix_->DrawOpenButton(output.empty() ? model_panel_->ModelField() : output, &widgets_);
   ImGui::Separator();
   log_pane_->Draw();
   ImGui::End();
+}
+
+void GuiApp::CheckImageFolderOfModel(const fs::path& images) {
+  // Not while a run grows its model: its images are the Images field's by construction.
+  if (controller_->Running()) return;
+  const Scene* scene = view_->scene();
+  std::shared_ptr<const Reconstruction> model = scene == nullptr ? nullptr : scene->model;
+  if (model == folder_check_.model && images == folder_check_.image_dir) return;
+  folder_check_ = CheckImageFolder(std::move(model), images);
 }
 
 void GuiApp::Render(RgbImage* capture) {
@@ -280,6 +296,7 @@ std::optional<std::array<float, 2>> GuiApp::ProjectToWindow(const Eigen::Vector3
 }
 image_t GuiApp::selected_image() const { return view_->selected_image; }
 point3D_t GuiApp::selected_point() const { return view_->selected_point; }
+const std::string& GuiApp::PhotoProblem() const { return picking_->photo_problem(); }
 
 int RunGui(const GuiCommandOptions& options) {
   if (!options.screenshot.empty() && options.gui.model.empty() && options.gui.images.empty()) {

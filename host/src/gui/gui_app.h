@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "gui/image_folder_check.h"
 #include "gui/log_sink.h"
 #include "gui/match_matrix.h"
 #include "gui/run_controller.h"
@@ -126,6 +127,11 @@ class GuiApp {
   // Shows `scene` (framed) as if opened.
   void SetScene(std::shared_ptr<const Scene> scene);
   image_t selected_image() const;
+  // The warning shown under the model's counts when the Images field's folder lacks the
+  // model's images or holds them at other sizes (see ImageFolderCheck); empty when not.
+  const std::string& ImageFolderWarning() const { return folder_check_.warning; }
+  // Why the picked camera's photograph is not shown (Picking::photo_problem).
+  const std::string& PhotoProblem() const;
   point3D_t selected_point() const;
   // For the window system's callbacks.
   void MarkChangedFromInput();
@@ -140,6 +146,8 @@ class GuiApp {
   // Clears the window and draws the 3D view and ImGui's windows; reads the pixels back
   // into `capture` when given.
   void Render(RgbImage* capture);
+  // Checks the Images field's folder against the model shown when either changed.
+  void CheckImageFolderOfModel(const std::filesystem::path& images);
 
   GuiOptions options_;
   GLFWwindow* window_ = nullptr;
@@ -160,6 +168,7 @@ class GuiApp {
   std::unique_ptr<MatchMatrixPanel> match_matrix_;
   std::unique_ptr<LogPane> log_pane_;
   WidgetRects widgets_;
+  ImageFolderCheck folder_check_;
 };
 
 // `tessera gui`: an interactive window, or with `screenshot` set, a PNG of the window

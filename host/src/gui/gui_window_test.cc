@@ -17,6 +17,7 @@
 #include "gui/xvfb.h"
 #include "manifest/manifest.h"
 #include "pipeline/stage_test_util.h"
+#include "small_colmap_model.h"
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
 #include "test_support.h"
@@ -321,6 +322,59 @@ TEST_F(GuiWindowTest, ClickingACameraOrAPointShowsItsDetails) {
   app.Frame(nullptr, &image);
   EXPECT_TRUE(app.Widget("point details").has_value());
   if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) WritePng(image, keep);
+}
+
+// Clicks the camera of `image_id` in the 3D view and draws the camera window.
+void ClickCamera(GuiApp* app, image_t image_id) {
+  for (const SceneCamera& camera : app->scene()->cameras) {
+    if (camera.image_id != image_id) continue;
+    const auto center = app->ProjectToWindow(camera.center_in_world);
+    ASSERT_TRUE(center.has_value());
+    for (bool down : {false, true, false}) {
+      SyntheticInput input;
+      input.x = (*center)[0];
+      input.y = (*center)[1];
+      input.left_down = down;
+      app->Frame(&input);
+    }
+    ASSERT_EQ(app->selected_image(), image_id);
+    app->Frame();
+    app->Frame();
+  }
+}
+
+// Issue 30 item 7: a model opened with a folder that is not its own (another data set's
+// photographs, of another size, or none) is warned about, and the camera window says why
+// it shows no photograph rather than showing another one under the model's points.
+TEST_F(GuiWindowTest, ImageFolderWithoutTheModelsImagesIsWarnedAbout) {
+  const fs::path photos = dir_.path() / "photos";
+  fs::create_directories(photos);
+  // SmallColmapModel: frame_1 and frame_2 on a 320x240 camera, frame_3 on a 640x480 one.
+  cv::imwrite((photos / "frame_1.jpg").string(),
+              cv::Mat(240, 320, CV_8UC3, cv::Scalar(90, 60, 30)));
+  cv::imwrite((photos / "frame_2.jpg").string(),
+              cv::Mat(100, 200, CV_8UC3, cv::Scalar(30, 60, 90)));
+  GuiOptions options;
+  options.images = photos;
+  GuiApp app(options);
+  app.SetScene(
+      MakeScene(std::make_shared<const Reconstruction>(tessera::testing::SmallColmapModel())));
+  app.Frame();
+  app.Frame();
+  EXPECT_EQ(app.ImageFolderWarning(),
+            "1 of 3 images of the model are not in " + photos.string() +
+                " and 1 of 3 do not match the model's cameras' sizes: is it the model's image "
+                "folder?");
+  EXPECT_TRUE(app.Widget("image folder warning").has_value());
+  EXPECT_TRUE(LogHas(app, std::regex("1 of 3 images of the model are not in")));
+  ClickCamera(&app, 1);
+  EXPECT_EQ(app.PhotoProblem(), "");
+  ClickCamera(&app, 2);
+  EXPECT_EQ(app.PhotoProblem(), "image does not match the model's camera: 200x100 vs 320x240");
+  EXPECT_TRUE(app.Widget("photo problem").has_value());
+  ClickCamera(&app, 3);
+  EXPECT_EQ(app.PhotoProblem(), "image not found");
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
 }
 
 TEST_F(GuiWindowTest, BadInputIsShownInThePanel) {

@@ -37,6 +37,8 @@ bool ImageTexture::Load(const fs::path& file, int max_width) {
   glBindTexture(GL_TEXTURE_2D, 0);
   width_ = rgb.cols;
   height_ = rgb.rows;
+  source_width_ = bgr.cols;
+  source_height_ = bgr.rows;
   scale_ = static_cast<float>(rgb.cols) / static_cast<float>(bgr.cols);
   return true;
 }

@@ -24,10 +24,14 @@ class ImageTexture {
   int width() const { return width_; }
   int height() const { return height_; }
   float scale() const { return scale_; }  // texture pixels per image pixel
+  // The file's size (as decoded, EXIF orientation applied), before shrinking.
+  int source_width() const { return source_width_; }
+  int source_height() const { return source_height_; }
 
  private:
   unsigned int id_ = 0;
   int width_ = 0, height_ = 0;
+  int source_width_ = 0, source_height_ = 0;
   float scale_ = 1;
 };
 

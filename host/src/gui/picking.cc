@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "gui/image_folder_check.h"
 #include "tessera/io/model_statistics.h"
 
 namespace tessera::gui {
@@ -92,7 +93,11 @@ void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& ima
                                 WidgetRects* widgets) {
   const Reconstruction& model = *view_->scene()->model;
   const image_t image_id = view_->selected_image;
-  if (image_id == kInvalidImageId || model.images.count(image_id) == 0) return;
+  if (image_id == kInvalidImageId || model.images.count(image_id) == 0) {
+    photo_image_ = kInvalidImageId;
+    photo_problem_.clear();
+    return;
+  }
   const Image& image = model.images.at(image_id);
   ImGui::SetNextWindowPos(ImVec2(view_rect.max_x - 10, 10), ImGuiCond_Appearing, ImVec2(1, 0));
   bool open = true;
@@ -117,12 +122,14 @@ void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& ima
   const ImVec2 position = ImGui::GetWindowPos();
   const ImVec2 size = ImGui::GetWindowSize();
   widgets->Set("camera window", {position.x, position.y, position.x + size.x, position.y + size.y});
-  // The photograph with its observations, when the image folder has it.
-  if (photo_image_ != image_id) {
+  // The photograph with its observations, when the image folder has it at the size of
+  // the model's camera: never another data set's photograph under this model's points.
+  if (photo_image_ != image_id || photo_dir_ != image_dir) {
     photo_image_ = image_id;
-    photo_.Load(image_dir / image.name, 480);
+    photo_dir_ = image_dir;
+    LoadPhoto(model, image, image_dir);
   }
-  if (!photo_.empty()) {
+  if (photo_problem_.empty()) {
     const ImVec2 origin = ImGui::GetCursorScreenPos();
     photo_.Draw();
     ImDrawList* draw = ImGui::GetWindowDrawList();
@@ -133,10 +140,21 @@ void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& ima
                       2.5f, IM_COL32(60, 255, 90, 255));
     }
   } else {
-    ImGui::TextDisabled("(the photograph is not in the image folder)");
+    ImGui::TextColored(ImVec4(1, 0.75f, 0.3f, 1), "(%s)", photo_problem_.c_str());
+    widgets->RecordLastItem("photo problem");
   }
   ImGui::End();
   if (!open) view_->selected_image = kInvalidImageId;
+}
+
+void Picking::LoadPhoto(const Reconstruction& model, const Image& image,
+                        const fs::path& image_dir) {
+  const bool found = !image_dir.empty() && photo_.Load(image_dir / image.name, 480);
+  const auto camera = model.cameras.find(image.camera_id);
+  photo_problem_ =
+      camera == model.cameras.end()
+          ? (found ? "" : "image not found")
+          : PhotoProblem(found, photo_.source_width(), photo_.source_height(), camera->second);
 }
 
 void Picking::DrawPointDetails(const WidgetRect& view_rect, WidgetRects* widgets) {

@@ -6,6 +6,7 @@
 // with its observations, their mean reprojection error) or point (its track).
 
 #include <filesystem>
+#include <string>
 
 #include "gui/image_texture.h"
 #include "gui/scene_view.h"
@@ -28,17 +29,26 @@ class Picking {
   // `image_dir`. Records "camera details", "camera window" and "point details".
   void DrawDetails(const WidgetRect& view_rect, const std::filesystem::path& image_dir,
                    WidgetRects* widgets);
+  // Why the picked camera's photograph is not shown ("image not found", "image does not
+  // match the model's camera: WxH vs WxH"); empty when it is (or no camera is picked).
+  const std::string& photo_problem() const { return photo_problem_; }
 
  private:
   void DrawCameraDetails(const WidgetRect& view_rect, const std::filesystem::path& image_dir,
                          WidgetRects* widgets);
   void DrawPointDetails(const WidgetRect& view_rect, WidgetRects* widgets);
+  // Loads the photograph of `image` from `image_dir`; photo_problem_ says why it is not
+  // shown (missing, or not the size of the model's camera).
+  void LoadPhoto(const Reconstruction& model, const Image& image,
+                 const std::filesystem::path& image_dir);
 
   SceneView* view_;
   bool dragging_ = false;
   float drag_distance_ = 0;  // pixels the mouse moved since the press
   ImageTexture photo_;       // the picked camera's photograph
   image_t photo_image_ = kInvalidImageId;
+  std::filesystem::path photo_dir_;  // the folder photo_ was read from
+  std::string photo_problem_;        // empty: photo_ is shown
 };
 
 }  // namespace tessera::gui
