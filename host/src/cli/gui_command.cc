@@ -13,7 +13,7 @@ namespace tessera {
 
 CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions&) {
   struct GuiArguments {
-    std::string images, output, manifest, model, screenshot;
+    std::string images, output, manifest, model, masks, screenshot;
     int frames = 3, width = 1280, height = 800;
     bool view_only = false;
   };
@@ -24,6 +24,9 @@ CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions&) {
   sub->add_option("--manifest", options->manifest, "Pipeline manifest (default: default.json)");
   sub->add_option("--model", options->model,
                   "Model to open: a COLMAP model folder, a workspace or its database.db");
+  sub->add_option("--masks", options->masks,
+                  "Folder of the images' masks (default: the manifest's camera.mask_path): the "
+                  "camera window darkens what they mask out");
   sub->add_option("--screenshot", options->screenshot,
                   "Write a PNG of the window (after the run, given --images and --output; or "
                   "of --model) and exit");
@@ -39,6 +42,7 @@ CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions&) {
             command.gui.output = options->output;
             command.gui.manifest = options->manifest;
             command.gui.model = options->model;
+            command.gui.masks = options->masks;
             command.gui.width = options->width;
             command.gui.height = options->height;
             command.gui.view_only = options->view_only;

@@ -18,6 +18,7 @@
 #include "gui/renderer.h"
 #include "gui/scene_view.h"
 #include "gui/setup_panel.h"
+#include "manifest/manifest.h"
 #include "tessera/errors.h"
 #include "util/exit_codes.h"
 
@@ -193,7 +194,7 @@ void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
     const fs::path images(setup_->ImagesField());
     CheckImageFolderOfModel(images);
     DrawSetupWindow(status);
-    picking_->DrawDetails(view, images, &widgets_);
+    picking_->DrawDetails(view, images, MaskDir(), &widgets_);
     match_matrix_->Draw(view, images, &widgets_);
   }
   picking_->HandleMouse(view);
@@ -231,6 +232,25 @@ void GuiApp::CheckImageFolderOfModel(const fs::path& images) {
   std::shared_ptr<const Reconstruction> model = scene == nullptr ? nullptr : scene->model;
   if (model == folder_check_.model && images == folder_check_.image_dir) return;
   folder_check_ = CheckImageFolder(std::move(model), images);
+}
+
+fs::path GuiApp::MaskDir() {
+  if (!options_.masks.empty()) return options_.masks;
+  // The run's manifest names the masks as camera.mask_path (relative to its folder).
+  const std::string manifest = setup_->ManifestField();
+  if (manifest != mask_manifest_) {
+    mask_manifest_ = manifest;
+    manifest_mask_dir_.clear();
+    std::error_code error;
+    if (!manifest.empty() && fs::is_regular_file(manifest, error)) {
+      try {
+        manifest_mask_dir_ = Manifest::Load(manifest).camera.mask_path;
+      } catch (const std::exception&) {
+        // A manifest that does not parse: the Run button says why; no masks here.
+      }
+    }
+  }
+  return manifest_mask_dir_;
 }
 
 void GuiApp::Render(RgbImage* capture) {
@@ -297,6 +317,7 @@ std::optional<std::array<float, 2>> GuiApp::ProjectToWindow(const Eigen::Vector3
 image_t GuiApp::selected_image() const { return view_->selected_image; }
 point3D_t GuiApp::selected_point() const { return view_->selected_point; }
 const std::string& GuiApp::PhotoProblem() const { return picking_->photo_problem(); }
+bool GuiApp::PhotoMasked() const { return picking_->photo_masked(); }
 
 int RunGui(const GuiCommandOptions& options) {
   if (!options.screenshot.empty() && options.gui.model.empty() && options.gui.images.empty()) {

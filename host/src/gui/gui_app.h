@@ -41,6 +41,8 @@ struct GuiOptions {
   std::filesystem::path output;
   std::filesystem::path manifest;
   std::filesystem::path model;
+  // The image masks' folder (`--masks`); empty: the manifest's camera.mask_path, if any.
+  std::filesystem::path masks;
   int width = 1280;  // window size in screen pixels
   int height = 800;
   bool view_only = false;  // no panels: the 3D view fills the window
@@ -132,6 +134,11 @@ class GuiApp {
   const std::string& ImageFolderWarning() const { return folder_check_.warning; }
   // Why the picked camera's photograph is not shown (Picking::photo_problem).
   const std::string& PhotoProblem() const;
+  // Whether the picked camera's photograph is shown with its mask's masked-out area
+  // darkened; the mask folder it is read from (--masks, else the manifest field's
+  // camera.mask_path; empty: none).
+  bool PhotoMasked() const;
+  std::filesystem::path MaskDir();
   point3D_t selected_point() const;
   // For the window system's callbacks.
   void MarkChangedFromInput();
@@ -169,6 +176,9 @@ class GuiApp {
   std::unique_ptr<LogPane> log_pane_;
   WidgetRects widgets_;
   ImageFolderCheck folder_check_;
+  // The manifest field's camera.mask_path, read when the field changes.
+  std::string mask_manifest_ = "(none read)";
+  std::filesystem::path manifest_mask_dir_;
 };
 
 // `tessera gui`: an interactive window, or with `screenshot` set, a PNG of the window

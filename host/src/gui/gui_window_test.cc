@@ -377,6 +377,48 @@ TEST_F(GuiWindowTest, ImageFolderWithoutTheModelsImagesIsWarnedAbout) {
   if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
 }
 
+// Issue 28 item 5: the manifest's camera.mask_path reaches the camera window, which
+// darkens what the mask of the picked image masks out (MASK_DIR/NAME.png).
+TEST_F(GuiWindowTest, CameraWindowDarkensTheMaskedOutArea) {
+  const fs::path photos = dir_.path() / "photos";
+  const fs::path masks = dir_.path() / "masks";
+  fs::create_directories(photos);
+  fs::create_directories(masks);
+  cv::imwrite((photos / "frame_1.jpg").string(),
+              cv::Mat(240, 320, CV_8UC3, cv::Scalar(200, 200, 200)));
+  cv::Mat mask(240, 320, CV_8UC1, cv::Scalar(255));
+  mask.colRange(0, 160).setTo(0);  // the left half masked out
+  cv::imwrite((masks / "frame_1.jpg.png").string(), mask);
+  const fs::path manifest = dir_.path() / "manifest.json";
+  std::ofstream(manifest) << R"({"camera": {"mask_path": "masks"}})";
+  GuiOptions options;
+  options.images = photos;
+  options.manifest = manifest;
+  GuiApp app(options);
+  EXPECT_EQ(app.MaskDir(), masks);
+  app.SetScene(
+      MakeScene(std::make_shared<const Reconstruction>(tessera::testing::SmallColmapModel())));
+  app.Frame();
+  app.Frame();
+  ClickCamera(&app, 1);
+  EXPECT_EQ(app.PhotoProblem(), "");
+  EXPECT_TRUE(app.PhotoMasked());
+  const std::optional<WidgetRect> photo = app.Widget("photo");
+  ASSERT_TRUE(photo.has_value());
+  RgbImage image;
+  app.Frame(nullptr, &image);
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) WritePng(image, keep);
+  // Below the observations (all in the top half): the masked-out left half is dark, the
+  // right half as the photograph.
+  const auto grey_at = [&](float fx) {
+    const int x = static_cast<int>(photo->min_x + fx * (photo->max_x - photo->min_x));
+    const int y = static_cast<int>(photo->min_y + 0.8f * (photo->max_y - photo->min_y));
+    return int(image.pixels[(static_cast<size_t>(y) * image.width + x) * 3]);
+  };
+  EXPECT_LT(grey_at(0.25f), 90);
+  EXPECT_GT(grey_at(0.75f), 170);
+}
+
 TEST_F(GuiWindowTest, BadInputIsShownInThePanel) {
   const fs::path empty = dir_.path() / "empty";
   fs::create_directories(empty);

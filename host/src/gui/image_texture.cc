@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "gui/gl.h"
+#include "image/image_masks.h"
 
 namespace tessera::gui {
 namespace fs = std::filesystem;
@@ -16,13 +17,23 @@ ImageTexture::~ImageTexture() {
   if (id_ != 0) glDeleteTextures(1, &id_);
 }
 
-bool ImageTexture::Load(const fs::path& file, int max_width) {
+bool ImageTexture::Load(const fs::path& file, int max_width, const fs::path& mask_file) {
   std::error_code error;
-  const cv::Mat bgr =
+  cv::Mat bgr =
       fs::is_regular_file(file, error) ? cv::imread(file.string(), cv::IMREAD_COLOR) : cv::Mat();
+  masked_ = false;
+  mask_problem_.clear();
   if (bgr.empty()) {
     width_ = 0;
     return false;
+  }
+  if (!mask_file.empty()) {
+    // Masked-out pixels at 30 % of their brightness: the photograph stays readable.
+    if (const auto mask = ReadMask(mask_file, bgr.cols, bgr.rows, &mask_problem_)) {
+      const cv::Mat dark = bgr * 0.3;
+      dark.copyTo(bgr, *mask == 0);
+      masked_ = true;
+    }
   }
   const double shrink = std::min(1.0, static_cast<double>(max_width) / bgr.cols);
   cv::Mat rgb;

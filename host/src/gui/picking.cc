@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "gui/image_folder_check.h"
+#include "image/image_masks.h"
 #include "tessera/io/model_statistics.h"
 
 namespace tessera::gui {
@@ -83,14 +84,14 @@ void Picking::Pick(float x, float y, const WidgetRect& view_rect) {
 }
 
 void Picking::DrawDetails(const WidgetRect& view_rect, const fs::path& image_dir,
-                          WidgetRects* widgets) {
+                          const fs::path& mask_dir, WidgetRects* widgets) {
   if (view_->scene() == nullptr) return;
-  DrawCameraDetails(view_rect, image_dir, widgets);
+  DrawCameraDetails(view_rect, image_dir, mask_dir, widgets);
   DrawPointDetails(view_rect, widgets);
 }
 
 void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& image_dir,
-                                WidgetRects* widgets) {
+                                const fs::path& mask_dir, WidgetRects* widgets) {
   const Reconstruction& model = *view_->scene()->model;
   const image_t image_id = view_->selected_image;
   if (image_id == kInvalidImageId || model.images.count(image_id) == 0) {
@@ -124,20 +125,26 @@ void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& ima
   widgets->Set("camera window", {position.x, position.y, position.x + size.x, position.y + size.y});
   // The photograph with its observations, when the image folder has it at the size of
   // the model's camera: never another data set's photograph under this model's points.
-  if (photo_image_ != image_id || photo_dir_ != image_dir) {
+  if (photo_image_ != image_id || photo_dir_ != image_dir || mask_dir_ != mask_dir) {
     photo_image_ = image_id;
     photo_dir_ = image_dir;
-    LoadPhoto(model, image, image_dir);
+    mask_dir_ = mask_dir;
+    LoadPhoto(model, image, image_dir, mask_dir);
   }
   if (photo_problem_.empty()) {
     const ImVec2 origin = ImGui::GetCursorScreenPos();
     photo_.Draw();
+    widgets->RecordLastItem("photo");
     ImDrawList* draw = ImGui::GetWindowDrawList();
     for (const Point2D& point : image.points2D) {
       if (!point.HasPoint3D() || model.points3D.count(point.point3D_id) == 0) continue;
       draw->AddCircle(ImVec2(origin.x + static_cast<float>(point.xy.x()) * photo_.scale(),
                              origin.y + static_cast<float>(point.xy.y()) * photo_.scale()),
                       2.5f, IM_COL32(60, 255, 90, 255));
+    }
+    if (photo_.masked()) ImGui::TextDisabled("darkened: masked out by %s", mask_dir.c_str());
+    if (!photo_.mask_problem().empty()) {
+      ImGui::TextDisabled("(mask not shown: %s)", photo_.mask_problem().c_str());
     }
   } else {
     ImGui::TextColored(ImVec4(1, 0.75f, 0.3f, 1), "(%s)", photo_problem_.c_str());
@@ -147,9 +154,11 @@ void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& ima
   if (!open) view_->selected_image = kInvalidImageId;
 }
 
-void Picking::LoadPhoto(const Reconstruction& model, const Image& image,
-                        const fs::path& image_dir) {
-  const bool found = !image_dir.empty() && photo_.Load(image_dir / image.name, 480);
+void Picking::LoadPhoto(const Reconstruction& model, const Image& image, const fs::path& image_dir,
+                        const fs::path& mask_dir) {
+  // The mask as detection finds it: MASK_DIR/NAME.png, else NAME with .png for its extension.
+  const fs::path mask_file = mask_dir.empty() ? fs::path() : FindMaskFile(mask_dir, image.name);
+  const bool found = !image_dir.empty() && photo_.Load(image_dir / image.name, 480, mask_file);
   const auto camera = model.cameras.find(image.camera_id);
   photo_problem_ =
       camera == model.cameras.end()

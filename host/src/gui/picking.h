@@ -26,21 +26,24 @@ class Picking {
   // nearest point within 6 pixels (none when there is none).
   void Pick(float x, float y, const WidgetRect& view_rect);
   // The windows of the picked camera and point; the camera's photograph is read from
-  // `image_dir`. Records "camera details", "camera window" and "point details".
+  // `image_dir`, its masked-out area darkened when `mask_dir` (camera.mask_path) has its
+  // mask. Records "camera details", "camera window", "photo" and "point details".
   void DrawDetails(const WidgetRect& view_rect, const std::filesystem::path& image_dir,
-                   WidgetRects* widgets);
+                   const std::filesystem::path& mask_dir, WidgetRects* widgets);
   // Why the picked camera's photograph is not shown ("image not found", "image does not
   // match the model's camera: WxH vs WxH"); empty when it is (or no camera is picked).
   const std::string& photo_problem() const { return photo_problem_; }
+  // Whether the photograph shown has its mask's masked-out area darkened.
+  bool photo_masked() const { return photo_problem_.empty() && photo_.masked(); }
 
  private:
   void DrawCameraDetails(const WidgetRect& view_rect, const std::filesystem::path& image_dir,
-                         WidgetRects* widgets);
+                         const std::filesystem::path& mask_dir, WidgetRects* widgets);
   void DrawPointDetails(const WidgetRect& view_rect, WidgetRects* widgets);
   // Loads the photograph of `image` from `image_dir`; photo_problem_ says why it is not
   // shown (missing, or not the size of the model's camera).
   void LoadPhoto(const Reconstruction& model, const Image& image,
-                 const std::filesystem::path& image_dir);
+                 const std::filesystem::path& image_dir, const std::filesystem::path& mask_dir);
 
   SceneView* view_;
   bool dragging_ = false;
@@ -48,6 +51,7 @@ class Picking {
   ImageTexture photo_;       // the picked camera's photograph
   image_t photo_image_ = kInvalidImageId;
   std::filesystem::path photo_dir_;  // the folder photo_ was read from
+  std::filesystem::path mask_dir_;   // and its mask
   std::string photo_problem_;        // empty: photo_ is shown
 };
 
