@@ -1,0 +1,32 @@
+#pragma once
+
+// numpy arrays over the host's storage. A view shares the C++ memory (no copy; writes
+// go through) and keeps `owner`, the Python object that owns that memory, alive while
+// the array lives. Where the storage is not one strided block (std::map of points),
+// the bindings make one bulk copy into a new array instead, and their docstrings say so.
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstddef>
+#include <vector>
+
+namespace tessera::python {
+
+// A view of `shape` with byte `strides` at `data`. An empty shape with null data gives
+// an empty array of its own (numpy needs no memory for it).
+template <typename T>
+pybind11::array_t<T> ArrayView(const T* data, std::vector<pybind11::ssize_t> shape,
+                               std::vector<pybind11::ssize_t> strides, pybind11::handle owner) {
+  return pybind11::array_t<T>(std::move(shape), std::move(strides), data, owner);
+}
+
+// A new (rows, cols) C-ordered array, for one bulk copy.
+template <typename T>
+pybind11::array_t<T> NewArray(size_t rows, size_t cols) {
+  if (cols == 1) return pybind11::array_t<T>({static_cast<pybind11::ssize_t>(rows)});
+  return pybind11::array_t<T>(
+      {static_cast<pybind11::ssize_t>(rows), static_cast<pybind11::ssize_t>(cols)});
+}
+
+}  // namespace tessera::python
