@@ -2,9 +2,10 @@
 // carrying the C++ message, which names the file, JSON path or plugin:
 //   tessera.Error         exit code 1: an unexpected failure (base of the others)
 //   tessera.InputError    exit code 2: bad input or configuration
-//   tessera.OptionError   exit code 2: an invalid manifest or plugin option (.path)
 //   tessera.NoModelError  exit code 3: the inputs were fine, but no model was built
 // Exit code 130 (interrupted) is Python's own KeyboardInterrupt, re-raised as it came.
+// (An invalid option is an InputError whose message starts with its JSON path: the
+// host words it so, naming the manifest or the plugin, before it reaches here.)
 
 #include "errors.h"
 
@@ -20,12 +21,7 @@ namespace py = pybind11;
 namespace tessera::python {
 namespace {
 
-// Raises `type` with `message` and, for options, the JSON path as `.path`.
-void Raise(const py::handle& type, const char* message, const std::string& path = "") {
-  py::object error = type(message);
-  if (!path.empty()) error.attr("path") = path;
-  PyErr_SetObject(type.ptr(), error.ptr());
-}
+void Raise(const py::handle& type, const char* message) { PyErr_SetString(type.ptr(), message); }
 
 }  // namespace
 
@@ -34,7 +30,6 @@ void BindErrors(py::module_& module) {
   // translator captures stay valid.
   static py::exception<std::runtime_error> error(module, "Error", PyExc_RuntimeError);
   static py::exception<InputError> input_error(module, "InputError", error.ptr());
-  static py::exception<OptionError> option_error(module, "OptionError", input_error.ptr());
   static py::exception<NoModelError> no_model_error(module, "NoModelError", error.ptr());
   error.attr("exit_code") = static_cast<int>(kExitInternalError);
   input_error.attr("exit_code") = static_cast<int>(kExitBadInput);
@@ -42,7 +37,6 @@ void BindErrors(py::module_& module) {
   error.doc() = "A failure of Tessera (the CLI's exit code 1); base of its other exceptions.";
   input_error.doc() =
       "Bad input or configuration, the message names the file, field or plugin (exit code 2).";
-  option_error.doc() = "An invalid manifest or plugin option; .path is its JSON path (exit 2).";
   no_model_error.doc() = "The inputs were fine but no model could be built (exit code 3).";
 
   py::register_exception_translator([](std::exception_ptr pointer) {
@@ -50,20 +44,10 @@ void BindErrors(py::module_& module) {
       if (pointer) std::rethrow_exception(pointer);
     } catch (const py::builtin_exception&) {
       throw;  // pybind11's own (KeyError of a mapping, ...): its translator maps them
-    } catch (const OptionError& exception) {
-      Raise(option_error, exception.what(), exception.path());
     } catch (const InputError& exception) {
       Raise(input_error, exception.what());
     } catch (const PluginError& exception) {
-      if (exception.option_error()) {
-        Raise(option_error, exception.what(), exception.option_path());
-      } else {
-        if (exception.input_error()) {
-          Raise(input_error, exception.what());
-        } else {
-          Raise(error, exception.what());
-        }
-      }
+      Raise(exception.input_error() ? input_error.ptr() : error.ptr(), exception.what());
     } catch (const NoModelError& exception) {
       Raise(no_model_error, exception.what());
     } catch (const std::bad_alloc&) {
