@@ -17,4 +17,7 @@ void BindModel(pybind11::module_& module);
 // tessera.run, extract, match, map, export (stage_bindings.cc).
 void BindStages(pybind11::module_& module);
 
+// tessera.Database (database_bindings.cc).
+void BindDatabase(pybind11::module_& module);
+
 }  // namespace tessera::python

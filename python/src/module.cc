@@ -35,4 +35,5 @@ PYBIND11_MODULE(tessera, module) {
   tessera::python::BindErrors(module);
   tessera::python::BindModel(module);
   tessera::python::BindStages(module);
+  tessera::python::BindDatabase(module);
 }

@@ -9,6 +9,7 @@
 #include <pybind11/pybind11.h>
 
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 namespace tessera::python {
@@ -19,6 +20,17 @@ template <typename T>
 pybind11::array_t<T> ArrayView(const T* data, std::vector<pybind11::ssize_t> shape,
                                std::vector<pybind11::ssize_t> strides, pybind11::handle owner) {
   return pybind11::array_t<T>(std::move(shape), std::move(strides), data, owner);
+}
+
+// An array over the data of `container`, which moves to the heap and is freed with the
+// array: the host's result becomes numpy's without a copy. `data` gives its first T.
+template <typename T, typename Container, typename DataOf>
+pybind11::array_t<T> MoveIntoArray(Container container, std::vector<pybind11::ssize_t> shape,
+                                   std::vector<pybind11::ssize_t> strides, DataOf data) {
+  auto* owned = new Container(std::move(container));
+  const pybind11::capsule owner(owned,
+                                [](void* pointer) { delete static_cast<Container*>(pointer); });
+  return pybind11::array_t<T>(std::move(shape), std::move(strides), data(*owned), owner);
 }
 
 // A new (rows, cols) C-ordered array, for one bulk copy.
