@@ -20,4 +20,8 @@ void BindStages(pybind11::module_& module);
 // tessera.Database (database_bindings.cc).
 void BindDatabase(pybind11::module_& module);
 
+// tessera.plugins (plugin_bindings.cc) and tessera.evaluate (eval_bindings.cc).
+void BindPlugins(pybind11::module_& module);
+void BindEvaluate(pybind11::module_& module);
+
 }  // namespace tessera::python

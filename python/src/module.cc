@@ -36,4 +36,6 @@ PYBIND11_MODULE(tessera, module) {
   tessera::python::BindModel(module);
   tessera::python::BindStages(module);
   tessera::python::BindDatabase(module);
+  tessera::python::BindPlugins(module);
+  tessera::python::BindEvaluate(module);
 }

@@ -14,6 +14,7 @@
 
 #include "bindings.h"
 #include "errors.h"
+#include "json_objects.h"
 #include "pipeline/export_model.h"
 #include "pipeline/run_pipeline.h"
 #include "pipeline/stage_arguments.h"
@@ -25,15 +26,6 @@ using OptionalPath = std::optional<std::filesystem::path>;
 
 namespace tessera::python {
 namespace {
-
-nlohmann::json ToJson(const py::handle& object) {
-  return nlohmann::json::parse(
-      py::module_::import("json").attr("dumps")(object).cast<std::string>());
-}
-
-py::object ToPython(const nlohmann::json& json) {
-  return py::module_::import("json").attr("loads")(json.dump());
-}
 
 std::string PathText(const OptionalPath& path) { return path ? path->string() : std::string(); }
 
