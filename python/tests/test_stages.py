@@ -3,6 +3,7 @@ same model files, a cancel from the progress callback that the same call resumes
 bad manifests raised as the named exceptions."""
 
 import json
+import pathlib
 import subprocess
 import sys
 
@@ -117,3 +118,18 @@ except KeyboardInterrupt:
     assert result.returncode == 130, result.stderr
     summary = tessera.run(images=images, output=tmp_path / "out", manifest=manifest, threads=2)
     assert summary["extract"]["num_reused"] >= 3
+
+
+def test_the_example_writes_a_png_of_the_sample(sample, tmp_path):
+    images, manifest, _ = sample
+    script = (pathlib.Path(__file__).resolve().parents[2] / "examples" / "python" /
+              "reconstruct_and_plot.py")
+    result = subprocess.run(
+        [sys.executable, script, "--images", images, "--output", tmp_path / "out", "--manifest",
+         manifest, "--threads", "2"], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    png = tmp_path / "out" / "top_view.png"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    import matplotlib.image
+    assert matplotlib.image.imread(png).shape[:2] == (960, 960)
+    assert "registered in 1 model(s)" in result.stdout
