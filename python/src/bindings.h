@@ -24,4 +24,7 @@ void BindDatabase(pybind11::module_& module);
 void BindPlugins(pybind11::module_& module);
 void BindEvaluate(pybind11::module_& module);
 
+// tessera.bench (bench_bindings.cc).
+void BindBench(pybind11::module_& module);
+
 }  // namespace tessera::python

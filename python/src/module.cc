@@ -38,4 +38,5 @@ PYBIND11_MODULE(tessera, module) {
   tessera::python::BindDatabase(module);
   tessera::python::BindPlugins(module);
   tessera::python::BindEvaluate(module);
+  tessera::python::BindBench(module);
 }

@@ -30,6 +30,13 @@ std::filesystem::path ExecutableDir() {
   return error ? std::filesystem::current_path() : exe.parent_path();
 }
 
+std::filesystem::path TesseraExecutable() {
+  if (!ExecutableDirOverride().empty()) return ExecutableDirOverride() / "tessera";
+  std::error_code error;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", error);
+  return error ? std::filesystem::path("tessera") : exe;
+}
+
 std::filesystem::path BundledPluginDir() {
   return (ExecutableDir() / ".." / TESSERA_PLUGIN_SUBDIR).lexically_normal();
 }

@@ -15,6 +15,10 @@ std::filesystem::path ExecutableDir();
 // interpreter's. Call it before any stage runs; empty: the running executable's again.
 void SetExecutableDir(const std::filesystem::path& dir);
 
+// The `tessera` executable, for verbs that run it as a child process (bench): this
+// process's own, or <dir>/tessera when SetExecutableDir named a folder.
+std::filesystem::path TesseraExecutable();
+
 // Where the bundled plugins are: <exe>/../lib/tessera/plugins, in the build tree and
 // in an install alike.
 std::filesystem::path BundledPluginDir();
