@@ -68,23 +68,22 @@ void CheckModels(const MapStageSummary& summary, const std::filesystem::path& ou
   if (summary.num_models == 0) throw NoModelError(NoModelMessage(output / "database.db"));
 }
 
-}  // namespace
+// The keywords the verbs share, in the CLI's terms, and what the docstrings say of them.
+const char* const kCommonDoc =
+    " manifest: a file or a dict (default: default.json); camera_K: a K.txt file; threads: "
+    "0 for the manifest's; progress(stage, done, total): called with the GIL held, an "
+    "exception from it (KeyboardInterrupt) cancels the stage, keeping what was finished "
+    "for the same call to resume, and propagates. The GIL is released while it runs.";
+py::arg_v ImagesArg() { return py::arg("images") = py::none(); }
+py::arg_v ManifestArg() { return py::arg("manifest") = py::none(); }
+py::arg_v CameraKArg() { return py::arg("camera_K") = py::none(); }
+py::arg_v MasksArg() { return py::arg("masks") = py::none(); }
+py::arg_v VideosArg() { return py::arg("videos") = std::vector<std::filesystem::path>(); }
+py::arg_v ThreadsArg() { return py::arg("threads") = 0; }
+py::arg_v ProgressArg() { return py::arg("progress") = py::none(); }
 
-void BindStages(py::module_& module) {
-  const auto images = py::arg("images") = py::none();
-  const auto output = py::arg("output");
-  const auto manifest = py::arg("manifest") = py::none();
-  const auto camera_K = py::arg("camera_K") = py::none();
-  const auto masks = py::arg("masks") = py::none();
-  const auto videos = py::arg("videos") = std::vector<std::filesystem::path>();
-  const auto threads = py::arg("threads") = 0;
-  const auto progress = py::arg("progress") = py::none();
-  const char* common =
-      " manifest: a file or a dict (default: default.json); camera_K: a K.txt file; threads: "
-      "0 for the manifest's; progress(stage, done, total): called with the GIL held, an "
-      "exception from it (KeyboardInterrupt) cancels the stage, keeping what was finished "
-      "for the same call to resume, and propagates. The GIL is released while it runs.";
-
+// `run` and `extract`: images (or videos) in.
+void BindImageStages(py::module_& module) {
   module.def(
       "run",
       [](const OptionalPath& images, const std::filesystem::path& output,
@@ -100,10 +99,11 @@ void BindStages(py::module_& module) {
         CheckModels(run.summary.map, output);
         return ToPython(run.summary.ToJson());
       },
-      images, output, manifest, camera_K, masks, videos, threads, progress,
+      ImagesArg(), py::arg("output"), ManifestArg(), CameraKArg(), MasksArg(), VideosArg(),
+      ThreadsArg(), ProgressArg(),
       (std::string("Every stage, images in, models out (`tessera run`); returns "
                    "run_summary.json as a dict, NoModelError when no model was built.") +
-       common)
+       kCommonDoc)
           .c_str());
 
   module.def(
@@ -120,12 +120,16 @@ void BindStages(py::module_& module) {
         });
         return ToPython(StageJson("extract", summary));
       },
-      images, output, manifest, camera_K, masks, videos, threads, progress,
+      ImagesArg(), py::arg("output"), ManifestArg(), CameraKArg(), MasksArg(), VideosArg(),
+      ThreadsArg(), ProgressArg(),
       (std::string("Ingests images and detects features (`tessera extract`); returns the "
                    "summary's 'extract' part.") +
-       common)
+       kCommonDoc)
           .c_str());
+}
 
+// `match` and `map`: on a workspace that `extract` filled.
+void BindWorkspaceStages(py::module_& module) {
   module.def(
       "match",
       [](const std::filesystem::path& output, const py::object& manifest,
@@ -138,10 +142,10 @@ void BindStages(py::module_& module) {
         });
         return ToPython(StageJson("match", summary));
       },
-      output, manifest, camera_K, threads, progress,
+      py::arg("output"), ManifestArg(), CameraKArg(), ThreadsArg(), ProgressArg(),
       (std::string("Matches and verifies the workspace's pairs (`tessera match`); returns "
                    "the summary's 'match' part.") +
-       common)
+       kCommonDoc)
           .c_str());
 
   module.def(
@@ -159,12 +163,18 @@ void BindStages(py::module_& module) {
         CheckModels(summary.map, output);
         return ToPython(StageJson("map", summary));
       },
-      output, images, manifest, camera_K, threads, progress,
+      py::arg("output"), ImagesArg(), ManifestArg(), CameraKArg(), ThreadsArg(), ProgressArg(),
       (std::string("Maps a workspace into models (`tessera map`); returns the summary's "
                    "'map' part, NoModelError when no model was built.") +
-       common)
+       kCommonDoc)
           .c_str());
+}
 
+}  // namespace
+
+void BindStages(py::module_& module) {
+  BindImageStages(module);
+  BindWorkspaceStages(module);
   module.def(
       "export",
       [](const std::filesystem::path& model, const std::string& format,
