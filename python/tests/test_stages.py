@@ -3,6 +3,7 @@ same model files, a cancel from the progress callback that the same call resumes
 bad manifests raised as the named exceptions."""
 
 import json
+import os
 import pathlib
 import subprocess
 import sys
@@ -133,3 +134,17 @@ def test_the_example_writes_a_png_of_the_sample(sample, tmp_path):
     import matplotlib.image
     assert matplotlib.image.imread(png).shape[:2] == (960, 960)
     assert "registered in 1 model(s)" in result.stdout
+
+
+def test_the_full_size_sample_gives_the_reference_models(tmp_path):
+    # The default recipe (manifest=None: the default.json beside the module's install)
+    # on the 1024x683 sample: the model files whose digests the CLI's
+    # sample_model_end_to_end test checks.
+    source = pathlib.Path(os.environ["TESSERA_SOURCE_DIR"])
+    reference = {}
+    for line in (source / "tests/end_to_end/sample_model_digests.txt").read_text().splitlines():
+        digest, name = line.split()
+        reference[name] = digest
+    tessera.run(images=source / "examples/fountain-P11-small/images", output=tmp_path / "out",
+                threads=2)
+    assert model_digests(tmp_path / "out") == reference
