@@ -243,9 +243,15 @@ void BindModel(py::module_& module) {
   BindPoint3D(module);
   // Each mapping in its value's class (tessera.Camera.Map, ...): camera and image ids are
   // both uint32, and pybind11 names a map's key view after the key type.
-  py::bind_map<std::map<camera_t, Camera>>(module.attr("Camera"), "Map");
-  py::bind_map<std::map<image_t, Image>>(module.attr("Image"), "Map");
-  py::bind_map<std::map<point3D_t, Point3D>>(module.attr("Point3D"), "Map");
+  // Read-only: the objects and views handed out point into the maps' nodes, which a
+  // deletion or replacement would free under them.
+  for (py::object map_class :
+       {py::object(py::bind_map<std::map<camera_t, Camera>>(module.attr("Camera"), "Map")),
+        py::object(py::bind_map<std::map<image_t, Image>>(module.attr("Image"), "Map")),
+        py::object(py::bind_map<std::map<point3D_t, Point3D>>(module.attr("Point3D"), "Map"))}) {
+    py::delattr(map_class, "__setitem__");
+    py::delattr(map_class, "__delitem__");
+  }
 
   py::class_<ModelHandle, std::shared_ptr<ModelHandle>> model_class(
       module, "Reconstruction", "A COLMAP sparse model: cameras, images and 3D points.");

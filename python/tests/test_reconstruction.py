@@ -2,6 +2,7 @@
 projection, a byte-for-byte round trip, and the errors of bad models."""
 
 import filecmp
+import gc
 import shutil
 
 import numpy as np
@@ -51,6 +52,19 @@ def test_arrays_have_their_shapes_and_views_share_memory(model_dir):
     assert np.shares_memory(keypoints, image.keypoints)
     assert np.shares_memory(model.points3D[first].xyz, model.points3D[first].xyz)
     assert model.points3D[first].track.shape[1] == 2
+    # A view keeps the model alive: its data outlives every name of the model.
+    expected = arrays["xyz"][0].copy()
+    view = model.points3D[first].xyz
+    del model, image, keypoints
+    gc.collect()
+    np.testing.assert_array_equal(view, expected)
+    model = tessera.Reconstruction(model_dir)
+    image = next(iter(model.images.values()))
+    # The mappings are read-only: a deletion would free what the views point into.
+    with pytest.raises(TypeError):
+        del model.points3D[first]
+    with pytest.raises(TypeError):
+        model.images[image.image_id] = image
 
 
 def test_poses_and_projection_agree_with_the_host(model_dir):
