@@ -290,7 +290,12 @@ void BindModel(py::module_& module) {
           "points3D", [](ModelHandle & handle) -> auto& { return handle.model.points3D; },
           py::return_value_policy::reference_internal, "point3D_id -> Point3D")
       .def("num_reg_images",
-           [](const ModelHandle& handle) { return handle.model.NumRegisteredImages(); });
+           [](const ModelHandle& handle) { return handle.model.NumRegisteredImages(); })
+      .def("__repr__", [](const ModelHandle& handle) {
+        return "Reconstruction(cameras=" + std::to_string(handle.model.cameras.size()) +
+               ", images=" + std::to_string(handle.model.images.size()) +
+               ", points3D=" + std::to_string(handle.model.points3D.size()) + ")";
+      });
   BindModelArrays(model_class);
 }
 

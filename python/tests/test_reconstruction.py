@@ -22,6 +22,8 @@ def test_reads_the_cli_model_as_mappings(model_dir):
     assert len(model.cameras) == statistics["num_cameras"] == 1
     assert len(model.images) == statistics["num_images"] == model.num_reg_images() >= 8
     assert len(model.points3D) == statistics["num_points3D"] > 500
+    assert repr(model) == (f"Reconstruction(cameras=1, images={len(model.images)}, "
+                           f"points3D={len(model.points3D)})")
     camera = next(iter(model.cameras.values()))
     assert camera.model == "SIMPLE_RADIAL"
     assert (camera.width, camera.height) == (512, 342)
