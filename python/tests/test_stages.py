@@ -7,6 +7,8 @@ import os
 import pathlib
 import subprocess
 import sys
+import threading
+import time
 
 import pytest
 
@@ -148,3 +150,31 @@ def test_the_full_size_sample_gives_the_reference_models(tmp_path):
     tessera.run(images=source / "examples/fountain-P11-small/images", output=tmp_path / "out",
                 threads=2)
     assert model_digests(tmp_path / "out") == reference
+
+
+def test_other_python_threads_run_while_a_stage_runs(sample, tmp_path):
+    # Between the map stage's first and last report the mapper runs without the GIL:
+    # a Python thread keeps counting meanwhile.
+    images, manifest, _ = sample
+    counter = {"ticks": 0, "stop": False}
+
+    def count():
+        while not counter["stop"]:
+            counter["ticks"] += 1
+            time.sleep(0.0005)
+
+    ticks_at = {}
+
+    def progress(stage, done, total):
+        if stage == "map":
+            ticks_at[done] = counter["ticks"]
+
+    thread = threading.Thread(target=count)
+    thread.start()
+    try:
+        tessera.run(images=images, output=tmp_path / "out", manifest=manifest, threads=2,
+                    progress=progress)
+    finally:
+        counter["stop"] = True
+        thread.join()
+    assert ticks_at[1] - ticks_at[0] >= 10
