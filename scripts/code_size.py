@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Reports the longest functions and files of host/ and plugins/ and checks limits.
+"""Reports the longest functions and files of host/, plugins/ and python/ and checks limits.
 
 A function is a brace-delimited body opened at namespace or class scope whose header
 has a parameter list; everything inside it (lambdas, local classes, blocks) counts as
@@ -17,7 +17,7 @@ import os
 import re
 import sys
 
-SOURCE_FOLDERS = ("host", "plugins")
+SOURCE_FOLDERS = ("host", "plugins", "python")
 SOURCE_SUFFIXES = (".cc", ".h")
 SKIPPED_SUFFIXES = ("_test.cc", "_benchmark.cc")
 SKIPPED_FOLDERS = ("fuzz", "testdata")

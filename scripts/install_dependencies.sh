@@ -13,6 +13,8 @@ packages=(
   libxxhash-dev
   clang libclang-rt-dev
   xvfb xauth libgl1-mesa-dri
+  # The Python module (python/) and its tests and example.
+  pybind11-dev python3-dev python3-pytest python3-matplotlib
 )
 # The reference system, for the interoperability tests and benchmarks, and Open3D, an
 # independent PLY reader for the ply exporter's test; optional.

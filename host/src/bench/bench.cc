@@ -40,6 +40,7 @@
 #include "tessera/io/file_io.h"
 #include "tessera/io/model_statistics.h"
 #include "util/exit_codes.h"
+#include "util/paths.h"
 #include "util/timer.h"
 
 extern char** environ;
@@ -214,13 +215,13 @@ void CheckBenchWorkspace(const fs::path& folder) {
   std::error_code error;
   const fs::file_status status = fs::symlink_status(folder, error);
   if (status.type() == fs::file_type::not_found) return;
-  const bool made_by_bench = status.type() == fs::file_type::directory &&
-                             fs::symlink_status(folder / kBenchMark, error).type() ==
-                                 fs::file_type::regular;
+  const bool made_by_bench =
+      status.type() == fs::file_type::directory &&
+      fs::symlink_status(folder / kBenchMark, error).type() == fs::file_type::regular;
   if (made_by_bench) return;
   if (status.type() == fs::file_type::directory && fs::is_empty(folder, error)) return;
-  throw InputError(folder.string() +
-                   ": exists and was not made by tessera bench (no " + kBenchMark +
+  throw InputError(folder.string() + ": exists and was not made by tessera bench (no " +
+                   kBenchMark +
                    "), so it is not replaced; choose another --output or move it away");
 }
 
@@ -252,14 +253,9 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
     Workspace::Open(workspace)->database().ClearMatches();
     row.extract_shared_with = shared_from;
   }
-  std::vector<std::string> argv = {fs::read_symlink("/proc/self/exe").string(),
-                                   "run",
-                                   "--images",
-                                   options.images,
-                                   "--output",
-                                   workspace.string(),
-                                   "--manifest",
-                                   manifest_file};
+  std::vector<std::string> argv = {
+      TesseraExecutable().string(), "run",        "--images",   options.images, "--output",
+      workspace.string(),           "--manifest", manifest_file};
   if (options.threads > 0) argv.insert(argv.end(), {"--threads", std::to_string(options.threads)});
   if (!options.camera_K.empty()) argv.insert(argv.end(), {"--camera-K", options.camera_K});
   spdlog::info("bench: {} ({}) ...", name, row.plugins);
@@ -532,9 +528,25 @@ std::string ExtractionKey(const nlohmann::json& manifest) {
          (manifest.contains("camera") ? manifest.at("camera").dump() : "");
 }
 
+// Every row is printed and written first; then the first failure decides the exit code.
+int ExitCodeOfRows(const std::vector<BenchRow>& rows) {
+  for (const BenchRow& row : rows) {
+    if (row.exit_code != 0) {
+      spdlog::error(
+          "bench: {} ended with exit code {}; its log: {}", row.name, row.exit_code,
+          (fs::path(row.workspace) / (row.name == "colmap" ? "colmap.log" : "run.log")).string());
+      // A documented exit code stays what it is; a signal or failure to start is 1.
+      const bool documented = row.exit_code == kExitBadInput || row.exit_code == kExitNoModel ||
+                              row.exit_code == kExitPluginCrash;
+      return documented ? row.exit_code : static_cast<int>(kExitInternalError);
+    }
+  }
+  return kExitSuccess;
+}
+
 }  // namespace
 
-int RunBench(const BenchOptions& options) {
+BenchReport RunBenchReport(const BenchOptions& options) {
   if (!fs::is_directory(options.images)) {
     throw InputError(options.images + ": --images is not a folder");
   }
@@ -615,19 +627,9 @@ int RunBench(const BenchOptions& options) {
   if (!options.csv_file.empty()) WriteFileAtomically(options.csv_file, Csv(rows));
   if (!options.chart_file.empty()) WriteChart(options, rows);
 
-  // Every row is printed and written first; then the first failure decides the exit code.
-  for (const BenchRow& row : rows) {
-    if (row.exit_code != 0) {
-      spdlog::error(
-          "bench: {} ended with exit code {}; its log: {}", row.name, row.exit_code,
-          (fs::path(row.workspace) / (row.name == "colmap" ? "colmap.log" : "run.log")).string());
-      // A documented exit code stays what it is; a signal or failure to start is 1.
-      const bool documented = row.exit_code == kExitBadInput || row.exit_code == kExitNoModel ||
-                              row.exit_code == kExitPluginCrash;
-      return documented ? row.exit_code : static_cast<int>(kExitInternalError);
-    }
-  }
-  return kExitSuccess;
+  return {ExitCodeOfRows(rows), json};
 }
+
+int RunBench(const BenchOptions& options) { return RunBenchReport(options).exit_code; }
 
 }  // namespace tessera

@@ -2,6 +2,7 @@
 
 // `tessera bench`: several manifests (and COLMAP) on the same images, compared.
 
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -20,11 +21,20 @@ struct BenchOptions {
   std::vector<std::string> manifests;
 };
 
+// What a bench gave: the exit code RunBench returns, and the JSON that --json writes
+// ({"images", "ground_truth", "hardware_threads", "rows": [...]}).
+struct BenchReport {
+  int exit_code = 0;
+  nlohmann::json json;
+};
+
 // Runs every manifest as its own `tessera run` child process (this executable), reads
 // back each run's run_summary.json and mapping_summary.json (RunSummary,
 // MappingSummary), prints the Markdown table and writes the files asked for. Returns
 // the exit code: 0 when every row ended with 0, else the first failing row's documented
 // code (2, 3 or 4), or 1. Throws InputError for bad options or a malformed manifest.
 int RunBench(const BenchOptions& options);
+// The same, with the rows (for the Python module).
+BenchReport RunBenchReport(const BenchOptions& options);
 
 }  // namespace tessera

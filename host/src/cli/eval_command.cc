@@ -6,11 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
-#include "eval/evaluation.h"
-#include "eval/ground_truth.h"
-#include "pipeline/workspace.h"
-#include "tessera/errors.h"
-#include "tessera/io/colmap_model_io.h"
+#include "pipeline/evaluate_model.h"
 #include "util/exit_codes.h"
 
 namespace tessera {
@@ -32,22 +28,14 @@ CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions&) {
   sub->add_flag("--json", options->json, "Print JSON instead of a table");
 
   auto run = [options]() {
-    // A model of a workspace is read while no run can rewrite it.
-    const auto workspaces = HoldEnclosingWorkspaces({options->model});
-    const Reconstruction model = ReadColmapModel(options->model);
-    const auto ground_truth = ReadGroundTruth(options->ground_truth);
-    const EvaluationResult result = EvaluateReconstruction(model, ground_truth, options->model);
+    const EvaluationResult result = EvaluateModelFolder(options->model, options->ground_truth);
     if (options->json) {
       std::cout << result.ToJson().dump(2) << std::endl;
     } else {
       std::cout << result.ToTable() << std::flush;
     }
-    // Figures that cannot be computed are the user's to fix (wrong ground truth, names
-    // that do not match), so they end as bad input after the partial result.
-    if (!result.aligned) {
-      throw InputError("Cannot score " + options->model + " against " + options->ground_truth +
-                       ": " + result.error + ".");
-    }
+    // Figures that cannot be computed end as bad input after the partial result.
+    if (!result.aligned) throw UnscoredError(result, options->model, options->ground_truth);
     return static_cast<int>(kExitSuccess);
   };
   return {sub, run};

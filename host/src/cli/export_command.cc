@@ -7,16 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
-#include "outputs/output_transaction.h"
-#include "pipeline/workspace.h"
-#include "plugin/plugin_registry.h"
+#include "pipeline/export_model.h"
 #include "tessera/errors.h"
-#include "tessera/io/colmap_model_io.h"
-#include "tessera/io/file_io.h"
-#include "tessera/io/model_statistics.h"
 #include "util/exit_codes.h"
-#include "util/paths.h"
-#include "util/timer.h"
 
 namespace tessera {
 
@@ -52,47 +45,23 @@ CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions&) {
       ->check(CLI::NonNegativeNumber);
 
   auto run = [options]() {
-    const Timer timer;
-    nlohmann::json plugin_options;
+    ExportArguments arguments;
     try {
-      plugin_options = nlohmann::json::parse(options->options);
+      arguments.options = nlohmann::json::parse(options->options);
     } catch (const nlohmann::json::exception& error) {
       throw InputError("--options: not valid JSON: " + std::string(error.what()));
     }
-    // The plugin and its options are checked before the model is read.
-    const PluginRegistry registry = PluginRegistry::Discover(PluginSearchPath({}));
-    PluginInstance<Exporter> exporter =
-        registry.Create<Exporter>("exporter", options->format, plugin_options, "exporter");
-    // The workspaces of the model read and of the folder written are held as a stage
-    // holds them: a run in progress refuses the export with the lock's message.
-    const auto workspaces = HoldEnclosingWorkspaces({options->model, options->output});
-    const Reconstruction reconstruction = ReadColmapModel(options->model);
-
-    // Written as one set (outputs/output_transaction.h): placed whole or not at all,
-    // replacing only what Tessera wrote in the output folder.
-    CreateFolder(options->output);
-    OutputTransaction outputs(options->output, OutputTransaction::Mode::kAddToSet);
-    outputs.Protect(options->images);
-    outputs.Protect(options->masks);
-    ExportContext context;
-    context.output_dir = outputs.StageFor(exporter.name());
-    context.image_dir = options->images;
-    context.model_index = options->model_index;
-    context.mask_dir = options->masks;
-    try {
-      exporter.Call(PluginStage::kExport, "model " + std::to_string(context.model_index),
-                    [&](auto& plugin) { plugin.Export(reconstruction, context); });
-    } catch (const PluginError& error) {
-      outputs.Keep();
-      throw error.Reworded(outputs.NamedAsOutput(error.message()));
-    }
-    outputs.Commit();
-
-    const size_t num_observations = NumObservations(reconstruction);
+    arguments.model = options->model;
+    arguments.format = options->format;
+    arguments.output = options->output;
+    arguments.images = options->images;
+    arguments.masks = options->masks;
+    arguments.model_index = options->model_index;
+    const ExportSummary summary = ExportModel(arguments);
     spdlog::info(
         "export: {} images, {} points, {} observations written with '{}' to {} in {:.2f} s",
-        reconstruction.NumRegisteredImages(), reconstruction.points3D.size(), num_observations,
-        exporter.name(), options->output, timer.ElapsedSeconds());
+        summary.num_images, summary.num_points3D, summary.num_observations, summary.exporter,
+        options->output, summary.seconds);
     return static_cast<int>(kExitSuccess);
   };
   return {sub, run};

@@ -28,13 +28,7 @@ CommandRegistration RegisterPluginsCommand(CLI::App& app, const GlobalOptions&) 
     const PluginRegistry registry = PluginRegistry::Discover(PluginSearchPath(manifest_paths));
 
     if (options->json) {
-      nlohmann::json json = {{"abi_version", kPluginAbiVersion},
-                             {"search_paths", nlohmann::json::array()},
-                             {"plugins", nlohmann::json::array()}};
-      for (const auto& path : registry.search_paths())
-        json["search_paths"].push_back(path.string());
-      for (const auto& record : registry.records()) json["plugins"].push_back(record.ToJson());
-      std::cout << json.dump(2) << std::endl;
+      std::cout << registry.ToJson().dump(2) << std::endl;
       return static_cast<int>(kExitSuccess);
     }
     std::cout << "Plugin ABI version " << kPluginAbiVersion << "; searched:";

@@ -14,6 +14,7 @@
 #include "pipeline/match_stage.h"
 #include "pipeline/pipeline_context.h"
 #include "pipeline/run_pipeline.h"
+#include "pipeline/stage_arguments.h"
 #include "util/exit_codes.h"
 #include "util/paths.h"
 
@@ -23,12 +24,8 @@ namespace {
 struct StageOptions {
   std::string images;
   std::string output;
-  std::string manifest;
-  std::string camera_K;
-  std::string masks;
-  std::vector<std::string> videos;
-  int threads = 0;
-  std::string shard;  // extract and match: "K/N", one shard (distributed/)
+  StageArguments arguments;  // --manifest, --camera-K, --masks, --video, --threads
+  std::string shard;         // extract and match: "K/N", one shard (distributed/)
 };
 
 void AddShardOption(CLI::App* sub, StageOptions* options) {
@@ -41,7 +38,7 @@ void AddCommonOptions(CLI::App* sub, StageOptions* options, bool needs_images) {
   auto* images = sub->add_option("--images", options->images, "Folder of input images");
   if (needs_images) {
     // --video instead of --images: keyframes of the videos become the images.
-    auto* videos = sub->add_option("--video", options->videos,
+    auto* videos = sub->add_option("--video", options->arguments.videos,
                                    "A video to take sharp keyframes from (repeatable)");
     images->excludes(videos);
     sub->callback([images, videos] {
@@ -52,35 +49,21 @@ void AddCommonOptions(CLI::App* sub, StageOptions* options, bool needs_images) {
   }
   sub->add_option("--output", options->output, "Workspace folder (database.db, models)")
       ->required();
-  sub->add_option("--manifest", options->manifest, "Pipeline manifest (default: default.json)");
-  sub->add_option("--camera-K", options->camera_K,
+  sub->add_option("--manifest", options->arguments.manifest,
+                  "Pipeline manifest (default: default.json)");
+  sub->add_option("--camera-K", options->arguments.camera_K,
                   "Known intrinsics: a text file with the 3x3 matrix K (overrides EXIF)");
   if (needs_images) {
-    sub->add_option("--masks", options->masks,
+    sub->add_option("--masks", options->arguments.masks,
                     "Folder of image masks, IMAGE.png per image (black: no features)");
   }
-  sub->add_option("--threads", options->threads,
+  sub->add_option("--threads", options->arguments.threads,
                   "Worker threads (default: manifest, else all cores)")
       ->check(CLI::Range(0, 1024));
 }
 
 PipelineContext LoadContext(const StageOptions& options) {
-  std::filesystem::path file =
-      options.manifest.empty() ? std::filesystem::path() : std::filesystem::path(options.manifest);
-  // Video: ordered frames that may come back to where they started.
-  if (file.empty() && !options.videos.empty()) {
-    file = DefaultManifestFile().parent_path() / "ordered_loop.json";
-  }
-  PipelineContext context = PipelineContext::Create(file);
-  if (options.threads > 0) context.manifest.num_threads = options.threads;
-  if (!options.camera_K.empty()) {
-    const Eigen::Matrix3d K = ReadCalibrationMatrixFile(options.camera_K);
-    context.manifest.camera.known_intrinsics = Eigen::Vector4d(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
-    context.manifest.camera.known_intrinsics_source = options.camera_K;
-  }
-  if (!options.masks.empty()) context.manifest.camera.mask_path = options.masks;
-  context.LimitLibraryThreads();
-  return context;
+  return LoadPipelineContext(options.arguments);
 }
 
 // Ctrl-C (SIGINT) or SIGTERM cancels the stages: what they finished is kept.
@@ -93,10 +76,7 @@ StageControl InterruptibleControl() {
 int MappingExitCode(const MapStageSummary& summary, const std::filesystem::path& database) {
   if (summary.status == StageStatus::kCancelled) return ReportInterrupted("map");
   if (summary.num_models > 0) return kExitSuccess;
-  spdlog::error(
-      "{}: no model could be built: no pair of images initialised a model "
-      "(see the warnings above)",
-      database.string());
+  spdlog::error("{}", NoModelMessage(database));
   return kExitNoModel;
 }
 
@@ -119,26 +99,27 @@ CommandRegistration RegisterExtractCommand(CLI::App& app, const GlobalOptions&) 
   CLI::App* sub = app.add_subcommand("extract", "Ingest images and detect features");
   AddCommonOptions(sub, options.get(), /*needs_images=*/true);
   AddShardOption(sub, options.get());
-  return {
-      sub, [options]() {
-        if (!options->shard.empty()) {
-          const Shard shard = ParseShard(options->shard);
-          const PipelineContext context = LoadContext(*options);
-          const ExtractionSummary summary = RunExtractShard(
-              context, {options->images, options->output}, shard, InterruptibleControl());
-          LogExtraction(summary);
-          return summary.status == StageStatus::kCancelled ? ReportInterrupted("extract")
-                                                           : kExitSuccess;
-        }
-        const PipelineContext context = LoadContext(*options);
-        const ExtractionSummary summary = RunExtract(
-            context,
-            {options->images, options->output, {options->videos.begin(), options->videos.end()}},
-            InterruptibleControl());
-        LogExtraction(summary);
-        return summary.status == StageStatus::kCancelled ? ReportInterrupted("extract")
-                                                         : kExitSuccess;
-      }};
+  return {sub, [options]() {
+            if (!options->shard.empty()) {
+              const Shard shard = ParseShard(options->shard);
+              const PipelineContext context = LoadContext(*options);
+              const ExtractionSummary summary = RunExtractShard(
+                  context, {options->images, options->output}, shard, InterruptibleControl());
+              LogExtraction(summary);
+              return summary.status == StageStatus::kCancelled ? ReportInterrupted("extract")
+                                                               : kExitSuccess;
+            }
+            const PipelineContext context = LoadContext(*options);
+            const ExtractionSummary summary =
+                RunExtract(context,
+                           {options->images,
+                            options->output,
+                            {options->arguments.videos.begin(), options->arguments.videos.end()}},
+                           InterruptibleControl());
+            LogExtraction(summary);
+            return summary.status == StageStatus::kCancelled ? ReportInterrupted("extract")
+                                                             : kExitSuccess;
+          }};
 }
 
 CommandRegistration RegisterMatchCommand(CLI::App& app, const GlobalOptions&) {
@@ -169,17 +150,18 @@ CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions&) {
   auto options = std::make_shared<StageOptions>();
   CLI::App* sub = app.add_subcommand("run", "Run every stage: images in, model out");
   AddCommonOptions(sub, options.get(), /*needs_images=*/true);
-  return {
-      sub, [options]() {
-        const PipelineContext context = LoadContext(*options);
-        const RunResult run = RunPipeline(
-            context,
-            {options->images, options->output, {options->videos.begin(), options->videos.end()}},
-            InterruptibleControl());
-        if (run.status == StageStatus::kCancelled) return ReportInterrupted("run");
-        return MappingExitCode(run.summary.map,
-                               std::filesystem::path(options->output) / "database.db");
-      }};
+  return {sub, [options]() {
+            const PipelineContext context = LoadContext(*options);
+            const RunResult run =
+                RunPipeline(context,
+                            {options->images,
+                             options->output,
+                             {options->arguments.videos.begin(), options->arguments.videos.end()}},
+                            InterruptibleControl());
+            if (run.status == StageStatus::kCancelled) return ReportInterrupted("run");
+            return MappingExitCode(run.summary.map,
+                                   std::filesystem::path(options->output) / "database.db");
+          }};
 }
 
 }  // namespace tessera

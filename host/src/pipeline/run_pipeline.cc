@@ -129,4 +129,10 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
   return run;
 }
 
+std::string NoModelMessage(const std::filesystem::path& database) {
+  return database.string() +
+         ": no model could be built: no pair of images initialised a model (see the warnings "
+         "above)";
+}
+
 }  // namespace tessera

@@ -5,6 +5,7 @@
 // run_summary.json. Each checks the plugins it needs, prepares and locks the workspace.
 
 #include <filesystem>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -55,5 +56,9 @@ MapStageSummary RunMap(const PipelineContext& context, const RunOptions& options
 // summary.map.num_models 0.
 RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
                       const StageControl& control = {});
+
+// What a `map` or `run` that built no model says, naming the workspace's database
+// (the CLI's exit code 3).
+std::string NoModelMessage(const std::filesystem::path& database);
 
 }  // namespace tessera

@@ -223,6 +223,21 @@ const PluginRecord& PluginRegistry::Resolve(const std::string& kind, const std::
   throw InputError(message);
 }
 
+nlohmann::json PluginRegistry::ToJson() const {
+  nlohmann::json json = {{"abi_version", kPluginAbiVersion},
+                         {"search_paths", nlohmann::json::array()},
+                         {"plugins", nlohmann::json::array()}};
+  for (const auto& path : search_paths_) json["search_paths"].push_back(path.string());
+  for (const auto& record : records_) json["plugins"].push_back(record.ToJson());
+  return json;
+}
+
+nlohmann::json PluginRegistry::DefaultOptions(const PluginRecord& record) const {
+  const std::unique_ptr<Plugin> plugin =
+      CreateObject(record, nlohmann::json::object(), record.kind);
+  return plugin->EffectiveOptions();
+}
+
 std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
                                                      const nlohmann::json& options,
                                                      const std::string& json_path) const {

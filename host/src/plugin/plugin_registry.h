@@ -114,6 +114,15 @@ class PluginRegistry {
   const std::vector<PluginRecord>& records() const { return records_; }
   const std::vector<std::filesystem::path>& search_paths() const { return search_paths_; }
 
+  // What `tessera plugins --json` prints: {"abi_version", "search_paths", "plugins":
+  // [PluginRecord::ToJson, ...]}.
+  nlohmann::json ToJson() const;
+
+  // The options a usable plugin runs with when given none, defaults filled in: it is
+  // loaded here and made with {}. Throws InputError naming the file when its factory
+  // refuses that (a plugin with a required option).
+  nlohmann::json DefaultOptions(const PluginRecord& record) const;
+
   // Usable plugin names of a kind, sorted.
   std::vector<std::string> NamesOfKind(const std::string& kind) const;
 

@@ -12,10 +12,29 @@
 
 namespace tessera {
 
+namespace {
+
+std::filesystem::path& ExecutableDirOverride() {
+  static std::filesystem::path dir;
+  return dir;
+}
+
+}  // namespace
+
+void SetExecutableDir(const std::filesystem::path& dir) { ExecutableDirOverride() = dir; }
+
 std::filesystem::path ExecutableDir() {
+  if (!ExecutableDirOverride().empty()) return ExecutableDirOverride();
   std::error_code error;
   const auto exe = std::filesystem::read_symlink("/proc/self/exe", error);
   return error ? std::filesystem::current_path() : exe.parent_path();
+}
+
+std::filesystem::path TesseraExecutable() {
+  if (!ExecutableDirOverride().empty()) return ExecutableDirOverride() / "tessera";
+  std::error_code error;
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe", error);
+  return error ? std::filesystem::path("tessera") : exe;
 }
 
 std::filesystem::path BundledPluginDir() {

@@ -6,8 +6,18 @@
 
 namespace tessera {
 
-// Folder of the running executable.
+// Folder of the running executable, or the one SetExecutableDir named.
 std::filesystem::path ExecutableDir();
+
+// For a program that embeds the host (the Python module, loaded by python3): names the
+// folder that stands for the executable's, <prefix>/bin, so that the bundled plugins
+// and manifests are found beside the module's own install rather than the
+// interpreter's. Call it before any stage runs; empty: the running executable's again.
+void SetExecutableDir(const std::filesystem::path& dir);
+
+// The `tessera` executable, for verbs that run it as a child process (bench): this
+// process's own, or <dir>/tessera when SetExecutableDir named a folder.
+std::filesystem::path TesseraExecutable();
 
 // Where the bundled plugins are: <exe>/../lib/tessera/plugins, in the build tree and
 // in an install alike.

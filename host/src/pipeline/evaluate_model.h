@@ -1,0 +1,25 @@
+#pragma once
+
+// `eval`: a model folder scored against ground truth, shared by the CLI verb and the
+// Python module.
+
+#include <filesystem>
+
+#include "eval/evaluation.h"
+#include "tessera/errors.h"
+
+namespace tessera {
+
+// Reads the COLMAP model in `model_dir` (holding its workspace, so that no run rewrites
+// it meanwhile) and the ground truth (*.camera files, a transforms.json or a model
+// folder) and scores the model's poses. Throws InputError naming the file on bad input;
+// a result that could not be aligned is returned with `aligned` false.
+EvaluationResult EvaluateModelFolder(const std::filesystem::path& model_dir,
+                                     const std::filesystem::path& ground_truth);
+
+// Why a result could not be scored (result.aligned false), naming both inputs: the
+// user's to fix (wrong ground truth, names that do not match), so bad input.
+InputError UnscoredError(const EvaluationResult& result, const std::filesystem::path& model_dir,
+                         const std::filesystem::path& ground_truth);
+
+}  // namespace tessera

@@ -1,0 +1,37 @@
+#include "pipeline/stage_arguments.h"
+
+#include "manifest/manifest.h"
+#include "util/paths.h"
+
+namespace tessera {
+namespace {
+
+PipelineContext CreateContext(const StageArguments& arguments) {
+  if (arguments.manifest_json) {
+    return PipelineContext::Create(
+        Manifest::FromJson(*arguments.manifest_json, std::filesystem::current_path(), "manifest"));
+  }
+  std::filesystem::path file = arguments.manifest;
+  // Video: ordered frames that may come back to where they started.
+  if (file.empty() && !arguments.videos.empty()) {
+    file = DefaultManifestFile().parent_path() / "ordered_loop.json";
+  }
+  return PipelineContext::Create(file);
+}
+
+}  // namespace
+
+PipelineContext LoadPipelineContext(const StageArguments& arguments) {
+  PipelineContext context = CreateContext(arguments);
+  if (arguments.threads > 0) context.manifest.num_threads = arguments.threads;
+  if (!arguments.camera_K.empty()) {
+    const Eigen::Matrix3d K = ReadCalibrationMatrixFile(arguments.camera_K);
+    context.manifest.camera.known_intrinsics = Eigen::Vector4d(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
+    context.manifest.camera.known_intrinsics_source = arguments.camera_K;
+  }
+  if (!arguments.masks.empty()) context.manifest.camera.mask_path = arguments.masks;
+  context.LimitLibraryThreads();
+  return context;
+}
+
+}  // namespace tessera

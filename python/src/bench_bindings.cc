@@ -1,0 +1,52 @@
+// tessera.bench(...): `tessera bench` (several manifests, and COLMAP, on the same
+// images), its rows as a list of dicts.
+
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bench/bench.h"
+#include "bindings.h"
+#include "json_objects.h"
+
+namespace py = pybind11;
+using OptionalPath = std::optional<std::filesystem::path>;
+
+namespace tessera::python {
+
+void BindBench(py::module_& module) {
+  module.def(
+      "bench",
+      [](const std::filesystem::path& images, const std::vector<std::filesystem::path>& manifests,
+         const std::filesystem::path& output, const OptionalPath& ground_truth,
+         const OptionalPath& camera_K, bool with_colmap, int threads) {
+        BenchOptions options;
+        options.images = images.string();
+        for (const auto& manifest : manifests) options.manifests.push_back(manifest.string());
+        options.output = output.string();
+        options.ground_truth = ground_truth ? ground_truth->string() : "";
+        options.camera_K = camera_K ? camera_K->string() : "";
+        options.with_colmap = with_colmap;
+        options.threads = threads;
+        BenchReport report;
+        {
+          const py::gil_scoped_release release;
+          report = RunBenchReport(options);
+        }
+        return ToPython(report.json["rows"]);
+      },
+      py::arg("images"), py::arg("manifests"), py::arg("output") = "bench-output",
+      py::arg("ground_truth") = py::none(), py::arg("camera_K") = py::none(),
+      py::arg("with_colmap") = false, py::arg("threads") = 0,
+      "Runs each manifest (each a `tessera run` of the installed executable, in "
+      "OUTPUT/<name>) on the same images and returns the rows `tessera bench --json` "
+      "writes, one dict per manifest (and COLMAP's): a row that failed keeps its exit_code. "
+      "InputError for bad arguments or a malformed manifest, before any run.");
+}
+
+}  // namespace tessera::python

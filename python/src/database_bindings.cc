@@ -1,0 +1,157 @@
+// tessera.Database: a workspace's database.db (COLMAP 3.8's schema) read from Python:
+// cameras, images, keypoints and descriptors as numpy, matches, and two-view geometries
+// with their kind. Opened read-only (database/database.h, Mode::kReadOnly): it takes no
+// lock and writes nothing, so it reads a workspace that no run is writing.
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <memory>
+#include <string>
+
+#include "bindings.h"
+#include "database/database.h"
+#include "numpy_views.h"
+
+namespace py = pybind11;
+
+namespace tessera::python {
+namespace {
+
+static_assert(sizeof(FeatureKeypoint) == 6 * sizeof(float), "keypoints are 6 floats");
+static_assert(sizeof(FeatureMatch) == 2 * sizeof(point2D_t), "matches are 2 indices");
+
+// The kind of relation a geometry's configuration stands for: an essential matrix
+// ("E"), a fundamental matrix ("F"), a homography ("H"), or none (None).
+py::object GeometryKind(int config) {
+  switch (config) {
+    case TwoViewGeometry::CALIBRATED:
+      return py::str("E");
+    case TwoViewGeometry::UNCALIBRATED:
+      return py::str("F");
+    case TwoViewGeometry::PLANAR:
+    case TwoViewGeometry::PANORAMIC:
+    case TwoViewGeometry::PLANAR_OR_PANORAMIC:
+      return py::str("H");
+    default:
+      return py::none();
+  }
+}
+
+py::array_t<point2D_t> MatchesArray(FeatureMatches matches) {
+  const auto n = static_cast<py::ssize_t>(matches.size());
+  return MoveIntoArray<point2D_t>(
+      std::move(matches), {n, 2}, {sizeof(FeatureMatch), sizeof(point2D_t)},
+      [](const FeatureMatches& m) { return m.empty() ? nullptr : &m[0].point2D_idx1; });
+}
+
+py::dict GeometryDict(image_t image_id1, image_t image_id2, TwoViewGeometry geometry) {
+  py::dict result;
+  result["image_id1"] = image_id1;
+  result["image_id2"] = image_id2;
+  result["config"] = geometry.config;
+  result["kind"] = GeometryKind(geometry.config);
+  result["E"] = geometry.E;
+  result["F"] = geometry.F;
+  result["H"] = geometry.H;
+  result["cam2_from_cam1"] = py::make_tuple(Eigen::Matrix3d(geometry.cam2_from_cam1.rotation),
+                                            geometry.cam2_from_cam1.translation);
+  result["inlier_matches"] = MatchesArray(std::move(geometry.inlier_matches));
+  return result;
+}
+
+}  // namespace
+
+void BindDatabase(py::module_& module) {
+  py::class_<Database, std::shared_ptr<Database>>(
+      module, "Database", "A workspace's database.db, read-only; results are numpy where arrays")
+      .def(py::init([](const std::filesystem::path& path) {
+             return std::make_shared<Database>(path, Database::Mode::kReadOnly);
+           }),
+           py::arg("path"), "InputError names the file when it is not a usable database")
+      .def_property_readonly(
+          "cameras",
+          [](const Database& database) {
+            py::dict cameras;
+            for (Camera& camera : database.ReadAllCameras()) {
+              cameras[py::int_(camera.camera_id)] = std::move(camera);
+            }
+            return cameras;
+          },
+          "{camera_id: Camera}, copies")
+      .def_property_readonly(
+          "images",
+          [](const Database& database) {
+            py::dict images;
+            for (Image& image : database.ReadAllImages()) {
+              images[py::int_(image.image_id)] = std::move(image);
+            }
+            return images;
+          },
+          "{image_id: Image} (name, camera_id; no pose), copies")
+      .def(
+          "keypoints",
+          [](const Database& database, image_t image_id) {
+            FeatureKeypoints keypoints = database.ReadKeypoints(image_id);
+            const auto n = static_cast<py::ssize_t>(keypoints.size());
+            return MoveIntoArray<float>(
+                std::move(keypoints), {n, 6}, {sizeof(FeatureKeypoint), sizeof(float)},
+                [](const FeatureKeypoints& k) { return k.empty() ? nullptr : &k[0].x; });
+          },
+          py::arg("image_id"),
+          "(M, 6) float32: x, y, a11, a12, a21, a22, COLMAP's columns; the rows read, not copied")
+      .def(
+          "descriptors",
+          [](const Database& database, image_t image_id) {
+            FeatureDescriptors descriptors =
+                database.ReadDescriptors(image_id, DescriptorMetric::kL2);
+            const py::ssize_t rows = descriptors.data.rows(), cols = descriptors.data.cols();
+            return MoveIntoArray<uint8_t>(std::move(descriptors.data), {rows, cols}, {cols, 1},
+                                          [](const FeatureDescriptors::Matrix& m) {
+                                            return m.size() == 0 ? nullptr : m.data();
+                                          });
+          },
+          py::arg("image_id"), "(M, D) uint8, one descriptor per keypoint; not copied")
+      .def(
+          "matches",
+          [](const Database& database, image_t image_id1, image_t image_id2) {
+            return MatchesArray(database.ReadMatches(image_id1, image_id2));
+          },
+          py::arg("image_id1"), py::arg("image_id2"),
+          "(K, 2) uint32 keypoint indices into image_id1's and image_id2's keypoints")
+      .def(
+          "matched_pairs",
+          [](const Database& database) {
+            py::list pairs;
+            for (const image_pair_t pair_id : database.ReadMatchedPairIds()) {
+              const auto [image_id1, image_id2] = PairIdToImagePair(pair_id);
+              pairs.append(py::make_tuple(image_id1, image_id2));
+            }
+            return pairs;
+          },
+          "(image_id1, image_id2) of every matched pair, image_id1 < image_id2")
+      .def(
+          "two_view_geometry",
+          [](const Database& database, image_t image_id1, image_t image_id2) {
+            return GeometryDict(image_id1, image_id2,
+                                database.ReadTwoViewGeometry(image_id1, image_id2));
+          },
+          py::arg("image_id1"), py::arg("image_id2"),
+          "{'config', 'kind' ('E', 'F', 'H' or None), 'E', 'F', 'H', 'cam2_from_cam1': (R, t), "
+          "'inlier_matches': (K, 2)}, relating image_id1 to image_id2")
+      .def(
+          "two_view_geometries",
+          [](const Database& database) {
+            py::list geometries;
+            for (auto& [pair_id, geometry] : database.ReadAllTwoViewGeometries()) {
+              const auto [image_id1, image_id2] = PairIdToImagePair(pair_id);
+              geometries.append(GeometryDict(image_id1, image_id2, std::move(geometry)));
+            }
+            return geometries;
+          },
+          "Every stored geometry as two_view_geometry gives it, image_id1 < image_id2");
+}
+
+}  // namespace tessera::python

@@ -1,0 +1,302 @@
+// tessera.Reconstruction and its Camera, Image and Point3D: a COLMAP model (binary or
+// text) read by the host's reader, walked as mappings of id to objects, with numpy
+// arrays over the C++ storage, and written back byte for byte.
+
+#include <pybind11/eigen.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl/filesystem.h>
+#include <pybind11/stl_bind.h>
+
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "bindings.h"
+#include "numpy_views.h"
+#include "tessera/errors.h"
+#include "tessera/io/colmap_model_io.h"
+#include "tessera/io/model_statistics.h"
+#include "tessera/reconstruction.h"
+
+// The maps are bound as mapping classes over the C++ storage, never converted to dicts.
+PYBIND11_MAKE_OPAQUE(std::map<tessera::camera_t, tessera::Camera>)
+PYBIND11_MAKE_OPAQUE(std::map<tessera::image_t, tessera::Image>)
+PYBIND11_MAKE_OPAQUE(std::map<tessera::point3D_t, tessera::Point3D>)
+
+namespace py = pybind11;
+
+namespace tessera::python {
+namespace {
+
+static_assert(sizeof(TrackElement) == 2 * sizeof(uint32_t), "track elements are (image, point2D)");
+
+// A model and the order of its records in the files it was read from, which writing
+// keeps so that a read and a write reproduce the files byte for byte.
+struct ModelHandle {
+  Reconstruction model;
+  ColmapModelFileOrder order;
+};
+
+using DoubleRows = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// Rows of an (N, 3) array of points; ValueError naming the argument otherwise.
+size_t NumPointRows(const DoubleRows& points, const char* name) {
+  if (points.ndim() != 2 || points.shape(1) != 3) {
+    throw py::value_error(std::string(name) + ": expected an (N, 3) array of points");
+  }
+  return static_cast<size_t>(points.shape(0));
+}
+
+// Pixels of camera-frame points; NaN for points not in front of the camera.
+py::array_t<double> ImgFromCam(const Camera& camera, const Rigid3d& cam_from_world,
+                               const DoubleRows& points) {
+  const size_t n = NumPointRows(points, "points");
+  py::array_t<double> pixels = NewArray<double>(n, 2);
+  auto in = points.unchecked<2>();
+  auto out = pixels.mutable_unchecked<2>();
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3d point_in_cam =
+        cam_from_world * Eigen::Vector3d(in(i, 0), in(i, 1), in(i, 2));
+    Eigen::Vector2d xy = Eigen::Vector2d::Constant(std::numeric_limits<double>::quiet_NaN());
+    if (point_in_cam.z() > std::numeric_limits<double>::epsilon()) {
+      xy = camera.ImgFromCam(point_in_cam);
+    }
+    out(i, 0) = xy.x();
+    out(i, 1) = xy.y();
+  }
+  return pixels;
+}
+
+void BindCamera(py::module_& module) {
+  py::class_<Camera>(module, "Camera", "A camera: model, image size and parameters.")
+      .def_readonly("camera_id", &Camera::camera_id)
+      .def_property_readonly("model", &Camera::ModelName, "COLMAP's model name, e.g. 'PINHOLE'")
+      .def_readonly("width", &Camera::width)
+      .def_readonly("height", &Camera::height)
+      .def_property_readonly(
+          "params",
+          [](py::object self) {
+            const Camera& camera = self.cast<const Camera&>();
+            return ArrayView<double>(camera.params.data(),
+                                     {static_cast<py::ssize_t>(camera.params.size())},
+                                     {sizeof(double)}, self);
+          },
+          "Parameters in COLMAP's order for the model, (P,) float64: a view (no copy)")
+      .def("calibration_matrix", &Camera::CalibrationMatrix, "K, 3x3, of the pinhole part")
+      .def(
+          "img_from_cam",
+          [](const Camera& camera, const DoubleRows& points) {
+            return ImgFromCam(camera, Rigid3d(), points);
+          },
+          py::arg("points"),
+          "Pixels (N, 2) of camera-frame points (N, 3); NaN for points not in front")
+      .def("__repr__", [](const Camera& camera) {
+        return "Camera(camera_id=" + std::to_string(camera.camera_id) +
+               ", model=" + camera.ModelName() + ", width=" + std::to_string(camera.width) +
+               ", height=" + std::to_string(camera.height) + ")";
+      });
+}
+
+void BindImage(py::module_& module) {
+  py::class_<Image>(module, "Image", "An image: its camera, name, pose and keypoints.")
+      .def_readonly("image_id", &Image::image_id)
+      .def_readonly("camera_id", &Image::camera_id)
+      .def_readonly("name", &Image::name)
+      .def_readonly("registered", &Image::registered)
+      .def_property_readonly(
+          "cam_from_world",
+          [](const Image& image) {
+            return py::make_tuple(Eigen::Matrix3d(image.cam_from_world.rotation),
+                                  Eigen::Vector3d(image.cam_from_world.translation));
+          },
+          "(R, t): x_cam = R @ x_world + t, R (3, 3) and t (3,), copies")
+      .def("projection_center", &Image::ProjectionCenter, "The camera centre in the world, (3,)")
+      .def_property_readonly(
+          "keypoints",
+          [](py::object self) {
+            const Image& image = self.cast<const Image&>();
+            const auto n = static_cast<py::ssize_t>(image.points2D.size());
+            const double* data = n > 0 ? image.points2D[0].xy.data() : nullptr;
+            return ArrayView<double>(data, {n, 2}, {sizeof(Point2D), sizeof(double)}, self);
+          },
+          "The keypoints' pixels, (M, 2) float64: a strided view (no copy)")
+      .def_property_readonly(
+          "point3D_ids",
+          [](py::object self) {
+            const Image& image = self.cast<const Image&>();
+            const auto n = static_cast<py::ssize_t>(image.points2D.size());
+            const point3D_t* data = n > 0 ? &image.points2D[0].point3D_id : nullptr;
+            return ArrayView<point3D_t>(data, {n}, {sizeof(Point2D)}, self);
+          },
+          "Each keypoint's 3D point id, (M,) uint64, 2**64-1 where none: a strided view")
+      .def("num_points3D",
+           [](const Image& image) {
+             size_t n = 0;
+             for (const Point2D& point : image.points2D) n += point.HasPoint3D() ? 1 : 0;
+             return n;
+           })
+      .def("__repr__", [](const Image& image) {
+        return "Image(image_id=" + std::to_string(image.image_id) + ", name='" + image.name +
+               "', camera_id=" + std::to_string(image.camera_id) + ")";
+      });
+}
+
+void BindPoint3D(py::module_& module) {
+  py::class_<Point3D>(module, "Point3D", "A 3D point: position, colour, error and track.")
+      .def_property_readonly(
+          "xyz",
+          [](py::object self) {
+            return ArrayView<double>(self.cast<const Point3D&>().xyz.data(), {3}, {sizeof(double)},
+                                     self);
+          },
+          "Position in the world, (3,) float64: a view")
+      .def_property_readonly(
+          "color",
+          [](py::object self) {
+            return ArrayView<uint8_t>(self.cast<const Point3D&>().color.data(), {3}, {1}, self);
+          },
+          "RGB, (3,) uint8: a view")
+      .def_readonly("error", &Point3D::error, "Mean reprojection error in pixels, -1 if unknown")
+      .def_property_readonly(
+          "track",
+          [](py::object self) {
+            const Track& track = self.cast<const Point3D&>().track;
+            const auto n = static_cast<py::ssize_t>(track.size());
+            const uint32_t* data = n > 0 ? &track[0].image_id : nullptr;
+            return ArrayView<uint32_t>(data, {n, 2}, {sizeof(TrackElement), sizeof(uint32_t)},
+                                       self);
+          },
+          "(image_id, point2D_idx) per observation, (K, 2) uint32: a view");
+}
+
+// The whole-model arrays, projection and statistics (one bulk copy each: the points
+// live in a std::map, not in one block).
+void BindModelArrays(py::class_<ModelHandle, std::shared_ptr<ModelHandle>>& model_class) {
+  model_class
+      .def(
+          "points3D_arrays",
+          [](const ModelHandle& handle) {
+            const auto& points = handle.model.points3D;
+            py::array_t<point3D_t> ids = NewArray<point3D_t>(points.size(), 1);
+            py::array_t<double> xyz = NewArray<double>(points.size(), 3);
+            py::array_t<uint8_t> colors = NewArray<uint8_t>(points.size(), 3);
+            py::array_t<double> errors = NewArray<double>(points.size(), 1);
+            auto id = ids.mutable_unchecked<1>();
+            auto position = xyz.mutable_unchecked<2>();
+            auto color = colors.mutable_unchecked<2>();
+            auto error = errors.mutable_unchecked<1>();
+            py::ssize_t i = 0;
+            for (const auto& [point3D_id, point] : points) {
+              id(i) = point3D_id;
+              for (int k = 0; k < 3; ++k) {
+                position(i, k) = point.xyz[k];
+                color(i, k) = point.color[k];
+              }
+              error(i) = point.error;
+              ++i;
+            }
+            py::dict arrays;
+            arrays["ids"] = ids;
+            arrays["xyz"] = xyz;
+            arrays["colors"] = colors;
+            arrays["errors"] = errors;
+            return arrays;
+          },
+          "{'ids': (N,) uint64, 'xyz': (N, 3) float64, 'colors': (N, 3) uint8, 'errors': "
+          "(N,) float64}, rows by ascending id: one bulk copy each (the points are a map)")
+      .def(
+          "project",
+          [](const ModelHandle& handle, image_t image_id, const DoubleRows& points) {
+            const auto image = handle.model.images.find(image_id);
+            if (image == handle.model.images.end()) {
+              throw py::key_error("no image " + std::to_string(image_id));
+            }
+            const Camera& camera = handle.model.cameras.at(image->second.camera_id);
+            return ImgFromCam(camera, image->second.cam_from_world, points);
+          },
+          py::arg("image_id"), py::arg("points"),
+          "Pixels (N, 2) of world points (N, 3) in an image; NaN for points behind it")
+      .def(
+          "statistics",
+          [](const ModelHandle& handle) {
+            const ModelStatistics statistics = ComputeModelStatistics(handle.model);
+            py::dict result;
+            result["num_cameras"] = handle.model.cameras.size();
+            result["num_images"] = handle.model.NumRegisteredImages();
+            result["num_points3D"] = statistics.num_points3D;
+            result["num_observations"] = statistics.num_observations;
+            result["mean_track_length"] = statistics.mean_track_length;
+            result["mean_reprojection_error"] = statistics.mean_reprojection_error;
+            return result;
+          },
+          "What `colmap model_analyzer` reports, as the host computes it");
+}
+
+}  // namespace
+
+void BindModel(py::module_& module) {
+  BindCamera(module);
+  BindImage(module);
+  BindPoint3D(module);
+  // Each mapping in its value's class (tessera.Camera.Map, ...): camera and image ids are
+  // both uint32, and pybind11 names a map's key view after the key type.
+  // Read-only: the objects and views handed out point into the maps' nodes, which a
+  // deletion or replacement would free under them.
+  for (py::object map_class :
+       {py::object(py::bind_map<std::map<camera_t, Camera>>(module.attr("Camera"), "Map")),
+        py::object(py::bind_map<std::map<image_t, Image>>(module.attr("Image"), "Map")),
+        py::object(py::bind_map<std::map<point3D_t, Point3D>>(module.attr("Point3D"), "Map"))}) {
+    py::delattr(map_class, "__setitem__");
+    py::delattr(map_class, "__delitem__");
+  }
+
+  py::class_<ModelHandle, std::shared_ptr<ModelHandle>> model_class(
+      module, "Reconstruction", "A COLMAP sparse model: cameras, images and 3D points.");
+  model_class
+      .def(py::init([](const std::filesystem::path& path) {
+             auto handle = std::make_shared<ModelHandle>();
+             const py::gil_scoped_release release;
+             handle->model = ReadColmapModel(path, &handle->order);
+             return handle;
+           }),
+           py::arg("path"),
+           "Reads cameras, images and points3D from a folder: the .bin files when all three "
+           "are there, else the .txt files. InputError names the file on any problem.")
+      .def(
+          "write",
+          [](const ModelHandle& handle, const std::filesystem::path& path,
+             const std::string& format) {
+            if (format != "binary" && format != "text") {
+              throw InputError("format: '" + format + "' is neither 'binary' nor 'text'");
+            }
+            const py::gil_scoped_release release;
+            WriteColmapModel(
+                handle.model, path,
+                format == "text" ? ColmapModelFormat::kText : ColmapModelFormat::kBinary,
+                &handle.order);
+          },
+          py::arg("path"), py::arg("format") = "binary",
+          "Writes the model into a folder in COLMAP 3.8's layout, records in the order read")
+      .def_property_readonly(
+          "cameras", [](ModelHandle & handle) -> auto& { return handle.model.cameras; },
+          py::return_value_policy::reference_internal, "camera_id -> Camera")
+      .def_property_readonly(
+          "images", [](ModelHandle & handle) -> auto& { return handle.model.images; },
+          py::return_value_policy::reference_internal, "image_id -> Image")
+      .def_property_readonly(
+          "points3D", [](ModelHandle & handle) -> auto& { return handle.model.points3D; },
+          py::return_value_policy::reference_internal, "point3D_id -> Point3D")
+      .def("num_reg_images",
+           [](const ModelHandle& handle) { return handle.model.NumRegisteredImages(); })
+      .def("__repr__", [](const ModelHandle& handle) {
+        return "Reconstruction(cameras=" + std::to_string(handle.model.cameras.size()) +
+               ", images=" + std::to_string(handle.model.images.size()) +
+               ", points3D=" + std::to_string(handle.model.points3D.size()) + ")";
+      });
+  BindModelArrays(model_class);
+}
+
+}  // namespace tessera::python

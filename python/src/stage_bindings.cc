@@ -1,0 +1,207 @@
+// tessera.run, extract, match, map and export: the CLI's verbs with its arguments as
+// keywords (--camera-K as camera_K), built by the same functions the CLI calls
+// (pipeline/stage_arguments.h, pipeline/run_pipeline.h, pipeline/export_model.h). Each
+// returns its part of the run summary (run: all of run_summary.json) as a dict.
+
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "errors.h"
+#include "json_objects.h"
+#include "pipeline/export_model.h"
+#include "pipeline/run_pipeline.h"
+#include "pipeline/stage_arguments.h"
+#include "python_stage_control.h"
+#include "tessera/errors.h"
+
+namespace py = pybind11;
+using OptionalPath = std::optional<std::filesystem::path>;
+
+namespace tessera::python {
+namespace {
+
+std::string PathText(const OptionalPath& path) { return path ? path->string() : std::string(); }
+
+// The arguments every verb shares; `manifest`: None (the default), a path, or a dict
+// (the manifest's JSON, relative paths from the working folder).
+StageArguments MakeArguments(const py::object& manifest, const OptionalPath& camera_K,
+                             const OptionalPath& masks,
+                             const std::vector<std::filesystem::path>& videos, int threads) {
+  StageArguments arguments;
+  if (py::isinstance<py::dict>(manifest)) {
+    arguments.manifest_json = ToJson(manifest);
+  } else if (!manifest.is_none()) {
+    arguments.manifest = manifest.cast<std::filesystem::path>().string();
+  }
+  arguments.camera_K = PathText(camera_K);
+  arguments.masks = PathText(masks);
+  for (const auto& video : videos) arguments.videos.push_back(video.string());
+  if (threads < 0 || threads > 1024) {
+    throw InputError("threads: " + std::to_string(threads) + " is not in 0..1024");
+  }
+  arguments.threads = threads;
+  return arguments;
+}
+
+RunOptions MakeRunOptions(const OptionalPath& images, const std::filesystem::path& output,
+                          const std::vector<std::filesystem::path>& videos, bool needs_images) {
+  if (needs_images && !images && videos.empty()) {
+    throw InputError("images or videos: one of them is needed");
+  }
+  if (images && !videos.empty()) throw InputError("images and videos: give one of them, not both");
+  return RunOptions(images.value_or(std::filesystem::path()), output, videos);
+}
+
+// Each stage's fields as run_summary.json writes them.
+nlohmann::json StageJson(const char* stage, const RunSummary& summary) {
+  return summary.ToJson()[stage];
+}
+
+void CheckModels(const MapStageSummary& summary, const std::filesystem::path& output) {
+  if (summary.num_models == 0) throw NoModelError(NoModelMessage(output / "database.db"));
+}
+
+// The keywords the verbs share, in the CLI's terms, and what the docstrings say of them.
+const char* const kCommonDoc =
+    " manifest: a file or a dict (default: default.json); camera_K: a K.txt file; threads: "
+    "0 for the manifest's; progress(stage, done, total): called with the GIL held, an "
+    "exception from it (KeyboardInterrupt) cancels the stage, keeping what was finished "
+    "for the same call to resume, and propagates. The GIL is released while it runs.";
+py::arg_v ImagesArg() { return py::arg("images") = py::none(); }
+py::arg_v ManifestArg() { return py::arg("manifest") = py::none(); }
+py::arg_v CameraKArg() { return py::arg("camera_K") = py::none(); }
+py::arg_v MasksArg() { return py::arg("masks") = py::none(); }
+py::arg_v VideosArg() { return py::arg("videos") = std::vector<std::filesystem::path>(); }
+py::arg_v ThreadsArg() { return py::arg("threads") = 0; }
+py::arg_v ProgressArg() { return py::arg("progress") = py::none(); }
+
+// `run` and `extract`: images (or videos) in.
+void BindImageStages(py::module_& module) {
+  module.def(
+      "run",
+      [](const OptionalPath& images, const std::filesystem::path& output,
+         const py::object& manifest, const OptionalPath& camera_K, const OptionalPath& masks,
+         const std::vector<std::filesystem::path>& videos, int threads, py::object progress) {
+        const RunOptions options = MakeRunOptions(images, output, videos, true);
+        const PipelineContext context =
+            LoadPipelineContext(MakeArguments(manifest, camera_K, masks, videos, threads));
+        RunResult run;
+        PythonStageControl(std::move(progress)).Run([&](const StageControl& control) {
+          run = RunPipeline(context, options, control);
+        });
+        CheckModels(run.summary.map, output);
+        return ToPython(run.summary.ToJson());
+      },
+      ImagesArg(), py::arg("output"), ManifestArg(), CameraKArg(), MasksArg(), VideosArg(),
+      ThreadsArg(), ProgressArg(),
+      (std::string("Every stage, images in, models out (`tessera run`); returns "
+                   "run_summary.json as a dict, NoModelError when no model was built.") +
+       kCommonDoc)
+          .c_str());
+
+  module.def(
+      "extract",
+      [](const OptionalPath& images, const std::filesystem::path& output,
+         const py::object& manifest, const OptionalPath& camera_K, const OptionalPath& masks,
+         const std::vector<std::filesystem::path>& videos, int threads, py::object progress) {
+        const RunOptions options = MakeRunOptions(images, output, videos, true);
+        const PipelineContext context =
+            LoadPipelineContext(MakeArguments(manifest, camera_K, masks, videos, threads));
+        RunSummary summary;
+        PythonStageControl(std::move(progress)).Run([&](const StageControl& control) {
+          summary.extract = RunExtract(context, options, control);
+        });
+        return ToPython(StageJson("extract", summary));
+      },
+      ImagesArg(), py::arg("output"), ManifestArg(), CameraKArg(), MasksArg(), VideosArg(),
+      ThreadsArg(), ProgressArg(),
+      (std::string("Ingests images and detects features (`tessera extract`); returns the "
+                   "summary's 'extract' part.") +
+       kCommonDoc)
+          .c_str());
+}
+
+// `match` and `map`: on a workspace that `extract` filled.
+void BindWorkspaceStages(py::module_& module) {
+  module.def(
+      "match",
+      [](const std::filesystem::path& output, const py::object& manifest,
+         const OptionalPath& camera_K, int threads, py::object progress) {
+        const PipelineContext context =
+            LoadPipelineContext(MakeArguments(manifest, camera_K, {}, {}, threads));
+        RunSummary summary;
+        PythonStageControl(std::move(progress)).Run([&](const StageControl& control) {
+          summary.match = RunMatch(context, RunOptions({}, output), control);
+        });
+        return ToPython(StageJson("match", summary));
+      },
+      py::arg("output"), ManifestArg(), CameraKArg(), ThreadsArg(), ProgressArg(),
+      (std::string("Matches and verifies the workspace's pairs (`tessera match`); returns "
+                   "the summary's 'match' part.") +
+       kCommonDoc)
+          .c_str());
+
+  module.def(
+      "map",
+      [](const std::filesystem::path& output, const OptionalPath& images,
+         const py::object& manifest, const OptionalPath& camera_K, int threads,
+         py::object progress) {
+        const PipelineContext context =
+            LoadPipelineContext(MakeArguments(manifest, camera_K, {}, {}, threads));
+        RunSummary summary;
+        PythonStageControl(std::move(progress)).Run([&](const StageControl& control) {
+          summary.map = RunMap(
+              context, RunOptions(images.value_or(std::filesystem::path()), output), control);
+        });
+        CheckModels(summary.map, output);
+        return ToPython(StageJson("map", summary));
+      },
+      py::arg("output"), ImagesArg(), ManifestArg(), CameraKArg(), ThreadsArg(), ProgressArg(),
+      (std::string("Maps a workspace into models (`tessera map`); returns the summary's "
+                   "'map' part, NoModelError when no model was built.") +
+       kCommonDoc)
+          .c_str());
+}
+
+}  // namespace
+
+void BindStages(py::module_& module) {
+  BindImageStages(module);
+  BindWorkspaceStages(module);
+  module.def(
+      "export",
+      [](const std::filesystem::path& model, const std::string& format,
+         const std::filesystem::path& output, const OptionalPath& images, const py::object& options,
+         int model_index, const OptionalPath& masks) {
+        ExportArguments arguments;
+        arguments.model = model;
+        arguments.format = format;
+        arguments.output = output;
+        arguments.images = images.value_or(std::filesystem::path());
+        if (!options.is_none()) arguments.options = ToJson(options);
+        arguments.model_index = model_index;
+        arguments.masks = masks.value_or(std::filesystem::path());
+        ExportSummary summary;
+        {
+          const py::gil_scoped_release release;
+          summary = ExportModel(arguments);
+        }
+        return ToPython({{"exporter", summary.exporter},
+                         {"num_images", summary.num_images},
+                         {"num_points3D", summary.num_points3D},
+                         {"num_observations", summary.num_observations},
+                         {"seconds", summary.seconds}});
+      },
+      py::arg("model"), py::arg("format"), py::arg("output"), py::arg("images") = py::none(),
+      py::arg("options") = py::none(), py::arg("model_index") = 0, py::arg("masks") = py::none(),
+      "Writes a COLMAP model with an exporter plugin (`tessera export`); options: a dict.");
+}
+
+}  // namespace tessera::python

@@ -1,0 +1,54 @@
+"""tessera.Database on the CLI's workspace of the sample: the keypoints the model's
+images hold, matches in the caller's order, inliers among the matches, geometry kinds."""
+
+import numpy as np
+import pytest
+
+import tessera
+
+
+def test_images_cameras_keypoints_and_descriptors(sample):
+    _, _, output = sample
+    database = tessera.Database(output / "database.db")
+    model = tessera.Reconstruction(output / "sparse" / "0")
+    assert len(database.images) == 11
+    assert list(database.cameras) == list(model.cameras)
+    for image_id, image in model.images.items():
+        assert database.images[image_id].name == image.name
+        keypoints = database.keypoints(image_id)
+        assert keypoints.shape == (len(image.keypoints), 6) and keypoints.dtype == np.float32
+        # The model's keypoints are the database's, as the mapper read them.
+        np.testing.assert_array_equal(keypoints[:, :2].astype(np.float64), image.keypoints)
+        descriptors = database.descriptors(image_id)
+        assert descriptors.shape == (len(keypoints), 32) and descriptors.dtype == np.uint8
+        assert not keypoints.flags.owndata and not descriptors.flags.owndata
+
+
+def test_matches_and_two_view_geometries(sample):
+    _, _, output = sample
+    database = tessera.Database(output / "database.db")
+    pairs = database.matched_pairs()
+    assert len(pairs) == 55 and all(id1 < id2 for id1, id2 in pairs)
+    id1, id2 = pairs[0]
+    matches = database.matches(id1, id2)
+    assert matches.shape[1] == 2 and len(matches) > 0
+    np.testing.assert_array_equal(database.matches(id2, id1), matches[:, ::-1])
+    geometries = database.two_view_geometries()
+    assert len(geometries) == 55
+    verified = [g for g in geometries if g["kind"] is not None]
+    assert len(verified) >= 10
+    assert {g["kind"] for g in verified} <= {"E", "F", "H"}
+    for geometry in verified:
+        inliers = {tuple(row) for row in geometry["inlier_matches"]}
+        matched = {tuple(row) for row in database.matches(geometry["image_id1"],
+                                                          geometry["image_id2"])}
+        assert len(inliers) >= 15 and inliers <= matched
+    single = database.two_view_geometry(verified[0]["image_id1"], verified[0]["image_id2"])
+    np.testing.assert_array_equal(single["inlier_matches"], verified[0]["inlier_matches"])
+
+
+def test_a_file_that_is_not_a_database_raises_input_error(sample, tmp_path):
+    not_a_database = tmp_path / "not_a.db"
+    not_a_database.write_text("hello")
+    with pytest.raises(tessera.InputError, match="not_a.db"):
+        tessera.Database(not_a_database)

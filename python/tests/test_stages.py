@@ -1,0 +1,180 @@
+"""tessera.run, extract, match, map and export against the CLI on the same input: the
+same model files, a cancel from the progress callback that the same call resumes, and
+bad manifests raised as the named exceptions."""
+
+import json
+import os
+import pathlib
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+import tessera
+from conftest import MANIFEST, model_digests
+
+
+def test_run_gives_the_cli_model(sample, tmp_path):
+    images, manifest, cli_output = sample
+    calls = []
+    summary = tessera.run(images=images, output=tmp_path / "py", manifest=manifest, threads=2,
+                          progress=lambda stage, done, total: calls.append((stage, done, total)))
+    assert model_digests(tmp_path / "py") == model_digests(cli_output)
+    # The summary is run_summary.json, as the CLI writes it.
+    written = json.loads((tmp_path / "py" / "run_summary.json").read_text())
+    assert summary["map"] == written["map"]
+    assert summary["extract"]["num_images"] == 11
+    assert {stage for stage, _, _ in calls} >= {"extract", "match", "map"}
+    assert ("extract", 11, 11) in calls
+
+
+def test_stages_one_by_one_with_a_dict_manifest_give_the_cli_model(sample, tmp_path):
+    images, _, cli_output = sample
+    output = tmp_path / "py"
+    extract = tessera.extract(images=images, output=output, manifest=MANIFEST, threads=2)
+    assert extract["num_detected"] == 11
+    match = tessera.match(output=output, manifest=MANIFEST, threads=2)
+    assert match["num_pairs"] == 55
+    mapped = tessera.map(output=output, manifest=MANIFEST, threads=2)
+    assert mapped["num_models"] >= 1
+    assert model_digests(output) == model_digests(cli_output)
+
+
+def test_an_exception_in_progress_cancels_and_the_same_call_resumes(sample, tmp_path):
+    images, manifest, cli_output = sample
+    output = tmp_path / "py"
+
+    def interrupt(stage, done, total):
+        if stage == "extract" and done == 4:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        tessera.run(images=images, output=output, manifest=manifest, threads=2,
+                    progress=interrupt)
+    assert not (output / "run_summary.json").exists()
+    summary = tessera.run(images=images, output=output, manifest=manifest, threads=2)
+    # The images finished before the cancel are kept, not detected again.
+    assert summary["extract"]["num_reused"] >= 4
+    assert summary["extract"]["num_detected"] + summary["extract"]["num_reused"] == 11
+    assert model_digests(output) == model_digests(cli_output)
+
+
+def test_bad_manifests_and_arguments_raise_the_named_exception(sample, tmp_path):
+    images, _, _ = sample
+    bad_option = json.loads(json.dumps(MANIFEST))
+    bad_option["pipeline"]["detector"]["options"]["max_num_featurez"] = 5
+    with pytest.raises(tessera.InputError, match="pipeline.detector.options.max_num_featurez"):
+        tessera.run(images=images, output=tmp_path / "a", manifest=bad_option)
+    with pytest.raises(tessera.InputError, match="missing.json"):
+        tessera.run(images=images, output=tmp_path / "b", manifest=tmp_path / "missing.json")
+    with pytest.raises(tessera.InputError, match="images or videos"):
+        tessera.run(output=tmp_path / "c", manifest=MANIFEST)
+    with pytest.raises(tessera.InputError, match="database"):
+        tessera.map(output=tmp_path / "empty", manifest=MANIFEST)
+
+
+def test_no_model_raises_no_model_error_naming_the_database(sample, tmp_path):
+    images, _, _ = sample
+    two = tmp_path / "two"
+    two.mkdir()
+    for name in ("0000.jpg", "0005.jpg"):
+        (two / name).write_bytes((images / name).read_bytes())
+    strict = json.loads(json.dumps(MANIFEST))
+    strict["verification"]["min_num_inliers"] = 100000
+    with pytest.raises(tessera.NoModelError, match="database.db"):
+        tessera.run(images=two, output=tmp_path / "out", manifest=strict, threads=2)
+    assert tessera.NoModelError.exit_code == 3
+
+
+def test_export_writes_the_model_with_a_plugin(sample, tmp_path):
+    _, _, cli_output = sample
+    summary = tessera.export(model=cli_output / "sparse" / "0", format="colmap_text",
+                             output=tmp_path / "text")
+    assert summary["exporter"] == "colmap_text"
+    model = tessera.Reconstruction(cli_output / "sparse" / "0")
+    assert summary["num_points3D"] == len(model.points3D)
+    exported = tessera.Reconstruction(next((tmp_path / "text").rglob("points3D.txt")).parent)
+    assert len(exported.points3D) == len(model.points3D)
+    with pytest.raises(tessera.InputError, match="no_such_exporter"):
+        tessera.export(model=cli_output / "sparse" / "0", format="no_such_exporter",
+                       output=tmp_path / "x")
+
+
+def test_ctrl_c_while_a_stage_runs_raises_keyboard_interrupt(sample, tmp_path):
+    # SIGINT to the interpreter (its handler only sets a flag while C++ runs): the stage
+    # is cancelled from the caller's thread, with no exception from the callback.
+    images, manifest, _ = sample
+    script = f"""
+import os, signal, sys, tessera
+def progress(stage, done, total):
+    if stage == "extract" and done == 3:
+        os.kill(os.getpid(), signal.SIGINT)
+try:
+    tessera.run(images={str(images)!r}, output={str(tmp_path / "out")!r},
+                manifest={str(manifest)!r}, threads=2, progress=progress)
+except KeyboardInterrupt:
+    sys.exit(130)
+"""
+    result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True)
+    assert result.returncode == 130, result.stderr
+    summary = tessera.run(images=images, output=tmp_path / "out", manifest=manifest, threads=2)
+    assert summary["extract"]["num_reused"] >= 3
+
+
+def test_the_example_writes_a_png_of_the_sample(sample, tmp_path):
+    images, manifest, _ = sample
+    script = (pathlib.Path(__file__).resolve().parents[2] / "examples" / "python" /
+              "reconstruct_and_plot.py")
+    result = subprocess.run(
+        [sys.executable, script, "--images", images, "--output", tmp_path / "out", "--manifest",
+         manifest, "--threads", "2"], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    png = tmp_path / "out" / "top_view.png"
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    import matplotlib.image
+    assert matplotlib.image.imread(png).shape[:2] == (960, 960)
+    assert "registered in 1 model(s)" in result.stdout
+
+
+def test_the_full_size_sample_gives_the_reference_models(tmp_path):
+    # The default recipe (manifest=None: the default.json beside the module's install)
+    # on the 1024x683 sample: the model files whose digests the CLI's
+    # sample_model_end_to_end test checks.
+    source = pathlib.Path(os.environ["TESSERA_SOURCE_DIR"])
+    reference = {}
+    for line in (source / "tests/end_to_end/sample_model_digests.txt").read_text().splitlines():
+        digest, name = line.split()
+        reference[name] = digest
+    tessera.run(images=source / "examples/fountain-P11-small/images", output=tmp_path / "out",
+                threads=2)
+    assert model_digests(tmp_path / "out") == reference
+
+
+def test_other_python_threads_run_while_a_stage_runs(sample, tmp_path):
+    # Between the map stage's first and last report the mapper runs without the GIL:
+    # a Python thread keeps counting meanwhile.
+    images, manifest, _ = sample
+    counter = {"ticks": 0, "stop": False}
+
+    def count():
+        while not counter["stop"]:
+            counter["ticks"] += 1
+            time.sleep(0.0005)
+
+    ticks_at = {}
+
+    def progress(stage, done, total):
+        if stage == "map":
+            ticks_at[done] = counter["ticks"]
+
+    thread = threading.Thread(target=count)
+    thread.start()
+    try:
+        tessera.run(images=images, output=tmp_path / "out", manifest=manifest, threads=2,
+                    progress=progress)
+    finally:
+        counter["stop"] = True
+        thread.join()
+    assert ticks_at[1] - ticks_at[0] >= 10
