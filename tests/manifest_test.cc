@@ -49,6 +49,36 @@ TEST(Manifest, ParsesSlotsCameraVerificationAndPaths) {
   EXPECT_EQ(manifest.verification.min_num_inliers, 15);
 }
 
+TEST(Manifest, TheMapperIsASlotAndIncrementalByDefault) {
+  const Manifest plain = Manifest::FromJson(nlohmann::json::object(), "/base", "m.json");
+  EXPECT_EQ(plain.mapper.plugin, "incremental");
+  EXPECT_EQ(plain.mapper.json_path, "pipeline.mapper");
+  EXPECT_FALSE(plain.legacy_mapper_settings);
+
+  const Manifest named = Manifest::FromJson(
+      {{"pipeline", {{"mapper", {{"plugin", "global"}, {"options", {{"max_num_iterations", 3}}}}}}}},
+      "/base", "m.json");
+  EXPECT_EQ(named.mapper.plugin, "global");
+  EXPECT_EQ(named.mapper.options["max_num_iterations"], 3);
+  EXPECT_TRUE(named.mapper.options_path.empty());
+
+  // Manifests of before the mapper kind: the top-level object is the incremental
+  // mapper's options, and errors in it keep naming "mapper.KEY".
+  const Manifest legacy = Manifest::FromJson({{"mapper", {{"min_num_matches", 20}}}}, "/base", "m.json");
+  EXPECT_EQ(legacy.mapper.plugin, "incremental");
+  EXPECT_EQ(legacy.mapper.options["min_num_matches"], 20);
+  EXPECT_EQ(legacy.mapper.options_path, "mapper");
+  EXPECT_TRUE(legacy.legacy_mapper_settings);
+
+  const std::string both = ErrorOf({{"mapper", {{"min_num_matches", 20}}},
+                                    {"pipeline", {{"mapper", {{"plugin", "incremental"}}}}}});
+  EXPECT_NE(both.find("m.json: mapper:"), std::string::npos) << both;
+  EXPECT_NE(both.find("pipeline.mapper.options"), std::string::npos) << both;
+  EXPECT_NE(ErrorOf({{"mapper", 3}}).find("mapper: expected a JSON object"), std::string::npos);
+  EXPECT_NE(ErrorOf({{"pipeline", {{"mapper", {{"options", {}}}}}}}).find("pipeline.mapper"),
+            std::string::npos);
+}
+
 TEST(Manifest, UnknownKeysNameTheirPathAndTheClosestKey) {
   EXPECT_EQ(ErrorOf({{"pipline", nlohmann::json::object()}}),
             "m.json: pipline: unknown key; did you mean 'pipeline'?");

@@ -65,10 +65,10 @@ TEST(PluginLoader, RefusesAnotherAbiVersionNamingBothNumbers) {
 }
 
 TEST(PluginLoader, RefusesAPluginBuiltAgainstAbiOne) {
-  ASSERT_EQ(kPluginAbiVersion, 5u);
+  ASSERT_EQ(kPluginAbiVersion, 6u);
   const auto file = File("abi_one", "abi_one");
   EXPECT_EQ(InspectPluginFile(file).refusal,
-            file.string() + ": wrong plugin ABI version: got version 1, supported version is 5");
+            file.string() + ": wrong plugin ABI version: got version 1, supported version is 6");
   const PluginRegistry registry = PluginRegistry::Discover({kRoot / "abi_one"});
   EXPECT_TRUE(registry.NamesOfKind("pair_selector").empty());
 }
@@ -223,6 +223,30 @@ TEST(PluginLoader, RefusesAPluginOfAnotherKindForASlot) {
     EXPECT_EQ(std::string(error.what()), "pipeline.detector.plugin: plugin 'consecutive' (" +
                                              File("good", "good").string() +
                                              ") is a pair_selector, not a detector");
+  }
+}
+
+TEST(PluginLoader, RefusesAPluginOfAnotherKindAsTheMapper) {
+  const PluginRegistry registry = PluginRegistry::Discover({kRoot / "good"});
+  try {
+    registry.Create<Mapper>("mapper", "consecutive", {}, "pipeline.mapper");
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()), "pipeline.mapper.plugin: plugin 'consecutive' (" +
+                                             File("good", "good").string() +
+                                             ") is a pair_selector, not a mapper");
+  }
+}
+
+TEST(PluginLoader, OptionErrorsNameTheOptionsPathTheSlotGives) {
+  const PluginRegistry registry = PluginRegistry::Discover({kRoot / "good"});
+  try {
+    registry.Create<PairSelector>("pair_selector", "consecutive", {{"overlap", 0}},
+                                  "pipeline.pair_selector", "legacy");
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()).rfind("legacy.overlap: = 0 is out of range", 0), 0u)
+        << error.what();
   }
 }
 

@@ -26,7 +26,7 @@
 
 #include "eval/ground_truth.h"
 #include "geometry/essential_matrix.h"
-#include "sfm/incremental_mapper.h"
+#include "tessera/sfm/incremental_mapper.h"
 #include "tessera/rigid3.h"
 #include "util/random.h"
 

@@ -1,7 +1,8 @@
 #!/bin/bash
 # Installs Tessera from BUILD_DIR into a temporary prefix and builds this folder's
 # plugins, one of every kind (the akaze detector, the symmetric_ratio matcher, the
-# window_stride pair selector, the cauchy bundle adjuster and the bundler exporter),
+# window_stride pair selector, the strict mapper, the cauchy bundle adjuster and the
+# bundler exporter),
 # against the installed SDK alone. Then: `tessera plugins --json` lists all five as
 # usable, from the out-of-tree build; akaze and symmetric_ratio extract and match three
 # images; and ONE `tessera bench` run compares a row of bundled plugins (orb, exhaustive,
@@ -22,7 +23,7 @@ cmake --install "$build_dir" --prefix "$work/prefix" > "$work/install.log"
 # guide and one page per plugin kind.
 docs="$work/prefix/share/doc/tessera"
 for page in plugin_authors_guide.md manifest_reference.md plugins/detector.md plugins/matcher.md \
-    plugins/pair_selector.md plugins/bundle_adjuster.md plugins/exporter.md; do
+    plugins/pair_selector.md plugins/mapper.md plugins/bundle_adjuster.md plugins/exporter.md; do
   [ -s "$docs/$page" ] || { echo "FAIL: $docs/$page is not installed"; exit 1; }
 done
 for example in "$source_dir"/*.cc "$source_dir"/CMakeLists.txt; do
@@ -73,12 +74,13 @@ plugins = json.load(open(sys.argv[1]))["plugins"]
 found = {(p["kind"], p["name"]): p for p in plugins if p["usable"]}
 assert ("detector", "sift") in found, "bundled sift not found by the installed binary"
 for kind, name in [("detector", "akaze"), ("matcher", "symmetric_ratio"),
-                   ("pair_selector", "window_stride"), ("bundle_adjuster", "cauchy"),
+                   ("pair_selector", "window_stride"), ("mapper", "strict"),
+                   ("bundle_adjuster", "cauchy"),
                    ("exporter", "bundler")]:
     assert (kind, name) in found, "%s %s not listed as usable" % (kind, name)
     folder = os.path.dirname(os.path.realpath(found[(kind, name)]["file"]))
     assert folder == os.path.realpath(sys.argv[2]), (kind, name, folder)
-print("plugins --json lists the five out-of-tree plugins")
+print("plugins --json lists the six out-of-tree plugins")
 PY
 
 mkdir -p "$work/images"
@@ -103,6 +105,23 @@ refuse pair_selector '{"plugin": "window_stride", "options": {"window": 3, "stri
   "pipeline.pair_selector.options.stride: = 2 must be 0 or greater than window = 3"
 refuse matcher '{"plugin": "symmetric_ratio", "options": {"cross_check": false}}' \
   "pipeline.matcher.options.cross_check: = false contradicts symmetric = true"
+# The mapper slot: options checked (the incremental options nested in the strict ones),
+# and a plugin of another kind refused naming its kind.
+cat > "$work/mapper_bad.json" <<JSON
+{"plugin_paths": ["build/plugins"],
+ "pipeline": {"mapper": {"plugin": "strict", "options": {"incremental": {"max_reg_trials": -1}}}}}
+JSON
+cat > "$work/mapper_kind.json" <<JSON
+{"plugin_paths": ["build/plugins"], "pipeline": {"mapper": {"plugin": "akaze"}}}
+JSON
+for case in "mapper_bad:pipeline.mapper.options.incremental.max_reg_trials" \
+            "mapper_kind:pipeline.mapper.plugin: plugin 'akaze'"; do
+  rc=0
+  "$tessera" match --output "$work/out" --manifest "$work/${case%%:*}.json" 2> "$work/bad.log" || rc=$?
+  [ "$rc" = 2 ] && grep -qF "${case#*:}" "$work/bad.log" || {
+    echo "expected exit code 2 and '${case#*:}', got $rc:"; cat "$work/bad.log"; exit 1; }
+done
+grep -qF "is a detector, not a mapper" "$work/bad.log" || { cat "$work/bad.log"; exit 1; }
 
 # One bench: a row of bundled plugins next to a row of the five out-of-tree ones.
 cat > "$work/bundled.json" <<JSON
@@ -123,6 +142,7 @@ cat > "$work/third_party.json" <<JSON
     "detector": {"plugin": "akaze", "options": {"max_num_features": 2000}},
     "pair_selector": {"plugin": "window_stride", "options": {"window": 3, "stride": 5}},
     "matcher": {"plugin": "symmetric_ratio"},
+    "mapper": {"plugin": "strict", "options": {"min_agreement": 0.8}},
     "bundle_adjuster": {"plugin": "cauchy"},
     "exporters": [{"plugin": "colmap_binary"}, {"plugin": "bundler"}]
   }
@@ -136,8 +156,9 @@ rows = json.load(open(sys.argv[1]))["rows"]
 # Every plugin with its version, the exporters too: two rows that differ only in an
 # exporter do not look alike.
 assert [r["plugins"] for r in rows] == [
-    "orb 1.0.0 / exhaustive 1.0.0 / brute_force 1.0.0 / ceres 1.0.0 / colmap_binary 1.0.0",
-    "akaze 1.0.0 / window_stride 1.0.0 / symmetric_ratio 1.0.0 / cauchy 1.0.0 / "
+    "orb 1.0.0 / exhaustive 1.0.0 / brute_force 1.0.0 / incremental 1.0.0 / ceres 1.0.0 / "
+    "colmap_binary 1.0.0",
+    "akaze 1.0.0 / window_stride 1.0.0 / symmetric_ratio 1.0.0 / strict 1.0.0 / cauchy 1.0.0 / "
     "colmap_binary 1.0.0+bundler 1.0.0"], rows
 for r in rows:
     assert r["exit_code"] == 0 and r["num_registered"] == 11, r

@@ -1,10 +1,14 @@
 #pragma once
 
+#include <map>
 #include <set>
 #include <string>
+#include <vector>
 
+#include "tessera/camera_rig.h"
 #include "tessera/ids.h"
 #include "tessera/plugin.h"
+#include "tessera/position_prior.h"
 #include "tessera/reconstruction.h"
 
 namespace tessera {
@@ -30,6 +34,16 @@ struct BundleAdjustmentConfig {
   // adjuster's own setting. Lets the mapper stop local adjustments, which only have
   // to be good enough for the next registration, earlier than global ones.
   double function_tolerance = -1;
+  // Camera centres held near known positions (GPS priors in the model's frame): one
+  // residual (centre - position) / sigma per axis for each image of the problem listed.
+  // With any prior in the problem the priors fix the gauge, and fix_gauge is ignored.
+  std::map<image_t, PositionPrior> position_priors;
+  // Rigs whose frames keep their images' relative poses: every image of a frame in the
+  // problem gets cam_from_world = cam_from_rig * rig_from_world, one rig_from_world per
+  // frame; cam_from_rig is refined when refine_rig_poses and the rig's poses are not
+  // known. An adjuster that cannot keep a rig returns usable = false, saying so.
+  std::vector<CameraRig> rigs;
+  bool refine_rig_poses = true;
 };
 
 struct BundleAdjustmentSummary {

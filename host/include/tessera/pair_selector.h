@@ -8,6 +8,7 @@
 
 #include "tessera/camera.h"
 #include "tessera/errors.h"
+#include "tessera/feature_reader.h"
 #include "tessera/features.h"
 #include "tessera/ids.h"
 #include "tessera/image_metadata.h"
@@ -24,21 +25,6 @@ struct PairSelectionImage {
   std::string name;  // path relative to the image folder, '/' separated
   Camera camera;     // its camera (width and height are the image's, as detection saw it)
   ImageMetadata metadata;
-};
-
-// Reads one image's features from the workspace on demand, by index into
-// PairSelectionInput::images. The host never holds every image's features at once,
-// and neither should a selector: read, reduce (e.g. to a global descriptor), drop.
-// Safe to call from several threads at once.
-class TESSERA_API FeatureReader {
- public:
-  virtual ~FeatureReader() = default;
-  virtual FeatureKeypoints ReadKeypoints(size_t index) const = 0;
-  virtual FeatureDescriptors ReadDescriptors(size_t index) const = 0;
-  // How the workspace's descriptors are compared, and their width in bytes per row;
-  // known without reading any image.
-  virtual DescriptorMetric Metric() const = 0;
-  virtual int DescriptorDimension() const = 0;
 };
 
 struct PairSelectionInput {

@@ -25,7 +25,7 @@
 // abi_headers.sha256 records it with a hash of every header here, comments and whitespace
 // excluded: the test sdk_abi_check fails when a header changes without a bump (bump it,
 // then run scripts/sdk_abi_check.py --update).
-#define TESSERA_PLUGIN_ABI_VERSION 5
+#define TESSERA_PLUGIN_ABI_VERSION 6
 
 extern "C" {
 // How a binary was built, as far as the C++ objects that cross the plugin boundary
@@ -48,7 +48,8 @@ struct TesseraBuildRecord {
 // any host can read it.
 struct TesseraPluginInfo {
   uint32_t abi_version;
-  const char* kind;  // "detector", "matcher", "pair_selector", "bundle_adjuster", "exporter"
+  const char* kind;  // "detector", "matcher", "pair_selector", "mapper", "bundle_adjuster",
+                    // "exporter"
   const char* name;
   const char* version;
   const char* description;
@@ -114,7 +115,7 @@ using PluginFactory = std::unique_ptr<Plugin>(const nlohmann::json& options);
 }  // namespace tessera
 
 // Defines the info record and the factory of a plugin. KIND is one of detector,
-// matcher, pair_selector, bundle_adjuster, exporter; CLASS derives from that kind's
+// matcher, pair_selector, mapper, bundle_adjuster, exporter; CLASS derives from that kind's
 // interface and has a constructor taking `const nlohmann::json& options`.
 //
 //   TESSERA_PLUGIN(detector, SiftDetector, "sift", "1.0.0", "SIFT (OpenCV)")

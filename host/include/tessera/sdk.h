@@ -11,6 +11,7 @@
 #include "tessera/detector.h"
 #include "tessera/errors.h"
 #include "tessera/exporter.h"
+#include "tessera/mapper.h"
 #include "tessera/matcher.h"
 #include "tessera/options.h"
 #include "tessera/pair_selector.h"
@@ -21,6 +22,7 @@ namespace tessera::plugin_kinds {
 using detector = ::tessera::Detector;
 using matcher = ::tessera::Matcher;
 using pair_selector = ::tessera::PairSelector;
+using mapper = ::tessera::Mapper;
 using bundle_adjuster = ::tessera::BundleAdjuster;
 using exporter = ::tessera::Exporter;
 }  // namespace tessera::plugin_kinds

@@ -34,7 +34,6 @@
 #include "pipeline/mapping_summary.h"
 #include "pipeline/run_summary.h"
 #include "pipeline/workspace.h"
-#include "sfm/incremental_pipeline.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
@@ -168,7 +167,9 @@ void ScoreModel(const Reconstruction& model, const GroundTruth* ground_truth, Be
 
 std::string SlotPlugin(const nlohmann::json& manifest, const std::string& slot) {
   const auto pipeline = manifest.find("pipeline");
-  if (pipeline == manifest.end() || !pipeline->contains(slot)) return "-";
+  if (pipeline == manifest.end() || !pipeline->contains(slot)) {
+    return slot == "mapper" ? "incremental" : "-";  // the default mapper
+  }
   const auto plugin = [](const nlohmann::json& value) {
     return value.is_object() && value.contains("plugin") && value.at("plugin").is_string()
                ? value.at("plugin").get<std::string>()
@@ -242,8 +243,8 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
   row.name = name;
   row.workspace = workspace.string();
   row.plugins = SlotPlugin(manifest, "detector") + " / " + SlotPlugin(manifest, "pair_selector") +
-                " / " + SlotPlugin(manifest, "matcher") + " / " +
-                SlotPlugin(manifest, "bundle_adjuster") + " / " + SlotPlugin(manifest, "exporters");
+                " / " + SlotPlugin(manifest, "matcher") + " / " + SlotPlugin(manifest, "mapper") +
+                " / " + SlotPlugin(manifest, "bundle_adjuster") + " / " + SlotPlugin(manifest, "exporters");
   ResetBenchWorkspace(workspace);
   if (!shared_from.empty()) {
     fs::copy_file(fs::path(options.output) / shared_from / "database.db",

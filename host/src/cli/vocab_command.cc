@@ -37,7 +37,7 @@ struct VocabOptions {
 // The manifest's `retrieval` slot (or a new one when it has none), made to train:
 // without its `codebook` (the file this command writes), with --codebook-size.
 PluginSlot TrainingSlot(const Manifest& manifest, int codebook_size) {
-  PluginSlot slot{"retrieval", nlohmann::json::object(), "pipeline.pair_selector"};
+  PluginSlot slot{"retrieval", nlohmann::json::object(), "pipeline.pair_selector", ""};
   const auto it = std::find_if(manifest.pair_selectors.begin(), manifest.pair_selectors.end(),
                                [](const PluginSlot& s) { return s.plugin == "retrieval"; });
   if (it != manifest.pair_selectors.end()) slot = *it;

@@ -302,7 +302,7 @@ Manifest Manifest::FromJson(const nlohmann::json& json, const std::filesystem::p
     const nlohmann::json pipeline = top.GetJson("pipeline", nlohmann::json::object());
     const nlohmann::json camera = top.GetJson("camera", nlohmann::json::object());
     const nlohmann::json verification = top.GetJson("verification", nlohmann::json::object());
-    manifest.mapper = top.GetJson("mapper", nlohmann::json::object());
+    const nlohmann::json legacy_mapper = top.GetJson("mapper", nullptr);
     manifest.video = top.GetJson("video", nlohmann::json::object());
     top.GetJson("description", "");
     top.Finish();
@@ -325,6 +325,11 @@ Manifest Manifest::FromJson(const nlohmann::json& json, const std::filesystem::p
         slots.GetJson(kSlotNames[i], nullptr);
       }
     }
+    if (slots.Has("mapper")) {
+      manifest.mapper = ParseSlot(slots.GetJson("mapper", nullptr), "pipeline.mapper");
+    } else {
+      slots.GetJson("mapper", nullptr);
+    }
     const nlohmann::json pair_selector = slots.GetJson("pair_selector", nullptr);
     const nlohmann::json exporters = slots.GetJson("exporters", nlohmann::json::array());
     slots.Finish();
@@ -337,7 +342,17 @@ Manifest Manifest::FromJson(const nlohmann::json& json, const std::filesystem::p
 
     manifest.camera = ParseCamera(camera, base_dir);
     manifest.verification = ParseVerification(verification);
-    if (!manifest.mapper.is_object()) throw OptionError("mapper", "expected a JSON object");
+    if (!legacy_mapper.is_null()) {
+      if (!legacy_mapper.is_object()) throw OptionError("mapper", "expected a JSON object");
+      if (pipeline.is_object() && pipeline.contains("mapper")) {
+        throw OptionError("mapper",
+                          "the mapper's settings belong in pipeline.mapper.options now; this "
+                          "manifest has pipeline.mapper too, so move them there");
+      }
+      manifest.mapper.options = legacy_mapper;
+      manifest.mapper.options_path = "mapper";
+      manifest.legacy_mapper_settings = true;
+    }
     if (!manifest.video.is_object()) throw OptionError("video", "expected a JSON object");
     return manifest;
   } catch (const OptionError& error) {

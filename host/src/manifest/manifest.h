@@ -19,6 +19,9 @@ struct PluginSlot {
   std::string plugin;
   nlohmann::json options = nlohmann::json::object();
   std::string json_path;  // where it sits in the manifest, e.g. "pipeline.detector"
+  // Where its options sit, when not at json_path + ".options" (the top-level "mapper"
+  // object of manifests written before the mapper became a plugin).
+  std::string options_path;
 };
 
 // The whole run configuration. Parsed and checked completely before any image is
@@ -37,13 +40,17 @@ struct Manifest {
   // are united. Empty when the manifest names none.
   std::vector<PluginSlot> pair_selectors;
   std::optional<PluginSlot> matcher;
+  // `pipeline.mapper`; `incremental` when the manifest names none.
+  PluginSlot mapper{"incremental", nlohmann::json::object(), "pipeline.mapper", ""};
   std::optional<PluginSlot> bundle_adjuster;
   std::vector<PluginSlot> exporters;
 
   CameraSettings camera;
   VerificationSettings verification;
-  // Mapper settings, read by the incremental mapper.
-  nlohmann::json mapper = nlohmann::json::object();
+  // The manifest gave the incremental mapper's options as a top-level "mapper" object
+  // (before mappers were plugins); they are read as pipeline.mapper's options, and the
+  // run says how to move them.
+  bool legacy_mapper_settings = false;
   // Keyframe selection of video input, read by video/video_frames.h.
   nlohmann::json video = nlohmann::json::object();
 

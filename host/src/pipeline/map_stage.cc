@@ -2,14 +2,17 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <optional>
 #include <string>
 
+#include "feature/database_feature_reader.h"
 #include "outputs/output_transaction.h"
+#include "pipeline/mapper_result_check.h"
 #include "pipeline/workspace.h"
 #include "plugin/bundle_adjuster_guard.h"
 #include "plugin/plugin_call.h"
-#include "sfm/mapper_input.h"
+#include "pipeline/load_mapper_input.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/model_statistics.h"
 #include "tessera/io/point_colors.h"
@@ -19,7 +22,8 @@ namespace tessera {
 
 MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& input,
                                 const std::filesystem::path& sparse_dir,
-                                const IncrementalMapperOptions& options, uint64_t seed) {
+                                const std::string& mapper, const nlohmann::json& mapper_options,
+                                uint64_t seed) {
   MappingSummary summary;
   for (size_t index = 0; index < result.models.size(); ++index) {
     const Reconstruction& model = result.models[index];
@@ -52,7 +56,9 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
   summary.view_graph_pairs_dropped = result.num_pairs_dropped;
   summary.registrations_refused = result.num_registrations_refused;
   summary.merges = result.merges;
-  summary.mapper_options = options.ToJson();
+  summary.mapper = mapper;
+  summary.mapper_options = mapper_options;
+  summary.mapper_details = result.details;
   summary.seed = seed;
   return summary;
 }
@@ -104,7 +110,11 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
                      MapStageSummary* summary) {
   const std::filesystem::path& output_dir = workspace.folder();
   MappingSummary mapping =
-      SummarizeMapping(result, input, output_dir / "sparse", settings.mapper, settings.seed);
+      SummarizeMapping(result, input, output_dir / "sparse",
+                       settings.mapper != nullptr ? settings.mapper->name() : "",
+                       settings.mapper != nullptr ? settings.mapper->EffectiveOptions()
+                                                  : nlohmann::json::object(),
+                       settings.seed);
   summary->num_models = result.models.size();
   OutputTransaction outputs(output_dir);
   outputs.Protect(image_dir);
@@ -144,8 +154,8 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
                              const StageScope& scope, const StageControl& control) {
   const Timer timer;
   MapStageSummary summary;
-  if (settings.bundle_adjuster == nullptr || !scope.IsWhole()) {
-    throw std::logic_error("MapWorkspace: no bundle adjuster, or a scope it cannot map");
+  if (settings.mapper == nullptr || settings.bundle_adjuster == nullptr || !scope.IsWhole()) {
+    throw std::logic_error("MapWorkspace: no mapper or bundle adjuster, or a scope it cannot map");
   }
   Database* database = &workspace.database();
   const MapperInput input = LoadMapperInput(*database);
@@ -175,16 +185,44 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
   }
   summary.num_images = input.images.size();
   if (cancelled()) return summary;
-  control.Report("map", 0, 1);
+  control.Report("map", 0, input.images.size());
   const BundleAdjusterGuard bundle_adjuster(*settings.bundle_adjuster, &workspace.crash_log());
-  const IncrementalPipeline mapper(settings.mapper, bundle_adjuster, settings.seed);
-  MapperObserver observer;
-  observer.should_stop = [&control] { return control.Cancelled(); };
-  observer.on_model_changed = control.model_changed;
-  MapperResult result = mapper.Reconstruct(input, observer);
-  // result.cancelled implies control.Cancelled(): the mapper stops only when asked.
+  std::vector<image_t> image_ids;
+  for (const auto& [image_id, image] : input.images) image_ids.push_back(image_id);
+  // A COLMAP database has no provenance: its descriptors are SIFT's (L2).
+  const auto provenance = database->ReadStageProvenance(Database::kFeaturesStage);
+  const bool hamming = provenance && provenance->value("metric", "l2") ==
+                                         DescriptorMetricName(DescriptorMetric::kHamming);
+  const DatabaseFeatureReader features(database, image_ids,
+                                       hamming ? DescriptorMetric::kHamming : DescriptorMetric::kL2,
+                                       database->DescriptorDimension().value_or(0));
+  MapperContext context;
+  context.bundle_adjuster = &bundle_adjuster;
+  context.features = &features;
+  context.seed = settings.seed;
+  context.num_threads = settings.num_threads;
+  context.control.should_stop = [&control] { return control.Cancelled(); };
+  context.control.on_model_changed = control.model_changed;
+  // The map bar never goes back (a second model starts from 2 images again) and says
+  // each count once.
+  size_t reported = 0;
+  context.control.on_progress = [&control, &reported](const std::string& step, size_t done,
+                                                      size_t total) {
+    if (step != "registration" || total == 0 || std::min(done, total) <= reported) return;
+    reported = std::min(done, total);
+    control.Report("map", reported, total);
+  };
+  const PluginInstance<Mapper>& mapper = *settings.mapper;
+  if (!mapper) throw std::logic_error("MapWorkspace: the mapper slot is empty");
+  MapperResult result = mapper.Call(PluginStage::kMap, std::to_string(input.images.size()) +
+                                                           " images",
+                                    [&](const Mapper& plugin) { return plugin.Map(input, context); });
+  // Asked to stop: whatever the mapper returned is dropped, and the old outputs stay.
   if (cancelled()) return summary;
-  control.Report("map", 1, 1);
+  CheckMapperResult(mapper.name(), input, &result);
+  if (reported < input.images.size()) {
+    control.Report("map", input.images.size(), input.images.size());
+  }
 
   if (image_dir.empty()) {
     spdlog::warn("map: the image folder is unknown (pass --images); points are not coloured");
@@ -202,10 +240,10 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
   }
   summary.seconds = timer.ElapsedSeconds();
   spdlog::info(
-      "map: {} of {} images registered in {} model(s), {} global and {} local bundle "
-      "adjustments, {:.2f} s",
-      summary.num_registered, summary.num_images, summary.num_models, result.num_global_ba,
-      result.num_local_ba, summary.seconds);
+      "map: {} of {} images registered in {} model(s) by the {} mapper, {} global and {} local "
+      "bundle adjustments, {:.2f} s",
+      summary.num_registered, summary.num_images, summary.num_models, mapper.name(),
+      result.num_global_ba, result.num_local_ba, summary.seconds);
   return summary;
 }
 

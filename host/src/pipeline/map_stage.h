@@ -13,19 +13,19 @@
 #include "pipeline/stage_scope.h"
 #include "pipeline/workspace.h"
 #include "plugin/plugin_registry.h"
-#include "sfm/incremental_mapper_options.h"
-#include "sfm/incremental_pipeline.h"
+#include "tessera/mapper.h"
 
 namespace tessera {
 
 // What the map stage needs besides the workspace; PipelineContext fills it from the
 // manifest.
 struct MapSettings {
+  const PluginInstance<Mapper>* mapper = nullptr;                   // required
   const PluginInstance<BundleAdjuster>* bundle_adjuster = nullptr;  // required
   // The exporters each model is written with; none (or null): COLMAP binary in
   // OUTPUT/sparse/<index>/.
   const std::vector<PluginInstance<Exporter>>* exporters = nullptr;
-  IncrementalMapperOptions mapper;  // the manifest's "mapper", checked
+  int num_threads = 1;
   uint64_t seed = 0;
   // The images the points are coloured from and the exporters read; empty: the folder
   // extract recorded.
@@ -35,10 +35,12 @@ struct MapSettings {
 };
 
 // The mapping summary of a mapper result: models (sparse_dir/<index>), why images were
-// left out, focal lengths estimated; the options as given; `seconds` left 0.
+// left out, focal lengths estimated; the mapper and its effective options; `seconds`
+// left 0.
 MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& input,
                                 const std::filesystem::path& sparse_dir,
-                                const IncrementalMapperOptions& options, uint64_t seed);
+                                const std::string& mapper, const nlohmann::json& mapper_options,
+                                uint64_t seed);
 
 // Maps the workspace's verified matches and writes every model: through the settings'
 // exporters, or as COLMAP binary in OUTPUT/sparse/<index>/ when there are none; then
@@ -51,9 +53,14 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
 // the set cannot be placed, and the first failing exporter's PluginError (the
 // exporters after it are not run; the earlier outputs stay whole).
 //
-// `control`: progress ("map" 0/1 then 1/1; "export", models written of all) and
-// cancellation, checked before mapping, by the mapper before each registration, and
-// before each model is written; `control.model_changed` sees the model grow. Cancelled:
+// The mapper plugin is called through its PluginInstance: what it throws is a
+// PluginError naming it (its bundle adjuster's errors name the adjuster), a crash is
+// attributed to it (or to the adjuster inside it).
+//
+// `control`: progress ("map": registered images of all while the mapper reports them,
+// 1/1 when it returns; "export", models written of all) and cancellation, checked
+// before mapping, by the mapper (MapperControl::should_stop), and before each model is
+// written; `control.model_changed` sees the model grow. Cancelled:
 // nothing of the old output is touched, nothing new is placed. Status kCancelled.
 MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& settings,
                              const StageScope& scope = {}, const StageControl& control = {});

@@ -41,7 +41,9 @@ nlohmann::json MappingSummary::ToJson() const {
   json["merges"] = merges;
   json["quarantined"] = quarantined;
   json["seconds"] = seconds;
+  json["mapper"] = mapper;
   json["mapper_options"] = mapper_options;
+  json["mapper_details"] = mapper_details;
   json["seed"] = seed;
   return json;
 }
@@ -87,7 +89,10 @@ MappingSummary MappingSummary::FromJson(const nlohmann::json& json) {
   summary.quarantined =
       json.value("quarantined", nlohmann::json::array()).get<std::vector<std::string>>();
   summary.seconds = json.at("seconds").get<double>();
+  // Absent in summaries written before mappers were plugins: the incremental one.
+  summary.mapper = json.value("mapper", "incremental");
   summary.mapper_options = json.at("mapper_options");
+  summary.mapper_details = json.value("mapper_details", nlohmann::json::object());
   summary.seed = json.at("seed").get<uint64_t>();
   return summary;
 }

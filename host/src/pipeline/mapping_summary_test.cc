@@ -43,7 +43,9 @@ TEST(MappingSummary, JsonKeys) {
   EXPECT_EQ(json.at("focal_lengths_estimated").at(0).at("method"), "view graph");
   EXPECT_EQ(json.at("seed").get<uint64_t>(), 42u);
   EXPECT_EQ(json.at("quarantined").size(), 1u);
-  EXPECT_EQ(json.size(), 10u);
+  EXPECT_EQ(json.at("mapper"), "incremental");
+  EXPECT_TRUE(json.at("mapper_details").is_object());
+  EXPECT_EQ(json.size(), 12u);
 }
 
 TEST(MappingSummary, RoundTripThroughAFile) {

@@ -6,7 +6,7 @@
 
 #include "pipeline/extract_stage.h"
 #include "pipeline/stage_test_util.h"
-#include "sfm/mapper_input.h"
+#include "pipeline/load_mapper_input.h"
 
 namespace tessera {
 namespace {

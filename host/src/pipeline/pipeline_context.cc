@@ -1,5 +1,7 @@
 #include "pipeline/pipeline_context.h"
 
+#include <spdlog/spdlog.h>
+
 #include <opencv2/core/utility.hpp>
 
 #include "pipeline/match_stage.h"
@@ -37,7 +39,18 @@ PipelineContext PipelineContext::Create(Manifest manifest) {
       context.bundle_adjuster = context.registry.Create<BundleAdjuster>(
           "bundle_adjuster", slot.plugin, slot.options, slot.json_path);
     }
-    context.mapper_options = IncrementalMapperOptions::FromJson(manifest.mapper);
+    {
+      const PluginSlot& slot = manifest.mapper;
+      context.mapper = context.registry.Create<Mapper>("mapper", slot.plugin, slot.options,
+                                                       slot.json_path, slot.options_path);
+      if (manifest.legacy_mapper_settings) {
+        spdlog::warn(
+            "{}: the top-level \"mapper\" object is read as the options of the incremental "
+            "mapper; move it to \"pipeline\": {{\"mapper\": {{\"plugin\": \"incremental\", "
+            "\"options\": {{...}}}}}}",
+            source);
+      }
+    }
     context.video_options = VideoFrameOptions::FromJson(manifest.video);
     for (const auto& slot : manifest.exporters) {
       context.exporters.push_back(
@@ -53,7 +66,8 @@ PipelineContext PipelineContext::Create(Manifest manifest) {
 void PipelineContext::Require(const std::string& slot, const std::string& stage) const {
   const bool present =
       (slot == "detector" && detector) || (slot == "pair_selector" && !pair_selectors.empty()) ||
-      (slot == "matcher" && matcher) || (slot == "bundle_adjuster" && bundle_adjuster);
+      (slot == "matcher" && matcher) || (slot == "mapper" && mapper) ||
+      (slot == "bundle_adjuster" && bundle_adjuster);
   if (!present) {
     const std::string source = manifest.file.empty() ? "manifest" : manifest.file.string();
     throw InputError(source + ": pipeline." + slot + ": missing; the " + stage + " stage needs a " +
@@ -109,7 +123,8 @@ MapSettings PipelineContext::MakeMapSettings(const std::filesystem::path& image_
   MapSettings settings;
   settings.bundle_adjuster = &bundle_adjuster;
   settings.exporters = &exporters;
-  settings.mapper = mapper_options;
+  settings.mapper = &mapper;
+  settings.num_threads = manifest.EffectiveNumThreads();
   settings.seed = manifest.seed;
   settings.image_dir = image_dir;
   settings.mask_dir = manifest.camera.mask_path;

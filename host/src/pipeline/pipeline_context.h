@@ -10,7 +10,6 @@
 #include "pipeline/match_stage.h"
 #include "pipeline/workspace.h"
 #include "plugin/plugin_registry.h"
-#include "sfm/incremental_mapper_options.h"
 #include "tessera/sdk.h"
 #include "video/video_frames.h"
 
@@ -27,10 +26,10 @@ struct PipelineContext {
   // Every `pipeline.pair_selector`, in manifest order; their pairs are united.
   std::vector<PluginInstance<PairSelector>> pair_selectors;
   PluginInstance<Matcher> matcher;
+  PluginInstance<Mapper> mapper;  // pipeline.mapper (incremental unless named)
   PluginInstance<BundleAdjuster> bundle_adjuster;
   std::vector<PluginInstance<Exporter>> exporters;
-  IncrementalMapperOptions mapper_options;  // the manifest's "mapper", checked
-  VideoFrameOptions video_options;          // the manifest's "video", checked
+  VideoFrameOptions video_options;  // the manifest's "video", checked
 
   // `manifest_file` empty: the default manifest. Throws InputError on any problem.
   static PipelineContext Create(const std::filesystem::path& manifest_file);

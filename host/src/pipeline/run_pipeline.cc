@@ -31,6 +31,7 @@ std::vector<PluginUsed> PluginsUsed(const PipelineContext& context) {
     plugins.push_back({"pair_selector", selector.name(), selector.version()});
   }
   plugins.push_back({"matcher", context.matcher.name(), context.matcher.version()});
+  plugins.push_back({"mapper", context.mapper.name(), context.mapper.version()});
   plugins.push_back(
       {"bundle_adjuster", context.bundle_adjuster.name(), context.bundle_adjuster.version()});
   for (const auto& exporter : context.exporters) {

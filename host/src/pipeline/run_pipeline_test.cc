@@ -40,12 +40,14 @@ TEST(RunPipeline, ProgressGoesThroughEveryStageInOrderAndTheSummariesAreWritten)
   ASSERT_EQ(run.status, StageStatus::kCompleted);
   ASSERT_GE(run.summary.map.num_models, 1u);
 
-  // extract 1..4 of 4, match 1..6 of 6, map 0 then 1 of 1, export 1..n of n.
+  // extract 1..4 of 4, match 1..6 of 6, map 0 of 4, the registered images as the model
+  // grows (the initial pair's 2 are not reported alone), 4 of 4, export 1..n of n.
   std::vector<std::tuple<std::string, size_t, size_t>> expected;
   for (size_t k = 1; k <= 4; ++k) expected.emplace_back("extract", k, 4);
   for (size_t k = 1; k <= 6; ++k) expected.emplace_back("match", k, 6);
-  expected.emplace_back("map", 0, 1);
-  expected.emplace_back("map", 1, 1);
+  expected.emplace_back("map", 0, 4);
+  expected.emplace_back("map", 3, 4);
+  expected.emplace_back("map", 4, 4);
   const size_t num_models = run.summary.map.num_models;
   for (size_t k = 1; k <= num_models; ++k) expected.emplace_back("export", k, num_models);
   EXPECT_EQ(calls, expected);

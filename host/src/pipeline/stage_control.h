@@ -40,7 +40,7 @@ struct StageControl {
   ProgressCallback progress;                  // may be empty
   const CancellationToken* cancel = nullptr;  // may be null: never cancelled
   // The map stage's model as it grows, after each image registered (see
-  // MapperObserver::on_model_changed); may be empty. Called on the stage's thread.
+  // MapperControl::on_model_changed); may be empty. Called on the stage's thread.
   std::function<void(size_t model_index, const Reconstruction& model)> model_changed;
 
   bool Cancelled() const { return cancel != nullptr && cancel->IsCancelled(); }

@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cstdlib>
 #include <cstring>
+#include <vector>
 
 namespace tessera {
 namespace {
@@ -183,6 +184,8 @@ const char* PluginStageName(PluginStage stage) {
       return "match";
     case PluginStage::kSelectPairs:
       return "select_pairs";
+    case PluginStage::kMap:
+      return "map";
     case PluginStage::kAdjust:
       return "adjust";
     case PluginStage::kExport:
@@ -209,6 +212,8 @@ const char* PluginStageActivity(PluginStage stage) {
       return "matching";
     case PluginStage::kSelectPairs:
       return "selecting pairs among";
+    case PluginStage::kMap:
+      return "mapping";
     case PluginStage::kAdjust:
       return "adjusting";
     case PluginStage::kExport:
@@ -261,10 +266,18 @@ InputError PluginError::AsSlotError(const std::string& json_path, const std::str
   return InputError(json_path + ": " + what + ": " + message_);
 }
 
+// The records of the calls a nested call interrupted (a mapper calling the bundle
+// adjuster), restored when it returns: a crash names the innermost plugin.
+thread_local std::vector<CallRecord> t_outer_records;
+
 PluginCallScope::PluginCallScope(const std::string& plugin, PluginStage stage,
                                  const std::string& subject)
     : outermost_(!t_record.active) {
-  if (!outermost_) return;    // a nested call keeps the outer record
+  if (!outermost_) {
+    t_outer_records.push_back(t_record);
+    t_record.active = 0;
+    std::atomic_signal_fence(std::memory_order_seq_cst);
+  }
 #ifndef __SANITIZE_ADDRESS__  // AddressSanitizer gives every thread an alternate stack
   static thread_local AltStack alt_stack;
   (void)alt_stack;
@@ -297,7 +310,19 @@ LogSink PluginLogSink(const std::string& plugin) {
 }
 
 PluginCallScope::~PluginCallScope() {
-  if (!outermost_) return;
+  if (!outermost_) {
+    t_record.active = 0;
+    std::atomic_signal_fence(std::memory_order_seq_cst);
+    const CallRecord& outer = t_outer_records.back();
+    std::memcpy(t_record.plugin, outer.plugin, sizeof(outer.plugin));
+    std::memcpy(t_record.stage, outer.stage, sizeof(outer.stage));
+    std::memcpy(t_record.activity, outer.activity, sizeof(outer.activity));
+    std::memcpy(t_record.subject, outer.subject, sizeof(outer.subject));
+    std::atomic_signal_fence(std::memory_order_seq_cst);
+    t_record.active = 1;
+    t_outer_records.pop_back();
+    return;
+  }
   t_record.active = 0;
   CallRecord* expected = &t_record;
   g_last_started.compare_exchange_strong(expected, nullptr);

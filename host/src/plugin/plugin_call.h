@@ -25,6 +25,7 @@ enum class PluginStage {
   kDetect,
   kMatch,
   kSelectPairs,
+  kMap,
   kAdjust,
   kExport,
   kTrain,    // a pair selector learning from images (tessera vocab)
@@ -81,7 +82,8 @@ class PluginError : public std::runtime_error {
 };
 
 // Records a plugin call for the crash handler while it lives (one per thread; the
-// fields are copied, truncated, into a fixed-size thread-local buffer).
+// fields are copied, truncated, into a fixed-size thread-local buffer). A nested call (a
+// mapper calling the bundle adjuster) takes the record over until it returns.
 class PluginCallScope {
  public:
   PluginCallScope(const std::string& plugin, PluginStage stage, const std::string& subject);
@@ -110,6 +112,8 @@ auto CallPlugin(const std::string& plugin, PluginStage stage, const std::string&
   const PluginCallScope scope(plugin, stage, subject);
   try {
     return fn();
+  } catch (const PluginError&) {
+    throw;  // a plugin this one called (the mapper's bundle adjuster) failed: it is named
   } catch (const OptionError& error) {
     throw PluginError(plugin, stage, subject, error);
   } catch (const InputError& error) {

@@ -12,7 +12,7 @@ namespace {
 constexpr PluginStage kStages[] = {
     PluginStage::kLoad,  PluginStage::kCreate,      PluginStage::kOptions, PluginStage::kDetect,
     PluginStage::kMatch, PluginStage::kSelectPairs, PluginStage::kAdjust,  PluginStage::kExport,
-    PluginStage::kTrain, PluginStage::kPrepare};
+    PluginStage::kTrain, PluginStage::kPrepare,     PluginStage::kMap};
 
 bool IsSignal(const std::string& cause) { return cause.rfind("SIG", 0) == 0; }
 

@@ -67,7 +67,7 @@ const TesseraBuildRecord& HostBuildRecord() {
 
 const std::vector<std::string>& PluginKindNames() {
   static const std::vector<std::string> kinds = {"detector", "matcher", "pair_selector",
-                                                 "bundle_adjuster", "exporter"};
+                                                 "mapper", "bundle_adjuster", "exporter"};
   return kinds;
 }
 
@@ -234,13 +234,14 @@ nlohmann::json PluginRegistry::ToJson() const {
 
 nlohmann::json PluginRegistry::DefaultOptions(const PluginRecord& record) const {
   const std::unique_ptr<Plugin> plugin =
-      CreateObject(record, nlohmann::json::object(), record.kind);
+      CreateObject(record, nlohmann::json::object(), record.kind, "");
   return plugin->EffectiveOptions();
 }
 
 std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
                                                      const nlohmann::json& options,
-                                                     const std::string& json_path) const {
+                                                     const std::string& json_path,
+                                                     const std::string& options_path) const {
   if (!record.library) {
     // Inspected in a child process only: open it here now.
     PluginRecord loaded = InspectPluginFile(record.file);
@@ -257,8 +258,8 @@ std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
     plugin = factory(options);
   } catch (const OptionError& error) {
     // Plugins report paths relative to their options; anchor them in the manifest.
-    const std::string path =
-        json_path + ".options" + (error.path().empty() ? "" : "." + error.path());
+    const std::string path = (options_path.empty() ? json_path + ".options" : options_path) +
+                             (error.path().empty() ? "" : "." + error.path());
     throw InputError(path + ": " + error.message() + " (plugin " + Quote(record.name) + ", " +
                      record.file.string() + ")");
   } catch (const std::exception& error) {

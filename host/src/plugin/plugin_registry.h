@@ -13,7 +13,7 @@
 
 namespace tessera {
 
-// The five plugin kinds, by the names used in info records and manifests.
+// The six plugin kinds, by the names used in info records and manifests.
 const std::vector<std::string>& PluginKindNames();
 
 // One plugin file found on the search path, loadable or not.
@@ -128,14 +128,16 @@ class PluginRegistry {
 
   // Makes the plugin `name` for the slot of kind `kind`. `json_path` is where the
   // slot sits in the manifest (e.g. "pipeline.detector"); errors name it and the file.
+  // `options_path`: where the options sit when not at json_path + ".options".
   // Throws InputError when the plugin is missing, refused, of another kind, its
   // factory throws or it rejects its options.
   template <typename Interface>
   PluginInstance<Interface> Create(const std::string& kind, const std::string& name,
                                    const nlohmann::json& options,
-                                   const std::string& json_path) const {
+                                   const std::string& json_path,
+                                   const std::string& options_path = "") const {
     const PluginRecord& record = Resolve(kind, name, json_path);
-    std::unique_ptr<Plugin> plugin = CreateObject(record, options, json_path);
+    std::unique_ptr<Plugin> plugin = CreateObject(record, options, json_path, options_path);
     auto* typed = dynamic_cast<Interface*>(plugin.get());
     if (typed == nullptr) {
       throw InputError(record.file.string() + ": plugin '" + name + "' says it is a " + kind +
@@ -149,7 +151,8 @@ class PluginRegistry {
   const PluginRecord& Resolve(const std::string& kind, const std::string& name,
                               const std::string& json_path) const;
   std::unique_ptr<Plugin> CreateObject(const PluginRecord& record, const nlohmann::json& options,
-                                       const std::string& json_path) const;
+                                       const std::string& json_path,
+                                       const std::string& options_path) const;
 
   std::vector<std::filesystem::path> search_paths_;
   std::vector<PluginRecord> records_;

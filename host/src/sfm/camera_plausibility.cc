@@ -1,4 +1,4 @@
-#include "sfm/camera_plausibility.h"
+#include "tessera/sfm/camera_plausibility.h"
 
 #include <cmath>
 

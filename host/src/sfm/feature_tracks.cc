@@ -1,4 +1,4 @@
-#include "sfm/feature_tracks.h"
+#include "tessera/sfm/feature_tracks.h"
 
 #include <algorithm>
 #include <numeric>

@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "eval/evaluation.h"
-#include "sfm/incremental_pipeline.h"
+#include "tessera/sfm/incremental_pipeline.h"
 #include "synthetic_scene.h"
 #include "tessera/io/model_statistics.h"
 #include "test_support.h"

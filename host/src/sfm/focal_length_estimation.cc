@@ -1,4 +1,4 @@
-#include "sfm/focal_length_estimation.h"
+#include "tessera/sfm/focal_length_estimation.h"
 
 #include <Eigen/SVD>
 #include <algorithm>

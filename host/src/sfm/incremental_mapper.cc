@@ -1,4 +1,4 @@
-#include "sfm/incremental_mapper.h"
+#include "tessera/sfm/incremental_mapper.h"
 
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
@@ -13,7 +13,7 @@
 #include "estimators/ransac.h"
 #include "geometry/essential_matrix.h"
 #include "geometry/triangulation.h"
-#include "sfm/camera_plausibility.h"
+#include "tessera/sfm/camera_plausibility.h"
 #include "tessera/io/model_statistics.h"
 #include "util/random.h"
 

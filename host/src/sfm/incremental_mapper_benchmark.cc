@@ -20,7 +20,7 @@
 #include <map>
 #include <vector>
 
-#include "sfm/incremental_pipeline.h"
+#include "tessera/sfm/incremental_pipeline.h"
 #include "synthetic_scene.h"
 #include "test_support.h"
 

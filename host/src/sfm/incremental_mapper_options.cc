@@ -1,12 +1,13 @@
-#include "sfm/incremental_mapper_options.h"
+#include "tessera/sfm/incremental_mapper_options.h"
 
 #include "tessera/options.h"
 
 namespace tessera {
 
-IncrementalMapperOptions IncrementalMapperOptions::FromJson(const nlohmann::json& json) {
+IncrementalMapperOptions IncrementalMapperOptions::FromJson(const nlohmann::json& json,
+                                                           const std::string& path) {
   IncrementalMapperOptions o;
-  OptionReader reader(json, "mapper");
+  OptionReader reader(json, path);
   o.min_num_matches = reader.Get<int>("min_num_matches", o.min_num_matches, 5, 100000);
   o.init_min_num_inliers =
       reader.Get<int>("init_min_num_inliers", o.init_min_num_inliers, 8, 1000000);

@@ -1,4 +1,4 @@
-#include "sfm/incremental_mapper.h"
+#include "tessera/sfm/incremental_mapper.h"
 
 #include <gtest/gtest.h>
 

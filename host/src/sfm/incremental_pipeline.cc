@@ -1,4 +1,4 @@
-#include "sfm/incremental_pipeline.h"
+#include "tessera/sfm/incremental_pipeline.h"
 
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
@@ -10,9 +10,9 @@
 #include <set>
 #include <utility>
 
-#include "sfm/focal_length_estimation.h"
-#include "sfm/model_merger.h"
-#include "sfm/view_graph.h"
+#include "tessera/sfm/focal_length_estimation.h"
+#include "tessera/sfm/model_merger.h"
+#include "tessera/sfm/view_graph.h"
 #include "util/random.h"
 
 namespace tessera {
@@ -41,8 +41,9 @@ bool IsVerified(const TwoViewGeometry& geometry) {
 // The caller's observer (null: none, as in the calibration pass), the index of the
 // model being grown, and whether the observer asked to stop.
 struct RunControl {
-  const MapperObserver* observer = nullptr;
+  const MapperControl* observer = nullptr;
   size_t model_index = 0;
+  size_t num_images = 0;  // of the input, for progress
   bool cancelled = false;
 
   // Asks the observer; once true, stays true.
@@ -78,6 +79,10 @@ void Grow(IncrementalMapper* mapper, RunControl* control,
     mapper->TriangulateImage(next_image);
     if (control->observer != nullptr && control->observer->on_model_changed) {
       control->observer->on_model_changed(control->model_index, mapper->model());
+    }
+    if (control->observer != nullptr && control->observer->on_progress) {
+      control->observer->on_progress("registration", mapper->NumRegisteredImages(),
+                                     control->num_images);
     }
     mapper->LocalBundleAdjustment(next_image);
     if (mapper->GlobalRefinementDue()) mapper->GlobalRefinement();
@@ -430,12 +435,13 @@ IncrementalPipeline::IncrementalPipeline(const IncrementalMapperOptions& options
       ransac_options_(ransac_options) {}
 
 MapperResult IncrementalPipeline::Reconstruct(const MapperInput& input,
-                                              const MapperObserver& observer) const {
+                                              const MapperControl& observer) const {
   const auto start_time = std::chrono::steady_clock::now();
   MapperRunState run(input, bundle_adjuster_, seed_);
   run.ransac = ransac_options_;
   RunControl control;
   control.observer = &observer;
+  control.num_images = input.images.size();
   const auto should_stop = [&control] { return control.ShouldStop(); };
   MapperResult result;
 

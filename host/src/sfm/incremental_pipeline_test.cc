@@ -1,4 +1,4 @@
-#include "sfm/incremental_pipeline.h"
+#include "tessera/sfm/incremental_pipeline.h"
 
 #include <gtest/gtest.h>
 
@@ -419,7 +419,7 @@ TEST(IncrementalPipeline, SameSeedSameModel) {
 TEST(IncrementalMapperOptions, UnknownKeysAndBadValuesNameTheField) {
   EXPECT_EQ(IncrementalMapperOptions::FromJson(nlohmann::json::object()).init_min_tri_angle, 16.0);
   try {
-    IncrementalMapperOptions::FromJson({{"init_min_tri_angel", 8}});
+    IncrementalMapperOptions::FromJson({{"init_min_tri_angel", 8}}, "mapper");
     FAIL();
   } catch (const OptionError& error) {
     EXPECT_NE(std::string(error.what()).find("mapper.init_min_tri_angel"), std::string::npos);
@@ -435,7 +435,7 @@ TEST(IncrementalMapperOptions, UnknownKeysAndBadValuesNameTheField) {
 TEST(IncrementalPipeline, ObserverSeesTheModelGrowAndStopsIt) {
   const SyntheticScene scene = MakeSyntheticScene(SyntheticSceneOptions{});
   std::vector<size_t> num_registered;
-  MapperObserver observer;
+  MapperControl observer;
   observer.on_model_changed = [&](size_t model_index, const Reconstruction& model) {
     EXPECT_EQ(model_index, 0u);
     size_t n = 0;

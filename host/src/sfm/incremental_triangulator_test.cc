@@ -1,4 +1,4 @@
-#include "sfm/incremental_triangulator.h"
+#include "tessera/sfm/incremental_triangulator.h"
 
 #include <gtest/gtest.h>
 

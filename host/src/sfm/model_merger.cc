@@ -1,4 +1,4 @@
-#include "sfm/model_merger.h"
+#include "tessera/sfm/model_merger.h"
 
 #include <algorithm>
 #include <map>

@@ -1,4 +1,4 @@
-#include "sfm/observation_manager.h"
+#include "tessera/sfm/observation_manager.h"
 
 #include <gtest/gtest.h>
 

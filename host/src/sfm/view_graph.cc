@@ -1,4 +1,4 @@
-#include "sfm/view_graph.h"
+#include "tessera/sfm/view_graph.h"
 
 #include <Eigen/SVD>
 #include <algorithm>

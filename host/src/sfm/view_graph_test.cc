@@ -1,8 +1,8 @@
-#include "sfm/view_graph.h"
+#include "tessera/sfm/view_graph.h"
 
 #include <gtest/gtest.h>
 
-#include "sfm/focal_length_estimation.h"
+#include "tessera/sfm/focal_length_estimation.h"
 #include "synthetic_scene.h"
 
 namespace tessera {

@@ -90,6 +90,8 @@ struct AdjustmentProblem {
   std::map<image_t, PoseBlock> poses;
   std::map<camera_t, std::vector<double>> cameras;
   std::map<point3D_t, Eigen::Vector3d> points;
+  // Images whose centre a position prior holds.
+  std::set<image_t> priors;
   // Poses that may not move: constant in the configuration or holding the gauge.
   std::set<image_t> fixed_poses;
   std::set<camera_t> variable_cameras;
@@ -192,6 +194,41 @@ void AddResiduals(const Reconstruction& rec, ceres::LossFunction* loss_function,
   }
 }
 
+// One residual per image of the problem with a position prior; a sentence for a prior
+// with a sigma that is not positive and finite.
+std::string AddPositionPriors(const BundleAdjustmentConfig& config, AdjustmentProblem* adjustment) {
+  for (const auto& [image_id, prior] : config.position_priors) {
+    const auto pose_it = adjustment->poses.find(image_id);
+    if (pose_it == adjustment->poses.end()) continue;
+    if (!(prior.sigma.array() > 0).all() || !prior.sigma.allFinite() ||
+        !prior.position.allFinite()) {
+      return "the position prior of image " + std::to_string(image_id) +
+             " has a sigma that is not positive or a value that is not finite";
+    }
+    adjustment->problem.AddResidualBlock(
+        PositionPriorCostFunctor::Create(prior.position, prior.sigma), nullptr,
+        pose_it->second.data());
+    adjustment->priors.insert(image_id);
+  }
+  return "";
+}
+
+// A sentence when a rig frame has an image in the problem: this adjuster does not keep
+// rigs rigid, and must not pretend to.
+std::string RefuseRigs(const BundleAdjustmentConfig& config, const AdjustmentProblem& adjustment) {
+  for (const CameraRig& rig : config.rigs) {
+    for (const auto& frame : rig.frames) {
+      for (const auto& [camera_id, image_id] : frame) {
+        if (adjustment.poses.count(image_id) > 0) {
+          return "image " + std::to_string(image_id) +
+                 " belongs to a camera rig, and the ceres adjuster does not hold rigs rigid";
+        }
+      }
+    }
+  }
+  return "";
+}
+
 // Holds the configuration's constant points and every point seen once in the problem,
 // which would be free along its ray.
 void HoldPoints(const BundleAdjustmentConfig& config, AdjustmentProblem* adjustment) {
@@ -205,7 +242,8 @@ void HoldPoints(const BundleAdjustmentConfig& config, AdjustmentProblem* adjustm
   }
 }
 
-// Holds the configuration's constant poses; without any, and with fix_gauge, the gauge's
+// Holds the configuration's constant poses; without any, with no position prior and with
+// fix_gauge, the gauge's
 // 7 degrees of freedom: the first pose (6) and the scale through one translation
 // coordinate of the second, its largest so that the scale is well defined.
 void HoldPosesAndGauge(const BundleAdjustmentConfig& config, AdjustmentProblem* adjustment) {
@@ -216,7 +254,8 @@ void HoldPosesAndGauge(const BundleAdjustmentConfig& config, AdjustmentProblem* 
       adjustment->fixed_poses.insert(image_id);
     }
   }
-  if (config.fix_gauge && adjustment->fixed_poses.empty()) {
+  // Position priors fix the gauge themselves (with at least 3 non-collinear centres).
+  if (config.fix_gauge && adjustment->fixed_poses.empty() && adjustment->priors.empty()) {
     auto pose_it = adjustment->poses.begin();
     problem.SetParameterBlockConstant(pose_it->second.data());
     adjustment->fixed_poses.insert(pose_it->first);
@@ -331,6 +370,9 @@ class CeresBundleAdjuster : public BundleAdjuster {
 
     // The loss is shared by every residual and owned by the problem.
     AddResiduals(*reconstruction, CreateLossFunction(), &adjustment);
+    error = RefuseRigs(config, adjustment);
+    if (error.empty()) error = AddPositionPriors(config, &adjustment);
+    if (!error.empty()) return InvalidProblem(error);
     HoldPoints(config, &adjustment);
     HoldPosesAndGauge(config, &adjustment);
     ParametrizeIntrinsics(config, *reconstruction, &adjustment);

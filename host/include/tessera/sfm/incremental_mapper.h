@@ -26,12 +26,13 @@
 #include <utility>
 #include <vector>
 
-#include "sfm/feature_tracks.h"
-#include "sfm/incremental_mapper_options.h"
-#include "sfm/incremental_triangulator.h"
-#include "sfm/mapper_input.h"
-#include "sfm/observation_manager.h"
-#include "sfm/view_graph.h"
+#include "tessera/sfm/export.h"
+#include "tessera/sfm/feature_tracks.h"
+#include "tessera/sfm/incremental_mapper_options.h"
+#include "tessera/sfm/incremental_triangulator.h"
+#include "tessera/mapper.h"
+#include "tessera/sfm/observation_manager.h"
+#include "tessera/sfm/view_graph.h"
 #include "tessera/bundle_adjuster.h"
 #include "tessera/reconstruction.h"
 
@@ -59,7 +60,7 @@ struct MapperRansacOptions {
 
 // What the models of one run share: the verified pairs the view graph kept and their
 // tracks, which images a model took, why images failed, and counters.
-struct MapperRunState {
+struct TESSERA_SFM_EXPORT MapperRunState {
   MapperRunState(const MapperInput& input, const BundleAdjuster& bundle_adjuster, uint64_t seed)
       : input(input), bundle_adjuster(bundle_adjuster), seed(seed), cameras(input.cameras) {}
 
@@ -89,7 +90,7 @@ struct MapperRunState {
   size_t num_registrations_refused = 0;
 };
 
-class IncrementalMapper {
+class TESSERA_SFM_EXPORT IncrementalMapper {
  public:
   enum class Status {
     kSuccess,
@@ -215,6 +216,6 @@ class IncrementalMapper {
 };
 
 // "success", "no initial pair", ...: for the log.
-const char* StatusName(IncrementalMapper::Status status);
+TESSERA_SFM_EXPORT const char* StatusName(IncrementalMapper::Status status);
 
 }  // namespace tessera

@@ -10,7 +10,8 @@
 #include <map>
 #include <vector>
 
-#include "sfm/mapper_input.h"
+#include "tessera/sfm/export.h"
+#include "tessera/mapper.h"
 
 namespace tessera {
 
@@ -40,7 +41,7 @@ struct FocalLengthEstimationOptions {
 // Estimates the focal length of every camera of `input` that has no prior focal length,
 // from the fundamental matrices of `pairs` (each a verified pair of `input`), the
 // principal points staying where they are. Cameras with a prior act as known.
-std::map<camera_t, FocalLengthEstimate> EstimateFocalLengths(
+TESSERA_SFM_EXPORT std::map<camera_t, FocalLengthEstimate> EstimateFocalLengths(
     const MapperInput& input, const std::vector<const MapperInput::Pair*>& pairs,
     const FocalLengthEstimationOptions& options);
 

@@ -8,7 +8,8 @@
 #include <cstddef>
 #include <set>
 
-#include "sfm/observation_manager.h"
+#include "tessera/sfm/export.h"
+#include "tessera/sfm/observation_manager.h"
 
 namespace tessera {
 
@@ -22,7 +23,7 @@ struct IncrementalTriangulatorOptions {
   size_t max_num_pairs = 200;
 };
 
-class IncrementalTriangulator {
+class TESSERA_SFM_EXPORT IncrementalTriangulator {
  public:
   // `observations` must outlive the triangulator.
   IncrementalTriangulator(const IncrementalTriangulatorOptions& options,

@@ -8,7 +8,8 @@
 #include <cstdint>
 #include <string>
 
-#include "sfm/feature_tracks.h"
+#include "tessera/sfm/export.h"
+#include "tessera/sfm/feature_tracks.h"
 #include "tessera/reconstruction.h"
 
 namespace tessera {
@@ -35,7 +36,7 @@ struct ModelMergeReport {
 // Moves `source` into `target` when they align (see above). `tracks` are the run's
 // feature tracks, before any model merged some of them: they tell which points of the
 // two models come from one track. The merged model needs a bundle adjustment.
-ModelMergeReport MergeModels(const FeatureTracks& tracks, const ModelMergeOptions& options,
+TESSERA_SFM_EXPORT ModelMergeReport MergeModels(const FeatureTracks& tracks, const ModelMergeOptions& options,
                              uint64_t seed, const Reconstruction& source, Reconstruction* target);
 
 }  // namespace tessera

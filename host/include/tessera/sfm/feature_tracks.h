@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "tessera/sfm/export.h"
 #include "tessera/features.h"
 #include "tessera/ids.h"
 #include "tessera/reconstruction.h"
@@ -27,7 +28,7 @@ struct ImagePairMatches {
   FeatureMatches matches;  // point2D_idx1 in image_id1, point2D_idx2 in image_id2
 };
 
-struct FeatureTracks {
+struct TESSERA_SFM_EXPORT FeatureTracks {
   // Each with at least two elements from distinct images, elements sorted by image.
   std::vector<Track> tracks;
   // Pairs of tracks (first < second) joined by a refused match, sorted, without repeats.
@@ -49,7 +50,7 @@ struct FeatureTracks {
 // features of each image; a match past it throws InputError naming the pair. Pairs
 // are joined strongest first (most matches, then by image ids), so the result does not
 // depend on the input order.
-FeatureTracks BuildFeatureTracks(const std::vector<ImagePairMatches>& pairs,
+TESSERA_SFM_EXPORT FeatureTracks BuildFeatureTracks(const std::vector<ImagePairMatches>& pairs,
                                  const std::map<image_t, size_t>& num_points2D);
 
 }  // namespace tessera

@@ -1,4 +1,4 @@
-#include "sfm/mapper_input.h"
+#include "pipeline/load_mapper_input.h"
 
 #include <spdlog/spdlog.h>
 
@@ -27,6 +27,9 @@ MapperInput LoadMapperInput(const Database& database) {
   }
   if (input.images.empty()) {
     throw InputError(database.path().string() + ": the workspace has no images; run extract first");
+  }
+  for (auto& [image_id, metadata] : database.ReadAllImageMetadata()) {
+    if (input.images.count(image_id) > 0) input.metadata.emplace(image_id, std::move(metadata));
   }
   // Pairs of an earlier pair selection stay cached in the database, out of the input.
   const std::optional<std::vector<image_pair_t>> selected = database.ReadSelectedPairs();

@@ -9,12 +9,13 @@
 #include <set>
 #include <vector>
 
-#include "sfm/feature_tracks.h"
+#include "tessera/sfm/export.h"
+#include "tessera/sfm/feature_tracks.h"
 #include "tessera/reconstruction.h"
 
 namespace tessera {
 
-class ObservationManager {
+class TESSERA_SFM_EXPORT ObservationManager {
  public:
   // The model starts with `cameras` and every image of `images`, none registered and
   // no keypoint with a 3D point. `tracks` is copied: merging tracks is this model's

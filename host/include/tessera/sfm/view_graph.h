@@ -12,7 +12,8 @@
 #include <map>
 #include <vector>
 
-#include "sfm/mapper_input.h"
+#include "tessera/sfm/export.h"
+#include "tessera/mapper.h"
 #include "tessera/reconstruction.h"
 
 namespace tessera {
@@ -30,7 +31,7 @@ struct ViewGraphEdge {
   bool removed = false;
 };
 
-class ViewGraph {
+class TESSERA_SFM_EXPORT ViewGraph {
  public:
   // Relative rotations of `pairs` (each a verified pair of `input`) with the intrinsics
   // in `cameras`: from the stored E for calibrated pairs, else from E estimated on the
@@ -84,7 +85,7 @@ struct ModelAgreement {
   std::vector<ImageDisagreement> disagreeing_images;
 };
 
-ModelAgreement ComputeModelAgreement(const ViewGraph& view_graph,
+TESSERA_SFM_EXPORT ModelAgreement ComputeModelAgreement(const ViewGraph& view_graph,
                                      const Reconstruction& reconstruction, double max_error_deg);
 
 }  // namespace tessera

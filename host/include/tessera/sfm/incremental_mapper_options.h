@@ -1,12 +1,16 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <string>
+
+#include "tessera/sfm/export.h"
 
 namespace tessera {
 
-// Settings of the incremental mapper: the manifest's "mapper" object. Names and
+// Settings of the incremental mapper: the options of `pipeline.mapper` when it is
+// `incremental` (the manifest's top-level "mapper" object before ABI 6). Names and
 // defaults follow COLMAP's IncrementalMapper options where there is one.
-struct IncrementalMapperOptions {
+struct TESSERA_SFM_EXPORT IncrementalMapperOptions {
   // Pairs with fewer verified inliers do not take part.
   int min_num_matches = 15;
 
@@ -100,9 +104,10 @@ struct IncrementalMapperOptions {
   // Models with fewer registered images are dropped.
   int min_model_size = 3;
 
-  // Reads the manifest's "mapper" object; unknown keys and out-of-range values throw
-  // OptionError naming "mapper.<key>".
-  static IncrementalMapperOptions FromJson(const nlohmann::json& json);
+  // Reads the `incremental` mapper's options; unknown keys and out-of-range values throw
+  // OptionError naming "<path>.<key>" ("<key>" when `path` is empty, as a plugin's
+  // factory reads them).
+  static IncrementalMapperOptions FromJson(const nlohmann::json& json, const std::string& path = "");
   // Every option with its value, for provenance and logs.
   nlohmann::json ToJson() const;
 };
