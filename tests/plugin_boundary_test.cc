@@ -70,6 +70,11 @@ void CallFailingPlugin(const std::string& kind, const std::string& how) {
     input.images.resize(3);
     selector.Call(PluginStage::kSelectPairs, "3 images",
                   [&](const PairSelector& plugin) { return plugin.SelectPairs(input); });
+  } else if (kind == "mapper") {
+    const auto mapper = registry.Create<Mapper>(kind, name, options, "pipeline.mapper");
+    MapperInput input;
+    mapper.Call(PluginStage::kMap, "3 images",
+                [&](const Mapper& plugin) { return plugin.Map(input, MapperContext()); });
   } else if (kind == "bundle_adjuster") {
     const auto adjuster =
         registry.Create<BundleAdjuster>(kind, name, options, "pipeline.bundle_adjuster");
@@ -88,6 +93,7 @@ TEST(PluginBoundary, EveryExceptionFromEveryKindBecomesOneHostErrorNamingPluginA
       {"detector", "detecting image a.png"},
       {"matcher", "matching images a.png and b.png"},
       {"pair_selector", "selecting pairs among 3 images"},
+      {"mapper", "mapping 3 images"},
       {"bundle_adjuster", "adjusting a bundle of 0 images and 0 points"},
       {"exporter", "exporting model 0"}};
   for (const auto& [kind, activity] : activities) {
@@ -111,7 +117,7 @@ TEST(PluginBoundary, EveryExceptionFromEveryKindBecomesOneHostErrorNamingPluginA
 TEST(PluginBoundary, FactoryFailuresOfEveryKindNameTheFileAndPlugin) {
   const PluginRegistry registry = PluginRegistry::Discover({kFailing});
   for (const std::string kind :
-       {"detector", "matcher", "pair_selector", "bundle_adjuster", "exporter"}) {
+       {"detector", "matcher", "pair_selector", "mapper", "bundle_adjuster", "exporter"}) {
     for (const Expected& failure : Failures()) {
       SCOPED_TRACE(kind + " " + failure.how);
       const nlohmann::json options = {{"fail", failure.how}, {"in", "factory"}};

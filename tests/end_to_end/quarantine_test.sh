@@ -1,5 +1,6 @@
 #!/bin/bash
-# Crash quarantine beyond detectors and matchers (issue 28, item 3), on a 512 px copy of
+# Crash quarantine beyond detectors and matchers (issue 28, item 3; the mapper, issue 24),
+# on a 512 px copy of
 # the sample (5 images, ORB): a pair selector or a bundle adjuster that crashes is named (exit 4), reported by the
 # next run, and refused with its name once it has crashed twice on the same bundle
 # (exit 2), the workspace kept; an exporter that crashes twice on a model is skipped for
@@ -89,4 +90,42 @@ grep -q "\[warning\] map: exporter 'failing_exporter' skipped for model 0: it cr
 python3 -c 'import json,sys; q=json.load(open(sys.argv[1]))["quarantined"]; assert len(q) == 1 and "failing_exporter" in q[0], q' \
   "$work/e/mapping_summary.json" || fail "quarantined exporter: not in mapping_summary.json"
 echo "exporter: skipped for the model after two crashes, listed in the summary, the rest placed"
+
+# A mapper that crashes: exit 4 naming it, then refused by name; the model of an earlier
+# run with the bundled mapper stays, and the incremental mapper maps the same workspace.
+mapper_manifest() {  # mapper_manifest FILE MAPPER_JSON
+  sed "s|\"bundle_adjuster\": {\"plugin\": \"ceres\"}|\"mapper\": $2, \"bundle_adjuster\": {\"plugin\": \"ceres\"}|" \
+    "$work/ex.json" | sed 's|\[{"plugin": "failing_exporter", "options": {"fail": "segv"}}, |[|' > "$1"
+}
+mapper_manifest "$work/ma.json" '{"plugin": "failing_mapper", "options": {"fail": "segv"}}'
+mapper_manifest "$work/mb.json" '{"plugin": "failing_mapper", "options": {"fail": "bad_result"}}'
+mapper_manifest "$work/mi.json" '{"plugin": "incremental"}'
+tess "$work/m0.log" "$work/mi.json" run --images "$work/d" --output "$work/m" ||
+  { cat "$work/m0.log"; fail "incremental mapper run"; }
+before=$(sha256sum < "$work/m/sparse/0/images.txt")
+cp -a "$work/m" "$work/n"  # for the bad result, away from the crashes' quarantine
+for k in 1 2; do
+  tess "$work/m$k.log" "$work/ma.json" map --images "$work/d" --output "$work/m"
+  code=$?
+  [ "$code" = 4 ] || { cat "$work/m$k.log"; fail "mapper crash $k: exit $code, expected 4"; }
+done
+grep -q "\[error\] plugin 'failing_mapper' crashed (SIGSEGV) while mapping 5 images" "$work/m1.log" ||
+  { cat "$work/m1.log"; fail "mapper crash: not named"; }
+tess "$work/m3.log" "$work/ma.json" map --images "$work/d" --output "$work/m"
+code=$?
+[ "$code" = 2 ] || { cat "$work/m3.log"; fail "quarantined mapper: exit $code, expected 2"; }
+grep -q "\[error\] pipeline.mapper: mapper 'failing_mapper' crashed twice mapping 5 images" "$work/m3.log" ||
+  { cat "$work/m3.log"; fail "quarantined mapper: message"; }
+tess "$work/m4.log" "$work/mb.json" map --images "$work/d" --output "$work/n"
+code=$?
+[ "$code" = 1 ] || { cat "$work/m4.log"; fail "a mapper's bad result: exit $code, expected 1"; }
+grep -q "plugin 'failing_mapper' failed while mapping: it returned model 0 where image .* comes back with another id, name or camera" "$work/m4.log" ||
+  { cat "$work/m4.log"; fail "a mapper's bad result: message"; }
+for ws in m n; do
+  [ "$before" = "$(sha256sum < "$work/$ws/sparse/0/images.txt")" ] || fail "the earlier model in $ws was touched"
+done
+[ ! -e "$work/outside.jpg" ] || fail "a file was written outside the workspace"
+tess "$work/m5.log" "$work/mi.json" map --images "$work/d" --output "$work/m" ||
+  { cat "$work/m5.log"; fail "the incremental mapper after the failing one"; }
+echo "mapper: named at each crash, refused by name after two, a bad result refused, the model kept"
 echo "PASS"

@@ -50,7 +50,8 @@ struct NotAnException {
 
 // Options shared by the failing plugins: "fail" says how (none, input_error,
 // option_error, runtime_error, custom, non_std, segv, abort, exit: exit(0), quick_exit:
-// quick_exit(0); bad_indices: a matcher returns a match beyond the keypoints) and "in"
+// quick_exit(0); bad_indices: a matcher returns a match beyond the keypoints; bad_result: a
+// mapper returns a model with an image renamed) and "in"
 // where (call: the kind's main method; factory: the constructor). A detector fails only
 // on images "on_width" pixels wide when that is not 0.
 struct Failure {
@@ -61,7 +62,8 @@ struct Failure {
   explicit Failure(tessera::OptionReader* reader)
       : how(reader->GetString("fail", "none",
                               {"none", "input_error", "option_error", "runtime_error", "custom",
-                               "non_std", "segv", "abort", "exit", "quick_exit", "bad_indices"})),
+                               "non_std", "segv", "abort", "exit", "quick_exit", "bad_indices",
+                               "bad_result"})),
         where(reader->GetString("in", "call", {"call", "factory"})),
         on_width(reader->Get<int>("on_width", 0, 0, 100000)) {}
 
@@ -168,6 +170,37 @@ class FailingBundleAdjuster : public tessera::BundleAdjuster {
   Failure failure_;
 };
 
+// Maps nothing (every image left out, with why), or fails on request; "bad_result"
+// returns a model holding an image renamed outside the image folder.
+class FailingMapper : public tessera::Mapper {
+ public:
+  explicit FailingMapper(const nlohmann::json& options)
+      : failure_(ReadFailure(options, &effective_options_)) {}
+  tessera::MapperResult Map(const tessera::MapperInput& input,
+                            const tessera::MapperContext&) const override {
+    failure_.Trigger("call");
+    tessera::MapperResult result;
+    if (failure_.how == "bad_result" && !input.images.empty()) {
+      tessera::Reconstruction model;
+      tessera::Image image = input.images.begin()->second;
+      image.name = "../outside.jpg";
+      image.registered = true;
+      model.cameras[image.camera_id] = input.cameras.at(image.camera_id);
+      model.images[image.image_id] = image;
+      result.models.push_back(model);
+      result.self_checks.resize(1);
+      return result;
+    }
+    for (const auto& [image_id, image] : input.images) {
+      result.unregistered_reasons[image_id] = "failing_mapper maps nothing";
+    }
+    return result;
+  }
+
+ private:
+  Failure failure_;
+};
+
 class FailingExporter : public tessera::Exporter {
  public:
   explicit FailingExporter(const nlohmann::json& options)
@@ -192,6 +225,8 @@ TESSERA_PLUGIN(pair_selector, FailingPairSelector, "failing_pair_selector", "1.0
 #elif defined(TESSERA_TEST_CASE_FAILING_BUNDLE_ADJUSTER)
 TESSERA_PLUGIN(bundle_adjuster, FailingBundleAdjuster, "failing_bundle_adjuster", "1.0.0",
                "Fails on request")
+#elif defined(TESSERA_TEST_CASE_FAILING_MAPPER)
+TESSERA_PLUGIN(mapper, FailingMapper, "failing_mapper", "1.0.0", "Fails on request")
 #elif defined(TESSERA_TEST_CASE_FAILING_EXPORTER)
 TESSERA_PLUGIN(exporter, FailingExporter, "failing_exporter", "1.0.0", "Fails on request")
 

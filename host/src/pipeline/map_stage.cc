@@ -214,9 +214,24 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
   };
   const PluginInstance<Mapper>& mapper = *settings.mapper;
   if (!mapper) throw std::logic_error("MapWorkspace: the mapper slot is empty");
-  MapperResult result = mapper.Call(PluginStage::kMap, std::to_string(input.images.size()) +
-                                                           " images",
-                                    [&](const Mapper& plugin) { return plugin.Map(input, context); });
+  // Crashed twice on these images: refused by name, the stage cannot go on without it.
+  const std::string subject = std::to_string(input.images.size()) + " images";
+  if (workspace.crash_log().IsQuarantined(mapper.name(), PluginStage::kMap, subject)) {
+    throw InputError("pipeline.mapper: mapper '" + mapper.name() + "' crashed twice mapping " +
+                     subject + " in this workspace (plugin_crashes.tsv) and is not run on them "
+                     "again; choose another mapper, or fix the plugin");
+  }
+  MapperResult result;
+  try {
+    result = mapper.Call(PluginStage::kMap, subject,
+                         [&](const Mapper& plugin) { return plugin.Map(input, context); });
+  } catch (const PluginError& error) {
+    // Its own bad options, found only now, are named as the manifest names them.
+    if (error.plugin() == mapper.name() && error.option_error()) {
+      throw error.AsSlotError("pipeline.mapper", "mapper '" + mapper.name() + "'");
+    }
+    throw;
+  }
   // Asked to stop: whatever the mapper returned is dropped, and the old outputs stay.
   if (cancelled()) return summary;
   CheckMapperResult(mapper.name(), input, &result);

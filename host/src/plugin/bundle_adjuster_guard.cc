@@ -26,7 +26,7 @@ BundleAdjustmentSummary BundleAdjusterGuard::Adjust(const BundleAdjustmentConfig
                                                     Reconstruction* reconstruction) const {
   const std::string subject = Subject(config, reconstruction);
   if (crash_log_ != nullptr && crash_log_->IsQuarantined(plugin_.name(), PluginStage::kAdjust, subject)) {
-    throw InputError("bundle adjuster '" + plugin_.name() + "' crashed twice on " + subject +
+    throw HostInputError("bundle adjuster '" + plugin_.name() + "' crashed twice on " + subject +
                      " in this workspace (plugin_crashes.tsv) and is not given it again; "
                      "choose another pipeline.bundle_adjuster, or fix the plugin");
   }

@@ -81,6 +81,14 @@ class PluginError : public std::runtime_error {
   std::string option_message_;  // the OptionError's message, without its path
 };
 
+// Bad input the host itself finds during a plugin call that calls back into the host (a
+// mapper's bundle adjustment refused as quarantined): it passes through CallPlugin as it
+// is, not reworded as the calling plugin's failure. Exit code 2, as any InputError.
+class HostInputError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 // Records a plugin call for the crash handler while it lives (one per thread; the
 // fields are copied, truncated, into a fixed-size thread-local buffer). A nested call (a
 // mapper calling the bundle adjuster) takes the record over until it returns.
@@ -114,6 +122,8 @@ auto CallPlugin(const std::string& plugin, PluginStage stage, const std::string&
     return fn();
   } catch (const PluginError&) {
     throw;  // a plugin this one called (the mapper's bundle adjuster) failed: it is named
+  } catch (const HostInputError&) {
+    throw;  // the host refused what this plugin asked of it: the host's words
   } catch (const OptionError& error) {
     throw PluginError(plugin, stage, subject, error);
   } catch (const InputError& error) {
