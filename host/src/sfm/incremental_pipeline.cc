@@ -288,6 +288,8 @@ void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
     report.estimated = estimate.focal_length;
     report.method = "view graph";
     report.num_pairs = estimate.num_pairs;
+    spdlog::debug("map: camera {}: {:.1f} px from {} pairs' fundamental matrices (cost {:.3f})",
+                  camera_id, estimate.focal_length, estimate.num_pairs, estimate.cost);
   }
 
   // 2. Refined by bundle adjustment in a first model, mapped once for that alone: with
@@ -296,8 +298,18 @@ void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
   // first model holds one scene; where the photos hold several (several cameras, as in a
   // mixed folder), the cameras it leaves out get first models of their own, from the
   // pairs among their images.
+  // A camera whose focal length many pairs determine needs no first model: the real
+  // pass refines it in every bundle adjustment, and mapping the images twice was half
+  // of the map stage's time.
   std::set<camera_t> unrefined;
-  for (const auto& [camera_id, report] : by_camera) unrefined.insert(camera_id);
+  for (const auto& [camera_id, report] : by_camera) {
+    if (report.method == "view graph" &&
+        report.num_pairs >= static_cast<size_t>(options.min_view_graph_focal_pairs) &&
+        options.min_view_graph_focal_pairs > 0) {
+      continue;
+    }
+    unrefined.insert(camera_id);
+  }
   std::vector<const MapperInput::Pair*> pairs = verified_pairs;
   while (!unrefined.empty() && !pairs.empty()) {
     const Reconstruction model = MapFirstModel(options, run, *cameras, pairs);

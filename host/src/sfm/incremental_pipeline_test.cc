@@ -230,8 +230,10 @@ TEST(IncrementalPipeline, EstimatesTheFocalLengthWhenThereIsNoPrior) {
 
 TEST(IncrementalPipeline, EstimatesTheFocalLengthOfEachSceneInAMixedSet) {
   // Two unrelated scenes, each with its own camera and no prior (as in a folder that mixes
-  // photos of two captures): a first model holds one scene only, so the other camera
-  // needs a first model of its own.
+  // photos of two captures). Where the pairs determine a camera's focal length (many
+  // pairs) mapping starts from it; with min_view_graph_focal_pairs 0 every camera is
+  // refined in a first model, and a first model holds one scene only, so the other
+  // camera needs a first model of its own. Both end at the true focal lengths.
   SyntheticSceneOptions first;
   first.focal_prior = false;
   first.prior_focal_factor = 1.6;
@@ -242,19 +244,30 @@ TEST(IncrementalPipeline, EstimatesTheFocalLengthOfEachSceneInAMixedSet) {
   second.seed = 13;
   SyntheticScene scene = MakeSyntheticScene(first);
   AppendScene(MakeSyntheticScene(second), 100, "second_", 2, &scene);
-  const MapperResult result = Map(scene);
-  ASSERT_EQ(result.focal_lengths.size(), 2u);
-  for (const FocalLengthReport& report : result.focal_lengths) {
-    const double truth = report.camera_id == 1 ? first.focal_length : second.focal_length;
-    EXPECT_NEAR(report.estimated, truth, 0.02 * truth) << "camera " << report.camera_id;
-    EXPECT_GE(report.num_images, 5u) << "camera " << report.camera_id << ": " << report.method;
-  }
-  ASSERT_EQ(result.models.size(), 2u);
-  for (const Reconstruction& model : result.models) {
-    EXPECT_EQ(model.images.size(), 12u);
-    const Camera& camera = model.cameras.begin()->second;
-    const double truth = camera.camera_id == 1 ? first.focal_length : second.focal_length;
-    EXPECT_NEAR(camera.FocalLengthX(), truth, 0.005 * truth);
+  for (const int min_pairs : {10, 0}) {
+    SCOPED_TRACE("min_view_graph_focal_pairs " + std::to_string(min_pairs));
+    IncrementalMapperOptions options;
+    options.min_view_graph_focal_pairs = min_pairs;
+    const MapperResult result = Map(scene, options);
+    ASSERT_EQ(result.focal_lengths.size(), 2u);
+    for (const FocalLengthReport& report : result.focal_lengths) {
+      const double truth = report.camera_id == 1 ? first.focal_length : second.focal_length;
+      EXPECT_NEAR(report.estimated, truth, 0.02 * truth) << "camera " << report.camera_id;
+      if (min_pairs == 0) {
+        EXPECT_GE(report.num_images, 5u) << "camera " << report.camera_id << ": " << report.method;
+      } else {
+        EXPECT_EQ(report.method, "view graph") << "camera " << report.camera_id;
+        EXPECT_GE(report.num_pairs, 10u) << "camera " << report.camera_id;
+        EXPECT_EQ(report.num_images, 0u) << "camera " << report.camera_id;
+      }
+    }
+    ASSERT_EQ(result.models.size(), 2u);
+    for (const Reconstruction& model : result.models) {
+      EXPECT_EQ(model.images.size(), 12u);
+      const Camera& camera = model.cameras.begin()->second;
+      const double truth = camera.camera_id == 1 ? first.focal_length : second.focal_length;
+      EXPECT_NEAR(camera.FocalLengthX(), truth, 0.005 * truth);
+    }
   }
 }
 
