@@ -1,7 +1,9 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 
+#include "tessera/georeference.h"
 #include "tessera/plugin.h"
 #include "tessera/reconstruction.h"
 
@@ -15,6 +17,10 @@ struct ExportContext {
   // MASK_DIR/NAME.png, else MASK_DIR/NAME with the image's extension replaced by .png;
   // white keeps, black masks out. Empty: the run has no masks.
   std::filesystem::path mask_dir;
+  // The model's frame: a local east-north-up frame in metres anchored at this WGS84
+  // position when the mapper anchored it to GPS; absent: an arbitrary frame and scale.
+  // Exporters that can say which frame they write say so.
+  std::optional<Georeference> georeference;
 };
 
 // Writes a reconstruction to files. `reconstruction` may hold images that are not

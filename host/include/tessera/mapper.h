@@ -9,17 +9,19 @@
 #include <cstdint>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "tessera/bundle_adjuster.h"
+#include "tessera/camera_rig.h"
 #include "tessera/feature_reader.h"
 #include "tessera/features.h"
+#include "tessera/georeference.h"
 #include "tessera/image_metadata.h"
 #include "tessera/plugin.h"
-#include "tessera/reconstruction.h"
-#include "tessera/camera_rig.h"
 #include "tessera/position_prior.h"
+#include "tessera/reconstruction.h"
 #include "tessera/two_view_geometry.h"
 
 namespace tessera {
@@ -72,6 +74,9 @@ struct MapperResult {
   std::vector<Reconstruction> models;
   // One per model, in the same order.
   std::vector<ModelSelfCheck> self_checks;
+  // Empty, or one per model: the WGS84 origin of the local east-north-up frame (metres)
+  // of a model anchored to its images' GPS; nullopt for a model in an arbitrary frame.
+  std::vector<std::optional<Georeference>> georeferences;
   // Focal lengths estimated for cameras without a prior.
   std::vector<FocalLengthReport> focal_lengths;
   // Pairs dropped by view-graph filtering, of those verified.

@@ -6,6 +6,7 @@
 #include "plugin/plugin_registry.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
+#include "tessera/io/georeference_io.h"
 #include "tessera/io/model_statistics.h"
 #include "util/paths.h"
 #include "util/timer.h"
@@ -22,6 +23,8 @@ ExportSummary ExportModel(const ExportArguments& arguments) {
   // holds them: a run in progress refuses the export with the lock's message.
   const auto workspaces = HoldEnclosingWorkspaces({arguments.model, arguments.output});
   const Reconstruction reconstruction = ReadColmapModel(arguments.model);
+  // A model anchored to GPS keeps saying where it is.
+  const std::optional<Georeference> georeference = ReadGeoreference(arguments.model);
 
   // Written as one set (outputs/output_transaction.h): placed whole or not at all,
   // replacing only what Tessera wrote in the output folder.
@@ -34,6 +37,7 @@ ExportSummary ExportModel(const ExportArguments& arguments) {
   context.image_dir = arguments.images;
   context.model_index = arguments.model_index;
   context.mask_dir = arguments.masks;
+  context.georeference = georeference;
   try {
     exporter.Call(PluginStage::kExport, "model " + std::to_string(context.model_index),
                   [&](auto& plugin) { plugin.Export(reconstruction, context); });

@@ -14,6 +14,7 @@
 #include "plugin/plugin_call.h"
 #include "pipeline/load_mapper_input.h"
 #include "tessera/io/colmap_model_io.h"
+#include "tessera/io/georeference_io.h"
 #include "tessera/io/model_statistics.h"
 #include "tessera/io/point_colors.h"
 #include "util/timer.h"
@@ -44,6 +45,13 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
       entry.view_graph_check.disagreeing_images.push_back(model.images.at(image_id).name);
     }
     for (const auto& [image_id, image] : model.images) entry.images.push_back(image.name);
+    if (index < result.georeferences.size() && result.georeferences[index]) {
+      const Georeference& georeference = *result.georeferences[index];
+      entry.georeference = {{"latitude", georeference.latitude_deg},
+                            {"longitude", georeference.longitude_deg},
+                            {"altitude", georeference.altitude_m},
+                            {"frame", georeference.frame}};
+    }
     summary.models.push_back(std::move(entry));
   }
   for (const auto& [image_id, reason] : result.unregistered_reasons) {
@@ -67,12 +75,14 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
 // folder, or as COLMAP binary in sparse/<index> when there is none. A failing exporter
 // stops the set: its error is thrown, the earlier outputs stay whole, and what this run
 // wrote is kept in the staging folder until the next run.
-void ExportModel(const Reconstruction& model, size_t index, const MapSettings& settings,
+void ExportModel(const Reconstruction& model, size_t index,
+                 const std::optional<Georeference>& georeference, const MapSettings& settings,
                  const std::filesystem::path& image_dir, const PluginCrashLog& crash_log,
                  OutputTransaction* outputs, std::vector<std::string>* quarantined) {
   if (settings.exporters == nullptr || settings.exporters->empty()) {
-    WriteColmapModel(model, outputs->StageFor("tessera") / "sparse" / std::to_string(index),
-                     ColmapModelFormat::kBinary);
+    const std::filesystem::path dir = outputs->StageFor("tessera") / "sparse" / std::to_string(index);
+    WriteColmapModel(model, dir, ColmapModelFormat::kBinary);
+    if (georeference) WriteGeoreference(*georeference, dir);
     return;
   }
   for (size_t k = 0; k < settings.exporters->size(); ++k) {
@@ -88,7 +98,8 @@ void ExportModel(const Reconstruction& model, size_t index, const MapSettings& s
     const std::filesystem::path staged = outputs->StageFor(exporter.name(), k);
     try {
       exporter.Call(PluginStage::kExport, subject, [&](auto& plugin) {
-        plugin.Export(model, {staged, image_dir, static_cast<int>(index), settings.mask_dir});
+        plugin.Export(model, {staged, image_dir, static_cast<int>(index), settings.mask_dir,
+                              georeference});
       });
     } catch (const PluginError& error) {
       outputs->Keep();
@@ -123,7 +134,9 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
   for (size_t index = 0; index < result.models.size(); ++index) {
     if (control.Cancelled()) return false;
     const Reconstruction& model = result.models[index];
-    ExportModel(model, index, settings, image_dir, workspace.crash_log(), &outputs,
+    ExportModel(model, index,
+                index < result.georeferences.size() ? result.georeferences[index] : std::nullopt,
+                settings, image_dir, workspace.crash_log(), &outputs,
                 &mapping.quarantined);
     summary->num_registered += model.images.size();
     summary->images_per_model.push_back(model.images.size());

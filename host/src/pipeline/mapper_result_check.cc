@@ -77,6 +77,11 @@ void CheckMapperResult(const std::string& mapper, const MapperInput& input, Mapp
     fail(std::to_string(result->models.size()) + " models but " +
          std::to_string(result->self_checks.size()) + " self-checks");
   }
+  if (!result->georeferences.empty() && result->georeferences.size() != result->models.size()) {
+    fail(std::to_string(result->models.size()) + " models but " +
+         std::to_string(result->georeferences.size()) + " georeferences");
+  }
+  result->georeferences.resize(result->models.size());
   std::set<image_t> in_models;
   for (size_t index = 0; index < result->models.size(); ++index) {
     const std::string fault = CheckModel(input, result->models[index]);
@@ -115,12 +120,15 @@ void CheckMapperResult(const std::string& mapper, const MapperInput& input, Mapp
   });
   std::vector<Reconstruction> models;
   std::vector<ModelSelfCheck> checks;
+  std::vector<std::optional<Georeference>> georeferences;
   for (const size_t i : order) {
     models.push_back(std::move(result->models[i]));
     checks.push_back(std::move(result->self_checks[i]));
+    georeferences.push_back(std::move(result->georeferences[i]));
   }
   result->models = std::move(models);
   result->self_checks = std::move(checks);
+  result->georeferences = std::move(georeferences);
 }
 
 }  // namespace tessera

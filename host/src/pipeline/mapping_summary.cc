@@ -22,7 +22,8 @@ nlohmann::json MappingSummary::ToJson() const {
                               {"mean_track_length", model.mean_track_length},
                               {"mean_reprojection_error", model.mean_reprojection_error},
                               {"view_graph_check", self_check},
-                              {"images", model.images}});
+                              {"images", model.images},
+                              {"georeference", model.georeference}});
   }
   for (const Unregistered& image : unregistered) {
     json["unregistered"].push_back({{"image", image.image}, {"reason", image.reason}});
@@ -66,6 +67,8 @@ MappingSummary MappingSummary::FromJson(const nlohmann::json& json) {
     model.view_graph_check.disagreeing_images =
         check.at("disagreeing_images").get<std::vector<std::string>>();
     model.images = entry.at("images").get<std::vector<std::string>>();
+    // Absent in summaries written before models could be georeferenced.
+    model.georeference = entry.value("georeference", nlohmann::json());
     summary.models.push_back(std::move(model));
   }
   for (const nlohmann::json& entry : json.at("unregistered")) {

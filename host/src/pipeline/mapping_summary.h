@@ -32,6 +32,9 @@ struct MappingSummary {
     double mean_reprojection_error = 0;  // px
     ViewGraphCheck view_graph_check;
     std::vector<std::string> images;  // registered, by name, in image id order
+    // The frame's WGS84 origin ({"latitude", "longitude", "altitude", "frame": "ENU"})
+    // of a model anchored to GPS; null otherwise.
+    nlohmann::json georeference;
   };
   struct Unregistered {
     std::string image;

@@ -68,6 +68,11 @@ IncrementalMapperOptions IncrementalMapperOptions::FromJson(const nlohmann::json
   o.multiple_models = reader.GetBool("multiple_models", o.multiple_models);
   o.max_num_models = reader.Get<int>("max_num_models", o.max_num_models, 1, 100000);
   o.min_model_size = reader.Get<int>("min_model_size", o.min_model_size, 2, 1000000);
+  o.use_gps_prior = reader.GetBool("use_gps_prior", o.use_gps_prior);
+  o.gps_horizontal_sigma =
+      reader.Get<double>("gps_horizontal_sigma", o.gps_horizontal_sigma, 1e-3, 1e6);
+  o.gps_vertical_sigma = reader.Get<double>("gps_vertical_sigma", o.gps_vertical_sigma, 1e-3, 1e6);
+  o.gps_min_images = reader.Get<int>("gps_min_images", o.gps_min_images, 3, 1000000);
   reader.Finish();
   return o;
 }
@@ -100,6 +105,10 @@ nlohmann::json IncrementalMapperOptions::ToJson() const {
           {"ba_refine_extra_params", ba_refine_extra_params},
           {"estimate_focal_length", estimate_focal_length},
           {"min_view_graph_focal_pairs", min_view_graph_focal_pairs},
+          {"use_gps_prior", use_gps_prior},
+          {"gps_horizontal_sigma", gps_horizontal_sigma},
+          {"gps_vertical_sigma", gps_vertical_sigma},
+          {"gps_min_images", gps_min_images},
           {"filter_view_graph", filter_view_graph},
           {"view_graph_max_cycle_error", view_graph_max_cycle_error},
           {"check_registration", check_registration},

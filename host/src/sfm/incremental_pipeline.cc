@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "tessera/sfm/focal_length_estimation.h"
+#include "tessera/sfm/gps_anchoring.h"
 #include "tessera/sfm/model_merger.h"
 #include "tessera/sfm/view_graph.h"
 #include "util/random.h"
@@ -446,6 +447,39 @@ IncrementalPipeline::IncrementalPipeline(const IncrementalMapperOptions& options
       seed_(seed),
       ransac_options_(ransac_options) {}
 
+// Each model anchored to its images' GPS in a local east-north-up frame (gps_anchoring.h);
+// a model that cannot be stays in its own frame, with a warning that says why.
+void AnchorModelsToGps(const IncrementalMapperOptions& options, const MapperInput& input,
+                       const BundleAdjuster& bundle_adjuster, uint64_t seed,
+                       MapperResult* result) {
+  GpsAnchoringOptions anchoring;
+  anchoring.horizontal_sigma_m = options.gps_horizontal_sigma;
+  anchoring.vertical_sigma_m = options.gps_vertical_sigma;
+  anchoring.min_num_images = options.gps_min_images;
+  anchoring.ba_max_num_iterations = options.ba_global_max_num_iterations;
+  result->georeferences.clear();
+  for (size_t index = 0; index < result->models.size(); ++index) {
+    const GpsAnchoringReport report = AnchorModelToGps(input.metadata, bundle_adjuster, anchoring,
+                                                       DeriveSeed(seed, 0x69700 + index),
+                                                       &result->models[index]);
+    if (report.anchored) {
+      spdlog::info(
+          "map: model {}: anchored to the GPS of {} of its {} geotagged images, in an "
+          "east-north-up frame in metres from {:.7f}, {:.7f}, {:.1f} m; camera centres are a "
+          "mean {:.2f} m (median {:.2f} m) from their GPS positions",
+          index, report.num_agreeing, report.num_geotagged, report.origin.latitude_deg,
+          report.origin.longitude_deg, report.origin.altitude_m, report.mean_error_m,
+          report.median_error_m);
+      result->georeferences.push_back(report.origin);
+    } else {
+      spdlog::warn("map: model {} is not georeferenced (use_gps_prior): {}; it keeps its own "
+                   "frame and scale",
+                   index, report.reason);
+      result->georeferences.push_back(std::nullopt);
+    }
+  }
+}
+
 MapperResult IncrementalPipeline::Reconstruct(const MapperInput& input,
                                               const MapperControl& observer) const {
   const auto start_time = std::chrono::steady_clock::now();
@@ -513,6 +547,7 @@ MapperResult IncrementalPipeline::Reconstruct(const MapperInput& input,
     SortModels(&result.models);
   }
   result.self_checks = SelfCheckModels(options_, input, run.view_graph, result.models);
+  if (options_.use_gps_prior) AnchorModelsToGps(options_, input, bundle_adjuster_, seed_, &result);
   result.num_registrations_refused = run.num_registrations_refused;
   result.unregistered_reasons = UnregisteredReasons(options_, input, run, result.models);
   result.num_global_ba = run.num_global_ba;

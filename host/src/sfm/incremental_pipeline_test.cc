@@ -6,6 +6,7 @@
 #include "geometry/essential_matrix.h"
 #include "synthetic_scene.h"
 #include "tessera/errors.h"
+#include "tessera/sfm/gps_anchoring.h"
 #include "tessera/io/model_statistics.h"
 #include "test_support.h"
 
@@ -269,6 +270,94 @@ TEST(IncrementalPipeline, EstimatesTheFocalLengthOfEachSceneInAMixedSet) {
       EXPECT_NEAR(camera.FocalLengthX(), truth, 0.005 * truth);
     }
   }
+}
+
+// GPS for each image of `scene`: its true centre, scaled to metres, in an east-north-up
+// frame at `origin`, plus noise; `shuffle` hands each image another's position.
+void Geotag(SyntheticScene* scene, const Georeference& origin, double metres_per_unit,
+            double horizontal_noise_m, double vertical_noise_m, bool shuffle,
+            std::map<image_t, Eigen::Vector3d>* true_enu) {
+  RandomEngine engine(3);
+  std::normal_distribution<double> horizontal(0, horizontal_noise_m), vertical(0, vertical_noise_m);
+  std::vector<image_t> ids;
+  for (const auto& [image_id, pose] : scene->true_cam_from_world) ids.push_back(image_id);
+  std::vector<image_t> sources = ids;
+  if (shuffle) std::rotate(sources.begin(), sources.begin() + sources.size() / 2, sources.end());
+  for (size_t k = 0; k < ids.size(); ++k) {
+    const Eigen::Vector3d enu =
+        metres_per_unit * scene->true_cam_from_world.at(sources[k]).Inverse().translation;
+    (*true_enu)[ids[k]] = metres_per_unit * scene->true_cam_from_world.at(ids[k]).Inverse().translation;
+    const Eigen::Vector3d noisy = enu + Eigen::Vector3d(horizontal(engine), horizontal(engine),
+                                                        vertical(engine));
+    scene->input.metadata[ids[k]].gps = Wgs84FromEnu(noisy, origin);
+  }
+}
+
+TEST(IncrementalPipeline, AnchorsTheModelToItsImagesGpsInEastNorthUpMetres) {
+  SyntheticScene scene = MakeSyntheticScene(SyntheticSceneOptions());
+  Georeference origin;
+  origin.latitude_deg = 47.3;
+  origin.longitude_deg = 8.5;
+  origin.altitude_m = 410;
+  std::map<image_t, Eigen::Vector3d> true_enu;
+  Geotag(&scene, origin, 40.0, 0.5, 1.0, /*shuffle=*/false, &true_enu);
+  IncrementalMapperOptions options;
+  options.use_gps_prior = true;
+  options.gps_horizontal_sigma = 0.5;
+  options.gps_vertical_sigma = 1.0;
+  const MapperResult result = Map(scene, options);
+  ASSERT_EQ(result.models.size(), 1u);
+  ASSERT_EQ(result.georeferences.size(), 1u);
+  ASSERT_TRUE(result.georeferences[0].has_value());
+  const Georeference& frame = *result.georeferences[0];
+  // Without any alignment: each centre where its true position is in the model's frame,
+  // within the GPS noise.
+  double sum = 0;
+  size_t n = 0;
+  for (const auto& [image_id, image] : result.models[0].images) {
+    const Eigen::Vector3d truth = EnuFromWgs84(Wgs84FromEnu(true_enu.at(image_id), origin), frame);
+    const double error = (image.ProjectionCenter() - truth).norm();
+    EXPECT_LT(error, 2.0) << image.name;
+    sum += error;
+    ++n;
+  }
+  EXPECT_EQ(n, scene.input.images.size());
+  EXPECT_LT(sum / n, 1.0);
+  // WGS84 and back: well below a millimetre.
+  const Eigen::Vector3d point(1234.5, -987.6, 55.5);
+  EXPECT_LT((EnuFromWgs84(Wgs84FromEnu(point, origin), origin) - point).norm(), 1e-6);
+}
+
+TEST(IncrementalPipeline, GpsThatContradictsTheModelLeavesItInItsOwnFrame) {
+  SyntheticScene scene = MakeSyntheticScene(SyntheticSceneOptions());
+  Georeference origin;
+  origin.latitude_deg = -33.9;
+  origin.longitude_deg = 151.2;
+  std::map<image_t, Eigen::Vector3d> true_enu;
+  Geotag(&scene, origin, 40.0, 0.5, 1.0, /*shuffle=*/true, &true_enu);
+  IncrementalMapperOptions options;
+  options.use_gps_prior = true;
+  options.gps_horizontal_sigma = 0.5;
+  options.gps_vertical_sigma = 1.0;
+  const MapperResult unanchored = Map(scene, options);
+  options.use_gps_prior = false;
+  const MapperResult plain = Map(scene, options);
+  ASSERT_EQ(unanchored.models.size(), 1u);
+  ASSERT_EQ(unanchored.georeferences.size(), 1u);
+  EXPECT_FALSE(unanchored.georeferences[0].has_value());
+  // The model as mapping left it.
+  for (const auto& [image_id, image] : plain.models[0].images) {
+    EXPECT_EQ(unanchored.models[0].images.at(image_id).cam_from_world.translation,
+              image.cam_from_world.translation);
+  }
+  // Too few geotagged images: the same.
+  SyntheticScene few = MakeSyntheticScene(SyntheticSceneOptions());
+  Geotag(&few, origin, 40.0, 0.5, 1.0, false, &true_enu);
+  while (few.input.metadata.size() > 2) few.input.metadata.erase(few.input.metadata.begin());
+  options.use_gps_prior = true;
+  const MapperResult result = Map(few, options);
+  ASSERT_EQ(result.georeferences.size(), 1u);
+  EXPECT_FALSE(result.georeferences[0].has_value());
 }
 
 // An object seen from all around whose back half repeats its front half turned by half a

@@ -8,6 +8,7 @@
 
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/exporter_paths.h"
+#include "tessera/io/georeference_io.h"
 #include "tessera/sdk.h"
 
 namespace tessera {
@@ -26,8 +27,10 @@ class ColmapModelExporter : public Exporter {
     effective_options_ = reader.Effective();
   }
 
-  // Writes OUTPUT/sparse/<model_index>/{cameras,images,points3D}.{txt|bin}.
+  // Writes OUTPUT/sparse/<model_index>/{cameras,images,points3D}.{txt|bin}, and
+  // georeference.json beside them for a model in a GPS-anchored ENU frame.
   void Export(const Reconstruction& reconstruction, const ExportContext& context) const override {
+    if (context.georeference) WriteGeoreference(*context.georeference, SparseModelDir(context));
     if (record_order_from_.empty()) {
       WriteColmapModel(reconstruction, SparseModelDir(context), format_);
       return;

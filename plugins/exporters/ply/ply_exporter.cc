@@ -2,6 +2,7 @@
 // CloudCompare, Open3D and Blender open unchanged; optionally the camera centres as
 // extra vertices in their own colour.
 
+#include <cstdio>
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
@@ -45,6 +46,17 @@ void Append(std::string* buffer, T value) {
 
 }  // namespace
 
+// Which frame the coordinates are in: a PLY comment line.
+std::string FrameComment(const tessera::ExportContext& context) {
+  if (!context.georeference) return "comment frame: arbitrary (not georeferenced)\n";
+  char line[200];
+  std::snprintf(line, sizeof(line),
+                "comment frame: ENU metres, origin latitude %.9f longitude %.9f altitude %.3f\n",
+                context.georeference->latitude_deg, context.georeference->longitude_deg,
+                context.georeference->altitude_m);
+  return line;
+}
+
 class PlyExporter : public Exporter {
  public:
   explicit PlyExporter(const nlohmann::json& options) {
@@ -81,7 +93,8 @@ class PlyExporter : public Exporter {
     const char* type = double_precision_ ? "double" : "float";
     std::string ply = "ply\nformat binary_little_endian 1.0\ncomment Tessera: " +
                       std::to_string(reconstruction.points3D.size()) + " 3D points, then " +
-                      std::to_string(centers.size()) + " camera centres\nelement vertex " +
+                      std::to_string(centers.size()) + " camera centres\n" +
+                      FrameComment(context) + "element vertex " +
                       std::to_string(reconstruction.points3D.size() + centers.size()) + "\n";
     for (const char* axis : {"x", "y", "z"})
       ply += std::string("property ") + type + " " + axis + "\n";

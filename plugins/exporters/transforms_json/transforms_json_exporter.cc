@@ -135,6 +135,13 @@ class TransformsJsonExporter : public Exporter {
             "camera_model for all frames");
       }
       json["camera_model"] = num_fisheye > 0 ? "OPENCV_FISHEYE" : "OPENCV";
+      // Which frame transform_matrix is in: GPS-anchored east-north-up metres, or none.
+      if (context.georeference) {
+        json["georeference"] = {{"latitude", context.georeference->latitude_deg},
+                                {"longitude", context.georeference->longitude_deg},
+                                {"altitude", context.georeference->altitude_m},
+                                {"frame", context.georeference->frame}};
+      }
       json["frames"] = nlohmann::json::array();
       for (const Image* image : frames) {
         nlohmann::json frame = shared_camera

@@ -108,6 +108,16 @@ struct TESSERA_SFM_EXPORT IncrementalMapperOptions {
   // Models with fewer registered images are dropped.
   int min_model_size = 3;
 
+  // Each model anchored to its images' GPS (tessera/sfm/gps_anchoring.h): moved into a
+  // local east-north-up frame in metres, then adjusted with every geotagged centre held
+  // to its GPS position with these standard deviations (metres). A model with fewer
+  // than gps_min_images geotagged images, or whose GPS contradicts it, keeps its own
+  // frame, with a warning.
+  bool use_gps_prior = false;
+  double gps_horizontal_sigma = 5.0;
+  double gps_vertical_sigma = 10.0;
+  int gps_min_images = 3;
+
   // Reads the `incremental` mapper's options; unknown keys and out-of-range values throw
   // OptionError naming "<path>.<key>" ("<key>" when `path` is empty, as a plugin's
   // factory reads them).

@@ -1,0 +1,25 @@
+#pragma once
+
+#include <filesystem>
+#include <optional>
+
+#include "tessera/georeference.h"
+#include "tessera/io/export.h"
+
+namespace tessera {
+
+// The file beside a model that says where its frame sits on the Earth.
+constexpr const char* kGeoreferenceFileName = "georeference.json";
+
+// Writes MODEL_DIR/georeference.json atomically (MODEL_DIR made when missing): {"latitude": deg, "longitude": deg,
+// "altitude": m, "frame": "ENU"}.
+TESSERA_IO_EXPORT void WriteGeoreference(const Georeference& georeference,
+                                         const std::filesystem::path& model_dir);
+
+// Reads MODEL_DIR/georeference.json; nullopt when the model has none. Throws InputError
+// naming the file and field when it is there but malformed (a latitude outside
+// [-90, 90], a longitude outside [-180, 180], a frame other than ENU).
+TESSERA_IO_EXPORT std::optional<Georeference> ReadGeoreference(
+    const std::filesystem::path& model_dir);
+
+}  // namespace tessera

@@ -1,0 +1,64 @@
+#pragma once
+
+// A model anchored to its images' GPS: moved into a local east-north-up frame in metres
+// by the similarity that most geotagged camera centres agree on, then bundle-adjusted
+// with each centre held to its GPS position (BundleAdjustmentConfig::position_priors),
+// as COLMAP's pose-prior mapper does. A model too few geotagged images define, or
+// whose GPS contradicts it, stays as it was, with the reason.
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "tessera/bundle_adjuster.h"
+#include "tessera/georeference.h"
+#include "tessera/image_metadata.h"
+#include "tessera/reconstruction.h"
+#include "tessera/sfm/export.h"
+
+namespace tessera {
+
+struct GpsAnchoringOptions {
+  // Standard deviations of the GPS positions, metres.
+  double horizontal_sigma_m = 5.0;
+  double vertical_sigma_m = 10.0;
+  // Geotagged registered images a model needs, not all on one line.
+  int min_num_images = 3;
+  // A geotagged centre agrees with the similarity within this many sigmas.
+  double max_error_sigmas = 5.0;
+  // Share of the geotagged images that must agree; else the GPS contradicts the model.
+  // Real GPS has a few outliers, not a quarter of the images off.
+  double min_inlier_ratio = 0.75;
+  int ransac_num_trials = 200;
+  int ba_max_num_iterations = 50;
+};
+
+struct GpsAnchoringReport {
+  bool anchored = false;
+  std::string reason;  // why not, when not
+  Georeference origin;
+  size_t num_geotagged = 0;  // registered images of the model with GPS
+  size_t num_agreeing = 0;   // of those, within max_error_sigmas of the similarity
+  // Distances of the geotagged centres to their GPS positions after anchoring, metres.
+  double mean_error_m = 0;
+  double median_error_m = 0;
+};
+
+// East, north, up of `position` (WGS84) in metres from `origin` (altitude 0 where the
+// position has none).
+TESSERA_SFM_EXPORT Eigen::Vector3d EnuFromWgs84(const GpsPosition& position,
+                                                const Georeference& origin);
+// The inverse: the WGS84 position (with altitude) of an east-north-up point.
+TESSERA_SFM_EXPORT GpsPosition Wgs84FromEnu(const Eigen::Vector3d& enu, const Georeference& origin);
+
+// Anchors `model` to the GPS in `metadata` (see above). The origin is the mean of the
+// geotagged images' positions. Every random choice comes from `seed`. The model is
+// changed only when the report says anchored.
+TESSERA_SFM_EXPORT GpsAnchoringReport AnchorModelToGps(
+    const std::map<image_t, ImageMetadata>& metadata, const BundleAdjuster& bundle_adjuster,
+    const GpsAnchoringOptions& options, uint64_t seed, Reconstruction* model);
+
+}  // namespace tessera
