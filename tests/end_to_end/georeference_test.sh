@@ -9,7 +9,10 @@
 #     PLY and transforms.json say which frame they are in;
 #  2. GPS that contradicts the images (each image tagged with another's position): the
 #     model keeps its own frame, no georeference.json, a warning that says why;
-#  3. a GPS sigma of 0: exit 2 naming the option.
+#  3. a GPS sigma of 0: exit 2 naming the option;
+#  and `eval --no-align` scores the anchored model in its own frame (the ground truth's
+#  given by --gt-origin), and refuses a model without georeference.json or ground truth
+#  without a frame.
 # usage: georeference_test.sh TESSERA DOWNSCALE GEOTAG SHARED_DIR SOURCE_DIR
 set -uo pipefail
 tessera=$1
@@ -112,6 +115,20 @@ assert frames["georeference"]["frame"] == "ENU", frames.get("georeference")
 assert b"comment frame: ENU metres" in open(os.path.join(out, "sparse/0/points3D.ply"), "rb").read(600)
 PY
 echo "anchored: georeference.json, centres within the GPS noise, PLY and transforms.json in ENU"
+# eval --no-align: the ground truth's frame is ENU about the geotag origin.
+"$tessera" eval "$work/out/sparse/0" "$dataset/gt" --no-align --gt-origin 46.52,6.57,400 --json \
+  > "$work/noalign.json" || fail "eval --no-align"
+python3 - "$work/noalign.json" <<'PY' || fail "eval --no-align: the figures"
+import json, sys
+r = json.load(open(sys.argv[1]))
+print("eval --no-align: %d registered, position error mean %.3f m, median %.3f m; rotation %.3f deg"
+      % (r["registered"], r["pos_mean"], r["pos_median"], r["rot_mean_deg"]))
+assert r["registered"] == 11 and r["pos_mean"] < 0.3 and r["alignment_scale"] == 1, r
+PY
+code=0
+"$tessera" eval "$work/out/sparse/0" "$dataset/gt" --no-align 2> "$work/noorigin.log" || code=$?
+[ "$code" = 2 ] && grep -q "needs the ground truth's frame: give --gt-origin" "$work/noorigin.log" ||
+  { cat "$work/noorigin.log"; fail "eval --no-align without the ground truth's frame: exit $code"; }
 
 # 2. Contradicting GPS: each image tagged with the position of the image 5 after it.
 python3 - "$dataset/gt" "$work/shuffled.txt" <<'PY'
@@ -129,6 +146,11 @@ rm -rf "$work/images" && cp -r "$work/clean" "$work/images"
 grep -q "\[warning\] map: model 0 is not georeferenced (use_gps_prior): its GPS contradicts it" \
   "$work/bad.log" || { grep "map:" "$work/bad.log"; fail "no fallback warning"; }
 [ ! -e "$work/bad/sparse/0/georeference.json" ] || fail "a contradicted model has a georeference"
+code=0
+"$tessera" eval "$work/bad/sparse/0" "$dataset/gt" --no-align --gt-origin 46.52,6.57,400 \
+  2> "$work/unanchored.log" || code=$?
+[ "$code" = 2 ] && grep -q "needs a model anchored to GPS" "$work/unanchored.log" ||
+  { cat "$work/unanchored.log"; fail "eval --no-align of a model without georeference: exit $code"; }
 grep -q "11 of 11 images registered" "$work/bad.log" || fail "the fallback model lost images"
 echo "contradicting GPS: the model keeps its own frame, with a warning"
 

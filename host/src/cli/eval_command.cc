@@ -1,7 +1,9 @@
-// `tessera eval MODEL GT [--json]`: accuracy of a COLMAP-format model against ground-truth
+// `tessera eval MODEL GT [--json] [--no-align [--gt-origin LAT,LON,ALT]]`: accuracy of a COLMAP-format model against ground-truth
 // poses (Strecha *.camera files, a transforms.json or another model), as eval_gt.py
 // scores it.
 
+#include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
@@ -16,6 +18,8 @@ CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions&) {
     std::string model;
     std::string ground_truth;
     bool json = false;
+    bool no_align = false;
+    std::string gt_origin;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("eval", "Score a model's camera poses against ground truth");
@@ -26,9 +30,31 @@ CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions&) {
                   "model folder")
       ->required();
   sub->add_flag("--json", options->json, "Print JSON instead of a table");
+  sub->add_flag("--no-align", options->no_align,
+                "Score without a similarity alignment: the model's GPS-anchored frame "
+                "(georeference.json) against the ground truth's");
+  sub->add_option("--gt-origin", options->gt_origin,
+                  "With --no-align: the ground truth is in east-north-up metres about "
+                  "LAT,LON,ALT (degrees, degrees, metres)");
 
   auto run = [options]() {
-    const EvaluationResult result = EvaluateModelFolder(options->model, options->ground_truth);
+    std::optional<Georeference> gt_origin;
+    if (!options->gt_origin.empty()) {
+      double values[3];
+      char tail = 0;
+      if (std::sscanf(options->gt_origin.c_str(), "%lf,%lf,%lf%c", &values[0], &values[1],
+                      &values[2], &tail) != 3 ||
+          !(std::abs(values[0]) <= 90) || !(std::abs(values[1]) <= 180) ||
+          !std::isfinite(values[2])) {
+        throw InputError("--gt-origin: expected LAT,LON,ALT (latitude in [-90, 90], longitude "
+                         "in [-180, 180] degrees, altitude in metres), got '" +
+                         options->gt_origin + "'");
+      }
+      gt_origin = Georeference{values[0], values[1], values[2], "ENU"};
+    }
+    if (gt_origin && !options->no_align) throw InputError("--gt-origin: needs --no-align");
+    const EvaluationResult result = EvaluateModelFolder(options->model, options->ground_truth,
+                                                        options->no_align, gt_origin);
     if (options->json) {
       std::cout << result.ToJson().dump(2) << std::endl;
     } else {

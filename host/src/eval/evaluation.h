@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -70,8 +71,12 @@ struct EvaluationResult {
 
 // Throws InputError as PosesByBasename does for the model; `model_dir`, when given,
 // starts those messages.
-EvaluationResult EvaluateReconstruction(const Reconstruction& model,
-                                        const std::map<std::string, GroundTruthPose>& ground_truth,
-                                        const std::filesystem::path& model_dir = {});
+// `fixed_gt_from_model`: no alignment is estimated; this one is used (the identity when
+// model and ground truth share a frame, as a GPS-anchored model and ground truth in its
+// east-north-up frame do).
+EvaluationResult EvaluateReconstruction(
+    const Reconstruction& model, const std::map<std::string, GroundTruthPose>& ground_truth,
+    const std::filesystem::path& model_dir = {},
+    const std::optional<Similarity3d>& fixed_gt_from_model = std::nullopt);
 
 }  // namespace tessera

@@ -4,9 +4,11 @@
 // Python module.
 
 #include <filesystem>
+#include <optional>
 
 #include "eval/evaluation.h"
 #include "tessera/errors.h"
+#include "tessera/georeference.h"
 
 namespace tessera {
 
@@ -14,8 +16,15 @@ namespace tessera {
 // it meanwhile) and the ground truth (*.camera files, a transforms.json or a model
 // folder) and scores the model's poses. Throws InputError naming the file on bad input;
 // a result that could not be aligned is returned with `aligned` false.
+//
+// `no_align`: no similarity is estimated; the model must be anchored to GPS
+// (MODEL/georeference.json) and the ground truth's frame known: east-north-up metres about
+// `gt_origin`, or a georeferenced model folder. Its poses are moved into the model's frame
+// and scored there. Throws InputError saying which is missing.
 EvaluationResult EvaluateModelFolder(const std::filesystem::path& model_dir,
-                                     const std::filesystem::path& ground_truth);
+                                     const std::filesystem::path& ground_truth,
+                                     bool no_align = false,
+                                     const std::optional<Georeference>& gt_origin = std::nullopt);
 
 // Why a result could not be scored (result.aligned false), naming both inputs: the
 // user's to fix (wrong ground truth, names that do not match), so bad input.
