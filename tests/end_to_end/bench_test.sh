@@ -45,7 +45,7 @@ if have_colmap; then colmap_flag=(--with-colmap); else
   "$work/orb_exhaustive.json" "$work/orb_window.json" > "$work/1.md" 2> "$work/1.log" ||
   { cat "$work/1.log"; fail "tessera bench exited $?"; }
 cat "$work/1.md"
-grep -q "^| orb_window | orb 1.0.0 / window 1.0.0+sequential 1.0.0 / flann 1.0.0 / ceres 1.0.0 / colmap_binary 1.0.0+ply 1.0.0 | 0.0 (features of orb_exhaustive) |" \
+grep -q "^| orb_window | orb 1.0.0 / window 1.0.0+sequential 1.0.0 / flann 1.0.0 / incremental 1.0.0 / ceres 1.0.0 / colmap_binary 1.0.0+ply 1.0.0 | 0.0 (features of orb_exhaustive) |" \
   "$work/1.md" || fail "orb_window's row does not say it reused orb_exhaustive's features"
 grep -q "^| orb_window |.*| 40 | window 40 + sequential 19 = 40 |" "$work/1.md" ||
   fail "orb_window's row does not show the pairs of each selector"

@@ -69,9 +69,10 @@ struct TESSERA_SFM_EXPORT IncrementalMapperOptions {
   // fundamental matrices of the verified pairs before mapping, instead of starting
   // from default_focal_length_factor x the image size.
   bool estimate_focal_length = true;
-  // A camera whose view-graph estimate rests on at least this many pairs starts from it;
-  // the others are refined first in a first model of up to 20 images, mapped for that
-  // alone. 0: every camera gets a first model.
+  // A camera whose view-graph estimate rests on at least this many pairs, with a clear
+  // minimum (mean robust cost per pair at most 0.05), starts from it; the others are
+  // refined first in a first model of up to 20 images, mapped for that alone. 0: every
+  // camera gets a first model.
   int min_view_graph_focal_pairs = 10;
 
   // View-graph filtering before mapping: a pair in at least 3 rotation cycles
