@@ -24,7 +24,9 @@ namespace tessera {
 struct GlobalPositioningOptions {
   int max_num_iterations = 100;
   double huber_threshold = 0.1;    // on the ray residual (unit ray)
-  double function_tolerance = 1e-7;
+  // Relative cost change to stop at: the cost flattens within a few tens of iterations, then
+  // only creeps along the free scale (all positions shrinking, all scales growing).
+  double function_tolerance = 1e-5;
   double init_extent = 100;        // random positions uniform in [-extent, extent]^3
   uint64_t seed = 0;
   int num_threads = 1;
