@@ -122,6 +122,14 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   const auto seconds = [&start_time] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   };
+  auto lap_start = start_time;
+  // Adds the time since the last lap to `step`.
+  const auto lap = [&lap_start](double* step) {
+    const auto now = std::chrono::steady_clock::now();
+    *step += std::chrono::duration<double>(now - lap_start).count();
+    lap_start = now;
+  };
+  GlobalMapperResult::StepSeconds& steps = result.step_seconds;
   const auto stop = [&should_stop] { return should_stop && should_stop(); };
   const auto cancelled = [&] {
     GlobalMapperResult empty;
@@ -175,6 +183,8 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   }
   if (stop()) return cancelled();
 
+  lap(&steps.view_graph);
+
   // 4. Rotation averaging.
   std::vector<RelativeRotation> relative_rotations;
   std::vector<const MapperInput::Pair*> pair_of_rotation;
@@ -194,6 +204,7 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
       AverageRotations(relative_rotations, rotation_options, should_stop);
   if (rotations.cancelled || stop()) return cancelled();
   result.num_pairs_dropped_by_rotation_averaging = rotations.num_dropped;
+  lap(&steps.rotation_averaging);
   std::set<image_t> with_rotation_pair;
   for (const RelativeRotation& rotation : relative_rotations) {
     with_rotation_pair.insert(rotation.image_id1);
@@ -213,6 +224,7 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   for (const auto& [image_id, image] : input.images) num_points2D[image_id] = image.points2D.size();
   const FeatureTracks tracks = BuildFeatureTracks(pair_matches, num_points2D);
   result.num_tracks = tracks.tracks.size();
+  lap(&steps.tracks);
   spdlog::info(
       "global map: {} images, {} verified pairs, {} dropped by rotation cycles, {} by rotation "
       "averaging ({} steps); {} tracks",
@@ -247,6 +259,7 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
       positioning_tracks.push_back(part_tracks[t]);
     }
     result.num_tracks_positioned += positioning_tracks.size();
+    lap(&steps.tracks);
     std::map<image_t, Eigen::Matrix3d> part_rotations;
     for (const image_t image_id : part) {
       part_rotations[image_id] = rotations.R_cam_from_world.at(image_id);
@@ -261,6 +274,7 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
         PositionGlobally(cameras, input.images, part_rotations, positioning_tracks,
                          positioning_options, should_stop);
     if (positions.cancelled || stop()) return cancelled();
+    lap(&steps.positioning);
     spdlog::info(
         "global map: part {} ({} images): positioned with {} tracks in {} iterations, cost "
         "{:.3g} -> {:.3g}",
@@ -325,8 +339,10 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
     bool failed = false;
     const auto adjust_and_filter = [&](double max_reproj_error, const std::string& when) {
       if (model.images.size() < 2 || model.points3D.empty()) return;
+      lap(&steps.filtering);
       const BundleAdjustmentSummary summary = bundle_adjuster.Adjust(config, &model);
       ++result.num_bundle_adjustments;
+      lap(&steps.bundle_adjustment);
       spdlog::info("global map: part {}: bundle adjustment {}: {}", part_index, when,
                    summary.BriefReport());
       if (!summary.usable) {
@@ -381,6 +397,7 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
     }
     model.cameras = std::move(used_cameras);
     result.models.push_back(std::move(model));
+    lap(&steps.filtering);
   }
 
   std::stable_sort(result.models.begin(), result.models.end(),

@@ -49,6 +49,17 @@ struct GlobalMapperResult {
   size_t num_tracks_positioned = 0;  // chosen for global positioning, all models
   int num_bundle_adjustments = 0;
   double seconds = 0;
+  // Where the time went (seconds): pair selection, focal lengths and the view graph;
+  // rotation averaging; tracks; global positioning; bundle adjustments; filtering and
+  // retriangulation.
+  struct StepSeconds {
+    double view_graph = 0;
+    double rotation_averaging = 0;
+    double tracks = 0;
+    double positioning = 0;
+    double bundle_adjustment = 0;
+    double filtering = 0;
+  } step_seconds;
   // should_stop said so: `models` and the reasons are empty.
   bool cancelled = false;
 };

@@ -58,6 +58,11 @@ void BM_GlobalMapperPath(benchmark::State& state) {
   state.counters["points"] =
       static_cast<double>(num_models > 0 ? result.models[0].points3D.size() : 0);
   state.counters["ba"] = result.num_bundle_adjustments;
+  // Seconds of the main steps.
+  state.counters["s_viewgraph"] = result.step_seconds.view_graph;
+  state.counters["s_rotations"] = result.step_seconds.rotation_averaging;
+  state.counters["s_positions"] = result.step_seconds.positioning;
+  state.counters["s_ba"] = result.step_seconds.bundle_adjustment;
   if (num_models > 0) {
     // Accuracy of the largest model, not timed: the path is n - 1 units long.
     const EvaluationResult evaluation =

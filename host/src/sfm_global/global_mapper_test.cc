@@ -80,6 +80,12 @@ TEST(GlobalMapper, MapsThirtyImagesOfASyntheticScene) {
   EXPECT_TRUE(result.unregistered_reasons.empty());
   EXPECT_FALSE(result.cancelled);
   EXPECT_GT(result.num_bundle_adjustments, 0);
+  const GlobalMapperResult::StepSeconds& steps = result.step_seconds;
+  EXPECT_GT(steps.positioning, 0);
+  EXPECT_GT(steps.bundle_adjustment, 0);
+  EXPECT_LE(steps.view_graph + steps.rotation_averaging + steps.tracks + steps.positioning +
+                steps.bundle_adjustment + steps.filtering,
+            result.seconds);
   const EvaluationResult evaluation = EvaluateReconstruction(model, scene.GroundTruth());
   ASSERT_TRUE(evaluation.aligned) << evaluation.error;
   EXPECT_LT(evaluation.rotation_error_max_deg, 0.5);
