@@ -71,6 +71,36 @@ TEST(RunPipeline, ProgressGoesThroughEveryStageInOrderAndTheSummariesAreWritten)
   EXPECT_TRUE(fs::exists(dir.path() / "out" / "sparse" / "0" / "points3D.bin"));
 }
 
+// The mapper slot: each bundled mapper is made from the manifest, its options checked
+// before any image is read and named by their JSON path.
+TEST(PipelineContext, TheMapperSlotMakesEitherBundledMapperAndNamesBadOptions) {
+  for (const std::string name : {"incremental", "global"}) {
+    const PipelineContext context = PipelineContext::Create(Manifest::FromJson(
+        {{"pipeline", {{"mapper", {{"plugin", name}}}}}}, testing::SourceDir(), "m.json"));
+    EXPECT_EQ(context.mapper.name(), name);
+  }
+  const auto error_of = [](const nlohmann::json& mapper) {
+    try {
+      PipelineContext::Create(
+          Manifest::FromJson({{"pipeline", {{"mapper", mapper}}}}, testing::SourceDir(), "m.json"));
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string();
+  };
+  EXPECT_NE(error_of({{"plugin", "global"}, {"options", {{"ba_num_rounds", -1}}}})
+                .find("pipeline.mapper.options.ba_num_rounds"),
+            std::string::npos);
+  EXPECT_NE(error_of({{"plugin", "global"}, {"options", {{"ra_robust_sigma", 0}}}})
+                .find("pipeline.mapper.options.ra_robust_sigma"),
+            std::string::npos);
+  EXPECT_NE(error_of({{"plugin", "incremental"}, {"options", {{"gps_vertical_sigma", 0}}}})
+                .find("pipeline.mapper.options.gps_vertical_sigma"),
+            std::string::npos);
+  EXPECT_NE(error_of({{"plugin", "ceres"}}).find("is a bundle_adjuster, not a mapper"),
+            std::string::npos);
+}
+
 TEST(RunPipeline, CancelledDuringExtractionStopsThereAndWritesNoSummary) {
   const testing::TemporaryDir dir;
   testing::WriteSampleImages(dir.path() / "images", 3);

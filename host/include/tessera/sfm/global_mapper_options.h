@@ -1,0 +1,74 @@
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "tessera/sfm/export.h"
+
+namespace tessera {
+
+// Settings of the global mapper (GlobalMapper::Reconstruct). Names follow the
+// incremental mapper's where the meaning is the same; defaults follow GLOMAP's where it
+// has one. Angles in degrees, errors in pixels.
+struct TESSERA_SFM_EXPORT GlobalMapperOptions {
+  // Pairs with fewer verified inliers do not take part.
+  int min_num_matches = 15;
+  // Focal lengths of cameras without a prior from the view graph (its fundamental
+  // matrices), where the pairs determine them.
+  bool estimate_focal_length = true;
+  // Drop pairs whose relative rotation closes none of its rotation cycles.
+  bool filter_view_graph = true;
+  double view_graph_max_cycle_error = 10.0;
+
+  // Rotation averaging: IRLS steps with L1 weights, then Geman-McClure ones at most;
+  // the Geman-McClure scale; pairs off by more at the end are dropped.
+  int ra_num_l1_iterations = 5;
+  int ra_max_num_iterations = 100;
+  double ra_robust_sigma = 5.0;
+  double ra_max_residual = 10.0;
+
+  // Tracks for global positioning: at least tracks_min_length images, the longest
+  // first, each taken while one of its images has fewer than tracks_max_per_image.
+  int tracks_min_length = 2;
+  int tracks_max_per_image = 1000;
+
+  // Global positioning (Ceres): iterations at most and the Huber threshold on the ray
+  // residual; its seed is derived from `seed`.
+  int gp_max_num_iterations = 100;
+  double gp_huber_threshold = 0.1;
+  int gp_num_threads = 1;
+
+  // After positioning: observations whose ray is off the point's direction by more.
+  double filter_max_angle_error = 2.0;
+  // After each bundle adjustment: observations reprojecting further (the first rounds
+  // at a multiple: ba_num_rounds - round times this, at least once), and points whose
+  // rays meet at less than filter_min_tri_angle.
+  double filter_max_reproj_error = 4.0;
+  double filter_min_tri_angle = 1.5;
+  // Images left with fewer observations leave the model.
+  int min_num_observations_per_image = 10;
+
+  // Rounds of bundle adjustment and filtering, each adjustment of at most
+  // ba_max_num_iterations; what the adjuster may refine.
+  int ba_num_rounds = 3;
+  int ba_max_num_iterations = 100;
+  bool ba_refine_focal_length = true;
+  bool ba_refine_principal_point = false;
+  bool ba_refine_extra_params = true;
+
+  // Then every track triangulated again with the adjusted poses (observations within
+  // tri_max_error, rays meeting at tri_min_angle), one more adjustment and filtering.
+  bool retriangulate = true;
+  double tri_max_error = 4.0;
+  double tri_min_angle = 1.5;
+
+  // Connected parts of the view graph with fewer images make no model.
+  int min_model_size = 3;
+  int seed = 0;
+
+  // Reads the JSON object `json` (unknown keys and values out of range throw
+  // OptionError naming "<key>", which the host anchors at pipeline.mapper.options).
+  static GlobalMapperOptions FromJson(const nlohmann::json& json);
+  nlohmann::json ToJson() const;
+};
+
+}  // namespace tessera

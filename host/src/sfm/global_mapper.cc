@@ -1,0 +1,438 @@
+#include "tessera/sfm/global_mapper.h"
+
+#include <spdlog/spdlog.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <set>
+
+#include "tessera/sfm/feature_tracks.h"
+#include "tessera/sfm/focal_length_estimation.h"
+#include "tessera/sfm/view_graph.h"
+#include "tessera/sfm/global_positioning.h"
+#include "tessera/sfm/rotation_averaging.h"
+#include "tessera/sfm/track_filtering.h"
+#include "tessera/sfm/track_selection.h"
+#include "tessera/sfm/track_triangulation.h"
+#include "tessera/io/model_statistics.h"
+#include "util/random.h"
+
+namespace tessera {
+namespace {
+
+// Seed streams of the run's random choices.
+constexpr uint64_t kViewGraphStream = 1;
+constexpr uint64_t kPositioningStream = 2;  // + the part's index
+
+bool IsVerified(const TwoViewGeometry& geometry) {
+  return geometry.config == TwoViewGeometry::CALIBRATED ||
+         geometry.config == TwoViewGeometry::UNCALIBRATED ||
+         geometry.config == TwoViewGeometry::PLANAR ||
+         geometry.config == TwoViewGeometry::PANORAMIC ||
+         geometry.config == TwoViewGeometry::PLANAR_OR_PANORAMIC;
+}
+
+std::string Format(double value) { return fmt::format("{:g}", value); }
+
+// Union-find over image ids.
+class ImageGroups {
+ public:
+  image_t Find(image_t image_id) {
+    auto it = parent_.emplace(image_id, image_id).first;
+    while (it->second != it->first) {
+      const auto parent = parent_.find(it->second);
+      it->second = parent->second;
+      it = parent;
+    }
+    return it->first;
+  }
+  void Union(image_t a, image_t b) {
+    a = Find(a);
+    b = Find(b);
+    if (a != b) parent_[std::max(a, b)] = std::min(a, b);
+  }
+  // The groups, largest first, then by smallest image id.
+  std::vector<std::set<image_t>> Groups() {
+    std::map<image_t, std::set<image_t>> by_root;
+    std::vector<image_t> image_ids;
+    for (const auto& [image_id, parent] : parent_) image_ids.push_back(image_id);
+    for (const image_t image_id : image_ids) by_root[Find(image_id)].insert(image_id);
+    std::vector<std::set<image_t>> groups;
+    for (auto& [root, group] : by_root) groups.push_back(std::move(group));
+    std::stable_sort(groups.begin(), groups.end(),
+                     [](const auto& a, const auto& b) { return a.size() > b.size(); });
+    return groups;
+  }
+
+ private:
+  std::map<image_t, image_t> parent_;
+};
+
+// Removes images with fewer than `min_num_observations` observations (and what that
+// leaves of their points), until none is left; records why.
+void RemoveWeakImages(size_t min_num_observations, const std::string& when,
+                      Reconstruction* model, std::map<image_t, std::string>* reasons) {
+  bool changed = true;
+  while (changed) {
+    changed = false;
+    for (auto it = model->images.begin(); it != model->images.end();) {
+      size_t num_observations = 0;
+      for (const Point2D& point2D : it->second.points2D) num_observations += point2D.HasPoint3D();
+      if (num_observations >= min_num_observations) {
+        ++it;
+        continue;
+      }
+      const image_t image_id = it->first;
+      for (point2D_t idx = 0; idx < it->second.points2D.size(); ++idx) {
+        const point3D_t point3D_id = it->second.points2D[idx].point3D_id;
+        if (point3D_id == kInvalidPoint3DId) continue;
+        const Track& track = model->points3D.at(point3D_id).track;
+        for (size_t k = 0; k < track.size(); ++k) {
+          if (track[k].image_id == image_id && track[k].point2D_idx == idx) {
+            RemoveObservation(point3D_id, k, model);
+            break;
+          }
+        }
+      }
+      (*reasons)[image_id] = "only " + std::to_string(num_observations) +
+                             " observations of 3D points " + when +
+                             " (min_num_observations_per_image " +
+                             std::to_string(min_num_observations) + ")";
+      it = model->images.erase(it);
+      changed = true;
+    }
+  }
+}
+
+size_t NumObservationsOf(const Reconstruction& model) {
+  size_t n = 0;
+  for (const auto& [point3D_id, point3D] : model.points3D) n += point3D.track.size();
+  return n;
+}
+
+}  // namespace
+
+GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
+                                             const BundleAdjuster& bundle_adjuster,
+                                             const GlobalMapperOptions& options,
+                                             std::function<bool()> should_stop) {
+  const auto start_time = std::chrono::steady_clock::now();
+  GlobalMapperResult result;
+  const auto seconds = [&start_time] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
+  };
+  auto lap_start = start_time;
+  // Adds the time since the last lap to `step`.
+  const auto lap = [&lap_start](double* step) {
+    const auto now = std::chrono::steady_clock::now();
+    *step += std::chrono::duration<double>(now - lap_start).count();
+    lap_start = now;
+  };
+  GlobalMapperResult::StepSeconds& steps = result.step_seconds;
+  const auto stop = [&should_stop] { return should_stop && should_stop(); };
+  const auto cancelled = [&] {
+    GlobalMapperResult empty;
+    empty.cancelled = true;
+    empty.seconds = seconds();
+    spdlog::info("global map: stopped after {:.1f} s", empty.seconds);
+    return empty;
+  };
+  if (stop()) return cancelled();
+
+  // 1. The pairs that map.
+  std::vector<const MapperInput::Pair*> pairs;
+  std::set<image_t> in_verified_pair;
+  for (const MapperInput::Pair& pair : input.pairs) {
+    if (!IsVerified(pair.geometry) ||
+        pair.geometry.inlier_matches.size() < static_cast<size_t>(options.min_num_matches) ||
+        input.images.count(pair.image_id1) == 0 || input.images.count(pair.image_id2) == 0 ||
+        pair.image_id1 == pair.image_id2) {
+      continue;
+    }
+    pairs.push_back(&pair);
+    in_verified_pair.insert(pair.image_id1);
+    in_verified_pair.insert(pair.image_id2);
+  }
+  result.num_verified_pairs = pairs.size();
+
+  // 2. Focal lengths of cameras without a prior, from the view graph.
+  std::map<camera_t, Camera> cameras = input.cameras;
+  bool any_without_prior = false;
+  for (const auto& [camera_id, camera] : cameras) {
+    any_without_prior = any_without_prior || !camera.has_prior_focal_length;
+  }
+  if (options.estimate_focal_length && any_without_prior && !pairs.empty()) {
+    for (const auto& [camera_id, estimate] :
+         EstimateFocalLengths(input, pairs, FocalLengthEstimationOptions())) {
+      if (estimate.at_search_bound || estimate.num_pairs == 0) continue;
+      cameras.at(camera_id).SetFocalLength(estimate.focal_length);
+      result.estimated_focal_lengths[camera_id] = estimate.focal_length;
+      spdlog::info("global map: camera {}: focal length {:.1f} px from {} pairs", camera_id,
+                   estimate.focal_length, estimate.num_pairs);
+    }
+  }
+  if (stop()) return cancelled();
+
+  // 3. The view graph and its rotation-cycle filtering.
+  ViewGraph view_graph =
+      ViewGraph::Build(input, cameras, pairs, DeriveSeed(options.seed, kViewGraphStream));
+  if (options.filter_view_graph) {
+    result.num_pairs_dropped_by_cycles =
+        view_graph.FilterByRotationCycles(options.view_graph_max_cycle_error, 3);
+  }
+  if (stop()) return cancelled();
+
+  lap(&steps.view_graph);
+
+  // 4. Rotation averaging.
+  std::vector<RelativeRotation> relative_rotations;
+  std::vector<const MapperInput::Pair*> pair_of_rotation;
+  for (size_t e = 0; e < view_graph.edges().size(); ++e) {
+    const ViewGraphEdge& edge = view_graph.edges()[e];
+    if (!edge.has_rotation || edge.removed) continue;
+    relative_rotations.push_back({edge.image_id1, edge.image_id2, edge.R_cam2_from_cam1,
+                                  static_cast<double>(edge.num_inliers)});
+    pair_of_rotation.push_back(pairs[e]);
+  }
+  RotationAveragingOptions rotation_options;
+  rotation_options.num_l1_iterations = options.ra_num_l1_iterations;
+  rotation_options.max_num_irls_iterations = options.ra_max_num_iterations;
+  rotation_options.robust_sigma_deg = options.ra_robust_sigma;
+  rotation_options.max_residual_deg = options.ra_max_residual;
+  const RotationAveragingResult rotations =
+      AverageRotations(relative_rotations, rotation_options, should_stop);
+  if (rotations.cancelled || stop()) return cancelled();
+  result.num_pairs_dropped_by_rotation_averaging = rotations.num_dropped;
+  lap(&steps.rotation_averaging);
+  std::set<image_t> with_rotation_pair;
+  for (const RelativeRotation& rotation : relative_rotations) {
+    with_rotation_pair.insert(rotation.image_id1);
+    with_rotation_pair.insert(rotation.image_id2);
+  }
+
+  // 5. The pairs left, their connected parts and their tracks.
+  ImageGroups groups;
+  std::vector<ImagePairMatches> pair_matches;
+  for (size_t r = 0; r < relative_rotations.size(); ++r) {
+    if (rotations.dropped[r]) continue;
+    const MapperInput::Pair& pair = *pair_of_rotation[r];
+    groups.Union(pair.image_id1, pair.image_id2);
+    pair_matches.push_back({pair.image_id1, pair.image_id2, pair.geometry.inlier_matches});
+  }
+  std::map<image_t, size_t> num_points2D;
+  for (const auto& [image_id, image] : input.images) num_points2D[image_id] = image.points2D.size();
+  const FeatureTracks tracks = BuildFeatureTracks(pair_matches, num_points2D);
+  result.num_tracks = tracks.tracks.size();
+  lap(&steps.tracks);
+  spdlog::info(
+      "global map: {} images, {} verified pairs, {} dropped by rotation cycles, {} by rotation "
+      "averaging ({} steps); {} tracks",
+      input.images.size(), pairs.size(), result.num_pairs_dropped_by_cycles,
+      rotations.num_dropped, rotations.num_iterations, result.num_tracks);
+
+  std::map<image_t, std::string> reasons;
+  const std::vector<std::set<image_t>> parts = groups.Groups();
+  for (size_t part_index = 0; part_index < parts.size(); ++part_index) {
+    const std::set<image_t>& part = parts[part_index];
+    if (part.size() < static_cast<size_t>(options.min_model_size)) {
+      for (const image_t image_id : part) {
+        reasons[image_id] = "its pairs connect only " + std::to_string(part.size()) +
+                            " images, fewer than min_model_size (" +
+                            std::to_string(options.min_model_size) + ")";
+      }
+      continue;
+    }
+    if (stop()) return cancelled();
+
+    // 6. Tracks of the part and global positioning.
+    std::vector<Track> part_tracks;
+    for (const Track& track : tracks.tracks) {
+      if (track.empty() || part.count(track.front().image_id) == 0) continue;
+      Track restricted = RestrictTrack(track, part);
+      if (restricted.size() >= 2) part_tracks.push_back(std::move(restricted));
+    }
+    std::vector<Track> positioning_tracks;
+    for (const size_t t :
+         SelectTracks(part_tracks, part, static_cast<size_t>(options.tracks_min_length),
+                      static_cast<size_t>(options.tracks_max_per_image))) {
+      positioning_tracks.push_back(part_tracks[t]);
+    }
+    result.num_tracks_positioned += positioning_tracks.size();
+    lap(&steps.tracks);
+    std::map<image_t, Eigen::Matrix3d> part_rotations;
+    for (const image_t image_id : part) {
+      part_rotations[image_id] = rotations.R_cam_from_world.at(image_id);
+    }
+    GlobalPositioningOptions positioning_options;
+    positioning_options.max_num_iterations = options.gp_max_num_iterations;
+    positioning_options.huber_threshold = options.gp_huber_threshold;
+    positioning_options.num_threads = options.gp_num_threads;
+    positioning_options.seed =
+        DeriveSeed(static_cast<uint64_t>(options.seed), kPositioningStream + part_index);
+    const GlobalPositioningResult positions =
+        PositionGlobally(cameras, input.images, part_rotations, positioning_tracks,
+                         positioning_options, should_stop);
+    if (positions.cancelled || stop()) return cancelled();
+    lap(&steps.positioning);
+    spdlog::info(
+        "global map: part {} ({} images): positioned with {} tracks in {} iterations, cost "
+        "{:.3g} -> {:.3g}",
+        part_index, part.size(), positioning_tracks.size(), positions.num_iterations,
+        positions.initial_cost, positions.final_cost);
+    if (!positions.usable) {
+      for (const image_t image_id : part) reasons[image_id] = "global positioning failed";
+      continue;
+    }
+
+    // 7. The model: the positioned images and points, filtered by angles.
+    Reconstruction model;
+    for (const image_t image_id : part) {
+      const auto center = positions.centers.find(image_id);
+      if (center == positions.centers.end()) {
+        reasons[image_id] = "no feature track joins it to the other images of its part";
+        continue;
+      }
+      Image image = input.images.at(image_id);
+      for (Point2D& point2D : image.points2D) point2D.point3D_id = kInvalidPoint3DId;
+      const Eigen::Quaterniond rotation(part_rotations.at(image_id));
+      image.cam_from_world = Rigid3d(rotation, rotation * -center->second);
+      image.registered = true;
+      model.cameras[image.camera_id] = cameras.at(image.camera_id);
+      model.images[image_id] = std::move(image);
+    }
+    for (size_t t = 0; t < positioning_tracks.size(); ++t) {
+      Point3D point3D;
+      point3D.xyz = positions.points[t];
+      const point3D_t point3D_id = t + 1;
+      for (const TrackElement& element : positioning_tracks[t]) {
+        Point2D& point2D = model.images.at(element.image_id).points2D.at(element.point2D_idx);
+        if (point2D.HasPoint3D()) continue;
+        point2D.point3D_id = point3D_id;
+        point3D.track.push_back(element);
+      }
+      if (point3D.track.size() >= 2) {
+        model.points3D.emplace(point3D_id, std::move(point3D));
+      } else {
+        for (const TrackElement& element : point3D.track) {
+          model.images.at(element.image_id).points2D.at(element.point2D_idx).point3D_id =
+              kInvalidPoint3DId;
+        }
+      }
+    }
+    const size_t num_by_angle = FilterObservationsByAngle(options.filter_max_angle_error, &model);
+    const size_t num_by_tri_angle =
+        FilterPointsByTriangulationAngle(options.filter_min_tri_angle, &model);
+    RemoveWeakImages(options.min_num_observations_per_image, "after global positioning", &model,
+                     &reasons);
+    spdlog::info(
+        "global map: part {}: {} images, {} points after filtering {} observations by ray angle "
+        "and {} by triangulation angle",
+        part_index, model.images.size(), model.points3D.size(), num_by_angle, num_by_tri_angle);
+
+    // 8. Bundle adjustment and filtering, retriangulation.
+    BundleAdjustmentConfig config;
+    config.refine_focal_length = options.ba_refine_focal_length;
+    config.refine_principal_point = options.ba_refine_principal_point;
+    config.refine_extra_params = options.ba_refine_extra_params;
+    config.max_num_iterations = options.ba_max_num_iterations;
+    bool failed = false;
+    const auto adjust_and_filter = [&](double max_reproj_error, const std::string& when) {
+      if (model.images.size() < 2 || model.points3D.empty()) return;
+      lap(&steps.filtering);
+      const BundleAdjustmentSummary summary = bundle_adjuster.Adjust(config, &model);
+      ++result.num_bundle_adjustments;
+      lap(&steps.bundle_adjustment);
+      spdlog::info("global map: part {}: bundle adjustment {}: {}", part_index, when,
+                   summary.BriefReport());
+      if (!summary.usable) {
+        failed = true;
+        for (const auto& [image_id, image] : model.images) {
+          reasons[image_id] = "bundle adjustment failed: " + summary.message;
+        }
+        return;
+      }
+      const size_t num_by_error = FilterObservationsByReprojectionError(max_reproj_error, &model);
+      const size_t num_by_angle =
+          FilterPointsByTriangulationAngle(options.filter_min_tri_angle, &model);
+      RemoveWeakImages(options.min_num_observations_per_image, when, &model, &reasons);
+      spdlog::info(
+          "global map: part {}: {} observations beyond {:g} px and {} by triangulation angle "
+          "filtered; {} images, {} points, {} observations",
+          part_index, num_by_error, max_reproj_error, num_by_angle, model.images.size(),
+          model.points3D.size(), NumObservationsOf(model));
+    };
+    for (int round = 0; round < options.ba_num_rounds && !failed; ++round) {
+      if (stop()) return cancelled();
+      const double factor = std::max(1, options.ba_num_rounds - round);
+      adjust_and_filter(factor * options.filter_max_reproj_error,
+                        "after bundle adjustment round " + std::to_string(round + 1));
+    }
+    if (options.retriangulate && !failed) {
+      if (stop()) return cancelled();
+      TrackTriangulationOptions triangulation;
+      triangulation.max_error_px = options.tri_max_error;
+      triangulation.min_angle_deg = options.tri_min_angle;
+      const size_t num_points = TriangulateTracks(part_tracks, triangulation, &model);
+      spdlog::info("global map: part {}: retriangulated {} of {} tracks", part_index, num_points,
+                   part_tracks.size());
+      adjust_and_filter(options.filter_max_reproj_error, "after retriangulation");
+    }
+    if (failed) continue;
+    if (model.images.size() < static_cast<size_t>(options.min_model_size)) {
+      for (const auto& [image_id, image] : model.images) {
+        reasons[image_id] = "its model kept only " + std::to_string(model.images.size()) +
+                            " images, fewer than min_model_size (" +
+                            std::to_string(options.min_model_size) + ")";
+      }
+      continue;
+    }
+    for (auto& [point3D_id, point3D] : model.points3D) {
+      point3D.error = PointReprojectionError(model, point3D);
+    }
+    // Only the cameras of the images kept.
+    std::map<camera_t, Camera> used_cameras;
+    for (const auto& [image_id, image] : model.images) {
+      used_cameras[image.camera_id] = model.cameras.at(image.camera_id);
+    }
+    model.cameras = std::move(used_cameras);
+    result.models.push_back(std::move(model));
+    lap(&steps.filtering);
+  }
+
+  std::stable_sort(result.models.begin(), result.models.end(),
+                   [](const Reconstruction& a, const Reconstruction& b) {
+                     if (a.images.size() != b.images.size()) {
+                       return a.images.size() > b.images.size();
+                     }
+                     return a.points3D.size() > b.points3D.size();
+                   });
+  std::set<image_t> in_model;
+  for (const Reconstruction& model : result.models) {
+    for (const auto& [image_id, image] : model.images) in_model.insert(image_id);
+  }
+  for (const auto& [image_id, image] : input.images) {
+    if (in_model.count(image_id) > 0) continue;
+    std::string reason;
+    if (in_verified_pair.count(image_id) == 0) {
+      reason = "no verified pair with at least " + std::to_string(options.min_num_matches) +
+               " inlier matches";
+    } else if (with_rotation_pair.count(image_id) == 0) {
+      reason = "the view graph kept none of its pairs (no relative rotation, or none closing a "
+               "rotation cycle within " + Format(options.view_graph_max_cycle_error) + " deg)";
+    } else if (reasons.count(image_id) > 0) {
+      reason = reasons.at(image_id);
+    } else {
+      reason = "rotation averaging dropped all its pairs (off by more than " +
+               Format(options.ra_max_residual) + " deg)";
+    }
+    result.unregistered_reasons[image_id] = reason;
+  }
+  result.seconds = seconds();
+  spdlog::info("global map: {} models, {} images in none, {} bundle adjustments, {:.1f} s",
+               result.models.size(), result.unregistered_reasons.size(),
+               result.num_bundle_adjustments, result.seconds);
+  return result;
+}
+
+}  // namespace tessera

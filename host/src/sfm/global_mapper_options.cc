@@ -1,0 +1,84 @@
+#include "tessera/sfm/global_mapper_options.h"
+
+#include <limits>
+
+#include "tessera/options.h"
+
+namespace tessera {
+
+GlobalMapperOptions GlobalMapperOptions::FromJson(const nlohmann::json& json) {
+  GlobalMapperOptions o;
+  OptionReader reader(json);
+  o.min_num_matches = reader.Get<int>("min_num_matches", o.min_num_matches, 5, 100000);
+  o.estimate_focal_length = reader.GetBool("estimate_focal_length", o.estimate_focal_length);
+  o.filter_view_graph = reader.GetBool("filter_view_graph", o.filter_view_graph);
+  o.view_graph_max_cycle_error =
+      reader.Get<double>("view_graph_max_cycle_error", o.view_graph_max_cycle_error, 0.01, 180.0);
+  o.ra_num_l1_iterations =
+      reader.Get<int>("ra_num_l1_iterations", o.ra_num_l1_iterations, 0, 10000);
+  o.ra_max_num_iterations =
+      reader.Get<int>("ra_max_num_iterations", o.ra_max_num_iterations, 1, 10000);
+  o.ra_robust_sigma = reader.Get<double>("ra_robust_sigma", o.ra_robust_sigma, 0.01, 180.0);
+  o.ra_max_residual = reader.Get<double>("ra_max_residual", o.ra_max_residual, 0.01, 180.0);
+  o.tracks_min_length = reader.Get<int>("tracks_min_length", o.tracks_min_length, 2, 100000);
+  o.tracks_max_per_image =
+      reader.Get<int>("tracks_max_per_image", o.tracks_max_per_image, 1, 100000000);
+  o.gp_max_num_iterations =
+      reader.Get<int>("gp_max_num_iterations", o.gp_max_num_iterations, 1, 10000);
+  o.gp_huber_threshold = reader.Get<double>("gp_huber_threshold", o.gp_huber_threshold, 1e-4, 10.0);
+  o.gp_num_threads = reader.Get<int>("gp_num_threads", o.gp_num_threads, 1, 1024);
+  o.filter_max_angle_error =
+      reader.Get<double>("filter_max_angle_error", o.filter_max_angle_error, 1e-3, 180.0);
+  o.filter_max_reproj_error =
+      reader.Get<double>("filter_max_reproj_error", o.filter_max_reproj_error, 1e-3, 1000.0);
+  o.filter_min_tri_angle =
+      reader.Get<double>("filter_min_tri_angle", o.filter_min_tri_angle, 0.0, 90.0);
+  o.min_num_observations_per_image = reader.Get<int>(
+      "min_num_observations_per_image", o.min_num_observations_per_image, 0, 100000000);
+  o.ba_num_rounds = reader.Get<int>("ba_num_rounds", o.ba_num_rounds, 1, 100);
+  o.ba_max_num_iterations =
+      reader.Get<int>("ba_max_num_iterations", o.ba_max_num_iterations, 1, 10000);
+  o.ba_refine_focal_length = reader.GetBool("ba_refine_focal_length", o.ba_refine_focal_length);
+  o.ba_refine_principal_point =
+      reader.GetBool("ba_refine_principal_point", o.ba_refine_principal_point);
+  o.ba_refine_extra_params = reader.GetBool("ba_refine_extra_params", o.ba_refine_extra_params);
+  o.retriangulate = reader.GetBool("retriangulate", o.retriangulate);
+  o.tri_max_error = reader.Get<double>("tri_max_error", o.tri_max_error, 1e-3, 1000.0);
+  o.tri_min_angle = reader.Get<double>("tri_min_angle", o.tri_min_angle, 0.0, 90.0);
+  o.min_model_size = reader.Get<int>("min_model_size", o.min_model_size, 2, 1000000);
+  o.seed = reader.Get<int>("seed", o.seed, 0, std::numeric_limits<int>::max());
+  reader.Finish();
+  return o;
+}
+
+nlohmann::json GlobalMapperOptions::ToJson() const {
+  return {{"min_num_matches", min_num_matches},
+          {"estimate_focal_length", estimate_focal_length},
+          {"filter_view_graph", filter_view_graph},
+          {"view_graph_max_cycle_error", view_graph_max_cycle_error},
+          {"ra_num_l1_iterations", ra_num_l1_iterations},
+          {"ra_max_num_iterations", ra_max_num_iterations},
+          {"ra_robust_sigma", ra_robust_sigma},
+          {"ra_max_residual", ra_max_residual},
+          {"tracks_min_length", tracks_min_length},
+          {"tracks_max_per_image", tracks_max_per_image},
+          {"gp_max_num_iterations", gp_max_num_iterations},
+          {"gp_huber_threshold", gp_huber_threshold},
+          {"gp_num_threads", gp_num_threads},
+          {"filter_max_angle_error", filter_max_angle_error},
+          {"filter_max_reproj_error", filter_max_reproj_error},
+          {"filter_min_tri_angle", filter_min_tri_angle},
+          {"min_num_observations_per_image", min_num_observations_per_image},
+          {"ba_num_rounds", ba_num_rounds},
+          {"ba_max_num_iterations", ba_max_num_iterations},
+          {"ba_refine_focal_length", ba_refine_focal_length},
+          {"ba_refine_principal_point", ba_refine_principal_point},
+          {"ba_refine_extra_params", ba_refine_extra_params},
+          {"retriangulate", retriangulate},
+          {"tri_max_error", tri_max_error},
+          {"tri_min_angle", tri_min_angle},
+          {"min_model_size", min_model_size},
+          {"seed", seed}};
+}
+
+}  // namespace tessera

@@ -1,0 +1,191 @@
+#include "tessera/sfm/global_mapper.h"
+
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <set>
+
+#include "eval/evaluation.h"
+#include "synthetic_scene.h"
+#include "tessera/io/model_statistics.h"
+#include "test_support.h"
+
+namespace tessera {
+namespace {
+
+using testing::MakeSyntheticScene;
+using testing::SyntheticScene;
+using testing::SyntheticSceneOptions;
+
+const BundleAdjuster& Adjuster() {
+  static const auto adjuster =
+      testing::LoadBundledPlugin<BundleAdjuster>("bundle_adjuster", "ceres", {{"num_threads", 1}});
+  return testing::Unguarded(adjuster);
+}
+
+// Every point's track sees one true point, and every keypoint linked to a point is in
+// its track.
+void ExpectConsistentAndTrue(const SyntheticScene& scene, const Reconstruction& model) {
+  size_t num_wrong = 0, num_observations = 0;
+  for (const auto& [point3D_id, point3D] : model.points3D) {
+    std::set<int> true_points;
+    EXPECT_GE(point3D.track.size(), 2u);
+    EXPECT_GE(point3D.error, 0);
+    for (const TrackElement& element : point3D.track) {
+      true_points.insert(scene.true_point_of_keypoint.at(element.image_id)[element.point2D_idx]);
+      EXPECT_EQ(model.images.at(element.image_id).points2D.at(element.point2D_idx).point3D_id,
+                point3D_id);
+      ++num_observations;
+    }
+    if (true_points.size() != 1 || *true_points.begin() < 0) ++num_wrong;
+  }
+  size_t num_linked = 0;
+  for (const auto& [image_id, image] : model.images) {
+    EXPECT_TRUE(image.registered);
+    for (const Point2D& point2D : image.points2D) num_linked += point2D.HasPoint3D();
+  }
+  EXPECT_EQ(num_linked, num_observations);
+  EXPECT_LE(num_wrong, model.points3D.size() / 500) << "points whose track mixes true points";
+}
+
+// Adds `other`'s images and pairs to `scene`, ids shifted by `offset`; nothing matches
+// across the two.
+void AppendScene(const SyntheticScene& other, image_t offset, const std::string& prefix,
+                 SyntheticScene* scene) {
+  for (const auto& [image_id, image] : other.input.images) {
+    Image shifted = image;
+    shifted.image_id = image_id + offset;
+    shifted.name = prefix + image.name;
+    scene->input.images[shifted.image_id] = shifted;
+    scene->true_cam_from_world[shifted.image_id] = other.true_cam_from_world.at(image_id);
+    scene->true_point_of_keypoint[shifted.image_id] = other.true_point_of_keypoint.at(image_id);
+  }
+  for (MapperInput::Pair pair : other.input.pairs) {
+    pair.image_id1 += offset;
+    pair.image_id2 += offset;
+    scene->input.pairs.push_back(pair);
+  }
+}
+
+TEST(GlobalMapper, MapsThirtyImagesOfASyntheticScene) {
+  SyntheticSceneOptions options;
+  options.num_images = 30;
+  options.outlier_ratio = 0.02;
+  options.seed = 11;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const GlobalMapperResult result = GlobalMapper::Reconstruct(scene.input, Adjuster(), {});
+  ASSERT_EQ(result.models.size(), 1u);
+  const Reconstruction& model = result.models[0];
+  EXPECT_EQ(model.images.size(), 30u);
+  EXPECT_TRUE(result.unregistered_reasons.empty());
+  EXPECT_FALSE(result.cancelled);
+  EXPECT_GT(result.num_bundle_adjustments, 0);
+  const GlobalMapperResult::StepSeconds& steps = result.step_seconds;
+  EXPECT_GT(steps.positioning, 0);
+  EXPECT_GT(steps.bundle_adjustment, 0);
+  EXPECT_LE(steps.view_graph + steps.rotation_averaging + steps.tracks + steps.positioning +
+                steps.bundle_adjustment + steps.filtering,
+            result.seconds);
+  const EvaluationResult evaluation = EvaluateReconstruction(model, scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  EXPECT_LT(evaluation.rotation_error_max_deg, 0.5);
+  // Cameras 10 units from the scene, 0.5 px noise at 1000 px: as the incremental mapper.
+  EXPECT_LT(evaluation.position_error_max, 0.02);
+  EXPECT_LT(ComputeModelStatistics(model).mean_reprojection_error, 0.8);
+  EXPECT_GT(model.points3D.size(), 0.9 * options.num_points);
+  ExpectConsistentAndTrue(scene, model);
+}
+
+TEST(GlobalMapper, EstimatesAFocalLengthWithoutPrior) {
+  SyntheticSceneOptions options;
+  options.num_images = 20;
+  options.focal_prior = false;
+  options.prior_focal_factor = 1.2;
+  options.arc_deg = 90;
+  options.seed = 12;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const GlobalMapperResult result = GlobalMapper::Reconstruct(scene.input, Adjuster(), {});
+  ASSERT_EQ(result.models.size(), 1u);
+  EXPECT_EQ(result.models[0].images.size(), 20u);
+  EXPECT_NEAR(result.models[0].cameras.at(1).FocalLengthX(), options.focal_length,
+              0.01 * options.focal_length);
+  const EvaluationResult evaluation =
+      EvaluateReconstruction(result.models[0], scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  EXPECT_LT(evaluation.rotation_error_max_deg, 0.5);
+}
+
+TEST(GlobalMapper, DisconnectedScenesBecomeTwoModelsLargestFirst) {
+  SyntheticSceneOptions small_options;
+  small_options.num_images = 6;
+  small_options.seed = 4;
+  SyntheticSceneOptions large_options;
+  large_options.num_images = 9;
+  large_options.seed = 5;
+  SyntheticScene scene = MakeSyntheticScene(small_options);
+  AppendScene(MakeSyntheticScene(large_options), 6, "large_", &scene);
+  // An image that matches nothing, and two that match only each other.
+  Image lonely = scene.input.images.at(1);
+  lonely.image_id = 100;
+  lonely.name = "lonely.png";
+  scene.input.images[100] = lonely;
+  SyntheticSceneOptions pair_options;
+  pair_options.num_images = 2;
+  pair_options.seed = 6;
+  AppendScene(MakeSyntheticScene(pair_options), 200, "pair_", &scene);
+
+  const GlobalMapperResult result = GlobalMapper::Reconstruct(scene.input, Adjuster(), {});
+  ASSERT_EQ(result.models.size(), 2u);
+  EXPECT_EQ(result.models[0].images.size(), 9u);
+  EXPECT_EQ(result.models[0].images.begin()->first, 7u);
+  EXPECT_EQ(result.models[1].images.size(), 6u);
+  for (const Reconstruction& model : result.models) {
+    ExpectConsistentAndTrue(scene, model);
+    const EvaluationResult evaluation = EvaluateReconstruction(model, scene.GroundTruth());
+    ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+    EXPECT_LT(evaluation.rotation_error_max_deg, 0.5);
+    EXPECT_LT(evaluation.position_error_max, 0.02);
+  }
+  ASSERT_EQ(result.unregistered_reasons.size(), 3u);
+  EXPECT_EQ(result.unregistered_reasons.at(100),
+            "no verified pair with at least 15 inlier matches");
+  EXPECT_EQ(result.unregistered_reasons.at(201),
+            "its pairs connect only 2 images, fewer than min_model_size (3)");
+}
+
+TEST(GlobalMapper, StopsWithinASecondOfBeingAsked) {
+  SyntheticSceneOptions options;
+  options.num_images = 20;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  // A whole run polls between the steps and at every step of rotation averaging and
+  // global positioning.
+  int num_polls = 0;
+  const GlobalMapperResult full = GlobalMapper::Reconstruct(scene.input, Adjuster(), {}, [&] {
+    ++num_polls;
+    return false;
+  });
+  ASSERT_EQ(full.models.size(), 1u);
+  ASSERT_GT(num_polls, 15);
+  // Stopped at the first poll, in rotation averaging, in positioning, before the last
+  // bundle adjustments: the run returns at once, with nothing.
+  for (const int stop_at : {1, 4, num_polls / 2, num_polls - 2}) {
+    int polls = 0;
+    std::chrono::steady_clock::time_point asked;
+    const GlobalMapperResult result =
+        GlobalMapper::Reconstruct(scene.input, Adjuster(), {}, [&] {
+          if (++polls < stop_at) return false;
+          if (polls == stop_at) asked = std::chrono::steady_clock::now();
+          return true;
+        });
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
+    EXPECT_TRUE(result.cancelled) << stop_at;
+    EXPECT_TRUE(result.models.empty());
+    EXPECT_TRUE(result.unregistered_reasons.empty());
+    EXPECT_EQ(polls, stop_at) << "polled again after it said stop";
+    EXPECT_LT(seconds, 1.0) << stop_at;
+  }
+}
+
+}  // namespace
+}  // namespace tessera

@@ -1,0 +1,146 @@
+#include "tessera/sfm/global_positioning.h"
+
+#include <ceres/ceres.h>
+
+#include <algorithm>
+#include <memory>
+#include <random>
+
+#include "util/random.h"
+
+namespace tessera {
+namespace {
+
+// d - s (X - c): the unit ray against the scaled camera-to-point vector.
+struct RayResidual {
+  explicit RayResidual(const Eigen::Vector3d& ray) : ray(ray) {}
+  template <typename T>
+  bool operator()(const T* center, const T* point, const T* scale, T* residual) const {
+    for (int k = 0; k < 3; ++k) residual[k] = T(ray[k]) - scale[0] * (point[k] - center[k]);
+    return true;
+  }
+  Eigen::Vector3d ray;
+};
+
+class StopCallback : public ceres::IterationCallback {
+ public:
+  explicit StopCallback(const std::function<bool()>& should_stop) : should_stop_(should_stop) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    if (should_stop_ && should_stop_()) {
+      stopped_ = true;
+      return ceres::SOLVER_ABORT;
+    }
+    return ceres::SOLVER_CONTINUE;
+  }
+  bool stopped() const { return stopped_; }
+
+ private:
+  const std::function<bool()>& should_stop_;
+  bool stopped_ = false;
+};
+
+}  // namespace
+
+GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& cameras,
+                                         const std::map<image_t, Image>& images,
+                                         const std::map<image_t, Eigen::Matrix3d>& R_cam_from_world,
+                                         const std::vector<Track>& tracks,
+                                         const GlobalPositioningOptions& options,
+                                         const std::function<bool()>& should_stop) {
+  GlobalPositioningResult result;
+  RandomEngine engine(options.seed);
+  std::uniform_real_distribution<double> uniform(-options.init_extent, options.init_extent);
+  const auto random_vector = [&] {
+    const double x = uniform(engine), y = uniform(engine), z = uniform(engine);
+    return Eigen::Vector3d(x, y, z);
+  };
+
+  // Centres of the images with an observation; the first stays at the origin.
+  for (const Track& track : tracks) {
+    for (const TrackElement& element : track) {
+      if (R_cam_from_world.count(element.image_id) > 0) {
+        result.centers.emplace(element.image_id, Eigen::Vector3d::Zero());
+      }
+    }
+  }
+  if (result.centers.empty()) return result;
+  for (auto& [image_id, center] : result.centers) {
+    if (image_id != result.centers.begin()->first) center = random_vector();
+  }
+  result.points.resize(tracks.size());
+  for (Eigen::Vector3d& point : result.points) point = random_vector();
+
+  ceres::Problem::Options problem_options;
+  problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(problem_options);
+  ceres::HuberLoss loss(options.huber_threshold);
+  size_t num_observations = 0;
+  for (const Track& track : tracks) num_observations += track.size();
+  std::vector<double> scales;
+  scales.reserve(num_observations);  // the blocks' addresses must not move
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (size_t t = 0; t < tracks.size(); ++t) {
+    for (const TrackElement& element : tracks[t]) {
+      const auto rotation = R_cam_from_world.find(element.image_id);
+      if (rotation == R_cam_from_world.end()) continue;
+      const Image& image = images.at(element.image_id);
+      const Camera& camera = cameras.at(image.camera_id);
+      const Eigen::Vector3d ray_in_cam =
+          camera.CamFromImg(image.points2D.at(element.point2D_idx).xy).homogeneous().normalized();
+      const Eigen::Vector3d ray = rotation->second.transpose() * ray_in_cam;
+      scales.push_back(1.0);
+      double* center = result.centers.at(element.image_id).data();
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<RayResidual, 3, 3, 3, 1>(new RayResidual(ray)), &loss,
+          center, result.points[t].data(), &scales.back());
+      problem.SetParameterLowerBound(&scales.back(), 0, 1e-5);
+      ordering->AddElementToGroup(&scales.back(), 0);
+      ordering->AddElementToGroup(result.points[t].data(), 1);
+      ordering->AddElementToGroup(center, 2);
+    }
+  }
+  if (problem.NumResidualBlocks() == 0) return result;
+  problem.SetParameterBlockConstant(result.centers.begin()->second.data());
+
+  ceres::Solver::Options solver_options;
+  solver_options.max_num_iterations = options.max_num_iterations;
+  solver_options.function_tolerance = options.function_tolerance;
+  solver_options.num_threads = options.num_threads;
+  solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
+  solver_options.linear_solver_ordering = ordering;
+  std::string why;
+  if (!solver_options.IsValid(&why)) {
+    solver_options.linear_solver_type = ceres::ITERATIVE_SCHUR;
+    solver_options.preconditioner_type = ceres::SCHUR_JACOBI;
+  }
+  StopCallback callback(should_stop);
+  solver_options.callbacks.push_back(&callback);
+  solver_options.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, &problem, &summary);
+  result.num_iterations = static_cast<int>(summary.iterations.size());
+  result.initial_cost = summary.initial_cost;
+  result.final_cost = summary.final_cost;
+  result.cancelled = callback.stopped();
+  result.usable = summary.IsSolutionUsable() && !result.cancelled;
+
+  // Scale: the median camera-to-point distance over the observations becomes 1.
+  std::vector<double> distances;
+  for (size_t t = 0; t < tracks.size(); ++t) {
+    for (const TrackElement& element : tracks[t]) {
+      const auto center = result.centers.find(element.image_id);
+      if (center != result.centers.end()) {
+        distances.push_back((result.points[t] - center->second).norm());
+      }
+    }
+  }
+  std::nth_element(distances.begin(), distances.begin() + distances.size() / 2, distances.end());
+  const double median = distances[distances.size() / 2];
+  if (median > 0 && std::isfinite(median)) {
+    for (auto& [image_id, center] : result.centers) center /= median;
+    for (Eigen::Vector3d& point : result.points) point /= median;
+  }
+  return result;
+}
+
+}  // namespace tessera

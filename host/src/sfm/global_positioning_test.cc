@@ -1,0 +1,97 @@
+#include "tessera/sfm/global_positioning.h"
+
+#include <gtest/gtest.h>
+
+#include "geometry/similarity_transform.h"
+#include "tessera/sfm/feature_tracks.h"
+#include "synthetic_scene.h"
+
+namespace tessera {
+namespace {
+
+using testing::MakeSyntheticScene;
+using testing::SyntheticScene;
+using testing::SyntheticSceneOptions;
+
+std::vector<Track> TracksOf(const SyntheticScene& scene) {
+  std::vector<ImagePairMatches> pairs;
+  for (const MapperInput::Pair& pair : scene.input.pairs) {
+    pairs.push_back({pair.image_id1, pair.image_id2, pair.geometry.inlier_matches});
+  }
+  std::map<image_t, size_t> num_points2D;
+  for (const auto& [image_id, image] : scene.input.images) {
+    num_points2D[image_id] = image.points2D.size();
+  }
+  return BuildFeatureTracks(pairs, num_points2D).tracks;
+}
+
+std::map<image_t, Eigen::Matrix3d> TrueRotations(const SyntheticScene& scene) {
+  std::map<image_t, Eigen::Matrix3d> rotations;
+  for (const auto& [image_id, cam_from_world] : scene.true_cam_from_world) {
+    rotations[image_id] = cam_from_world.rotation.toRotationMatrix();
+  }
+  return rotations;
+}
+
+// Largest distance between an estimated centre, aligned to the truth by a similarity,
+// and the true one.
+double MaxCenterError(const SyntheticScene& scene, const std::map<image_t, Eigen::Vector3d>& centers) {
+  std::vector<Eigen::Vector3d> src, dst;
+  for (const auto& [image_id, center] : centers) {
+    src.push_back(center);
+    dst.push_back(scene.true_cam_from_world.at(image_id).Inverse().translation);
+  }
+  const Similarity3d true_from_estimate = EstimateSimilarity(src, dst);
+  double max_error = 0;
+  for (size_t i = 0; i < src.size(); ++i) {
+    max_error = std::max(max_error, (true_from_estimate * src[i] - dst[i]).norm());
+  }
+  return max_error;
+}
+
+TEST(GlobalPositioning, ExactRotationsGiveTheCentresFromARandomStart) {
+  SyntheticSceneOptions options;
+  options.num_images = 12;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const std::vector<Track> tracks = TracksOf(scene);
+  ASSERT_GT(tracks.size(), 1000u);
+  const GlobalPositioningResult result =
+      PositionGlobally(scene.input.cameras, scene.input.images, TrueRotations(scene), tracks, {});
+  ASSERT_TRUE(result.usable);
+  ASSERT_EQ(result.centers.size(), 12u);
+  EXPECT_EQ(result.centers.begin()->second, Eigen::Vector3d::Zero());
+  // The cameras stand 10 units from the scene: a few hundredths is a good start for BA.
+  EXPECT_LT(MaxCenterError(scene, result.centers), 0.05);
+}
+
+TEST(GlobalPositioning, APathOfCamerasSeeingLocalStretches) {
+  SyntheticSceneOptions options;
+  options.layout = SyntheticSceneOptions::Layout::kPath;
+  options.num_images = 30;
+  options.num_points = 40 * 30;
+  options.max_pair_gap = 10;
+  options.seed = 3;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const GlobalPositioningResult result = PositionGlobally(
+      scene.input.cameras, scene.input.images, TrueRotations(scene), TracksOf(scene), {});
+  ASSERT_TRUE(result.usable);
+  ASSERT_EQ(result.centers.size(), 30u);
+  // The path is 29 units long.
+  EXPECT_LT(MaxCenterError(scene, result.centers), 0.1);
+}
+
+TEST(GlobalPositioning, StopsWithinAnIteration) {
+  SyntheticSceneOptions options;
+  options.num_images = 8;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  int polls = 0;
+  const GlobalPositioningResult result =
+      PositionGlobally(scene.input.cameras, scene.input.images, TrueRotations(scene),
+                       TracksOf(scene), {}, [&polls] { return ++polls > 2; });
+  EXPECT_TRUE(result.cancelled);
+  EXPECT_FALSE(result.usable);
+  EXPECT_LE(result.num_iterations, 4);
+}
+
+}  // namespace
+}  // namespace tessera
