@@ -6,6 +6,7 @@
 #include <set>
 
 #include "eval/evaluation.h"
+#include "geometry/essential_matrix.h"
 #include "synthetic_scene.h"
 #include "tessera/io/model_statistics.h"
 #include "test_support.h"
@@ -151,6 +152,48 @@ TEST(GlobalMapper, DisconnectedScenesBecomeTwoModelsLargestFirst) {
             "no verified pair with at least 15 inlier matches");
   EXPECT_EQ(result.unregistered_reasons.at(201),
             "its pairs connect only 2 images, fewer than min_model_size (3)");
+}
+
+TEST(GlobalMapper, AnImageWhosePairsAllHaveWrongRotations) {
+  SyntheticSceneOptions options;
+  options.num_images = 12;
+  options.seed = 13;
+  SyntheticScene scene = MakeSyntheticScene(options);
+  // Every pair of image 12 says it is turned by 30 degrees more than it is, each about
+  // another axis (one turn for all would be a consistent rotation of image 12).
+  int k = 0;
+  for (MapperInput::Pair& pair : scene.input.pairs) {
+    if (pair.image_id2 != 12) continue;
+    const double axis_angle = 2 * M_PI * k++ / 11;
+    const Eigen::Vector3d axis(std::cos(axis_angle), std::sin(axis_angle), 0.5);
+    const Eigen::Quaterniond turn(Eigen::AngleAxisd(30 * M_PI / 180, axis.normalized()));
+    pair.geometry.cam2_from_cam1.rotation = turn * pair.geometry.cam2_from_cam1.rotation;
+    pair.geometry.E = EssentialMatrixFromPose(pair.geometry.cam2_from_cam1);
+  }
+  // The rotation cycles drop all but one of its pairs (an edge whose triangles all hold
+  // dropped ones stays); that one gives it a wrong rotation, which positioning and bundle
+  // adjustment then correct through its points.
+  const GlobalMapperResult filtered = GlobalMapper::Reconstruct(scene.input, Adjuster(), {});
+  EXPECT_EQ(filtered.num_pairs_dropped_by_cycles, 10u);
+  ASSERT_EQ(filtered.models.size(), 1u);
+  EXPECT_EQ(filtered.models[0].images.size(), 12u);
+  const EvaluationResult filtered_evaluation =
+      EvaluateReconstruction(filtered.models[0], scene.GroundTruth());
+  ASSERT_TRUE(filtered_evaluation.aligned) << filtered_evaluation.error;
+  EXPECT_LT(filtered_evaluation.rotation_error_max_deg, 0.5);
+  // Without them, rotation averaging drops the same pairs, with the same outcome.
+  GlobalMapperOptions unfiltered_options;
+  unfiltered_options.filter_view_graph = false;
+  const GlobalMapperResult unfiltered =
+      GlobalMapper::Reconstruct(scene.input, Adjuster(), unfiltered_options);
+  EXPECT_EQ(unfiltered.num_pairs_dropped_by_cycles, 0u);
+  EXPECT_EQ(unfiltered.num_pairs_dropped_by_rotation_averaging, 10u);
+  ASSERT_EQ(unfiltered.models.size(), 1u);
+  EXPECT_EQ(unfiltered.models[0].images.size(), 12u);
+  const EvaluationResult evaluation =
+      EvaluateReconstruction(unfiltered.models[0], scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  EXPECT_LT(evaluation.rotation_error_max_deg, 0.5);
 }
 
 TEST(GlobalMapper, StopsWithinASecondOfBeingAsked) {
