@@ -15,6 +15,7 @@ CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions&) {
   struct GuiArguments {
     std::string images, output, manifest, model, masks, screenshot;
     int frames = 3, width = 1280, height = 800;
+    float ui_scale = 0;
     bool view_only = false;
   };
   auto options = std::make_shared<GuiArguments>();
@@ -34,6 +35,9 @@ CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions&) {
       ->check(AtLeast(1));
   sub->add_option("--width", options->width, "Window width")->check(CLI::Range(200, 8192));
   sub->add_option("--height", options->height, "Window height")->check(CLI::Range(200, 8192));
+  sub->add_option("--ui-scale", options->ui_scale,
+                  "Size of text and widgets (1: 13-pixel text; default: the monitor's scale)")
+      ->check(CLI::Range(0.5, 4.0));
   sub->add_flag("--view-only", options->view_only, "Only the 3D view, without the panels");
   return {sub, [options]() -> int {
 #ifdef TESSERA_HAS_GUI
@@ -46,6 +50,7 @@ CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions&) {
             command.gui.width = options->width;
             command.gui.height = options->height;
             command.gui.view_only = options->view_only;
+            command.gui.ui_scale = options->ui_scale;
             command.screenshot = options->screenshot;
             command.frames = options->frames;
             return gui::RunGui(command);

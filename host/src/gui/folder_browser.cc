@@ -20,7 +20,10 @@ void FolderBrowser::Draw(const std::string& name, PathField* path, WidgetRects* 
   }
   widgets->RecordLastItem(popup);
   if (!ImGui::BeginPopup(popup.c_str())) return;
+  // A long path wraps at 30 lines' height of width (the popup fits its contents).
+  ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + ImGui::GetFontSize() * 30);
   ImGui::TextUnformatted(browse_dir_.string().c_str());
+  ImGui::PopTextWrapPos();
   if (file_extension.empty()) {
     if (ImGui::Button("Choose this folder")) {
       SetPathField(browse_dir_, path);

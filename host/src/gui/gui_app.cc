@@ -5,9 +5,11 @@
 #include <imgui.h>
 #include <imgui_impl_glfw.h>
 #include <imgui_impl_opengl3.h>
+#include <imgui_internal.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 
 #include "gui/gl.h"
@@ -35,9 +37,12 @@ void OnGlfwError(int /*code*/, const char* description) { GlfwError() = descript
 
 GuiApp* AppOf(GLFWwindow* window) { return static_cast<GuiApp*>(glfwGetWindowUserPointer(window)); }
 
-constexpr float kPanelWidth = 420;
-
 }  // namespace
+
+float PanelAutoWidth(float window_width, float font_size) {
+  const float width = std::clamp(0.34f * window_width, 30 * font_size, 48 * font_size);
+  return std::floor(std::min(width, 0.5f * window_width));
+}
 
 // Marks the window as changed on any input; ImGui's own callbacks chain to these.
 void MarkChanged(GLFWwindow* window);
@@ -82,6 +87,14 @@ GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;
   ImGui::StyleColorsDark();
+  float scale = options.ui_scale;
+  if (scale <= 0) {
+    float y_scale = 1;
+    glfwGetWindowContentScale(window_, &scale, &y_scale);
+  }
+  scale = std::clamp(scale, 0.5f, 4.0f);
+  ImGui::GetIO().FontGlobalScale = scale;
+  ImGui::GetStyle().ScaleAllSizes(scale);
   ImGui_ImplGlfw_InitForOpenGL(window_, true);
   ImGui_ImplOpenGL3_Init("#version 330 core");
   renderer_ = std::make_unique<Renderer>();
@@ -152,10 +165,23 @@ bool GuiApp::Step(double max_wait_s) {
 
 void GuiApp::MarkChangedFromInput() { changed_.store(true); }
 
+float GuiApp::UiScale() const { return ImGui::GetIO().FontGlobalScale; }
+
+float GuiApp::PanelWidth() const {
+  int width = 0, height = 0;
+  glfwGetWindowSize(window_, &width, &height);
+  const float font_size = 13 * UiScale();
+  if (panel_width_ > 0) {
+    // A width the user chose, kept within the window as it shrinks.
+    return std::clamp(panel_width_, 20 * font_size, std::max(20 * font_size, 0.8f * width));
+  }
+  return PanelAutoWidth(static_cast<float>(width), font_size);
+}
+
 WidgetRect GuiApp::ViewRect() const {
   int width = 0, height = 0;
   glfwGetWindowSize(window_, &width, &height);
-  const float left = options_.view_only ? 0 : std::min(kPanelWidth, 0.45f * width);
+  const float left = options_.view_only ? 0 : std::min(PanelWidth(), static_cast<float>(width));
   return {left, 0, static_cast<float>(width), static_cast<float>(height)};
 }
 
@@ -206,9 +232,12 @@ void GuiApp::DrawSetupWindow(const RunStatus& status) {
   int width = 0, height = 0;
   glfwGetWindowSize(window_, &width, &height);
   ImGui::SetNextWindowPos(ImVec2(0, 0), ImGuiCond_Always);
-  ImGui::SetNextWindowSize(ImVec2(ViewRect().min_x, static_cast<float>(height)), ImGuiCond_Always);
-  ImGui::Begin("Tessera", nullptr,
-               ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+  // Resizable at its right edge: a width the user drags to is kept (PanelWidth).
+  panel_set_width_ = ViewRect().min_x;
+  ImGui::SetNextWindowSize(ImVec2(panel_set_width_, static_cast<float>(height)), ImGuiCond_Always);
+  ImGui::Begin("Tessera", nullptr, ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoCollapse);
+  if (ImGui::GetWindowWidth() != panel_set_width_) panel_width_ = ImGui::GetWindowWidth();
+  widgets_.Set("setup window", {0, 0, ImGui::GetWindowWidth(), ImGui::GetWindowHeight()});
   setup_->Draw(status, &widgets_);
   ImGui::Separator();
   model_panel_->Draw(&widgets_);
@@ -221,7 +250,11 @@ void GuiApp::DrawSetupWindow(const RunStatus& status) {
   const std::string output = setup_->OutputField();
   match_matrix_->DrawOpenButton(output.empty() ? model_panel_->ModelField() : output, &widgets_);
   ImGui::Separator();
+  // What reaches past the visible area (the log is a child window of its own).
+  const ImGuiWindow* window = ImGui::GetCurrentWindow();
+  panel_overflow_ = std::max(0.0f, window->DC.CursorMaxPos.x - window->WorkRect.Max.x);
   log_pane_->Draw();
+  panel_overflow_ = std::max(panel_overflow_, log_pane_->overflow());
   ImGui::End();
 }
 

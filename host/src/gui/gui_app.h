@@ -45,6 +45,9 @@ struct GuiOptions {
   std::filesystem::path masks;
   int width = 1280;  // window size in screen pixels
   int height = 800;
+  // The size of text and widgets: 1 is ImGui's 13-pixel font; 0: the monitor's content
+  // scale (its DPI against 96).
+  float ui_scale = 0;
   bool view_only = false;  // no panels: the 3D view fills the window
   bool follow_run = true;  // show the model of a run as it grows (a check box)
 };
@@ -119,6 +122,18 @@ class GuiApp {
   std::optional<WidgetRect> Widget(const std::string& name) const { return widgets_.Find(name); }
   // The 3D view's rectangle in window pixels.
   WidgetRect ViewRect() const;
+  // The set-up window's width: its automatic width (PanelAutoWidth) until the user drags
+  // its right edge.
+  float PanelWidth() const;
+  // What the set-up window (its log included) drew this frame reaches past its visible
+  // area by this many pixels (0: nothing is cut off at its right edge).
+  float PanelOverflow() const { return panel_overflow_; }
+  // The texts drawn cut short ("...") in the last frame, and the tooltip shown.
+  const std::vector<std::pair<WidgetRect, std::string>>& ElidedTexts() const {
+    return widgets_.Elided();
+  }
+  const std::string& Tooltip() const { return widgets_.tooltip(); }
+  float UiScale() const;
   std::vector<LogLine> LogLines() const { return log_sink_->Lines(); }
   size_t NumScenePoints() const;
   size_t NumSceneCameras() const;
@@ -166,6 +181,9 @@ class GuiApp {
   size_t frames_drawn_ = 0;
   uint64_t scene_version_ = 0;  // of the run's model last shown
   RunState last_state_ = RunState::kIdle;
+  float panel_width_ = 0;  // set when the user resized the set-up window; 0: automatic
+  float panel_set_width_ = 0;  // the width the last frame asked for
+  float panel_overflow_ = 0;
 
   // The panels (destroyed before the OpenGL context: they hold textures).
   std::unique_ptr<SceneView> view_;
@@ -190,5 +208,9 @@ struct GuiCommandOptions {
   int frames = 3;
 };
 int RunGui(const GuiCommandOptions& options);
+
+// The set-up window's width before the user resizes it: about a third of the window,
+// at least 30 and at most 48 lines of text high, and never more than half the window.
+float PanelAutoWidth(float window_width, float font_size);
 
 }  // namespace tessera::gui

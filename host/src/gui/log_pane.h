@@ -1,10 +1,13 @@
 #pragma once
 
 // The log pane at the bottom of the set-up window: the lines of a LogSink (errors red,
-// warnings yellow), scrolled to the newest whenever a line arrives.
+// warnings yellow), each wrapped to the pane's width (no horizontal scrolling), scrolled
+// to the newest whenever a line arrives. Only the lines in sight are drawn: each line's
+// wrapped height is measured once per pane width.
 
 #include <cstddef>
 #include <memory>
+#include <vector>
 
 #include "gui/log_sink.h"
 
@@ -16,10 +19,16 @@ class LogPane {
 
   // The "Log" heading and a child window filling the rest of the window.
   void Draw();
+  // How far the last frame's lines reached past the pane's visible width (0: none).
+  float overflow() const { return overflow_; }
 
  private:
   std::shared_ptr<const LogSink> sink_;
   size_t lines_seen_ = 0;  // when more arrive, the pane scrolls to the end
+  float wrap_width_ = -1;  // of the heights below
+  std::vector<float> tops_;  // each line's top within the pane; one more: the end
+  float overflow_ = 0;
+  size_t first_line_ = 0;    // the number of lines logged before the first in tops_
 };
 
 }  // namespace tessera::gui

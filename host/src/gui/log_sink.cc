@@ -24,6 +24,12 @@ std::vector<LogLine> LogSink::Lines() const {
   return {lines_.begin(), lines_.end()};
 }
 
+std::vector<LogLine> LogSink::Lines(size_t* version) const {
+  std::lock_guard<std::mutex> lock(lines_mutex_);
+  *version = version_;
+  return {lines_.begin(), lines_.end()};
+}
+
 void LogSink::sink_it_(const spdlog::details::log_msg& message) {
   spdlog::memory_buf_t formatted;
   formatter_->format(message, formatted);

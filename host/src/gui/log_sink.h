@@ -28,6 +28,8 @@ class LogSink : public spdlog::sinks::base_sink<std::mutex> {
   // The lines and their version (the number of lines ever logged).
   size_t Version() const;
   std::vector<LogLine> Lines() const;
+  // The lines and, read with them, the version.
+  std::vector<LogLine> Lines(size_t* version) const;
 
  protected:
   void sink_it_(const spdlog::details::log_msg& message) override;

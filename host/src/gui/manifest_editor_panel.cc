@@ -176,13 +176,16 @@ void ManifestEditorPanel::Draw(WidgetRects* widgets) {
   if (plugins_by_kind_.empty()) FindPlugins();
   // One plugin per slot, from the plugins found on the plugin path; each dropdown shows
   // the plugin the text names now.
+  ImGui::PushItemWidth(-(ImGui::CalcTextSize("bundle_adjuster").x +
+                         ImGui::GetStyle().ItemInnerSpacing.x));
   for (const char* kind : kSlots) DrawSlot(kind, PluginOf(kind));
+  ImGui::PopItemWidth();
   if (ImGui::InputTextMultiline("##manifest json", text_.data(), text_.size(),
                                 ImVec2(-1, ImGui::GetTextLineHeight() * 12))) {
     status_.clear();  // a "valid" or "saved" no longer describes the text
     error_.clear();
   }
-  ImGui::TextDisabled("Run uses this text; saving is optional");
+  HintText("Run uses this text; saving is optional");
   if (ImGui::Button("Check")) Check();
   ImGui::SameLine();
   if (ImGui::Button("Reload")) Load();
@@ -193,7 +196,7 @@ void ManifestEditorPanel::Draw(WidgetRects* widgets) {
   ImGui::InputTextWithHint("##save path", "manifest file to write", save_path_.data(),
                            save_path_.size());
   ErrorText(error_);
-  if (!status_.empty()) ImGui::TextDisabled("%s", status_.c_str());
+  HintText(status_);
 }
 
 }  // namespace tessera::gui

@@ -31,7 +31,7 @@ void MatchMatrixPanel::DrawOpenButton(const fs::path& workspace, WidgetRects* wi
   if (ImGui::Button("Match matrix")) Open(workspace);
   widgets->RecordLastItem("match matrix");
   ImGui::SameLine();
-  ImGui::TextDisabled("of the output folder (else the model's workspace)");
+  FitText("of the output folder (else the model's workspace)", widgets, /*disabled=*/true);
   ErrorText(error_);
 }
 

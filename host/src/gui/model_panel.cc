@@ -57,8 +57,9 @@ void ModelPanel::LoadFolder(size_t index) {
 }
 
 void ModelPanel::Draw(WidgetRects* widgets) {
-  ImGui::TextUnformatted("Open a model (COLMAP folder, workspace or database.db)");
-  ImGui::InputTextWithHint("##model", "model folder", path_.data(), path_.size());
+  FitText("Open a model", widgets);
+  ImGui::InputTextWithHint("##model", "COLMAP folder, workspace or database.db", path_.data(),
+                           path_.size());
   widgets->RecordLastItem("model");
   ImGui::SameLine();
   if (ImGui::Button("Open")) Open(fs::path(path_.data()));
@@ -71,8 +72,7 @@ void ModelPanel::Draw(WidgetRects* widgets) {
   ImGui::SliderFloat("Point size", &view_->point_size, 1, 10, "%.0f px");
   ImGui::SliderFloat("Camera size", &view_->frustum_size, 0.01f, 0.5f, "%.2f");
   if (ImGui::Button("Recentre")) view_->Recentre();
-  ImGui::SameLine();
-  ImGui::TextDisabled("drag: orbit, shift+drag/right: pan, wheel: zoom, click: details");
+  HintText("drag: orbit, shift+drag or right button: pan, wheel: zoom, click: details");
 }
 
 void ModelPanel::DrawModelChoice() {

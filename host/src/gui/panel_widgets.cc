@@ -2,6 +2,7 @@
 
 #include <imgui.h>
 
+#include <algorithm>
 #include <cstring>
 
 namespace tessera::gui {
@@ -24,6 +25,45 @@ void HintText(const std::string& text) {
   ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
   ImGui::TextWrapped("%s", text.c_str());
   ImGui::PopStyleColor();
+}
+
+std::string ElideToWidth(const std::string& text, float width) {
+  if (ImGui::CalcTextSize(text.c_str()).x <= width) return text;
+  const float dots = ImGui::CalcTextSize("...").x;
+  // The longest prefix that fits with the dots (bisection: the width grows with it).
+  size_t low = 0, high = text.size();
+  while (low < high) {
+    const size_t mid = (low + high + 1) / 2;
+    const char* end = text.c_str() + mid;
+    if (ImGui::CalcTextSize(text.c_str(), end).x + dots <= width) {
+      low = mid;
+    } else {
+      high = mid - 1;
+    }
+  }
+  // Not inside a UTF-8 sequence.
+  while (low > 0 && (static_cast<unsigned char>(text[low]) & 0xC0) == 0x80) --low;
+  return text.substr(0, low) + "...";
+}
+
+void FitText(const std::string& text, WidgetRects* widgets, bool disabled) {
+  const float width = std::max(0.0f, ImGui::GetContentRegionAvail().x);
+  const std::string shown = ElideToWidth(text, width);
+  if (disabled) ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+  ImGui::TextUnformatted(shown.c_str());
+  if (disabled) ImGui::PopStyleColor();
+  if (shown == text) return;
+  const ImVec2 min = ImGui::GetItemRectMin();
+  const ImVec2 max = ImGui::GetItemRectMax();
+  if (widgets != nullptr) widgets->AddElided({min.x, min.y, max.x, max.y}, text);
+  if (ImGui::IsItemHovered()) {
+    ImGui::BeginTooltip();
+    ImGui::PushTextWrapPos(ImGui::GetFontSize() * 40);
+    ImGui::TextUnformatted(text.c_str());
+    ImGui::PopTextWrapPos();
+    ImGui::EndTooltip();
+    if (widgets != nullptr) widgets->set_tooltip(text);
+  }
 }
 
 }  // namespace tessera::gui

@@ -1,11 +1,14 @@
 #pragma once
 
 // Small pieces the panels share: the text buffer of a path field (ImGui edits a char
-// array in place), a message line in red and a greyed hint.
+// array in place), a message line in red, a greyed hint and a line of text that is cut
+// to the width left ("...") with the whole text in a tooltip.
 
 #include <array>
 #include <filesystem>
 #include <string>
+
+#include "gui/widget_rects.h"
 
 namespace tessera::gui {
 
@@ -19,5 +22,14 @@ void ErrorText(const std::string& text);
 
 // Draws `text` wrapped, greyed (a description or hint); nothing when it is empty.
 void HintText(const std::string& text);
+
+// Draws `text` on one line, elided with "..." when wider than the space left on the line;
+// an elided text shows the whole of it in a tooltip while hovered (recorded in `widgets`:
+// WidgetRects::Elided, WidgetRects::tooltip). `disabled`: greyed.
+void FitText(const std::string& text, WidgetRects* widgets, bool disabled = false);
+
+// `text` cut to `width` pixels of the current font, with "..." at the end; unchanged when
+// it fits.
+std::string ElideToWidth(const std::string& text, float width);
 
 }  // namespace tessera::gui

@@ -40,7 +40,7 @@ std::string FormatSeconds(double seconds) {
 }
 
 // A bar per stage: done/total, and once known the rate and the time left.
-void DrawStageProgress(const std::vector<StageProgress>& stages) {
+void DrawStageProgress(const std::vector<StageProgress>& stages, WidgetRects* widgets) {
   for (const StageProgress& stage : stages) {
     const float fraction =
         stage.total == 0 ? 1.0f : static_cast<float>(stage.done) / static_cast<float>(stage.total);
@@ -51,9 +51,12 @@ void DrawStageProgress(const std::vector<StageProgress>& stages) {
       overlay += rate;
       if (stage.done < stage.total) overlay += ", " + FormatSeconds(stage.remaining_s) + " left";
     }
-    ImGui::ProgressBar(fraction, ImVec2(-80, 0), overlay.c_str());
+    const float name_width = ImGui::GetFontSize() * 6;
+    ImGui::ProgressBar(fraction, ImVec2(-name_width, 0), overlay.c_str());
+    // The overlay is cut at the bar's ends: the whole of it in a tooltip.
+    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s: %s", stage.stage.c_str(), overlay.c_str());
     ImGui::SameLine();
-    ImGui::TextUnformatted(stage.stage.c_str());
+    FitText(stage.stage, widgets);
   }
 }
 
@@ -138,11 +141,15 @@ void SetupPanel::Draw(const RunStatus& status, WidgetRects* widgets) {
   DrawFields(widgets);
   editor_.Draw(widgets);
   DrawRunButtons(status, running, widgets);
-  DrawStageProgress(status.stages);
+  DrawStageProgress(status.stages, widgets);
 }
 
 void SetupPanel::DrawFields(WidgetRects* widgets) {
-  ImGui::PushItemWidth(-110);
+  // Room for the longest label and the browse button, in the font's size.
+  const ImGuiStyle& style = ImGui::GetStyle();
+  ImGui::PushItemWidth(-(ImGui::CalcTextSize("Manifest").x + ImGui::CalcTextSize("...").x +
+                         2 * style.FramePadding.x + 2 * style.ItemInnerSpacing.x +
+                         style.ItemSpacing.x));
   // A field's message is about the text that was checked: editing the field clears it.
   if (ImGui::InputTextWithHint("Images", "folder of photographs", images_.data(), images_.size())) {
     images_error_.clear();
@@ -183,7 +190,6 @@ void SetupPanel::DrawRunButtons(const RunStatus& status, bool running, WidgetRec
   widgets->RecordLastItem("cancel");
   ImGui::SameLine();
   ImGui::Text("%s", RunStateName(status.state));
-  ImGui::SameLine();
   ImGui::Checkbox("show the model growing", &follow_run_);
   if (status.state == RunState::kFailed || !error_.empty()) {
     ErrorText(error_.empty() ? status.error : error_);

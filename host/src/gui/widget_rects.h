@@ -6,6 +6,8 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace tessera::gui {
 
@@ -19,14 +21,26 @@ struct WidgetRect {
 class WidgetRects {
  public:
   // Forgets every rectangle (a new frame records them again).
-  void Clear() { rects_.clear(); }
+  void Clear() {
+    rects_.clear();
+    elided_.clear();
+    tooltip_.clear();
+  }
   // Records ImGui's last item under `name`.
   void RecordLastItem(const std::string& name);
   void Set(const std::string& name, const WidgetRect& rect) { rects_[name] = rect; }
   std::optional<WidgetRect> Find(const std::string& name) const;
+  // The texts drawn cut short ("...") this frame, with their whole text (FitText).
+  void AddElided(const WidgetRect& rect, const std::string& text) { elided_.emplace_back(rect, text); }
+  const std::vector<std::pair<WidgetRect, std::string>>& Elided() const { return elided_; }
+  // The text of the tooltip shown this frame for an elided text; empty when none.
+  void set_tooltip(const std::string& text) { tooltip_ = text; }
+  const std::string& tooltip() const { return tooltip_; }
 
  private:
   std::map<std::string, WidgetRect> rects_;
+  std::vector<std::pair<WidgetRect, std::string>> elided_;
+  std::string tooltip_;
 };
 
 }  // namespace tessera::gui

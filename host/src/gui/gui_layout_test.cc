@@ -1,0 +1,108 @@
+// Issue 30 item 5: the set-up window at 1024x640 and 1920x1080 pixels and at twice the
+// font size: a sensible width, nothing drawn past its right edge (the log wraps), every
+// text cut short showing the whole of it in a tooltip, and a width the user can drag.
+
+#include <spdlog/spdlog.h>
+
+#include <string>
+
+#include "gui/gui_window_test_fixture.h"
+
+namespace tessera::gui {
+namespace {
+namespace fs = std::filesystem;
+
+class GuiLayoutTest : public GuiWindowTest {
+ protected:
+  // A window with long text everywhere: a deep image folder, the manifest editor open,
+  // a long log line and a model of the sample's folder names.
+  void CheckLayout(int width, int height, float ui_scale) {
+    SCOPED_TRACE(std::to_string(width) + "x" + std::to_string(height) + " at scale " +
+                 std::to_string(ui_scale));
+    GuiOptions options;
+    options.width = width;
+    options.height = height;
+    options.ui_scale = ui_scale;
+    options.images = dir_.path() / std::string(150, 'i') / "images";
+    GuiApp app(options);
+    spdlog::info("a log line longer than any panel: {}", std::string(300, 'x'));
+    app.Frame();
+    app.Frame();
+    CheckTooltips(&app, height);
+    EXPECT_EQ(app.PanelOverflow(), 0.0f);
+    Click(&app, "manifest editor");
+    app.Frame();
+    app.Frame();
+    const float font = 13 * ui_scale;
+    const float panel = app.PanelWidth();
+    std::printf("%dx%d, scale %.1f: the set-up window is %.0f px wide, %zu texts elided\n", width,
+                height, ui_scale, panel, app.ElidedTexts().size());
+    EXPECT_GE(panel, std::min(30 * font, 0.5f * width));
+    EXPECT_LE(panel, 0.5f * width);
+    EXPECT_EQ(app.ViewRect().min_x, panel);
+    EXPECT_EQ(app.Widget("setup window")->max_x, panel);
+    EXPECT_EQ(app.PanelOverflow(), 0.0f);
+    CheckTooltips(&app, height);
+  }
+
+  // Every text cut short and in sight shows the whole of it when hovered.
+  static void CheckTooltips(GuiApp* app, int height) {
+    const auto elided = app->ElidedTexts();
+    for (const auto& [rect, text] : elided) {
+      if (rect.max_y > static_cast<float>(height)) continue;  // scrolled out of sight
+      SyntheticInput input;
+      input.x = rect.CenterX();
+      input.y = rect.CenterY();
+      app->Frame(&input);
+      app->Frame(&input);
+      EXPECT_EQ(app->Tooltip(), text);
+      ++tooltips_checked_;
+    }
+  }
+  static inline int tooltips_checked_ = 0;
+};
+
+TEST_F(GuiLayoutTest, SetUpWindowFitsAt1024And1920PixelsAndTwiceTheFont) {
+  CheckLayout(1024, 640, 1);
+  CheckLayout(1920, 1080, 1);
+  CheckLayout(1920, 1080, 2);
+  EXPECT_GT(tooltips_checked_, 0);  // at 1024 pixels, something is cut short
+}
+
+TEST_F(GuiLayoutTest, TheWidthScalesWithTheWindowAndTheFont) {
+  EXPECT_LT(PanelAutoWidth(1024, 13), PanelAutoWidth(1920, 13));
+  EXPECT_LT(PanelAutoWidth(1920, 13), PanelAutoWidth(1920, 20));
+  EXPECT_EQ(PanelAutoWidth(640, 13), 320);  // never more than half the window
+}
+
+TEST_F(GuiLayoutTest, DraggingTheRightEdgeResizesTheSetUpWindow) {
+  GuiOptions options;
+  options.width = 1280;
+  options.height = 800;
+  options.ui_scale = 1;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  const float before = app.PanelWidth();
+  // Press on the right edge, drag 200 pixels right, release.
+  SyntheticInput input;
+  input.x = before - 1;
+  input.y = 300;
+  app.Frame(&input);
+  app.Frame(&input);
+  input.left_down = true;
+  app.Frame(&input);
+  for (int step = 1; step <= 4; ++step) {
+    input.x = before - 1 + 50.0f * static_cast<float>(step);
+    app.Frame(&input);
+  }
+  input.left_down = false;
+  app.Frame(&input);
+  app.Frame();
+  EXPECT_NEAR(app.PanelWidth(), before + 200, 2);
+  EXPECT_NEAR(app.ViewRect().min_x, before + 200, 2);
+  EXPECT_EQ(app.PanelOverflow(), 0.0f);
+}
+
+}  // namespace
+}  // namespace tessera::gui
