@@ -54,6 +54,8 @@ TEST(Cli, PluginsJsonListsEveryBundledPluginWithKindAndVersion) {
                                                        {"window_anchor", "pair_selector"},
                                                        {"spatial", "pair_selector"},
                                                        {"retrieval", "pair_selector"},
+                                                       {"incremental", "mapper"},
+                                                       {"global", "mapper"},
                                                        {"ceres", "bundle_adjuster"},
                                                        {"colmap_binary", "exporter"},
                                                        {"colmap_text", "exporter"},
@@ -64,7 +66,7 @@ TEST(Cli, PluginsJsonListsEveryBundledPluginWithKindAndVersion) {
     ASSERT_TRUE(kinds.count(name)) << "bundled plugin '" << name << "' not listed";
     EXPECT_EQ(kinds[name], kind) << name;
   }
-  EXPECT_EQ(kinds.size(), 16u) << result.output;
+  EXPECT_EQ(kinds.size(), 18u) << result.output;
 }
 
 TEST(Cli, PluginsMarksRefusedFilesWithWhy) {

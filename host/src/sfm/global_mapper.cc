@@ -113,6 +113,319 @@ size_t NumObservationsOf(const Reconstruction& model) {
 
 }  // namespace
 
+namespace {
+
+// What mapping one connected part of the view graph shares with the whole run.
+struct PartRun {
+  const MapperInput& input;
+  const std::map<camera_t, Camera>& cameras;
+  const GlobalMapperOptions& options;
+  const std::function<bool()>& should_stop;
+  GlobalMapperResult* result;
+  std::map<image_t, std::string>* reasons;
+  std::function<void(double*)> lap;  // adds the time since the last lap to a step
+
+  bool Stop() const { return should_stop && should_stop(); }
+};
+
+enum class PartOutcome { kModel, kNoModel, kCancelled };
+
+// Steps 6 and 7 for one part: its tracks (all in `part_tracks_out`, those positioned
+// chosen among them), global positioning from a random start, and the model of the
+// positioned images and points, filtered by angles.
+PartOutcome PositionPart(const PartRun& run, size_t part_index, const std::set<image_t>& part,
+                         const FeatureTracks& tracks, const RotationAveragingResult& rotations,
+                         std::vector<Track>* part_tracks_out, Reconstruction* model_out) {
+  const MapperInput& input = run.input;
+  const std::map<camera_t, Camera>& cameras = run.cameras;
+  const GlobalMapperOptions& options = run.options;
+  const std::function<bool()>& should_stop = run.should_stop;
+  GlobalMapperResult& result = *run.result;
+  GlobalMapperResult::StepSeconds& steps = result.step_seconds;
+  std::map<image_t, std::string>& reasons = *run.reasons;
+  const auto& lap = run.lap;
+  const auto stop = [&run] { return run.Stop(); };
+  // 6. Tracks of the part and global positioning.
+  std::vector<Track>& part_tracks = *part_tracks_out;
+  for (const Track& track : tracks.tracks) {
+    if (track.empty() || part.count(track.front().image_id) == 0) continue;
+    Track restricted = RestrictTrack(track, part);
+    if (restricted.size() >= 2) part_tracks.push_back(std::move(restricted));
+  }
+  std::vector<Track> positioning_tracks;
+  for (const size_t t :
+       SelectTracks(part_tracks, part, static_cast<size_t>(options.tracks_min_length),
+                    static_cast<size_t>(options.tracks_max_per_image))) {
+    positioning_tracks.push_back(part_tracks[t]);
+  }
+  result.num_tracks_positioned += positioning_tracks.size();
+  lap(&steps.tracks);
+  std::map<image_t, Eigen::Matrix3d> part_rotations;
+  for (const image_t image_id : part) {
+    part_rotations[image_id] = rotations.R_cam_from_world.at(image_id);
+  }
+  GlobalPositioningOptions positioning_options;
+  positioning_options.max_num_iterations = options.gp_max_num_iterations;
+  positioning_options.huber_threshold = options.gp_huber_threshold;
+  positioning_options.num_threads = options.gp_num_threads;
+  positioning_options.seed =
+      DeriveSeed(static_cast<uint64_t>(options.seed), kPositioningStream + part_index);
+  const GlobalPositioningResult positions =
+      PositionGlobally(cameras, input.images, part_rotations, positioning_tracks,
+                       positioning_options, should_stop);
+  if (positions.cancelled || stop()) return PartOutcome::kCancelled;
+  lap(&steps.positioning);
+  spdlog::info(
+      "global map: part {} ({} images): positioned with {} tracks in {} iterations, cost "
+      "{:.3g} -> {:.3g}",
+      part_index, part.size(), positioning_tracks.size(), positions.num_iterations,
+      positions.initial_cost, positions.final_cost);
+  if (!positions.usable) {
+    for (const image_t image_id : part) reasons[image_id] = "global positioning failed";
+    return PartOutcome::kNoModel;
+  }
+
+  // 7. The model: the positioned images and points, filtered by angles.
+  Reconstruction& model = *model_out;
+  for (const image_t image_id : part) {
+    const auto center = positions.centers.find(image_id);
+    if (center == positions.centers.end()) {
+      reasons[image_id] = "no feature track joins it to the other images of its part";
+      continue;
+    }
+    Image image = input.images.at(image_id);
+    for (Point2D& point2D : image.points2D) point2D.point3D_id = kInvalidPoint3DId;
+    const Eigen::Quaterniond rotation(part_rotations.at(image_id));
+    image.cam_from_world = Rigid3d(rotation, rotation * -center->second);
+    image.registered = true;
+    model.cameras[image.camera_id] = cameras.at(image.camera_id);
+    model.images[image_id] = std::move(image);
+  }
+  for (size_t t = 0; t < positioning_tracks.size(); ++t) {
+    Point3D point3D;
+    point3D.xyz = positions.points[t];
+    const point3D_t point3D_id = t + 1;
+    for (const TrackElement& element : positioning_tracks[t]) {
+      Point2D& point2D = model.images.at(element.image_id).points2D.at(element.point2D_idx);
+      if (point2D.HasPoint3D()) continue;
+      point2D.point3D_id = point3D_id;
+      point3D.track.push_back(element);
+    }
+    if (point3D.track.size() >= 2) {
+      model.points3D.emplace(point3D_id, std::move(point3D));
+    } else {
+      for (const TrackElement& element : point3D.track) {
+        model.images.at(element.image_id).points2D.at(element.point2D_idx).point3D_id =
+            kInvalidPoint3DId;
+      }
+    }
+  }
+  const size_t num_by_angle = FilterObservationsByAngle(options.filter_max_angle_error, &model);
+  const size_t num_by_tri_angle =
+      FilterPointsByTriangulationAngle(options.filter_min_tri_angle, &model);
+  RemoveWeakImages(options.min_num_observations_per_image, "after global positioning", &model,
+                   &reasons);
+  spdlog::info(
+      "global map: part {}: {} images, {} points after filtering {} observations by ray angle "
+      "and {} by triangulation angle",
+      part_index, model.images.size(), model.points3D.size(), num_by_angle, num_by_tri_angle);
+  return PartOutcome::kModel;
+}
+
+// Step 8 for one part: rounds of bundle adjustment and filtering, retriangulation of
+// every track of the part, a last adjustment; kModel when the model keeps enough images.
+PartOutcome RefinePart(const PartRun& run, size_t part_index, const BundleAdjuster& bundle_adjuster,
+                       const std::vector<Track>& part_tracks, Reconstruction* model_out) {
+  const GlobalMapperOptions& options = run.options;
+  GlobalMapperResult& result = *run.result;
+  GlobalMapperResult::StepSeconds& steps = result.step_seconds;
+  std::map<image_t, std::string>& reasons = *run.reasons;
+  const auto& lap = run.lap;
+  const auto stop = [&run] { return run.Stop(); };
+  Reconstruction& model = *model_out;
+  // 8. Bundle adjustment and filtering, retriangulation.
+  BundleAdjustmentConfig config;
+  config.refine_focal_length = options.ba_refine_focal_length;
+  config.refine_principal_point = options.ba_refine_principal_point;
+  config.refine_extra_params = options.ba_refine_extra_params;
+  config.max_num_iterations = options.ba_max_num_iterations;
+  bool failed = false;
+  const auto adjust_and_filter = [&](double max_reproj_error, const std::string& when) {
+    if (model.images.size() < 2 || model.points3D.empty()) return;
+    lap(&steps.filtering);
+    const BundleAdjustmentSummary summary = bundle_adjuster.Adjust(config, &model);
+    ++result.num_bundle_adjustments;
+    lap(&steps.bundle_adjustment);
+    spdlog::info("global map: part {}: bundle adjustment {}: {}", part_index, when,
+                 summary.BriefReport());
+    if (!summary.usable) {
+      failed = true;
+      for (const auto& [image_id, image] : model.images) {
+        reasons[image_id] = "bundle adjustment failed: " + summary.message;
+      }
+      return;
+    }
+    const size_t num_by_error = FilterObservationsByReprojectionError(max_reproj_error, &model);
+    const size_t num_by_angle =
+        FilterPointsByTriangulationAngle(options.filter_min_tri_angle, &model);
+    RemoveWeakImages(options.min_num_observations_per_image, when, &model, &reasons);
+    spdlog::info(
+        "global map: part {}: {} observations beyond {:g} px and {} by triangulation angle "
+        "filtered; {} images, {} points, {} observations",
+        part_index, num_by_error, max_reproj_error, num_by_angle, model.images.size(),
+        model.points3D.size(), NumObservationsOf(model));
+  };
+  for (int round = 0; round < options.ba_num_rounds && !failed; ++round) {
+    if (stop()) return PartOutcome::kCancelled;
+    const double factor = std::max(1, options.ba_num_rounds - round);
+    adjust_and_filter(factor * options.filter_max_reproj_error,
+                      "after bundle adjustment round " + std::to_string(round + 1));
+  }
+  if (options.retriangulate && !failed) {
+    if (stop()) return PartOutcome::kCancelled;
+    TrackTriangulationOptions triangulation;
+    triangulation.max_error_px = options.tri_max_error;
+    triangulation.min_angle_deg = options.tri_min_angle;
+    const size_t num_points = TriangulateTracks(part_tracks, triangulation, &model);
+    spdlog::info("global map: part {}: retriangulated {} of {} tracks", part_index, num_points,
+                 part_tracks.size());
+    adjust_and_filter(options.filter_max_reproj_error, "after retriangulation");
+  }
+  if (failed) return PartOutcome::kNoModel;
+  if (model.images.size() < static_cast<size_t>(options.min_model_size)) {
+    for (const auto& [image_id, image] : model.images) {
+      reasons[image_id] = "its model kept only " + std::to_string(model.images.size()) +
+                          " images, fewer than min_model_size (" +
+                          std::to_string(options.min_model_size) + ")";
+    }
+    return PartOutcome::kNoModel;
+  }
+  return PartOutcome::kModel;
+}
+
+// Why each input image is in no model: no verified pair, none kept by the view graph,
+// the part's own reason, else rotation averaging.
+void ExplainUnregistered(const MapperInput& input, const GlobalMapperOptions& options,
+                         const std::set<image_t>& in_verified_pair,
+                         const std::set<image_t>& with_rotation_pair,
+                         const std::map<image_t, std::string>& reasons, GlobalMapperResult* out) {
+  GlobalMapperResult& result = *out;
+  std::set<image_t> in_model;
+  for (const Reconstruction& model : result.models) {
+    for (const auto& [image_id, image] : model.images) in_model.insert(image_id);
+  }
+  for (const auto& [image_id, image] : input.images) {
+    if (in_model.count(image_id) > 0) continue;
+    std::string reason;
+    if (in_verified_pair.count(image_id) == 0) {
+      reason = "no verified pair with at least " + std::to_string(options.min_num_matches) +
+               " inlier matches";
+    } else if (with_rotation_pair.count(image_id) == 0) {
+      reason = "the view graph kept none of its pairs (no relative rotation, or none closing a "
+               "rotation cycle within " + Format(options.view_graph_max_cycle_error) + " deg)";
+    } else if (reasons.count(image_id) > 0) {
+      reason = reasons.at(image_id);
+    } else {
+      reason = "rotation averaging dropped all its pairs (off by more than " +
+               Format(options.ra_max_residual) + " deg)";
+    }
+    result.unregistered_reasons[image_id] = reason;
+  }
+}
+
+// The verified pairs with at least min_num_matches inliers between two input images; the
+// images they join into `in_verified_pair`.
+std::vector<const MapperInput::Pair*> PairsThatMap(const MapperInput& input,
+                                                   const GlobalMapperOptions& options,
+                                                   std::set<image_t>* in_verified_pair) {
+  std::vector<const MapperInput::Pair*> pairs;
+  for (const MapperInput::Pair& pair : input.pairs) {
+    if (!IsVerified(pair.geometry) ||
+        pair.geometry.inlier_matches.size() < static_cast<size_t>(options.min_num_matches) ||
+        input.images.count(pair.image_id1) == 0 || input.images.count(pair.image_id2) == 0 ||
+        pair.image_id1 == pair.image_id2) {
+      continue;
+    }
+    pairs.push_back(&pair);
+    in_verified_pair->insert(pair.image_id1);
+    in_verified_pair->insert(pair.image_id2);
+  }
+  return pairs;
+}
+
+// The input's cameras, those without a prior with the focal length the view graph gives
+// where the pairs determine it (recorded in result->estimated_focal_lengths).
+std::map<camera_t, Camera> CamerasWithFocalLengths(
+    const MapperInput& input, const std::vector<const MapperInput::Pair*>& pairs,
+    const GlobalMapperOptions& options, GlobalMapperResult* result) {
+  std::map<camera_t, Camera> cameras = input.cameras;
+  bool any_without_prior = false;
+  for (const auto& [camera_id, camera] : cameras) {
+    any_without_prior = any_without_prior || !camera.has_prior_focal_length;
+  }
+  if (options.estimate_focal_length && any_without_prior && !pairs.empty()) {
+    for (const auto& [camera_id, estimate] :
+         EstimateFocalLengths(input, pairs, FocalLengthEstimationOptions())) {
+      if (estimate.at_search_bound || estimate.num_pairs == 0) continue;
+      cameras.at(camera_id).SetFocalLength(estimate.focal_length);
+      result->estimated_focal_lengths[camera_id] = estimate.focal_length;
+      spdlog::info("global map: camera {}: focal length {:.1f} px from {} pairs", camera_id,
+                   estimate.focal_length, estimate.num_pairs);
+    }
+  }
+  return cameras;
+}
+
+// Most images first, then most points.
+void SortLargestFirst(std::vector<Reconstruction>* models) {
+  std::stable_sort(models->begin(), models->end(),
+                   [](const Reconstruction& a, const Reconstruction& b) {
+                     if (a.images.size() != b.images.size()) {
+                       return a.images.size() > b.images.size();
+                     }
+                     return a.points3D.size() > b.points3D.size();
+                   });
+}
+
+RotationAveragingOptions RotationOptions(const GlobalMapperOptions& options) {
+  RotationAveragingOptions rotation_options;
+  rotation_options.num_l1_iterations = options.ra_num_l1_iterations;
+  rotation_options.max_num_irls_iterations = options.ra_max_num_iterations;
+  rotation_options.robust_sigma_deg = options.ra_robust_sigma;
+  rotation_options.max_residual_deg = options.ra_max_residual;
+  return rotation_options;
+}
+
+// The points' reprojection errors, and only the cameras of the images kept.
+void FinishModel(Reconstruction* model) {
+  for (auto& [point3D_id, point3D] : model->points3D) {
+    point3D.error = PointReprojectionError(*model, point3D);
+  }
+  std::map<camera_t, Camera> used_cameras;
+  for (const auto& [image_id, image] : model->images) {
+    used_cameras[image.camera_id] = model->cameras.at(image.camera_id);
+  }
+  model->cameras = std::move(used_cameras);
+}
+
+// The relative rotation of every edge the view graph kept, weighted by its inliers,
+// with the pair of each.
+std::vector<RelativeRotation> RelativeRotations(const ViewGraph& view_graph,
+                                                const std::vector<const MapperInput::Pair*>& pairs,
+                                                std::vector<const MapperInput::Pair*>* pair_of_rotation) {
+  std::vector<RelativeRotation> relative_rotations;
+  for (size_t e = 0; e < view_graph.edges().size(); ++e) {
+    const ViewGraphEdge& edge = view_graph.edges()[e];
+    if (!edge.has_rotation || edge.removed) continue;
+    relative_rotations.push_back({edge.image_id1, edge.image_id2, edge.R_cam2_from_cam1,
+                                  static_cast<double>(edge.num_inliers)});
+    pair_of_rotation->push_back(pairs[e]);
+  }
+  return relative_rotations;
+}
+
+}  // namespace
+
 GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
                                              const BundleAdjuster& bundle_adjuster,
                                              const GlobalMapperOptions& options,
@@ -141,37 +454,13 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   if (stop()) return cancelled();
 
   // 1. The pairs that map.
-  std::vector<const MapperInput::Pair*> pairs;
   std::set<image_t> in_verified_pair;
-  for (const MapperInput::Pair& pair : input.pairs) {
-    if (!IsVerified(pair.geometry) ||
-        pair.geometry.inlier_matches.size() < static_cast<size_t>(options.min_num_matches) ||
-        input.images.count(pair.image_id1) == 0 || input.images.count(pair.image_id2) == 0 ||
-        pair.image_id1 == pair.image_id2) {
-      continue;
-    }
-    pairs.push_back(&pair);
-    in_verified_pair.insert(pair.image_id1);
-    in_verified_pair.insert(pair.image_id2);
-  }
+  const std::vector<const MapperInput::Pair*> pairs =
+      PairsThatMap(input, options, &in_verified_pair);
   result.num_verified_pairs = pairs.size();
 
   // 2. Focal lengths of cameras without a prior, from the view graph.
-  std::map<camera_t, Camera> cameras = input.cameras;
-  bool any_without_prior = false;
-  for (const auto& [camera_id, camera] : cameras) {
-    any_without_prior = any_without_prior || !camera.has_prior_focal_length;
-  }
-  if (options.estimate_focal_length && any_without_prior && !pairs.empty()) {
-    for (const auto& [camera_id, estimate] :
-         EstimateFocalLengths(input, pairs, FocalLengthEstimationOptions())) {
-      if (estimate.at_search_bound || estimate.num_pairs == 0) continue;
-      cameras.at(camera_id).SetFocalLength(estimate.focal_length);
-      result.estimated_focal_lengths[camera_id] = estimate.focal_length;
-      spdlog::info("global map: camera {}: focal length {:.1f} px from {} pairs", camera_id,
-                   estimate.focal_length, estimate.num_pairs);
-    }
-  }
+  const std::map<camera_t, Camera> cameras = CamerasWithFocalLengths(input, pairs, options, &result);
   if (stop()) return cancelled();
 
   // 3. The view graph and its rotation-cycle filtering.
@@ -186,22 +475,11 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   lap(&steps.view_graph);
 
   // 4. Rotation averaging.
-  std::vector<RelativeRotation> relative_rotations;
   std::vector<const MapperInput::Pair*> pair_of_rotation;
-  for (size_t e = 0; e < view_graph.edges().size(); ++e) {
-    const ViewGraphEdge& edge = view_graph.edges()[e];
-    if (!edge.has_rotation || edge.removed) continue;
-    relative_rotations.push_back({edge.image_id1, edge.image_id2, edge.R_cam2_from_cam1,
-                                  static_cast<double>(edge.num_inliers)});
-    pair_of_rotation.push_back(pairs[e]);
-  }
-  RotationAveragingOptions rotation_options;
-  rotation_options.num_l1_iterations = options.ra_num_l1_iterations;
-  rotation_options.max_num_irls_iterations = options.ra_max_num_iterations;
-  rotation_options.robust_sigma_deg = options.ra_robust_sigma;
-  rotation_options.max_residual_deg = options.ra_max_residual;
+  const std::vector<RelativeRotation> relative_rotations =
+      RelativeRotations(view_graph, pairs, &pair_of_rotation);
   const RotationAveragingResult rotations =
-      AverageRotations(relative_rotations, rotation_options, should_stop);
+      AverageRotations(relative_rotations, RotationOptions(options), should_stop);
   if (rotations.cancelled || stop()) return cancelled();
   result.num_pairs_dropped_by_rotation_averaging = rotations.num_dropped;
   lap(&steps.rotation_averaging);
@@ -232,6 +510,7 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
       rotations.num_dropped, rotations.num_iterations, result.num_tracks);
 
   std::map<image_t, std::string> reasons;
+  const PartRun run{input, cameras, options, should_stop, &result, &reasons, lap};
   const std::vector<std::set<image_t>> parts = groups.Groups();
   for (size_t part_index = 0; part_index < parts.size(); ++part_index) {
     const std::set<image_t>& part = parts[part_index];
@@ -245,189 +524,22 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
     }
     if (stop()) return cancelled();
 
-    // 6. Tracks of the part and global positioning.
     std::vector<Track> part_tracks;
-    for (const Track& track : tracks.tracks) {
-      if (track.empty() || part.count(track.front().image_id) == 0) continue;
-      Track restricted = RestrictTrack(track, part);
-      if (restricted.size() >= 2) part_tracks.push_back(std::move(restricted));
-    }
-    std::vector<Track> positioning_tracks;
-    for (const size_t t :
-         SelectTracks(part_tracks, part, static_cast<size_t>(options.tracks_min_length),
-                      static_cast<size_t>(options.tracks_max_per_image))) {
-      positioning_tracks.push_back(part_tracks[t]);
-    }
-    result.num_tracks_positioned += positioning_tracks.size();
-    lap(&steps.tracks);
-    std::map<image_t, Eigen::Matrix3d> part_rotations;
-    for (const image_t image_id : part) {
-      part_rotations[image_id] = rotations.R_cam_from_world.at(image_id);
-    }
-    GlobalPositioningOptions positioning_options;
-    positioning_options.max_num_iterations = options.gp_max_num_iterations;
-    positioning_options.huber_threshold = options.gp_huber_threshold;
-    positioning_options.num_threads = options.gp_num_threads;
-    positioning_options.seed =
-        DeriveSeed(static_cast<uint64_t>(options.seed), kPositioningStream + part_index);
-    const GlobalPositioningResult positions =
-        PositionGlobally(cameras, input.images, part_rotations, positioning_tracks,
-                         positioning_options, should_stop);
-    if (positions.cancelled || stop()) return cancelled();
-    lap(&steps.positioning);
-    spdlog::info(
-        "global map: part {} ({} images): positioned with {} tracks in {} iterations, cost "
-        "{:.3g} -> {:.3g}",
-        part_index, part.size(), positioning_tracks.size(), positions.num_iterations,
-        positions.initial_cost, positions.final_cost);
-    if (!positions.usable) {
-      for (const image_t image_id : part) reasons[image_id] = "global positioning failed";
-      continue;
-    }
-
-    // 7. The model: the positioned images and points, filtered by angles.
     Reconstruction model;
-    for (const image_t image_id : part) {
-      const auto center = positions.centers.find(image_id);
-      if (center == positions.centers.end()) {
-        reasons[image_id] = "no feature track joins it to the other images of its part";
-        continue;
-      }
-      Image image = input.images.at(image_id);
-      for (Point2D& point2D : image.points2D) point2D.point3D_id = kInvalidPoint3DId;
-      const Eigen::Quaterniond rotation(part_rotations.at(image_id));
-      image.cam_from_world = Rigid3d(rotation, rotation * -center->second);
-      image.registered = true;
-      model.cameras[image.camera_id] = cameras.at(image.camera_id);
-      model.images[image_id] = std::move(image);
+    PartOutcome outcome =
+        PositionPart(run, part_index, part, tracks, rotations, &part_tracks, &model);
+    if (outcome == PartOutcome::kModel) {
+      outcome = RefinePart(run, part_index, bundle_adjuster, part_tracks, &model);
     }
-    for (size_t t = 0; t < positioning_tracks.size(); ++t) {
-      Point3D point3D;
-      point3D.xyz = positions.points[t];
-      const point3D_t point3D_id = t + 1;
-      for (const TrackElement& element : positioning_tracks[t]) {
-        Point2D& point2D = model.images.at(element.image_id).points2D.at(element.point2D_idx);
-        if (point2D.HasPoint3D()) continue;
-        point2D.point3D_id = point3D_id;
-        point3D.track.push_back(element);
-      }
-      if (point3D.track.size() >= 2) {
-        model.points3D.emplace(point3D_id, std::move(point3D));
-      } else {
-        for (const TrackElement& element : point3D.track) {
-          model.images.at(element.image_id).points2D.at(element.point2D_idx).point3D_id =
-              kInvalidPoint3DId;
-        }
-      }
-    }
-    const size_t num_by_angle = FilterObservationsByAngle(options.filter_max_angle_error, &model);
-    const size_t num_by_tri_angle =
-        FilterPointsByTriangulationAngle(options.filter_min_tri_angle, &model);
-    RemoveWeakImages(options.min_num_observations_per_image, "after global positioning", &model,
-                     &reasons);
-    spdlog::info(
-        "global map: part {}: {} images, {} points after filtering {} observations by ray angle "
-        "and {} by triangulation angle",
-        part_index, model.images.size(), model.points3D.size(), num_by_angle, num_by_tri_angle);
-
-    // 8. Bundle adjustment and filtering, retriangulation.
-    BundleAdjustmentConfig config;
-    config.refine_focal_length = options.ba_refine_focal_length;
-    config.refine_principal_point = options.ba_refine_principal_point;
-    config.refine_extra_params = options.ba_refine_extra_params;
-    config.max_num_iterations = options.ba_max_num_iterations;
-    bool failed = false;
-    const auto adjust_and_filter = [&](double max_reproj_error, const std::string& when) {
-      if (model.images.size() < 2 || model.points3D.empty()) return;
-      lap(&steps.filtering);
-      const BundleAdjustmentSummary summary = bundle_adjuster.Adjust(config, &model);
-      ++result.num_bundle_adjustments;
-      lap(&steps.bundle_adjustment);
-      spdlog::info("global map: part {}: bundle adjustment {}: {}", part_index, when,
-                   summary.BriefReport());
-      if (!summary.usable) {
-        failed = true;
-        for (const auto& [image_id, image] : model.images) {
-          reasons[image_id] = "bundle adjustment failed: " + summary.message;
-        }
-        return;
-      }
-      const size_t num_by_error = FilterObservationsByReprojectionError(max_reproj_error, &model);
-      const size_t num_by_angle =
-          FilterPointsByTriangulationAngle(options.filter_min_tri_angle, &model);
-      RemoveWeakImages(options.min_num_observations_per_image, when, &model, &reasons);
-      spdlog::info(
-          "global map: part {}: {} observations beyond {:g} px and {} by triangulation angle "
-          "filtered; {} images, {} points, {} observations",
-          part_index, num_by_error, max_reproj_error, num_by_angle, model.images.size(),
-          model.points3D.size(), NumObservationsOf(model));
-    };
-    for (int round = 0; round < options.ba_num_rounds && !failed; ++round) {
-      if (stop()) return cancelled();
-      const double factor = std::max(1, options.ba_num_rounds - round);
-      adjust_and_filter(factor * options.filter_max_reproj_error,
-                        "after bundle adjustment round " + std::to_string(round + 1));
-    }
-    if (options.retriangulate && !failed) {
-      if (stop()) return cancelled();
-      TrackTriangulationOptions triangulation;
-      triangulation.max_error_px = options.tri_max_error;
-      triangulation.min_angle_deg = options.tri_min_angle;
-      const size_t num_points = TriangulateTracks(part_tracks, triangulation, &model);
-      spdlog::info("global map: part {}: retriangulated {} of {} tracks", part_index, num_points,
-                   part_tracks.size());
-      adjust_and_filter(options.filter_max_reproj_error, "after retriangulation");
-    }
-    if (failed) continue;
-    if (model.images.size() < static_cast<size_t>(options.min_model_size)) {
-      for (const auto& [image_id, image] : model.images) {
-        reasons[image_id] = "its model kept only " + std::to_string(model.images.size()) +
-                            " images, fewer than min_model_size (" +
-                            std::to_string(options.min_model_size) + ")";
-      }
-      continue;
-    }
-    for (auto& [point3D_id, point3D] : model.points3D) {
-      point3D.error = PointReprojectionError(model, point3D);
-    }
-    // Only the cameras of the images kept.
-    std::map<camera_t, Camera> used_cameras;
-    for (const auto& [image_id, image] : model.images) {
-      used_cameras[image.camera_id] = model.cameras.at(image.camera_id);
-    }
-    model.cameras = std::move(used_cameras);
+    if (outcome == PartOutcome::kCancelled) return cancelled();
+    if (outcome == PartOutcome::kNoModel) continue;
+    FinishModel(&model);
     result.models.push_back(std::move(model));
     lap(&steps.filtering);
   }
 
-  std::stable_sort(result.models.begin(), result.models.end(),
-                   [](const Reconstruction& a, const Reconstruction& b) {
-                     if (a.images.size() != b.images.size()) {
-                       return a.images.size() > b.images.size();
-                     }
-                     return a.points3D.size() > b.points3D.size();
-                   });
-  std::set<image_t> in_model;
-  for (const Reconstruction& model : result.models) {
-    for (const auto& [image_id, image] : model.images) in_model.insert(image_id);
-  }
-  for (const auto& [image_id, image] : input.images) {
-    if (in_model.count(image_id) > 0) continue;
-    std::string reason;
-    if (in_verified_pair.count(image_id) == 0) {
-      reason = "no verified pair with at least " + std::to_string(options.min_num_matches) +
-               " inlier matches";
-    } else if (with_rotation_pair.count(image_id) == 0) {
-      reason = "the view graph kept none of its pairs (no relative rotation, or none closing a "
-               "rotation cycle within " + Format(options.view_graph_max_cycle_error) + " deg)";
-    } else if (reasons.count(image_id) > 0) {
-      reason = reasons.at(image_id);
-    } else {
-      reason = "rotation averaging dropped all its pairs (off by more than " +
-               Format(options.ra_max_residual) + " deg)";
-    }
-    result.unregistered_reasons[image_id] = reason;
-  }
+  SortLargestFirst(&result.models);
+  ExplainUnregistered(input, options, in_verified_pair, with_rotation_pair, reasons, &result);
   result.seconds = seconds();
   spdlog::info("global map: {} models, {} images in none, {} bundle adjustments, {:.1f} s",
                result.models.size(), result.unregistered_reasons.size(),

@@ -62,6 +62,103 @@ double RelativeRotationErrorDeg(const Eigen::Matrix3d& R_cam2_from_cam1,
   return Eigen::AngleAxisd(ProjectToRotation(error)).angle() / kDegToRad;
 }
 
+namespace {
+
+// A pair's relative rotation between two densely indexed images.
+struct RotationEdge {
+  size_t pair;  // index into the pairs given
+  size_t i, j;
+  Eigen::Matrix3d R_ij;  // cam j from cam i, projected onto SO(3)
+};
+
+// The start: each component chained along its maximum spanning tree (`tree`: the tree's
+// edges at each image) from its heaviest image, which becomes the component's root.
+void ChainFromHeaviestImages(const std::vector<RotationEdge>& edges,
+                             const std::vector<std::vector<size_t>>& tree,
+                             const std::vector<std::vector<size_t>>& groups,
+                             const std::vector<double>& weight_of_image,
+                             std::vector<Eigen::Matrix3d>* R, std::vector<bool>* is_root,
+                             std::vector<int>* component_of) {
+  for (size_t c = 0; c < groups.size(); ++c) {
+    size_t root = groups[c][0];
+    for (const size_t i : groups[c]) {
+      (*component_of)[i] = static_cast<int>(c);
+      if (weight_of_image[i] > weight_of_image[root]) root = i;
+    }
+    (*is_root)[root] = true;
+    std::vector<bool> visited(R->size(), false);
+    std::queue<size_t> queue;
+    queue.push(root);
+    visited[root] = true;
+    while (!queue.empty()) {
+      const size_t i = queue.front();
+      queue.pop();
+      for (const size_t e : tree[i]) {
+        const RotationEdge& edge = edges[e];
+        const size_t k = edge.i == i ? edge.j : edge.i;
+        if (visited[k]) continue;
+        visited[k] = true;
+        // R_j = R_ij R_i, R_i = R_ij^T R_j.
+        (*R)[k] = edge.i == i ? Eigen::Matrix3d(edge.R_ij * (*R)[i])
+                              : Eigen::Matrix3d(edge.R_ij.transpose() * (*R)[i]);
+        queue.push(k);
+      }
+    }
+  }
+}
+
+// One IRLS step's normal equations J^T W J x = -J^T W r over every edge, with L1 weights
+// or Geman-McClure ones of scale `sigma` (radians); each edge's residual into `residual`.
+void AddNormalEquations(const std::vector<RotationEdge>& edges,
+                        const std::vector<Eigen::Matrix3d>& R, const std::vector<int>& variable_of,
+                        bool l1, double sigma, std::vector<Eigen::Triplet<double>>* triplets,
+                        Eigen::VectorXd* rhs, std::vector<Eigen::Vector3d>* residual) {
+  for (size_t e = 0; e < edges.size(); ++e) {
+    const RotationEdge& edge = edges[e];
+    // The residual of pair e: log(R_j R_i^T R_ij^T); linearised in x_i, x_j it is
+    // r + x_j - R_ij x_i.
+    (*residual)[e] = LogRotation(R[edge.j] * R[edge.i].transpose() * edge.R_ij.transpose());
+    const double r = (*residual)[e].norm();
+    const double w = l1 ? 1.0 / std::max(r, 1e-4)
+                        : sigma * sigma / std::pow(r * r + sigma * sigma, 2) * sigma * sigma;
+    // Blocks of J = [-R_ij at i, I at j]; J^T W J and -J^T W r.
+    const int vi = variable_of[edge.i], vj = variable_of[edge.j];
+    const Eigen::Matrix3d Ji = -edge.R_ij;
+    auto add_block = [&](int row, int col, const Eigen::Matrix3d& block) {
+      for (int a = 0; a < 3; ++a) {
+        for (int b = 0; b < 3; ++b) triplets->emplace_back(row + a, col + b, block(a, b));
+      }
+    };
+    if (vi >= 0) {
+      add_block(vi, vi, w * Ji.transpose() * Ji);
+      rhs->segment<3>(vi) -= w * Ji.transpose() * (*residual)[e];
+    }
+    if (vj >= 0) {
+      add_block(vj, vj, w * Eigen::Matrix3d::Identity());
+      rhs->segment<3>(vj) -= w * (*residual)[e];
+    }
+    if (vi >= 0 && vj >= 0) {
+      add_block(vi, vj, w * Ji.transpose());
+      add_block(vj, vi, w * Ji);
+    }
+  }
+}
+
+// Each pair's residual, and the pairs off by more than max_residual_deg dropped.
+void MarkDroppedPairs(const std::vector<RotationEdge>& edges, const std::vector<Eigen::Matrix3d>& R,
+                      double max_residual_deg, RotationAveragingResult* result) {
+  for (const RotationEdge& edge : edges) {
+    const double error = RelativeRotationErrorDeg(edge.R_ij, R[edge.i], R[edge.j]);
+    result->residuals_deg[edge.pair] = error;
+    if (error > max_residual_deg) {
+      result->dropped[edge.pair] = true;
+      ++result->num_dropped;
+    }
+  }
+}
+
+}  // namespace
+
 RotationAveragingResult AverageRotations(const std::vector<RelativeRotation>& pairs,
                                          const RotationAveragingOptions& options,
                                          const std::function<bool()>& should_stop) {
@@ -84,12 +181,7 @@ RotationAveragingResult AverageRotations(const std::vector<RelativeRotation>& pa
   const size_t num_images = image_ids.size();
   if (num_images == 0) return result;
 
-  struct Edge {
-    size_t pair;  // index into pairs
-    size_t i, j;
-    Eigen::Matrix3d R_ij;  // cam j from cam i, projected onto SO(3)
-  };
-  std::vector<Edge> edges;
+  std::vector<RotationEdge> edges;
   for (size_t p = 0; p < pairs.size(); ++p) {
     if (pairs[p].image_id1 == pairs[p].image_id2) continue;
     edges.push_back({p, index_of.at(pairs[p].image_id1), index_of.at(pairs[p].image_id2),
@@ -121,39 +213,14 @@ RotationAveragingResult AverageRotations(const std::vector<RelativeRotation>& pa
 
   // Each component is chained from its heaviest image (sum of its pairs' weights).
   std::vector<double> weight_of_image(num_images, 0.0);
-  for (const Edge& edge : edges) {
+  for (const RotationEdge& edge : edges) {
     weight_of_image[edge.i] += pairs[edge.pair].weight;
     weight_of_image[edge.j] += pairs[edge.pair].weight;
   }
   std::vector<Eigen::Matrix3d> R(num_images, Eigen::Matrix3d::Identity());
   std::vector<bool> is_root(num_images, false);
   std::vector<int> component_of(num_images, -1);
-  for (size_t c = 0; c < groups.size(); ++c) {
-    size_t root = groups[c][0];
-    for (const size_t i : groups[c]) {
-      component_of[i] = static_cast<int>(c);
-      if (weight_of_image[i] > weight_of_image[root]) root = i;
-    }
-    is_root[root] = true;
-    std::vector<bool> visited(num_images, false);
-    std::queue<size_t> queue;
-    queue.push(root);
-    visited[root] = true;
-    while (!queue.empty()) {
-      const size_t i = queue.front();
-      queue.pop();
-      for (const size_t e : tree[i]) {
-        const Edge& edge = edges[e];
-        const size_t k = edge.i == i ? edge.j : edge.i;
-        if (visited[k]) continue;
-        visited[k] = true;
-        // R_j = R_ij R_i, R_i = R_ij^T R_j.
-        R[k] = edge.i == i ? Eigen::Matrix3d(edge.R_ij * R[i])
-                           : Eigen::Matrix3d(edge.R_ij.transpose() * R[i]);
-        queue.push(k);
-      }
-    }
-  }
+  ChainFromHeaviestImages(edges, tree, groups, weight_of_image, &R, &is_root, &component_of);
 
   // 2. IRLS. Variables: 3 per image but the roots.
   std::vector<int> variable_of(num_images, -1);
@@ -177,35 +244,7 @@ RotationAveragingResult AverageRotations(const std::vector<RelativeRotation>& pa
     std::vector<Eigen::Triplet<double>> triplets;
     triplets.reserve(edges.size() * 36);
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(num_variables);
-    for (size_t e = 0; e < edges.size(); ++e) {
-      const Edge& edge = edges[e];
-      // The residual of pair e: log(R_j R_i^T R_ij^T); linearised in x_i, x_j it is
-      // r + x_j - R_ij x_i.
-      residual[e] = LogRotation(R[edge.j] * R[edge.i].transpose() * edge.R_ij.transpose());
-      const double r = residual[e].norm();
-      const double w = l1 ? 1.0 / std::max(r, 1e-4)
-                          : sigma * sigma / std::pow(r * r + sigma * sigma, 2) * sigma * sigma;
-      // Blocks of J = [-R_ij at i, I at j]; J^T W J and -J^T W r.
-      const int vi = variable_of[edge.i], vj = variable_of[edge.j];
-      const Eigen::Matrix3d Ji = -edge.R_ij;
-      auto add_block = [&](int row, int col, const Eigen::Matrix3d& block) {
-        for (int a = 0; a < 3; ++a) {
-          for (int b = 0; b < 3; ++b) triplets.emplace_back(row + a, col + b, block(a, b));
-        }
-      };
-      if (vi >= 0) {
-        add_block(vi, vi, w * Ji.transpose() * Ji);
-        rhs.segment<3>(vi) -= w * Ji.transpose() * residual[e];
-      }
-      if (vj >= 0) {
-        add_block(vj, vj, w * Eigen::Matrix3d::Identity());
-        rhs.segment<3>(vj) -= w * residual[e];
-      }
-      if (vi >= 0 && vj >= 0) {
-        add_block(vi, vj, w * Ji.transpose());
-        add_block(vj, vi, w * Ji);
-      }
-    }
+    AddNormalEquations(edges, R, variable_of, l1, sigma, &triplets, &rhs, &residual);
     Eigen::SparseMatrix<double> normal(num_variables, num_variables);
     normal.setFromTriplets(triplets.begin(), triplets.end());
     // A tiny damping keeps the system definite where a weight underflows.
@@ -229,14 +268,7 @@ RotationAveragingResult AverageRotations(const std::vector<RelativeRotation>& pa
   }
 
   // 3. Residuals and dropped pairs.
-  for (const Edge& edge : edges) {
-    const double error = RelativeRotationErrorDeg(edge.R_ij, R[edge.i], R[edge.j]);
-    result.residuals_deg[edge.pair] = error;
-    if (error > options.max_residual_deg) {
-      result.dropped[edge.pair] = true;
-      ++result.num_dropped;
-    }
-  }
+  MarkDroppedPairs(edges, R, options.max_residual_deg, &result);
   for (size_t i = 0; i < num_images; ++i) {
     result.R_cam_from_world[image_ids[i]] = R[i];
     result.component[image_ids[i]] = component_of[i];

@@ -90,6 +90,7 @@ TEST(PlyExporter, WritesPointsWithModelColoursAsFloats) {
   EXPECT_EQ(ply.header, (std::vector<std::string>{
                             "ply", "format binary_little_endian 1.0",
                             "comment Tessera: " + n + " 3D points, then 0 camera centres",
+                            "comment frame: arbitrary (not georeferenced)",
                             "element vertex " + n, "property float x", "property float y",
                             "property float z", "property uchar red", "property uchar green",
                             "property uchar blue", "end_header"}));
@@ -110,7 +111,7 @@ TEST(PlyExporter, CameraCentresInTheirOwnColourAndDoublePrecision) {
   testing::TemporaryDir output;
   testing::Unguarded(exporter).Export(model, ContextFor(output.path()));
   const PlyFile ply = ReadPly(output.path() / "sparse" / "0" / "points3D.ply");
-  EXPECT_EQ(ply.header[4], "property double x");
+  EXPECT_EQ(ply.header[5], "property double x");
   ASSERT_EQ(ply.vertices.size(), model.points3D.size() + 3);
   EXPECT_EQ(ply.vertices[0].xyz, model.points3D.begin()->second.xyz);
   size_t i = model.points3D.size();
