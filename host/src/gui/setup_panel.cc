@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "gui/stage_progress_bars.h"
 #include "manifest/manifest.h"
 #include "tessera/errors.h"
 
@@ -30,34 +31,6 @@ bool HasImageFile(const fs::path& dir) {
     }
   }
   return false;
-}
-
-std::string FormatSeconds(double seconds) {
-  if (seconds < 0) return "?";
-  if (seconds < 60) return std::to_string(static_cast<int>(std::lround(seconds))) + " s";
-  const long minutes = std::lround(seconds) / 60;
-  return std::to_string(minutes) + " min " + std::to_string(std::lround(seconds) % 60) + " s";
-}
-
-// A bar per stage: done/total, and once known the rate and the time left.
-void DrawStageProgress(const std::vector<StageProgress>& stages, WidgetRects* widgets) {
-  for (const StageProgress& stage : stages) {
-    const float fraction =
-        stage.total == 0 ? 1.0f : static_cast<float>(stage.done) / static_cast<float>(stage.total);
-    std::string overlay = std::to_string(stage.done) + "/" + std::to_string(stage.total);
-    if (stage.rate_per_s > 0) {
-      char rate[64];
-      std::snprintf(rate, sizeof(rate), "  %.2f/s", stage.rate_per_s);
-      overlay += rate;
-      if (stage.done < stage.total) overlay += ", " + FormatSeconds(stage.remaining_s) + " left";
-    }
-    const float name_width = ImGui::GetFontSize() * 6;
-    ImGui::ProgressBar(fraction, ImVec2(-name_width, 0), overlay.c_str());
-    // The overlay is cut at the bar's ends: the whole of it in a tooltip.
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s: %s", stage.stage.c_str(), overlay.c_str());
-    ImGui::SameLine();
-    FitText(stage.stage, widgets);
-  }
 }
 
 }  // namespace
