@@ -186,6 +186,8 @@ WidgetRect GuiApp::ViewRect() const {
 }
 
 bool GuiApp::Run() { return setup_->Run(); }
+bool GuiApp::RequestRun() { return setup_->RequestRun(); }
+const std::string& GuiApp::OverwriteQuestion() const { return setup_->OverwriteQuestion(); }
 
 RunStatus GuiApp::FollowRun() {
   if (auto scene = controller_->TakeScene(&scene_version_)) {
@@ -356,15 +358,22 @@ int RunGui(const GuiCommandOptions& options) {
   if (!options.screenshot.empty() && options.gui.model.empty() && options.gui.images.empty()) {
     throw InputError("gui: --screenshot needs --model or --images");
   }
+  if (!options.screenshot.empty() && options.gui.model.empty() && options.gui.output.empty()) {
+    throw InputError("gui: --screenshot with --images runs the pipeline: it needs --output");
+  }
   GuiApp app(options.gui);
   // OpenModel has logged the one-line message.
   if (!options.gui.model.empty() && !app.ModelError().empty()) return kExitBadInput;
+  // --model opens a model (with --images, its photographs) and starts no run; without
+  // it, --images and --output start one (asking first in the window before replacing a
+  // model of the output folder).
+  const bool run = options.gui.model.empty() && !options.gui.images.empty();
   if (options.screenshot.empty()) {
-    if (!options.gui.images.empty() && !options.gui.output.empty()) app.Run();
+    if (run && !options.gui.output.empty()) app.RequestRun();
     while (!app.ShouldClose()) app.Step(1.0);
     return kExitSuccess;
   }
-  if (!options.gui.images.empty()) {
+  if (run) {
     if (!app.Run()) throw InputError(app.SetupError());
     while (app.controller().Running()) app.Step(0.1);
     app.controller().Join();

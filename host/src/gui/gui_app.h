@@ -80,6 +80,10 @@ class GuiApp {
   // Starts a run from the set-up fields (as the Run button does); false with the
   // message shown next to the field (SetupError) when a field is wrong.
   bool Run();
+  // As the Run button: asks first in the window when the run would replace a model of
+  // the output folder (OverwriteQuestion); see SetupPanel::RequestRun.
+  bool RequestRun();
+  const std::string& OverwriteQuestion() const;
 
   bool ShouldClose() const;
   size_t frames_drawn() const { return frames_drawn_; }

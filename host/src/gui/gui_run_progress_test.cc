@@ -81,8 +81,11 @@ TEST_F(GuiWindowTest, MapBarMovesWithEachRegistrationAndAResumedRunSaysReused) {
   app.Frame();
   EXPECT_TRUE(app.Widget("progress map").has_value());
 
-  // Run again: extraction and matching have nothing left to do.
+  // Run again (replacing the model, when asked): extraction and matching have nothing
+  // left to do.
   Click(&app, "run");
+  app.Frame();
+  Click(&app, "replace model");
   ASSERT_TRUE(WaitFor(&app, [&] { return !app.controller().Running(); }, 120));
   status = app.controller().Status();
   ASSERT_EQ(status.state, RunState::kCompleted) << status.error;

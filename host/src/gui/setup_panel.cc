@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "gui/model_loader.h"
 #include "gui/stage_progress_bars.h"
 #include "manifest/manifest.h"
 #include "tessera/errors.h"
@@ -91,6 +92,54 @@ bool SetupPanel::Run() {
   return true;
 }
 
+bool SetupPanel::RequestRun() {
+  if (!CheckFields()) return Run();  // Run sets and logs the message
+  std::vector<fs::path> models;
+  try {
+    models = FindModelFolders(fs::path(output_.data()));
+  } catch (const InputError&) {
+    // No model there (or no workspace yet): nothing to replace.
+  }
+  if (models.empty()) return Run();
+  overwrite_question_ = fs::path(output_.data()).string() + " holds " +
+                        (models.size() == 1 ? "a model (" + models[0].filename().string() + ")"
+                                            : std::to_string(models.size()) + " models") +
+                        "; this run maps again and replaces " +
+                        (models.size() == 1 ? "it." : "them.");
+  overwrite_popup_open_ = false;
+  return true;
+}
+
+void SetupPanel::DrawOverwriteQuestion(WidgetRects* widgets) {
+  if (overwrite_question_.empty()) return;
+  constexpr const char* kTitle = "Replace the model?";
+  if (!overwrite_popup_open_) {
+    ImGui::OpenPopup(kTitle);
+    overwrite_popup_open_ = true;
+  }
+  const ImVec2 centre = ImGui::GetMainViewport()->GetCenter();
+  ImGui::SetNextWindowPos(centre, ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  if (!ImGui::BeginPopupModal(kTitle, nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
+  ImGui::PushTextWrapPos(ImGui::GetFontSize() * 30);
+  ImGui::TextUnformatted(overwrite_question_.c_str());
+  ImGui::PopTextWrapPos();
+  bool close = false;
+  if (ImGui::Button("Run and replace")) {
+    close = true;
+    overwrite_question_.clear();
+    Run();
+  }
+  widgets->RecordLastItem("replace model");
+  ImGui::SameLine();
+  if (ImGui::Button("Keep it")) close = true;
+  widgets->RecordLastItem("keep model");
+  if (close) {
+    overwrite_question_.clear();
+    ImGui::CloseCurrentPopup();
+  }
+  ImGui::EndPopup();
+}
+
 bool SetupPanel::ChooseRecipe(const std::string& name) {
   const Recipe* recipe = recipes_.Find(name);
   if (recipe == nullptr) {
@@ -115,6 +164,7 @@ void SetupPanel::Draw(const RunStatus& status, WidgetRects* widgets) {
   editor_.Draw(widgets);
   DrawRunButtons(status, running, widgets);
   DrawStageProgress(status.stages, widgets);
+  DrawOverwriteQuestion(widgets);
 }
 
 void SetupPanel::DrawFields(WidgetRects* widgets) {
@@ -153,7 +203,7 @@ void SetupPanel::DrawFields(WidgetRects* widgets) {
 
 void SetupPanel::DrawRunButtons(const RunStatus& status, bool running, WidgetRects* widgets) {
   ImGui::BeginDisabled(running);
-  if (ImGui::Button("Run")) Run();
+  if (ImGui::Button("Run")) RequestRun();
   ImGui::EndDisabled();
   widgets->RecordLastItem("run");
   ImGui::SameLine();
