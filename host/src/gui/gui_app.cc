@@ -110,12 +110,14 @@ GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
 
   view_ = std::make_unique<SceneView>(renderer_.get(), [this]() { changed_.store(true); });
   model_panel_ = std::make_unique<ModelPanel>(view_.get(), options.model);
-  // A run's models replace the ones opened.
+  // A run's models replace the ones opened: the view is cleared as it starts (when it
+  // follows the run), not to be taken for the run's model.
   setup_ =
       std::make_unique<SetupPanel>(RunRequest{options.images, options.output, options.manifest, {}},
                                    options.follow_run, controller_.get(), [this]() {
                                      view_->ForgetPicks();
                                      model_panel_->ForgetModels();
+                                     if (setup_->follow_run()) view_->Show(nullptr, false);
                                    });
   picking_ = std::make_unique<Picking>(view_.get());
   match_matrix_ = std::make_unique<MatchMatrixPanel>();
@@ -226,6 +228,14 @@ void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
     match_matrix_->Draw(view, images, &widgets_);
   }
   picking_->HandleMouse(view);
+  if (view_->scene() == nullptr && status.state == RunState::kRunning && setup_->follow_run()) {
+    // Until the mapper registers its first images.
+    const char* hint = "the run's model appears here as its images register";
+    const ImVec2 size = ImGui::CalcTextSize(hint);
+    ImGui::GetBackgroundDrawList()->AddText(
+        ImVec2((view.min_x + view.max_x - size.x) / 2, (view.min_y + view.max_y - size.y) / 2),
+        ImGui::GetColorU32(ImGuiCol_TextDisabled), hint);
+  }
   ImGui::Render();
   Render(capture);
 }

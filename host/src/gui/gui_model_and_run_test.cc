@@ -95,3 +95,37 @@ TEST_F(GuiModelAndRunTest, ARunThatWouldReplaceAModelAsksFirst) {
 
 }  // namespace
 }  // namespace tessera::gui
+
+namespace tessera::gui {
+namespace {
+
+// Issue 30 item 11: the model shown is cleared when a run starts (the view follows the
+// run), not to be taken for the run's model, until the run's own model arrives.
+TEST_F(GuiModelAndRunTest, TheOldModelIsClearedWhenARunStarts) {
+  const std::filesystem::path workspace = FinishedWorkspace();
+  GuiOptions options;
+  options.model = workspace;
+  options.images = dir_.path() / "images";
+  options.output = dir_.path() / "second";
+  options.manifest = manifest_;
+  GuiApp app(options);
+  app.Frame();
+  RgbImage before;
+  app.Frame(nullptr, &before);
+  ASSERT_GT(app.NumScenePoints(), 1000u);
+  EXPECT_GT(CountViewPixels(before, app.ViewRect()).frustum, 0u);
+  Click(&app, "run");
+  ASSERT_NE(app.controller().Status().state, RunState::kIdle) << app.SetupError();
+  // Extraction has barely begun: nothing registered yet.
+  RgbImage during;
+  app.Frame(nullptr, &during);
+  EXPECT_EQ(app.NumScenePoints(), 0u);
+  EXPECT_EQ(CountViewPixels(during, app.ViewRect()).frustum, 0u);
+  ASSERT_TRUE(WaitFor(&app, [&] { return !app.controller().Running(); }, 120));
+  ASSERT_EQ(app.controller().Status().state, RunState::kCompleted);
+  app.Frame();
+  EXPECT_GT(app.NumScenePoints(), 1000u);  // the run's model
+}
+
+}  // namespace
+}  // namespace tessera::gui
