@@ -347,6 +347,8 @@ std::string GuiApp::EditorPlugin(const std::string& slot) const {
 bool GuiApp::OpenMatchMatrix(const fs::path& path) { return match_matrix_->Open(path); }
 const std::string& GuiApp::MatchError() const { return match_matrix_->Error(); }
 std::pair<int, int> GuiApp::SelectedPair() const { return match_matrix_->SelectedPair(); }
+size_t GuiApp::PairLinesDrawn() const { return match_matrix_->pair_view().lines_drawn(); }
+bool GuiApp::PairShowsPutatives() const { return match_matrix_->pair_view().show_putatives; }
 const PairInliers& GuiApp::SelectedPairInliers() const {
   return match_matrix_->SelectedPairInliers();
 }

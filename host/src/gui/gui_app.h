@@ -123,6 +123,10 @@ class GuiApp {
   // The pair (row, column) clicked in the match matrix and its inlier matches.
   std::pair<int, int> SelectedPair() const;
   const PairInliers& SelectedPairInliers() const;
+  // The pair view's lines drawn in the last frame (at most kMaxPairLines) and whether it
+  // shows the putative matches rather than the inliers.
+  size_t PairLinesDrawn() const;
+  bool PairShowsPutatives() const;
   std::optional<WidgetRect> Widget(const std::string& name) const { return widgets_.Find(name); }
   // The 3D view's rectangle in window pixels.
   WidgetRect ViewRect() const;

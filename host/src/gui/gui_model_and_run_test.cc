@@ -12,23 +12,7 @@ namespace tessera::gui {
 namespace {
 namespace fs = std::filesystem;
 
-class GuiModelAndRunTest : public GuiWindowTest {
- protected:
-  // Runs the sample into out/ through the window and returns the workspace.
-  fs::path FinishedWorkspace() {
-    MakeSample();
-    GuiOptions options;
-    options.images = dir_.path() / "images";
-    options.output = dir_.path() / "out";
-    options.manifest = manifest_;
-    GuiApp app(options);
-    app.Frame();
-    EXPECT_TRUE(app.Run());
-    EXPECT_TRUE(WaitFor(&app, [&] { return !app.controller().Running(); }, 120));
-    EXPECT_EQ(app.controller().Status().state, RunState::kCompleted);
-    return options.output;
-  }
-};
+using GuiModelAndRunTest = GuiWindowTest;
 
 TEST_F(GuiModelAndRunTest, ModelWithImagesAndOutputOpensItAndStartsNoRun) {
   const fs::path workspace = FinishedWorkspace();
