@@ -357,6 +357,8 @@ const Scene* GuiApp::scene() const { return view_->scene(); }
 void GuiApp::SetScene(std::shared_ptr<const Scene> scene) { view_->Show(std::move(scene), true); }
 size_t GuiApp::NumScenePoints() const { return scene() == nullptr ? 0 : scene()->NumPoints(); }
 size_t GuiApp::NumSceneCameras() const { return scene() == nullptr ? 0 : scene()->cameras.size(); }
+float GuiApp::PointSize() const { return view_->point_size; }
+float GuiApp::FrustumSize() const { return view_->frustum_size; }
 void GuiApp::SetViewOrbit(float dx_px, float dy_px) { view_->camera().Orbit(dx_px, dy_px); }
 std::optional<std::array<float, 2>> GuiApp::ProjectToWindow(const Eigen::Vector3f& world) const {
   return view_->ProjectToWindow(world, ViewRect());

@@ -146,6 +146,9 @@ class GuiApp {
   size_t NumScenePoints() const;
   size_t NumSceneCameras() const;
   void SetViewOrbit(float dx_px, float dy_px);
+  // The 3D view's point size (pixels) and frustum depth (a fraction of the model's radius).
+  float PointSize() const;
+  float FrustumSize() const;
   // Where a world point shows in the 3D view, in window pixels; nothing when behind it.
   std::optional<std::array<float, 2>> ProjectToWindow(const Eigen::Vector3f& world) const;
   const Scene* scene() const;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "gui/camera_pick.h"
 #include "gui/image_folder_check.h"
 #include "image/image_masks.h"
 #include "tessera/io/model_statistics.h"
@@ -57,20 +58,21 @@ void Picking::Pick(float x, float y, const WidgetRect& view_rect) {
     const auto pixel = view_->ProjectToWindow(world, view_rect);
     return pixel ? std::hypot((*pixel)[0] - x, (*pixel)[1] - y) : 1e9f;
   };
-  float best = 10;
-  image_t best_image = kInvalidImageId;
-  for (const SceneCamera& camera : scene->cameras) {
-    const float distance = distance_to_click(camera.center_in_world);
-    if (distance < best) {
-      best = distance;
-      best_image = camera.image_id;
-    }
-  }
-  if (best_image != kInvalidImageId) {
-    view_->selected_image = best_image;
+  const Eigen::Matrix4f view_from_world = view_->camera().ViewMatrix();
+  const Projector project = [&](const Eigen::Vector3f& world) -> std::optional<ProjectedPoint> {
+    const auto pixel = view_->ProjectToWindow(world, view_rect);
+    if (!pixel) return std::nullopt;
+    const float depth = -(view_from_world * world.homogeneous()).z();
+    return ProjectedPoint{(*pixel)[0], (*pixel)[1], depth};
+  };
+  const image_t image =
+      PickCamera(*scene, view_->frustum_size * scene->radius, project, x, y);
+  if (image != kInvalidImageId) {
+    view_->selected_image = image;
+    view_->selected_point = kInvalidPoint3DId;
     return;
   }
-  best = 6;
+  float best = 6;
   point3D_t best_point = kInvalidPoint3DId;
   for (size_t i = 0; i < scene->point_ids.size(); ++i) {
     const float distance = distance_to_click(Eigen::Vector3f(
@@ -120,6 +122,8 @@ void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& ima
   ImGui::Text("%zu observations, mean reprojection error %.3f px", observations,
               usable > 0 ? error_sum / static_cast<double>(usable) : 0.0);
   widgets->RecordLastItem("camera details");
+  if (ImGui::Button("View from this camera")) view_->LookThrough(image_id);
+  widgets->RecordLastItem("look through");
   const ImVec2 position = ImGui::GetWindowPos();
   const ImVec2 size = ImGui::GetWindowSize();
   widgets->Set("camera window", {position.x, position.y, position.x + size.x, position.y + size.y});
