@@ -228,13 +228,19 @@ void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
     match_matrix_->Draw(view, images, &widgets_);
   }
   picking_->HandleMouse(view);
-  if (view_->scene() == nullptr && status.state == RunState::kRunning && setup_->follow_run()) {
-    // Until the mapper registers its first images.
-    const char* hint = "the run's model appears here as its images register";
+  if (view_->scene() == nullptr && !options_.view_only) {
+    // An empty view says what fills it: the run's model (until the mapper registers its
+    // first images), or what to do first.
+    const bool running = status.state == RunState::kRunning && setup_->follow_run();
+    const char* hint = running ? "the run's model appears here as its images register"
+                               : "choose a folder of images and press Run, or open a model";
     const ImVec2 size = ImGui::CalcTextSize(hint);
     ImGui::GetBackgroundDrawList()->AddText(
         ImVec2((view.min_x + view.max_x - size.x) / 2, (view.min_y + view.max_y - size.y) / 2),
         ImGui::GetColorU32(ImGuiCol_TextDisabled), hint);
+    widgets_.Set(running ? "view hint run" : "view hint",
+                 {(view.min_x + view.max_x - size.x) / 2, (view.min_y + view.max_y - size.y) / 2,
+                  (view.min_x + view.max_x + size.x) / 2, (view.min_y + view.max_y + size.y) / 2});
   }
   ImGui::Render();
   Render(capture);

@@ -105,6 +105,7 @@ TEST_F(GuiModelAndRunTest, TheOldModelIsClearedWhenARunStarts) {
   app.Frame(nullptr, &during);
   EXPECT_EQ(app.NumScenePoints(), 0u);
   EXPECT_EQ(CountViewPixels(during, app.ViewRect()).frustum, 0u);
+  EXPECT_TRUE(app.Widget("view hint run").has_value());
   ASSERT_TRUE(WaitFor(&app, [&] { return !app.controller().Running(); }, 120));
   ASSERT_EQ(app.controller().Status().state, RunState::kCompleted);
   app.Frame();

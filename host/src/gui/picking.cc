@@ -2,6 +2,7 @@
 
 #include <imgui.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "gui/camera_pick.h"
@@ -133,7 +134,10 @@ void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& ima
     photo_image_ = image_id;
     photo_dir_ = image_dir;
     mask_dir_ = mask_dir;
-    LoadPhoto(model, image, image_dir, mask_dir);
+    // A third of the view wide (240 to 480 pixels): the model stays in sight beside it.
+    const int width = static_cast<int>(
+        std::clamp((view_rect.max_x - view_rect.min_x) / 3, 240.0f, 480.0f));
+    LoadPhoto(model, image, image_dir, mask_dir, width);
   }
   if (photo_problem_.empty()) {
     const ImVec2 origin = ImGui::GetCursorScreenPos();
@@ -159,10 +163,10 @@ void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& ima
 }
 
 void Picking::LoadPhoto(const Reconstruction& model, const Image& image, const fs::path& image_dir,
-                        const fs::path& mask_dir) {
+                        const fs::path& mask_dir, int max_width) {
   // The mask as detection finds it: MASK_DIR/NAME.png, else NAME with .png for its extension.
   const fs::path mask_file = mask_dir.empty() ? fs::path() : FindMaskFile(mask_dir, image.name);
-  const bool found = !image_dir.empty() && photo_.Load(image_dir / image.name, 480, mask_file);
+  const bool found = !image_dir.empty() && photo_.Load(image_dir / image.name, max_width, mask_file);
   const auto camera = model.cameras.find(image.camera_id);
   photo_problem_ =
       camera == model.cameras.end()

@@ -41,10 +41,12 @@ class Picking {
   void DrawCameraDetails(const WidgetRect& view_rect, const std::filesystem::path& image_dir,
                          const std::filesystem::path& mask_dir, WidgetRects* widgets);
   void DrawPointDetails(const WidgetRect& view_rect, WidgetRects* widgets);
-  // Loads the photograph of `image` from `image_dir`; photo_problem_ says why it is not
-  // shown (missing, or not the size of the model's camera).
+  // Loads the photograph of `image` from `image_dir`, at most max_width pixels wide;
+  // photo_problem_ says why it is not shown (missing, or not the size of the model's
+  // camera).
   void LoadPhoto(const Reconstruction& model, const Image& image,
-                 const std::filesystem::path& image_dir, const std::filesystem::path& mask_dir);
+                 const std::filesystem::path& image_dir, const std::filesystem::path& mask_dir,
+                 int max_width);
 
   SceneView* view_;
   bool dragging_ = false;
