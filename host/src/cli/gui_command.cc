@@ -20,17 +20,21 @@ CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions&) {
   };
   auto options = std::make_shared<GuiArguments>();
   CLI::App* sub = app.add_subcommand("gui", "Desktop GUI: set up, run and watch the model grow");
-  sub->add_option("--images", options->images, "Folder of input images");
-  sub->add_option("--output", options->output, "Workspace folder");
+  sub->add_option("--images", options->images,
+                  "Folder of input images (with --model: the model's photographs)");
+  sub->add_option("--output", options->output,
+                  "Workspace folder; with --images and without --model a run starts at once "
+                  "(asking in the window before it replaces a model there)");
   sub->add_option("--manifest", options->manifest, "Pipeline manifest (default: default.json)");
   sub->add_option("--model", options->model,
-                  "Model to open: a COLMAP model folder, a workspace or its database.db");
+                  "Model to open: a COLMAP model folder, a workspace or its database.db; "
+                  "starts no run and needs no --output");
   sub->add_option("--masks", options->masks,
                   "Folder of the images' masks (default: the manifest's camera.mask_path): the "
                   "camera window darkens what they mask out");
   sub->add_option("--screenshot", options->screenshot,
-                  "Write a PNG of the window (after the run, given --images and --output; or "
-                  "of --model) and exit");
+                  "Write a PNG of the window and exit: of --model (no run), else after a run "
+                  "of --images into --output");
   sub->add_option("--frames", options->frames, "Frames drawn before the screenshot (at least 2)")
       ->check(AtLeast(1));
   sub->add_option("--width", options->width, "Window width")->check(CLI::Range(200, 8192));

@@ -22,7 +22,6 @@
 #include "gui/setup_panel.h"
 #include "manifest/manifest.h"
 #include "tessera/errors.h"
-#include "util/exit_codes.h"
 
 namespace tessera::gui {
 namespace fs = std::filesystem;
@@ -110,12 +109,14 @@ GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
 
   view_ = std::make_unique<SceneView>(renderer_.get(), [this]() { changed_.store(true); });
   model_panel_ = std::make_unique<ModelPanel>(view_.get(), options.model);
-  // A run's models replace the ones opened.
+  // A run's models replace the ones opened: the view is cleared as it starts (when it
+  // follows the run), not to be taken for the run's model.
   setup_ =
       std::make_unique<SetupPanel>(RunRequest{options.images, options.output, options.manifest, {}},
                                    options.follow_run, controller_.get(), [this]() {
                                      view_->ForgetPicks();
                                      model_panel_->ForgetModels();
+                                     if (setup_->follow_run()) view_->Show(nullptr, false);
                                    });
   picking_ = std::make_unique<Picking>(view_.get());
   match_matrix_ = std::make_unique<MatchMatrixPanel>();
@@ -186,6 +187,8 @@ WidgetRect GuiApp::ViewRect() const {
 }
 
 bool GuiApp::Run() { return setup_->Run(); }
+bool GuiApp::RequestRun() { return setup_->RequestRun(); }
+const std::string& GuiApp::OverwriteQuestion() const { return setup_->OverwriteQuestion(); }
 
 RunStatus GuiApp::FollowRun() {
   if (auto scene = controller_->TakeScene(&scene_version_)) {
@@ -224,6 +227,20 @@ void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
     match_matrix_->Draw(view, images, &widgets_);
   }
   picking_->HandleMouse(view);
+  if (view_->scene() == nullptr && !options_.view_only) {
+    // An empty view says what fills it: the run's model (until the mapper registers its
+    // first images), or what to do first.
+    const bool running = status.state == RunState::kRunning && setup_->follow_run();
+    const char* hint = running ? "the run's model appears here as its images register"
+                               : "choose a folder of images and press Run, or open a model";
+    const ImVec2 size = ImGui::CalcTextSize(hint);
+    ImGui::GetBackgroundDrawList()->AddText(
+        ImVec2((view.min_x + view.max_x - size.x) / 2, (view.min_y + view.max_y - size.y) / 2),
+        ImGui::GetColorU32(ImGuiCol_TextDisabled), hint);
+    widgets_.Set(running ? "view hint run" : "view hint",
+                 {(view.min_x + view.max_x - size.x) / 2, (view.min_y + view.max_y - size.y) / 2,
+                  (view.min_x + view.max_x + size.x) / 2, (view.min_y + view.max_y + size.y) / 2});
+  }
   ImGui::Render();
   Render(capture);
 }
@@ -335,6 +352,8 @@ std::string GuiApp::EditorPlugin(const std::string& slot) const {
 bool GuiApp::OpenMatchMatrix(const fs::path& path) { return match_matrix_->Open(path); }
 const std::string& GuiApp::MatchError() const { return match_matrix_->Error(); }
 std::pair<int, int> GuiApp::SelectedPair() const { return match_matrix_->SelectedPair(); }
+size_t GuiApp::PairLinesDrawn() const { return match_matrix_->pair_view().lines_drawn(); }
+bool GuiApp::PairShowsPutatives() const { return match_matrix_->pair_view().show_putatives; }
 const PairInliers& GuiApp::SelectedPairInliers() const {
   return match_matrix_->SelectedPairInliers();
 }
@@ -343,6 +362,8 @@ const Scene* GuiApp::scene() const { return view_->scene(); }
 void GuiApp::SetScene(std::shared_ptr<const Scene> scene) { view_->Show(std::move(scene), true); }
 size_t GuiApp::NumScenePoints() const { return scene() == nullptr ? 0 : scene()->NumPoints(); }
 size_t GuiApp::NumSceneCameras() const { return scene() == nullptr ? 0 : scene()->cameras.size(); }
+float GuiApp::PointSize() const { return view_->point_size; }
+float GuiApp::FrustumSize() const { return view_->frustum_size; }
 void GuiApp::SetViewOrbit(float dx_px, float dy_px) { view_->camera().Orbit(dx_px, dy_px); }
 std::optional<std::array<float, 2>> GuiApp::ProjectToWindow(const Eigen::Vector3f& world) const {
   return view_->ProjectToWindow(world, ViewRect());
@@ -351,31 +372,5 @@ image_t GuiApp::selected_image() const { return view_->selected_image; }
 point3D_t GuiApp::selected_point() const { return view_->selected_point; }
 const std::string& GuiApp::PhotoProblem() const { return picking_->photo_problem(); }
 bool GuiApp::PhotoMasked() const { return picking_->photo_masked(); }
-
-int RunGui(const GuiCommandOptions& options) {
-  if (!options.screenshot.empty() && options.gui.model.empty() && options.gui.images.empty()) {
-    throw InputError("gui: --screenshot needs --model or --images");
-  }
-  GuiApp app(options.gui);
-  // OpenModel has logged the one-line message.
-  if (!options.gui.model.empty() && !app.ModelError().empty()) return kExitBadInput;
-  if (options.screenshot.empty()) {
-    if (!options.gui.images.empty() && !options.gui.output.empty()) app.Run();
-    while (!app.ShouldClose()) app.Step(1.0);
-    return kExitSuccess;
-  }
-  if (!options.gui.images.empty()) {
-    if (!app.Run()) throw InputError(app.SetupError());
-    while (app.controller().Running()) app.Step(0.1);
-    app.controller().Join();
-    const RunStatus status = app.controller().Status();
-    if (status.state == RunState::kFailed) return status.exit_code;
-  }
-  // ImGui lays its windows out from the second frame on.
-  for (int i = 1; i < std::max(options.frames, 2); ++i) app.Frame();
-  app.SaveScreenshot(options.screenshot);
-  spdlog::info("gui: wrote {}", options.screenshot.string());
-  return kExitSuccess;
-}
 
 }  // namespace tessera::gui

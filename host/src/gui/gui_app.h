@@ -80,6 +80,10 @@ class GuiApp {
   // Starts a run from the set-up fields (as the Run button does); false with the
   // message shown next to the field (SetupError) when a field is wrong.
   bool Run();
+  // As the Run button: asks first in the window when the run would replace a model of
+  // the output folder (OverwriteQuestion); see SetupPanel::RequestRun.
+  bool RequestRun();
+  const std::string& OverwriteQuestion() const;
 
   bool ShouldClose() const;
   size_t frames_drawn() const { return frames_drawn_; }
@@ -119,6 +123,10 @@ class GuiApp {
   // The pair (row, column) clicked in the match matrix and its inlier matches.
   std::pair<int, int> SelectedPair() const;
   const PairInliers& SelectedPairInliers() const;
+  // The pair view's lines drawn in the last frame (at most kMaxPairLines) and whether it
+  // shows the putative matches rather than the inliers.
+  size_t PairLinesDrawn() const;
+  bool PairShowsPutatives() const;
   std::optional<WidgetRect> Widget(const std::string& name) const { return widgets_.Find(name); }
   // The 3D view's rectangle in window pixels.
   WidgetRect ViewRect() const;
@@ -138,6 +146,9 @@ class GuiApp {
   size_t NumScenePoints() const;
   size_t NumSceneCameras() const;
   void SetViewOrbit(float dx_px, float dy_px);
+  // The 3D view's point size (pixels) and frustum depth (a fraction of the model's radius).
+  float PointSize() const;
+  float FrustumSize() const;
   // Where a world point shows in the 3D view, in window pixels; nothing when behind it.
   std::optional<std::array<float, 2>> ProjectToWindow(const Eigen::Vector3f& world) const;
   const Scene* scene() const;

@@ -69,6 +69,23 @@ TEST_F(GuiLayoutTest, SetUpWindowFitsAt1024And1920PixelsAndTwiceTheFont) {
   EXPECT_GT(tooltips_checked_, 0);  // at 1024 pixels, something is cut short
 }
 
+// An empty 3D view says what to do first; a model replaces the hint.
+TEST_F(GuiLayoutTest, AnEmptyViewSaysWhatToDoFirst) {
+  GuiOptions options;
+  options.ui_scale = 1;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  const std::optional<WidgetRect> hint = app.Widget("view hint");
+  ASSERT_TRUE(hint.has_value());
+  EXPECT_GT(hint->min_x, app.ViewRect().min_x);
+  auto scene = std::make_shared<Scene>();
+  scene->model = std::make_shared<const Reconstruction>();
+  app.SetScene(scene);
+  app.Frame();
+  EXPECT_FALSE(app.Widget("view hint").has_value());
+}
+
 TEST_F(GuiLayoutTest, TheWidthScalesWithTheWindowAndTheFont) {
   EXPECT_LT(PanelAutoWidth(1024, 13), PanelAutoWidth(1920, 13));
   EXPECT_LT(PanelAutoWidth(1920, 13), PanelAutoWidth(1920, 20));

@@ -83,6 +83,21 @@ class GuiWindowTest : public ::testing::Test {
     })";
   }
 
+  // Runs the sample (MakeSample) into out/ through the window; returns the workspace.
+  std::filesystem::path FinishedWorkspace() {
+    MakeSample();
+    GuiOptions options;
+    options.images = dir_.path() / "images";
+    options.output = dir_.path() / "out";
+    options.manifest = manifest_;
+    GuiApp app(options);
+    app.Frame();
+    EXPECT_TRUE(app.Run());
+    EXPECT_TRUE(WaitFor(&app, [&] { return !app.controller().Running(); }, 120));
+    EXPECT_EQ(app.controller().Status().state, RunState::kCompleted);
+    return options.output;
+  }
+
   testing::Xvfb xvfb_;
   tessera::testing::TemporaryDir dir_;
   std::filesystem::path manifest_;

@@ -63,6 +63,17 @@ PairInliers ReadPairInliers(const fs::path& path, image_t image_id1, image_t ima
   const TwoViewGeometry geometry = database.ReadTwoViewGeometry(image_id1, image_id2);
   const FeatureKeypoints keypoints1 = database.ReadKeypoints(image_id1);
   const FeatureKeypoints keypoints2 = database.ReadKeypoints(image_id2);
+  if (database.ExistsMatches(image_id1, image_id2)) {
+    for (const FeatureMatch& match : database.ReadMatches(image_id1, image_id2)) {
+      if (match.point2D_idx1 >= keypoints1.size() || match.point2D_idx2 >= keypoints2.size()) {
+        continue;
+      }
+      pair.putative_xy1.emplace_back(keypoints1[match.point2D_idx1].x,
+                                     keypoints1[match.point2D_idx1].y);
+      pair.putative_xy2.emplace_back(keypoints2[match.point2D_idx2].x,
+                                     keypoints2[match.point2D_idx2].y);
+    }
+  }
   for (const FeatureMatch& match : geometry.inlier_matches) {
     if (match.point2D_idx1 >= keypoints1.size() || match.point2D_idx2 >= keypoints2.size()) {
       continue;

@@ -31,9 +31,11 @@ MatchMatrix ReadMatchMatrix(const std::filesystem::path& path);
 struct PairInliers {
   std::string name1, name2;
   std::vector<Eigen::Vector2f> xy1, xy2;  // keypoint positions, one per inlier match
+  // The putative matches (before geometric verification), likewise.
+  std::vector<Eigen::Vector2f> putative_xy1, putative_xy2;
 };
 
-// The inlier matches of the pair (image_id1, image_id2), in that order.
+// The inlier and putative matches of the pair (image_id1, image_id2), in that order.
 PairInliers ReadPairInliers(const std::filesystem::path& database, image_t image_id1,
                             image_t image_id2);
 

@@ -4,17 +4,31 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
 
 #include "gui/panel_widgets.h"
 #include "tessera/errors.h"
 
 namespace tessera::gui {
 namespace fs = std::filesystem;
+namespace {
+
+// Dark blue (a few inliers) to yellow (the most); near-black: no verified pair.
+ImU32 InlierColor(int inliers, int max_inliers) {
+  if (inliers <= 0) return IM_COL32(30, 30, 45, 255);
+  const float t = max_inliers > 0 ? static_cast<float>(inliers) / static_cast<float>(max_inliers) : 0;
+  return IM_COL32(static_cast<int>(40 + 215 * t), static_cast<int>(60 + 170 * t),
+                  static_cast<int>(150 - 120 * t), 255);
+}
+
+}  // namespace
 
 bool MatchMatrixPanel::Open(const fs::path& path) {
   error_.clear();
   pair_row_ = pair_column_ = -1;
-  pair_inliers_ = {};
+  pair_view_.Clear();
   try {
     matrix_ = ReadMatchMatrix(path);
     show_ = true;
@@ -41,31 +55,50 @@ void MatchMatrixPanel::Draw(const WidgetRect& view_rect, const fs::path& image_d
   ImGui::SetNextWindowPos(ImVec2(view_rect.min_x + 10, 10), ImGuiCond_Appearing);
   ImGui::Begin("Match matrix", &show_, ImGuiWindowFlags_AlwaysAutoResize);
   const size_t n = matrix_->size();
-  ImGui::Text("%zu images; colour: verified inliers (most: %d). Click a cell.", n,
-              matrix_->max_inliers);
+  ImGui::Text("%zu images; colour: verified inliers. Click a cell.", n);
   const float cell = std::clamp(360.0f / static_cast<float>(std::max<size_t>(n, 1)), 2.0f, 24.0f);
   DrawCells(cell, image_dir, widgets);
-  if (pair_row_ >= 0) DrawPair();
+  DrawLegend(widgets);
+  if (pair_row_ >= 0) pair_view_.Draw(widgets);
   ImGui::End();
 }
 
 void MatchMatrixPanel::DrawCells(float cell, const fs::path& image_dir, WidgetRects* widgets) {
   const MatchMatrix& matrix = *matrix_;
   const size_t n = matrix.size();
-  const ImVec2 origin = ImGui::GetCursorScreenPos();
+  // The axes: each row's number and image name on the left (at most 14 text heights
+  // wide), the column numbers on top; every k-th when the cells are smaller than a line.
+  const float line = ImGui::GetTextLineHeight();
+  const size_t every = static_cast<size_t>(std::ceil(line / cell));
+  float names_width = 0;
+  std::vector<std::string> row_names(n);
+  for (size_t i = 0; i < n; ++i) {
+    row_names[i] = ElideToWidth(std::to_string(i + 1) + " " + matrix.names[i], 14 * line);
+    names_width = std::max(names_width, ImGui::CalcTextSize(row_names[i].c_str()).x);
+  }
+  names_width += ImGui::GetStyle().ItemSpacing.x;
+  const ImVec2 corner = ImGui::GetCursorScreenPos();
+  const ImVec2 origin(corner.x + names_width, corner.y + line);
   const float side = cell * static_cast<float>(n);
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  const ImU32 text = ImGui::GetColorU32(ImGuiCol_Text);
+  for (size_t i = 0; i < n; i += every) {
+    const float y = origin.y + cell * static_cast<float>(i) + (cell - line) / 2;
+    draw->AddText(ImVec2(corner.x, y), text, row_names[i].c_str());
+    const std::string number = std::to_string(i + 1);
+    const float x = origin.x + cell * static_cast<float>(i) +
+                    (cell - ImGui::CalcTextSize(number.c_str()).x) / 2;
+    draw->AddText(ImVec2(x, corner.y), text, number.c_str());
+  }
+  widgets->Set("matrix row names", {corner.x, origin.y, origin.x, origin.y + side});
+  widgets->Set("matrix column numbers", {origin.x, corner.y, origin.x + side, origin.y});
+  ImGui::SetCursorScreenPos(origin);
   ImGui::InvisibleButton("cells", ImVec2(std::max(side, 1.0f), std::max(side, 1.0f)));
   widgets->RecordLastItem("match cells");
-  ImDrawList* draw = ImGui::GetWindowDrawList();
   for (size_t row = 0; row < n; ++row) {
     for (size_t column = 0; column < n; ++column) {
       const int inliers = matrix.Inliers(row, column);
-      const float t = matrix.max_inliers > 0 ? static_cast<float>(inliers) / matrix.max_inliers : 0;
-      // Dark blue (none) to yellow (most).
-      const ImU32 color =
-          inliers == 0 ? IM_COL32(30, 30, 45, 255)
-                       : IM_COL32(static_cast<int>(40 + 215 * t), static_cast<int>(60 + 170 * t),
-                                  static_cast<int>(150 - 120 * t), 255);
+      const ImU32 color = InlierColor(inliers, matrix.max_inliers);
       const ImVec2 min(origin.x + cell * static_cast<float>(column),
                        origin.y + cell * static_cast<float>(row));
       draw->AddRectFilled(
@@ -95,40 +128,45 @@ void MatchMatrixPanel::SelectPair(int row, int column, const fs::path& image_dir
   const MatchMatrix& matrix = *matrix_;
   pair_row_ = row;
   pair_column_ = column;
+  PairInliers pair;
   try {
-    pair_inliers_ = ReadPairInliers(matrix.database, matrix.image_ids[static_cast<size_t>(row)],
-                                    matrix.image_ids[static_cast<size_t>(column)]);
+    pair = ReadPairInliers(matrix.database, matrix.image_ids[static_cast<size_t>(row)],
+                           matrix.image_ids[static_cast<size_t>(column)]);
   } catch (const InputError& error) {
     error_ = error.what();
-    pair_inliers_ = {};
   }
-  pair_photos_[0].Load(image_dir / pair_inliers_.name1, 360);
-  pair_photos_[1].Load(image_dir / pair_inliers_.name2, 360);
+  pair_view_.Show(std::move(pair), image_dir);
 }
 
-void MatchMatrixPanel::DrawPair() {
-  ImGui::Text("%s - %s: %zu inlier matches", pair_inliers_.name1.c_str(),
-              pair_inliers_.name2.c_str(), pair_inliers_.xy1.size());
-  if (pair_photos_[0].empty() || pair_photos_[1].empty()) {
-    ImGui::TextDisabled("(the photographs are not in the image folder)");
-    return;
-  }
-  const ImVec2 left = ImGui::GetCursorScreenPos();
-  for (const ImageTexture& photo : pair_photos_) {
-    photo.Draw();
-    ImGui::SameLine();
-  }
-  ImGui::NewLine();
-  const float right_x =
-      left.x + static_cast<float>(pair_photos_[0].width()) + ImGui::GetStyle().ItemSpacing.x;
+void MatchMatrixPanel::DrawLegend(WidgetRects* widgets) {
+  // A gradient from 1 inlier to the most, and the colour of no verified pair.
+  const float line = ImGui::GetTextLineHeight();
+  const ImVec2 at = ImGui::GetCursorScreenPos();
   ImDrawList* draw = ImGui::GetWindowDrawList();
-  for (size_t i = 0; i < pair_inliers_.xy1.size(); ++i) {
-    const ImVec2 a(left.x + pair_inliers_.xy1[i].x() * pair_photos_[0].scale(),
-                   left.y + pair_inliers_.xy1[i].y() * pair_photos_[0].scale());
-    const ImVec2 b(right_x + pair_inliers_.xy2[i].x() * pair_photos_[1].scale(),
-                   left.y + pair_inliers_.xy2[i].y() * pair_photos_[1].scale());
-    draw->AddLine(a, b, IM_COL32(60, 255, 90, 160));
+  const ImU32 text = ImGui::GetColorU32(ImGuiCol_Text);
+  const float swatch = line;
+  draw->AddRectFilled(at, ImVec2(at.x + swatch, at.y + line), InlierColor(0, 1));
+  const char* none = "no verified pair";
+  draw->AddText(ImVec2(at.x + swatch + 4, at.y), text, none);
+  const float bar_x = at.x + swatch + 4 + ImGui::CalcTextSize(none).x + 3 * line;
+  const std::string low = "1";
+  const std::string high = std::to_string(matrix_->max_inliers) + " inliers";
+  draw->AddText(ImVec2(bar_x, at.y), text, low.c_str());
+  const float gradient_x = bar_x + ImGui::CalcTextSize(low.c_str()).x + 4;
+  constexpr int kSteps = 32;
+  const float step = 6 * line / kSteps;
+  for (int i = 0; i < kSteps; ++i) {
+    const int inliers =
+        std::max(1, static_cast<int>(std::lround(matrix_->max_inliers * (i + 0.5) / kSteps)));
+    const float x = gradient_x + step * static_cast<float>(i);
+    draw->AddRectFilled(ImVec2(x, at.y), ImVec2(x + step + 0.5f, at.y + line),
+                        InlierColor(inliers, matrix_->max_inliers));
   }
+  const float end_x = gradient_x + 6 * line + 4;
+  draw->AddText(ImVec2(end_x, at.y), text, high.c_str());
+  const float width = end_x + ImGui::CalcTextSize(high.c_str()).x - at.x;
+  ImGui::Dummy(ImVec2(width, line));
+  widgets->RecordLastItem("matrix legend");
 }
 
 }  // namespace tessera::gui

@@ -9,8 +9,8 @@
 #include <string>
 #include <utility>
 
-#include "gui/image_texture.h"
 #include "gui/match_matrix.h"
+#include "gui/pair_view.h"
 #include "gui/widget_rects.h"
 
 namespace tessera::gui {
@@ -32,7 +32,9 @@ class MatchMatrixPanel {
   const std::string& Error() const { return error_; }
   // The pair (row, column) clicked and its inlier matches; (-1, -1) when none.
   std::pair<int, int> SelectedPair() const { return {pair_row_, pair_column_}; }
-  const PairInliers& SelectedPairInliers() const { return pair_inliers_; }
+  const PairInliers& SelectedPairInliers() const { return pair_view_.pair(); }
+  PairView& pair_view() { return pair_view_; }
+  const PairView& pair_view() const { return pair_view_; }
 
  private:
   // The cells, `cell` pixels square, as one item recorded as "match cells"; hovering
@@ -40,15 +42,14 @@ class MatchMatrixPanel {
   void DrawCells(float cell, const std::filesystem::path& image_dir, WidgetRects* widgets);
   // Reads the inlier matches of (row, column) and loads its photographs.
   void SelectPair(int row, int column, const std::filesystem::path& image_dir);
-  // The selected pair's photographs and matches.
-  void DrawPair();
+  // The colour scale under the cells, recorded as "matrix legend".
+  void DrawLegend(WidgetRects* widgets);
 
   bool show_ = false;
   std::optional<MatchMatrix> matrix_;
   std::string error_;
   int pair_row_ = -1, pair_column_ = -1;
-  PairInliers pair_inliers_;
-  ImageTexture pair_photos_[2];
+  PairView pair_view_;
 };
 
 }  // namespace tessera::gui

@@ -69,9 +69,17 @@ void ModelPanel::Draw(WidgetRects* widgets) {
   const Scene* scene = view_->scene();
   ImGui::Text("%zu points, %zu cameras", scene == nullptr ? 0 : scene->NumPoints(),
               scene == nullptr ? 0 : scene->cameras.size());
-  ImGui::SliderFloat("Point size", &view_->point_size, 1, 10, "%.0f px");
+  if (ImGui::SliderFloat("Point size", &view_->point_size, 1, 10, "%.0f px")) {
+    view_->point_size_chosen = true;
+  }
   ImGui::SliderFloat("Camera size", &view_->frustum_size, 0.01f, 0.5f, "%.2f");
   if (ImGui::Button("Recentre")) view_->Recentre();
+  ImGui::SameLine();
+  ImGui::Checkbox("grid", &view_->show_grid);
+  widgets->RecordLastItem("grid");
+  ImGui::SameLine();
+  ImGui::Checkbox("axes", &view_->show_axes);
+  widgets->RecordLastItem("axes");
   HintText("drag: orbit, shift+drag or right button: pan, wheel: zoom, click: details");
 }
 

@@ -64,6 +64,15 @@ void OrbitCamera::Zoom(float steps) {
       std::clamp(distance_ / std::pow(1.15f, steps), scene_radius_ * 1e-3f, scene_radius_ * 1e3f);
 }
 
+void OrbitCamera::LookFrom(const Eigen::Vector3f& eye, const Eigen::Matrix3f& world_from_cam,
+                           float distance) {
+  world_from_view_.col(0) = world_from_cam.col(0).normalized();
+  world_from_view_.col(1) = -world_from_cam.col(1).normalized();
+  world_from_view_.col(2) = -world_from_cam.col(2).normalized();
+  distance_ = std::max(distance, 1e-6f);
+  target_ = eye - world_from_view_.col(2) * distance_;
+}
+
 Eigen::Vector3f OrbitCamera::Eye() const { return target_ + world_from_view_.col(2) * distance_; }
 
 Eigen::Matrix4f OrbitCamera::ViewMatrix() const {

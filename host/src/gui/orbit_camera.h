@@ -22,6 +22,9 @@ class OrbitCamera {
   void Orbit(float dx_px, float dy_px);
   // Moves the target with the drag so that the point under the cursor follows it.
   void Pan(float dx_px, float dy_px, float viewport_height_px);
+  // Looks from `eye` as a camera whose axes (x right, y down, z forward, COLMAP's) are
+  // the columns of `world_from_cam`, orbiting a target `distance` ahead.
+  void LookFrom(const Eigen::Vector3f& eye, const Eigen::Matrix3f& world_from_cam, float distance);
   // Wheel steps: each step divides the distance by 1.15 (positive: closer).
   void Zoom(float steps);
 

@@ -2,8 +2,10 @@
 
 #include <imgui.h>
 
+#include <algorithm>
 #include <cmath>
 
+#include "gui/camera_pick.h"
 #include "gui/image_folder_check.h"
 #include "image/image_masks.h"
 #include "tessera/io/model_statistics.h"
@@ -57,20 +59,21 @@ void Picking::Pick(float x, float y, const WidgetRect& view_rect) {
     const auto pixel = view_->ProjectToWindow(world, view_rect);
     return pixel ? std::hypot((*pixel)[0] - x, (*pixel)[1] - y) : 1e9f;
   };
-  float best = 10;
-  image_t best_image = kInvalidImageId;
-  for (const SceneCamera& camera : scene->cameras) {
-    const float distance = distance_to_click(camera.center_in_world);
-    if (distance < best) {
-      best = distance;
-      best_image = camera.image_id;
-    }
-  }
-  if (best_image != kInvalidImageId) {
-    view_->selected_image = best_image;
+  const Eigen::Matrix4f view_from_world = view_->camera().ViewMatrix();
+  const Projector project = [&](const Eigen::Vector3f& world) -> std::optional<ProjectedPoint> {
+    const auto pixel = view_->ProjectToWindow(world, view_rect);
+    if (!pixel) return std::nullopt;
+    const float depth = -(view_from_world * world.homogeneous()).z();
+    return ProjectedPoint{(*pixel)[0], (*pixel)[1], depth};
+  };
+  const image_t image =
+      PickCamera(*scene, view_->frustum_size * scene->radius, project, x, y);
+  if (image != kInvalidImageId) {
+    view_->selected_image = image;
+    view_->selected_point = kInvalidPoint3DId;
     return;
   }
-  best = 6;
+  float best = 6;
   point3D_t best_point = kInvalidPoint3DId;
   for (size_t i = 0; i < scene->point_ids.size(); ++i) {
     const float distance = distance_to_click(Eigen::Vector3f(
@@ -120,6 +123,8 @@ void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& ima
   ImGui::Text("%zu observations, mean reprojection error %.3f px", observations,
               usable > 0 ? error_sum / static_cast<double>(usable) : 0.0);
   widgets->RecordLastItem("camera details");
+  if (ImGui::Button("View from this camera")) view_->LookThrough(image_id);
+  widgets->RecordLastItem("look through");
   const ImVec2 position = ImGui::GetWindowPos();
   const ImVec2 size = ImGui::GetWindowSize();
   widgets->Set("camera window", {position.x, position.y, position.x + size.x, position.y + size.y});
@@ -129,7 +134,10 @@ void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& ima
     photo_image_ = image_id;
     photo_dir_ = image_dir;
     mask_dir_ = mask_dir;
-    LoadPhoto(model, image, image_dir, mask_dir);
+    // A third of the view wide (240 to 480 pixels): the model stays in sight beside it.
+    const int width = static_cast<int>(
+        std::clamp((view_rect.max_x - view_rect.min_x) / 3, 240.0f, 480.0f));
+    LoadPhoto(model, image, image_dir, mask_dir, width);
   }
   if (photo_problem_.empty()) {
     const ImVec2 origin = ImGui::GetCursorScreenPos();
@@ -155,10 +163,10 @@ void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& ima
 }
 
 void Picking::LoadPhoto(const Reconstruction& model, const Image& image, const fs::path& image_dir,
-                        const fs::path& mask_dir) {
+                        const fs::path& mask_dir, int max_width) {
   // The mask as detection finds it: MASK_DIR/NAME.png, else NAME with .png for its extension.
   const fs::path mask_file = mask_dir.empty() ? fs::path() : FindMaskFile(mask_dir, image.name);
-  const bool found = !image_dir.empty() && photo_.Load(image_dir / image.name, 480, mask_file);
+  const bool found = !image_dir.empty() && photo_.Load(image_dir / image.name, max_width, mask_file);
   const auto camera = model.cameras.find(image.camera_id);
   photo_problem_ =
       camera == model.cameras.end()

@@ -22,8 +22,9 @@ class Picking {
   // The mouse of this frame in `view_rect` (window pixels); after the panels are drawn,
   // which take the mouse first.
   void HandleMouse(const WidgetRect& view_rect);
-  // Picks at window pixel (x, y): the nearest camera centre within 10 pixels, else the
-  // nearest point within 6 pixels (none when there is none).
+  // Picks at window pixel (x, y): the nearest to the viewer of the cameras whose frustum
+  // covers it or whose centre is within 10 pixels (PickCamera), else the nearest point
+  // within 6 pixels (none when there is none).
   void Pick(float x, float y, const WidgetRect& view_rect);
   // The windows of the picked camera and point; the camera's photograph is read from
   // `image_dir`, its masked-out area darkened when `mask_dir` (camera.mask_path) has its
@@ -40,10 +41,12 @@ class Picking {
   void DrawCameraDetails(const WidgetRect& view_rect, const std::filesystem::path& image_dir,
                          const std::filesystem::path& mask_dir, WidgetRects* widgets);
   void DrawPointDetails(const WidgetRect& view_rect, WidgetRects* widgets);
-  // Loads the photograph of `image` from `image_dir`; photo_problem_ says why it is not
-  // shown (missing, or not the size of the model's camera).
+  // Loads the photograph of `image` from `image_dir`, at most max_width pixels wide;
+  // photo_problem_ says why it is not shown (missing, or not the size of the model's
+  // camera).
   void LoadPhoto(const Reconstruction& model, const Image& image,
-                 const std::filesystem::path& image_dir, const std::filesystem::path& mask_dir);
+                 const std::filesystem::path& image_dir, const std::filesystem::path& mask_dir,
+                 int max_width);
 
   SceneView* view_;
   bool dragging_ = false;

@@ -3,6 +3,8 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "gui/panel_widgets.h"
@@ -12,6 +14,16 @@
 
 namespace tessera::gui {
 namespace fs = std::filesystem;
+namespace {
+
+bool SameBytes(const fs::path& a, const fs::path& b) {
+  std::ifstream first(a, std::ios::binary), second(b, std::ios::binary);
+  if (!first || !second) return false;
+  return std::string(std::istreambuf_iterator<char>(first), {}) ==
+         std::string(std::istreambuf_iterator<char>(second), {});
+}
+
+}  // namespace
 namespace {
 
 // The recipe's own "description"; a recipe that cannot be read says why instead, and is
@@ -68,6 +80,14 @@ const Recipe* RecipeList::Current(const std::string& manifest_field) {
   std::error_code error;
   for (const Recipe& recipe : recipes()) {
     if (fs::equivalent(recipe.file, fs::path(manifest_field), error)) return &recipe;
+  }
+  // A copy of a recipe (the source tree's manifests/ beside an installed one): the same
+  // name and the same bytes.
+  for (const Recipe& recipe : recipes()) {
+    if (recipe.file.filename() == fs::path(manifest_field).filename() &&
+        SameBytes(recipe.file, manifest_field)) {
+      return &recipe;
+    }
   }
   return nullptr;
 }

@@ -36,11 +36,12 @@ class RecipeList {
   // preview the recipe the manifest field names (empty: the default), with that
   // recipe's description beneath it. Returns the recipe chosen this frame, or nullptr.
   const Recipe* Draw(const std::string& manifest_field, WidgetRects* widgets);
+  // The recipe whose file the manifest field names (or a copy of it: the same name and
+  // bytes); nullptr for another file.
+  const Recipe* Current(const std::string& manifest_field);
 
  private:
   const std::vector<Recipe>& recipes();
-  // The recipe whose file the manifest field names; nullptr for another file.
-  const Recipe* Current(const std::string& manifest_field);
 
   std::filesystem::path folder_;
   std::vector<Recipe> recipes_;

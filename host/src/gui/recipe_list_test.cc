@@ -45,3 +45,23 @@ TEST(RecipeList, TheShippedRecipesHaveDescriptions) {
 
 }  // namespace
 }  // namespace tessera::gui
+
+namespace tessera::gui {
+namespace {
+
+// The source tree's manifests/fast.json is the recipe "fast" of the list (a copy of it
+// beside the executable): the same name and bytes; a changed copy is another file.
+TEST(RecipeList, ACopyOfARecipeIsThatRecipe) {
+  RecipeList list;
+  const std::filesystem::path source = testing::SourceDir() / "manifests" / "fast.json";
+  const Recipe* current = list.Current(source.string());
+  ASSERT_NE(current, nullptr);
+  EXPECT_EQ(current->name, "fast");
+  testing::TemporaryDir dir;
+  std::filesystem::copy_file(source, dir.path() / "fast.json");
+  std::ofstream(dir.path() / "fast.json", std::ios::app) << "\n";
+  EXPECT_EQ(list.Current((dir.path() / "fast.json").string()), nullptr);
+}
+
+}  // namespace
+}  // namespace tessera::gui

@@ -1,5 +1,6 @@
 #include "gui/renderer.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -96,7 +97,8 @@ void Renderer::SetScene(std::shared_ptr<const Scene> scene) {
 }
 
 void Renderer::Draw(const std::array<int, 4>& viewport, const Eigen::Matrix4f& world_to_clip,
-                    float point_size, float frustum_size, image_t selected_image) {
+                    float point_size, float frustum_size, image_t selected_image,
+                    const Overlay& overlay) {
   glViewport(viewport[0], viewport[1], viewport[2], viewport[3]);
   glEnable(GL_SCISSOR_TEST);
   glScissor(viewport[0], viewport[1], viewport[2], viewport[3]);
@@ -104,7 +106,7 @@ void Renderer::Draw(const std::array<int, 4>& viewport, const Eigen::Matrix4f& w
                kBackgroundColor[2] / 255.0f, 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
   glDisable(GL_SCISSOR_TEST);
-  if (scene_ == nullptr) return;
+  if (scene_ == nullptr && overlay.line_positions.empty()) return;
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_BLEND);
@@ -112,7 +114,7 @@ void Renderer::Draw(const std::array<int, 4>& viewport, const Eigen::Matrix4f& w
   glUseProgram(program_);
   glUniformMatrix4fv(mvp_location_, 1, GL_FALSE, world_to_clip.data());
   glUniform1f(point_size_location_, point_size);
-  if (num_points_ > 0) {
+  if (scene_ != nullptr && num_points_ > 0) {
     glBindVertexArray(point_vao_);
     glDrawArrays(GL_POINTS, 0, static_cast<GLsizei>(num_points_));
   }
@@ -120,8 +122,9 @@ void Renderer::Draw(const std::array<int, 4>& viewport, const Eigen::Matrix4f& w
   // frustum_size * radius.
   std::vector<float> positions;
   std::vector<uint8_t> colors;
-  const float depth = frustum_size * scene_->radius;
-  for (const SceneCamera& camera : scene_->cameras) {
+  const float depth = scene_ == nullptr ? 0 : frustum_size * scene_->radius;
+  static const std::vector<SceneCamera> kNoCameras;
+  for (const SceneCamera& camera : scene_ == nullptr ? kNoCameras : scene_->cameras) {
     const auto& color = camera.image_id == selected_image ? kSelectedFrustumColor : kFrustumColor;
     std::array<Eigen::Vector3f, 4> corners;
     for (size_t i = 0; i < 4; ++i)
@@ -137,6 +140,13 @@ void Renderer::Draw(const std::array<int, 4>& viewport, const Eigen::Matrix4f& w
       add(corners[i], corners[(i + 1) % 4]);
     }
   }
+  // The overlay's lines after the frusta, its points after the lines.
+  positions.insert(positions.end(), overlay.line_positions.begin(), overlay.line_positions.end());
+  colors.insert(colors.end(), overlay.line_colors.begin(), overlay.line_colors.end());
+  const size_t num_line_vertices = positions.size() / 3;
+  positions.insert(positions.end(), overlay.point_positions.begin(),
+                   overlay.point_positions.end());
+  colors.insert(colors.end(), overlay.point_colors.begin(), overlay.point_colors.end());
   if (!positions.empty()) {
     glBindBuffer(GL_ARRAY_BUFFER, line_buffers_[0]);
     glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(positions.size() * sizeof(float)),
@@ -146,7 +156,15 @@ void Renderer::Draw(const std::array<int, 4>& viewport, const Eigen::Matrix4f& w
                  GL_STREAM_DRAW);
     glBindBuffer(GL_ARRAY_BUFFER, 0);
     glBindVertexArray(line_vao_);
-    glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(positions.size() / 3));
+    glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(num_line_vertices));
+    const size_t num_points = positions.size() / 3 - num_line_vertices;
+    if (num_points > 0) {
+      // The selected point over everything else.
+      glDisable(GL_DEPTH_TEST);
+      glUniform1f(point_size_location_, std::max(8.0f, kOverlayPointScale * point_size));
+      glDrawArrays(GL_POINTS, static_cast<GLint>(num_line_vertices),
+                   static_cast<GLsizei>(num_points));
+    }
   }
   glBindVertexArray(0);
   glUseProgram(0);

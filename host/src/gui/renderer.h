@@ -8,6 +8,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "gui/scene.h"
 
@@ -18,6 +19,16 @@ inline constexpr std::array<uint8_t, 3> kFrustumColor = {255, 64, 32};
 inline constexpr std::array<uint8_t, 3> kSelectedFrustumColor = {255, 230, 0};
 // The 3D view's background.
 inline constexpr std::array<uint8_t, 3> kBackgroundColor = {24, 26, 32};
+
+// Lines and large points drawn over the model (ViewOverlay): the ground grid, the axes,
+// the selected point and its track.
+struct Overlay {
+  std::vector<float> line_positions;  // xyz, two vertices per line
+  std::vector<uint8_t> line_colors;   // rgb per vertex
+  std::vector<float> point_positions;  // xyz, drawn kOverlayPointScale times the size
+  std::vector<uint8_t> point_colors;
+};
+inline constexpr float kOverlayPointScale = 4;
 
 class Renderer {
  public:
@@ -31,7 +42,8 @@ class Renderer {
   // Clears the viewport (x, y from the bottom-left, in framebuffer pixels) and draws.
   // frustum_size: the frustum depth as a fraction of the scene radius.
   void Draw(const std::array<int, 4>& viewport, const Eigen::Matrix4f& world_to_clip,
-            float point_size, float frustum_size, image_t selected_image);
+            float point_size, float frustum_size, image_t selected_image,
+            const Overlay& overlay = {});
 
  private:
   unsigned int program_ = 0;

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "gui/match_matrix.h"
 #include "manifest/manifest.h"
 #include "pipeline/pipeline_context.h"
 #include "pipeline/run_pipeline.h"
@@ -69,6 +70,7 @@ bool RunController::Start(const RunRequest& request) {
     status_ = RunStatus();
     status_.state = RunState::kRunning;
     status_.output_dir = request.output_dir;
+    output_dir_ = request.output_dir;
     stage_starts_.clear();
     cancel_ = std::make_unique<CancellationToken>();
   }
@@ -109,6 +111,83 @@ std::shared_ptr<const Scene> RunController::TakeScene(uint64_t* version) const {
   return scene_;
 }
 
+void RunController::UpdateLastStage(size_t done, size_t total) {
+  const auto now = std::chrono::steady_clock::now();
+  StageProgress& progress = status_.stages.back();
+  const double elapsed = std::chrono::duration<double>(now - stage_starts_.back()).count();
+  progress.done = done;
+  progress.total = total;
+  progress.elapsed_s = elapsed;
+  if (done > 0 && elapsed > 0) {
+    progress.rate_per_s = static_cast<double>(done) / elapsed;
+    progress.remaining_s = static_cast<double>(total - std::min(done, total)) / progress.rate_per_s;
+  }
+}
+
+void RunController::OnProgress(const std::string& stage, size_t done, size_t total) {
+  // The map stage reports (0, 1) as it starts: its bar counts registered images against
+  // the images of the view graph, read here on the worker.
+  size_t view_graph_images = 0;
+  if (stage == "map" && done == 0) {
+    try {
+      const MatchMatrix matrix = ReadMatchMatrix(output_dir_);
+      for (size_t row = 0; row < matrix.size(); ++row) {
+        for (size_t column = 0; column < matrix.size(); ++column) {
+          if (matrix.Inliers(row, column) > 0) {
+            ++view_graph_images;
+            break;
+          }
+        }
+      }
+    } catch (const std::exception&) {
+      // Unreadable: the bar shows the stage's own (0, 1).
+    }
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    const bool is_new = status_.stages.empty() || status_.stages.back().stage != stage;
+    if (is_new) {
+      StageProgress started;
+      started.stage = stage;
+      status_.stages.push_back(started);
+      stage_starts_.push_back(std::chrono::steady_clock::now());
+    }
+    StageProgress& progress = status_.stages.back();
+    if (stage == "map" && !progress.unit.empty()) {
+      // The end, (1, 1): done stays what the models registered.
+      if (done == total) progress.finished = true;
+    } else if (stage == "map" && view_graph_images > 0) {
+      progress.unit = "images registered";
+      registered_.clear();
+      UpdateLastStage(0, view_graph_images);
+    } else {
+      UpdateLastStage(done, total);
+      progress.finished = total > 0 && done >= total;
+    }
+  }
+  Notify();
+}
+
+void RunController::OnModelChanged(size_t model_index, const Reconstruction& model) {
+  // Copied and flattened here, on the worker; the UI thread only swaps the pointer.
+  std::shared_ptr<const Scene> scene = MakeScene(std::make_shared<const Reconstruction>(model));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    scene_ = std::move(scene);
+    ++scene_version_;
+    if (!status_.stages.empty() && status_.stages.back().stage == "map" &&
+        !status_.stages.back().unit.empty()) {
+      if (registered_.size() <= model_index) registered_.resize(model_index + 1, 0);
+      registered_[model_index] = model.NumRegisteredImages();
+      size_t done = 0;
+      for (const size_t each : registered_) done += each;
+      const StageProgress& map = status_.stages.back();
+      UpdateLastStage(std::min(done, map.total), map.total);
+    }
+  }
+  Notify();
+}
+
 void RunController::Notify() {
   if (on_change_) on_change_();
 }
@@ -130,35 +209,10 @@ void RunController::Work(RunRequest request) {
     control.cancel = cancel_.get();
   }
   control.progress = [this](const std::string& stage, size_t done, size_t total) {
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      const auto now = std::chrono::steady_clock::now();
-      if (status_.stages.empty() || status_.stages.back().stage != stage) {
-        status_.stages.push_back({stage, done, total});
-        stage_starts_.push_back(now);
-      }
-      StageProgress& progress = status_.stages.back();
-      const double elapsed = std::chrono::duration<double>(now - stage_starts_.back()).count();
-      progress.done = done;
-      progress.total = total;
-      progress.elapsed_s = elapsed;
-      if (done > 0 && elapsed > 0) {
-        progress.rate_per_s = static_cast<double>(done) / elapsed;
-        progress.remaining_s =
-            static_cast<double>(total - std::min(done, total)) / progress.rate_per_s;
-      }
-    }
-    Notify();
+    OnProgress(stage, done, total);
   };
-  control.model_changed = [this](size_t /*model_index*/, const Reconstruction& model) {
-    // Copied and flattened here, on the worker; the UI thread only swaps the pointer.
-    std::shared_ptr<const Scene> scene = MakeScene(std::make_shared<const Reconstruction>(model));
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      scene_ = std::move(scene);
-      ++scene_version_;
-    }
-    Notify();
+  control.model_changed = [this](size_t model_index, const Reconstruction& model) {
+    OnModelChanged(model_index, model);
   };
 
   RunState state = RunState::kFailed;

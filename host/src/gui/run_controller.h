@@ -38,6 +38,11 @@ struct StageProgress {
   // negative when not known yet.
   double rate_per_s = -1;
   double remaining_s = -1;
+  // What done and total count when not the stage's own units ("images registered": the
+  // map stage counts the images its models registered against the images of the view
+  // graph, those with a verified pair).
+  std::string unit;
+  bool finished = false;  // the stage ended (map: done stays what its models registered)
 };
 
 enum class RunState { kIdle, kRunning, kCompleted, kCancelled, kFailed };
@@ -77,12 +82,20 @@ class RunController {
 
  private:
   void Work(RunRequest request);
+  // The stage's report; for "map", its start and end (its registrations come from
+  // OnModelChanged).
+  void OnProgress(const std::string& stage, size_t done, size_t total);
+  void OnModelChanged(size_t model_index, const Reconstruction& model);
+  // The last stage's done, rate and time left from `done` (under the mutex).
+  void UpdateLastStage(size_t done, size_t total);
   void Notify();
 
   std::function<void()> on_change_;
   mutable std::mutex mutex_;
   RunStatus status_;
   std::vector<std::chrono::steady_clock::time_point> stage_starts_;
+  std::filesystem::path output_dir_;       // of the run going on
+  std::vector<size_t> registered_;         // per model of the map stage going on
   std::shared_ptr<const Scene> scene_;
   uint64_t scene_version_ = 0;
   std::unique_ptr<CancellationToken> cancel_;

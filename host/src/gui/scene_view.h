@@ -18,6 +18,10 @@ namespace tessera::gui {
 
 class Renderer;
 
+// The point size (pixels) for a model of `num_points`: larger for sparse models, 1 for
+// millions (300 / sqrt(n), 1 to 6).
+size_t DefaultPointSize(size_t num_points);
+
 class SceneView {
  public:
   // on_change: called whenever the model shown changes (the window draws again). The
@@ -28,6 +32,8 @@ class SceneView {
   void Show(std::shared_ptr<const Scene> scene, bool frame);
   // Frames the model shown (the Recentre button); nothing without one.
   void Recentre();
+  // Puts the view at the camera of `image_id`, looking as it looks (its up up).
+  void LookThrough(image_t image_id);
   // Forgets the camera and point picked, and that the user moved the camera: a new model.
   void ForgetPicks();
   // Draws the model into `viewport` (x, y from the bottom-left, width, height, in
@@ -41,7 +47,10 @@ class SceneView {
   OrbitCamera& camera() { return camera_; }
 
   // Set by the panels' sliders and the picking.
-  float point_size = 2;        // pixels
+  float point_size = 2;        // pixels; DefaultPointSize of a model shown framed
+  bool point_size_chosen = false;  // the user moved the slider: kept for every model
+  bool show_grid = false;      // the ground grid and the world axes (ViewOverlay)
+  bool show_axes = false;
   float frustum_size = 0.15f;  // frustum depth, a fraction of the model's radius
   image_t selected_image = kInvalidImageId;
   point3D_t selected_point = kInvalidPoint3DId;

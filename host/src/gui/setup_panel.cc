@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "gui/model_loader.h"
+#include "gui/stage_progress_bars.h"
 #include "manifest/manifest.h"
 #include "tessera/errors.h"
 
@@ -30,34 +32,6 @@ bool HasImageFile(const fs::path& dir) {
     }
   }
   return false;
-}
-
-std::string FormatSeconds(double seconds) {
-  if (seconds < 0) return "?";
-  if (seconds < 60) return std::to_string(static_cast<int>(std::lround(seconds))) + " s";
-  const long minutes = std::lround(seconds) / 60;
-  return std::to_string(minutes) + " min " + std::to_string(std::lround(seconds) % 60) + " s";
-}
-
-// A bar per stage: done/total, and once known the rate and the time left.
-void DrawStageProgress(const std::vector<StageProgress>& stages, WidgetRects* widgets) {
-  for (const StageProgress& stage : stages) {
-    const float fraction =
-        stage.total == 0 ? 1.0f : static_cast<float>(stage.done) / static_cast<float>(stage.total);
-    std::string overlay = std::to_string(stage.done) + "/" + std::to_string(stage.total);
-    if (stage.rate_per_s > 0) {
-      char rate[64];
-      std::snprintf(rate, sizeof(rate), "  %.2f/s", stage.rate_per_s);
-      overlay += rate;
-      if (stage.done < stage.total) overlay += ", " + FormatSeconds(stage.remaining_s) + " left";
-    }
-    const float name_width = ImGui::GetFontSize() * 6;
-    ImGui::ProgressBar(fraction, ImVec2(-name_width, 0), overlay.c_str());
-    // The overlay is cut at the bar's ends: the whole of it in a tooltip.
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s: %s", stage.stage.c_str(), overlay.c_str());
-    ImGui::SameLine();
-    FitText(stage.stage, widgets);
-  }
 }
 
 }  // namespace
@@ -118,6 +92,54 @@ bool SetupPanel::Run() {
   return true;
 }
 
+bool SetupPanel::RequestRun() {
+  if (!CheckFields()) return Run();  // Run sets and logs the message
+  std::vector<fs::path> models;
+  try {
+    models = FindModelFolders(fs::path(output_.data()));
+  } catch (const InputError&) {
+    // No model there (or no workspace yet): nothing to replace.
+  }
+  if (models.empty()) return Run();
+  overwrite_question_ = fs::path(output_.data()).string() + " holds " +
+                        (models.size() == 1 ? "a model (" + models[0].filename().string() + ")"
+                                            : std::to_string(models.size()) + " models") +
+                        "; this run maps again and replaces " +
+                        (models.size() == 1 ? "it." : "them.");
+  overwrite_popup_open_ = false;
+  return true;
+}
+
+void SetupPanel::DrawOverwriteQuestion(WidgetRects* widgets) {
+  if (overwrite_question_.empty()) return;
+  constexpr const char* kTitle = "Replace the model?";
+  if (!overwrite_popup_open_) {
+    ImGui::OpenPopup(kTitle);
+    overwrite_popup_open_ = true;
+  }
+  const ImVec2 centre = ImGui::GetMainViewport()->GetCenter();
+  ImGui::SetNextWindowPos(centre, ImGuiCond_Always, ImVec2(0.5f, 0.5f));
+  if (!ImGui::BeginPopupModal(kTitle, nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
+  ImGui::PushTextWrapPos(ImGui::GetFontSize() * 30);
+  ImGui::TextUnformatted(overwrite_question_.c_str());
+  ImGui::PopTextWrapPos();
+  bool close = false;
+  if (ImGui::Button("Run and replace")) {
+    close = true;
+    overwrite_question_.clear();
+    Run();
+  }
+  widgets->RecordLastItem("replace model");
+  ImGui::SameLine();
+  if (ImGui::Button("Keep it")) close = true;
+  widgets->RecordLastItem("keep model");
+  if (close) {
+    overwrite_question_.clear();
+    ImGui::CloseCurrentPopup();
+  }
+  ImGui::EndPopup();
+}
+
 bool SetupPanel::ChooseRecipe(const std::string& name) {
   const Recipe* recipe = recipes_.Find(name);
   if (recipe == nullptr) {
@@ -142,6 +164,7 @@ void SetupPanel::Draw(const RunStatus& status, WidgetRects* widgets) {
   editor_.Draw(widgets);
   DrawRunButtons(status, running, widgets);
   DrawStageProgress(status.stages, widgets);
+  DrawOverwriteQuestion(widgets);
 }
 
 void SetupPanel::DrawFields(WidgetRects* widgets) {
@@ -180,7 +203,7 @@ void SetupPanel::DrawFields(WidgetRects* widgets) {
 
 void SetupPanel::DrawRunButtons(const RunStatus& status, bool running, WidgetRects* widgets) {
   ImGui::BeginDisabled(running);
-  if (ImGui::Button("Run")) Run();
+  if (ImGui::Button("Run")) RequestRun();
   ImGui::EndDisabled();
   widgets->RecordLastItem("run");
   ImGui::SameLine();

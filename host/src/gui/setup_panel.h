@@ -31,6 +31,12 @@ class SetupPanel {
   // Starts a run of the fields (as the Run button does); false with the message in
   // Error() (also logged) when a field is wrong or a run is going on.
   bool Run();
+  // As the Run button: Run, unless the output folder holds a model the run would replace
+  // (its sparse/N): then the window asks first ("Run and replace" or "Keep it"). False
+  // with the message in Error() when a field is wrong.
+  bool RequestRun();
+  // The models the run asked about would replace; empty when it is not asking.
+  const std::string& OverwriteQuestion() const { return overwrite_question_; }
   // Makes the recipe `name` (manifests/<name>.json) the manifest field's file and loads
   // it into the editor (as choosing it in the recipe list does); false with the message
   // in Error() when there is no such recipe or it cannot be read.
@@ -54,11 +60,15 @@ class SetupPanel {
   void DrawFields(WidgetRects* widgets);
   // Run and Cancel (one of them enabled, by `running`), the state and the message.
   void DrawRunButtons(const RunStatus& status, bool running, WidgetRects* widgets);
+  // The question before a run that would replace a model (a modal popup).
+  void DrawOverwriteQuestion(WidgetRects* widgets);
 
   RunController* controller_;
   std::function<void()> before_start_;
   PathField images_{}, output_{}, manifest_{};
   std::string error_, images_error_, manifest_error_;
+  std::string overwrite_question_;
+  bool overwrite_popup_open_ = false;
   bool follow_run_ = true;
   FolderBrowser browser_;
   RecipeList recipes_;

@@ -1,0 +1,116 @@
+// Issue 30 item 10: `gui --model M --images I` opens M with I as its photographs and
+// starts no run (with --output and --screenshot too), and a run that would replace a
+// model of its output folder asks first in the window.
+
+#include <spdlog/spdlog.h>
+
+#include <string>
+
+#include "gui/gui_window_test_fixture.h"
+
+namespace tessera::gui {
+namespace {
+namespace fs = std::filesystem;
+
+using GuiModelAndRunTest = GuiWindowTest;
+
+TEST_F(GuiModelAndRunTest, ModelWithImagesAndOutputOpensItAndStartsNoRun) {
+  const fs::path workspace = FinishedWorkspace();
+  const fs::path model_file = workspace / "sparse" / "0" / "images.bin";
+  ASSERT_TRUE(fs::exists(model_file));
+  const auto written = fs::last_write_time(model_file);
+  // As `tessera gui --model ws --images I --output ws --screenshot shot.png`.
+  GuiCommandOptions command;
+  command.gui.model = workspace;
+  command.gui.images = dir_.path() / "images";
+  command.gui.output = workspace;
+  command.screenshot = dir_.path() / "shot.png";
+  EXPECT_EQ(RunGui(command), 0);
+  EXPECT_TRUE(fs::exists(command.screenshot));
+  EXPECT_EQ(fs::last_write_time(model_file), written);  // not mapped again
+  // Without --output too (it was an error: "choose an output folder").
+  command.gui.output.clear();
+  EXPECT_EQ(RunGui(command), 0);
+  EXPECT_EQ(fs::last_write_time(model_file), written);
+
+  // The window: the model shown, the images field its photographs, no run.
+  GuiOptions options = command.gui;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  EXPECT_EQ(app.controller().Status().state, RunState::kIdle);
+  EXPECT_GE(app.NumSceneCameras(), 6u);
+  EXPECT_EQ(app.ImagesField(), (dir_.path() / "images").string());
+  EXPECT_EQ(app.ImageFolderWarning(), "");
+}
+
+TEST_F(GuiModelAndRunTest, ARunThatWouldReplaceAModelAsksFirst) {
+  const fs::path workspace = FinishedWorkspace();
+  const fs::path model_file = workspace / "sparse" / "0" / "images.bin";
+  const auto written = fs::last_write_time(model_file);
+  GuiOptions options;
+  options.images = dir_.path() / "images";
+  options.output = workspace;
+  options.manifest = manifest_;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  Click(&app, "run");
+  app.Frame();
+  EXPECT_FALSE(app.controller().Running());
+  EXPECT_NE(app.OverwriteQuestion().find("holds a model (0)"), std::string::npos)
+      << app.OverwriteQuestion();
+  // "Keep it": no run, the model untouched.
+  Click(&app, "keep model");
+  app.Frame();
+  EXPECT_EQ(app.OverwriteQuestion(), "");
+  EXPECT_FALSE(app.Widget("keep model").has_value());
+  EXPECT_FALSE(app.controller().Running());
+  EXPECT_EQ(app.controller().Status().state, RunState::kIdle);
+  EXPECT_EQ(fs::last_write_time(model_file), written);
+  // "Run and replace": the run goes.
+  Click(&app, "run");
+  app.Frame();
+  Click(&app, "replace model");
+  EXPECT_NE(app.controller().Status().state, RunState::kIdle);
+  ASSERT_TRUE(WaitFor(&app, [&] { return !app.controller().Running(); }, 120));
+  EXPECT_EQ(app.controller().Status().state, RunState::kCompleted);
+}
+
+}  // namespace
+}  // namespace tessera::gui
+
+namespace tessera::gui {
+namespace {
+
+// Issue 30 item 11: the model shown is cleared when a run starts (the view follows the
+// run), not to be taken for the run's model, until the run's own model arrives.
+TEST_F(GuiModelAndRunTest, TheOldModelIsClearedWhenARunStarts) {
+  const std::filesystem::path workspace = FinishedWorkspace();
+  GuiOptions options;
+  options.model = workspace;
+  options.images = dir_.path() / "images";
+  options.output = dir_.path() / "second";
+  options.manifest = manifest_;
+  GuiApp app(options);
+  app.Frame();
+  RgbImage before;
+  app.Frame(nullptr, &before);
+  ASSERT_GT(app.NumScenePoints(), 1000u);
+  EXPECT_GT(CountViewPixels(before, app.ViewRect()).frustum, 0u);
+  Click(&app, "run");
+  ASSERT_NE(app.controller().Status().state, RunState::kIdle) << app.SetupError();
+  // Extraction has barely begun: nothing registered yet.
+  RgbImage during;
+  app.Frame(nullptr, &during);
+  EXPECT_EQ(app.NumScenePoints(), 0u);
+  EXPECT_EQ(CountViewPixels(during, app.ViewRect()).frustum, 0u);
+  EXPECT_TRUE(app.Widget("view hint run").has_value());
+  ASSERT_TRUE(WaitFor(&app, [&] { return !app.controller().Running(); }, 120));
+  ASSERT_EQ(app.controller().Status().state, RunState::kCompleted);
+  app.Frame();
+  EXPECT_GT(app.NumScenePoints(), 1000u);  // the run's model
+}
+
+}  // namespace
+}  // namespace tessera::gui

@@ -1,0 +1,69 @@
+// Issue 30 item 8: the pair view is readable: at most kMaxPairLines translucent lines,
+// a toggle between the verified inliers and the putative matches, the images' names on
+// the match matrix's axes and a colour legend.
+
+#include <set>
+
+#include "gui/gui_window_test_fixture.h"
+#include "gui/pair_view.h"
+
+namespace tessera::gui {
+namespace {
+
+TEST(PairView, SubsamplesEvenlyToAtMostTheLimit) {
+  const std::vector<size_t> few = SubsampleMatches(40, 300);
+  EXPECT_EQ(few.size(), 40u);
+  const std::vector<size_t> many = SubsampleMatches(1000, 300);
+  ASSERT_EQ(many.size(), 300u);
+  EXPECT_EQ(std::set<size_t>(many.begin(), many.end()).size(), 300u);
+  EXPECT_EQ(many.front(), 0u);
+  EXPECT_GE(many.back(), 990u);  // spread to the end, not the first 300
+}
+
+TEST_F(GuiWindowTest, PairViewTogglesInliersAndPutativesWithAxesAndLegend) {
+  const std::filesystem::path workspace = FinishedWorkspace();
+  GuiOptions options;
+  options.images = dir_.path() / "images";
+  options.output = workspace;
+  options.width = 1400;
+  options.height = 900;
+  GuiApp app(options);
+  app.Frame();
+  Click(&app, "match matrix");
+  app.Frame();
+  app.Frame();
+  const WidgetRect cells = app.Widget("match cells").value();
+  const float cell = (cells.max_x - cells.min_x) / 8;
+  // Row 1, column 2 (images 1 and 2 of the sample, neighbours).
+  Click(&app, WidgetRect{cells.min_x + 1.5f * cell, cells.min_y + 0.5f * cell,
+                         cells.min_x + 1.5f * cell, cells.min_y + 0.5f * cell});
+  ASSERT_EQ(app.SelectedPair(), std::make_pair(0, 1));
+  app.Frame();
+  app.Frame();
+  const PairInliers& pair = app.SelectedPairInliers();
+  std::printf("pair: %zu inliers, %zu putative matches\n", pair.xy1.size(),
+              pair.putative_xy1.size());
+  ASSERT_GT(pair.xy1.size(), 0u);
+  EXPECT_GE(pair.putative_xy1.size(), pair.xy1.size());
+  EXPECT_FALSE(app.PairShowsPutatives());
+  EXPECT_EQ(app.PairLinesDrawn(), std::min(pair.xy1.size(), kMaxPairLines));
+  Click(&app, "show putatives");
+  app.Frame();
+  EXPECT_TRUE(app.PairShowsPutatives());
+  EXPECT_EQ(app.PairLinesDrawn(), std::min(pair.putative_xy1.size(), kMaxPairLines));
+  EXPECT_LE(app.PairLinesDrawn(), kMaxPairLines);
+  // The axes and the legend.
+  const WidgetRect names = app.Widget("matrix row names").value();
+  EXPECT_GT(names.max_x - names.min_x, 40.0f);  // "1 image_000.png"-like labels
+  EXPECT_TRUE(app.Widget("matrix column numbers").has_value());
+  const WidgetRect legend = app.Widget("matrix legend").value();
+  EXPECT_GT(legend.min_y, cells.max_y);
+  Click(&app, "show inliers");
+  RgbImage image;
+  app.Frame(nullptr, &image);
+  EXPECT_FALSE(app.PairShowsPutatives());
+  if (const char* keep = std::getenv("TESSERA_GUI_PAIR_SCREENSHOT")) WritePng(image, keep);
+}
+
+}  // namespace
+}  // namespace tessera::gui
