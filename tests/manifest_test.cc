@@ -56,7 +56,8 @@ TEST(Manifest, TheMapperIsASlotAndIncrementalByDefault) {
   EXPECT_FALSE(plain.legacy_mapper_settings);
 
   const Manifest named = Manifest::FromJson(
-      {{"pipeline", {{"mapper", {{"plugin", "global"}, {"options", {{"max_num_iterations", 3}}}}}}}},
+      {{"pipeline",
+        {{"mapper", {{"plugin", "global"}, {"options", {{"max_num_iterations", 3}}}}}}}},
       "/base", "m.json");
   EXPECT_EQ(named.mapper.plugin, "global");
   EXPECT_EQ(named.mapper.options["max_num_iterations"], 3);
@@ -64,7 +65,8 @@ TEST(Manifest, TheMapperIsASlotAndIncrementalByDefault) {
 
   // Manifests of before the mapper kind: the top-level object is the incremental
   // mapper's options, and errors in it keep naming "mapper.KEY".
-  const Manifest legacy = Manifest::FromJson({{"mapper", {{"min_num_matches", 20}}}}, "/base", "m.json");
+  const Manifest legacy =
+      Manifest::FromJson({{"mapper", {{"min_num_matches", 20}}}}, "/base", "m.json");
   EXPECT_EQ(legacy.mapper.plugin, "incremental");
   EXPECT_EQ(legacy.mapper.options["min_num_matches"], 20);
   EXPECT_EQ(legacy.mapper.options_path, "mapper");

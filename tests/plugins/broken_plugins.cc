@@ -60,10 +60,10 @@ struct Failure {
   int on_width = 0;
 
   explicit Failure(tessera::OptionReader* reader)
-      : how(reader->GetString("fail", "none",
-                              {"none", "input_error", "option_error", "runtime_error", "custom",
-                               "non_std", "segv", "abort", "exit", "quick_exit", "bad_indices",
-                               "bad_result"})),
+      : how(reader->GetString(
+            "fail", "none",
+            {"none", "input_error", "option_error", "runtime_error", "custom", "non_std", "segv",
+             "abort", "exit", "quick_exit", "bad_indices", "bad_result"})),
         where(reader->GetString("in", "call", {"call", "factory"})),
         on_width(reader->Get<int>("on_width", 0, 0, 100000)) {}
 
@@ -245,8 +245,8 @@ extern "C" __attribute__((visibility("default"))) int tessera_unrelated_symbol()
 #elif defined(TESSERA_TEST_CASE_WRONG_ABI)
 extern "C" {
 // Its build record is empty: a host reads nothing past abi_version of another version.
-const TesseraPluginInfo wrong_abi_info = {999, "pair_selector", "future", "9.0.0",
-                                          "From the future", TesseraBuildRecord{}};
+const TesseraPluginInfo wrong_abi_info = {999,     "pair_selector",   "future",
+                                          "9.0.0", "From the future", TesseraBuildRecord{}};
 }
 static std::unique_ptr<tessera::Plugin> wrong_abi_create(const nlohmann::json& options) {
   return std::make_unique<TestPairSelector>(options);
@@ -257,8 +257,8 @@ BOOST_DLL_ALIAS(wrong_abi_create, tessera_plugin_create)
 #elif defined(TESSERA_TEST_CASE_ABI_ONE)
 // A plugin built against ABI 1 (pair selectors saw only file names): its record says 1.
 extern "C" {
-const TesseraPluginInfo abi_one_info = {1, "pair_selector", "names_only", "1.0.0",
-                                        "Built against ABI 1", TesseraBuildRecord{}};
+const TesseraPluginInfo abi_one_info = {1,       "pair_selector",       "names_only",
+                                        "1.0.0", "Built against ABI 1", TesseraBuildRecord{}};
 }
 static std::unique_ptr<tessera::Plugin> abi_one_create(const nlohmann::json& options) {
   return std::make_unique<TestPairSelector>(options);
@@ -268,8 +268,9 @@ BOOST_DLL_ALIAS(abi_one_create, tessera_plugin_create)
 
 #elif defined(TESSERA_TEST_CASE_UNKNOWN_KIND)
 extern "C" {
-const TesseraPluginInfo unknown_kind_info = {TESSERA_PLUGIN_ABI_VERSION, "detectr", "typo_kind",
-                                             "1.0.0", "A kind with a typo", TESSERA_BUILD_RECORD};
+const TesseraPluginInfo unknown_kind_info = {
+    TESSERA_PLUGIN_ABI_VERSION, "detectr",           "typo_kind", "1.0.0",
+    "A kind with a typo",       TESSERA_BUILD_RECORD};
 }
 static std::unique_ptr<tessera::Plugin> unknown_kind_create(const nlohmann::json& options) {
   return std::make_unique<TestPairSelector>(options);
@@ -279,9 +280,9 @@ BOOST_DLL_ALIAS(unknown_kind_create, tessera_plugin_create)
 
 #elif defined(TESSERA_TEST_CASE_NO_FACTORY)
 extern "C" {
-const TesseraPluginInfo no_factory_info = {TESSERA_PLUGIN_ABI_VERSION, "pair_selector",
-                                           "no_factory",  "1.0.0", "Info but no factory",
-                                           TESSERA_BUILD_RECORD};
+const TesseraPluginInfo no_factory_info = {
+    TESSERA_PLUGIN_ABI_VERSION, "pair_selector",     "no_factory", "1.0.0",
+    "Info but no factory",      TESSERA_BUILD_RECORD};
 }
 BOOST_DLL_ALIAS(no_factory_info, tessera_plugin_info)
 

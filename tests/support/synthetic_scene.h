@@ -26,8 +26,8 @@
 
 #include "eval/ground_truth.h"
 #include "geometry/essential_matrix.h"
-#include "tessera/sfm/incremental_mapper.h"
 #include "tessera/rigid3.h"
+#include "tessera/sfm/incremental_mapper.h"
 #include "util/random.h"
 
 namespace tessera::testing {

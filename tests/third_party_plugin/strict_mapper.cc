@@ -23,7 +23,8 @@ class StrictMapper : public tessera::Mapper {
     const nlohmann::json incremental = reader.GetJson("incremental", nlohmann::json::object());
     reader.Finish();
     incremental_ = tessera::IncrementalMapperOptions::FromJson(incremental, "incremental");
-    effective_options_ = {{"min_agreement", min_agreement_}, {"incremental", incremental_.ToJson()}};
+    effective_options_ = {{"min_agreement", min_agreement_},
+                          {"incremental", incremental_.ToJson()}};
   }
 
   tessera::MapperResult Map(const tessera::MapperInput& input,

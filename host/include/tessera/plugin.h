@@ -49,7 +49,7 @@ struct TesseraBuildRecord {
 struct TesseraPluginInfo {
   uint32_t abi_version;
   const char* kind;  // "detector", "matcher", "pair_selector", "mapper", "bundle_adjuster",
-                    // "exporter"
+                     // "exporter"
   const char* name;
   const char* version;
   const char* description;

@@ -52,7 +52,7 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 // One system on the images: a manifest, or COLMAP.
 struct BenchRow {
-  std::string name;     // the manifest's file stem, or "colmap"
+  std::string name;  // the manifest's file stem, or "colmap"
   // detector / pair_selector / matcher / bundle_adjuster / exporters, each with its
   // version once the run has said it (plugins_used)
   std::string plugins;
@@ -244,7 +244,8 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
   row.workspace = workspace.string();
   row.plugins = SlotPlugin(manifest, "detector") + " / " + SlotPlugin(manifest, "pair_selector") +
                 " / " + SlotPlugin(manifest, "matcher") + " / " + SlotPlugin(manifest, "mapper") +
-                " / " + SlotPlugin(manifest, "bundle_adjuster") + " / " + SlotPlugin(manifest, "exporters");
+                " / " + SlotPlugin(manifest, "bundle_adjuster") + " / " +
+                SlotPlugin(manifest, "exporters");
   ResetBenchWorkspace(workspace);
   if (!shared_from.empty()) {
     fs::copy_file(fs::path(options.output) / shared_from / "database.db",

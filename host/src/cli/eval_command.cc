@@ -1,6 +1,6 @@
-// `tessera eval MODEL GT [--json] [--no-align [--gt-origin LAT,LON,ALT]]`: accuracy of a COLMAP-format model against ground-truth
-// poses (Strecha *.camera files, a transforms.json or another model), as eval_gt.py
-// scores it.
+// `tessera eval MODEL GT [--json] [--no-align [--gt-origin LAT,LON,ALT]]`: accuracy of a
+// COLMAP-format model against ground-truth poses (Strecha *.camera files, a transforms.json or
+// another model), as eval_gt.py scores it.
 
 #include <cmath>
 #include <cstdio>
@@ -46,15 +46,16 @@ CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions&) {
                       &values[2], &tail) != 3 ||
           !(std::abs(values[0]) <= 90) || !(std::abs(values[1]) <= 180) ||
           !std::isfinite(values[2])) {
-        throw InputError("--gt-origin: expected LAT,LON,ALT (latitude in [-90, 90], longitude "
-                         "in [-180, 180] degrees, altitude in metres), got '" +
-                         options->gt_origin + "'");
+        throw InputError(
+            "--gt-origin: expected LAT,LON,ALT (latitude in [-90, 90], longitude "
+            "in [-180, 180] degrees, altitude in metres), got '" +
+            options->gt_origin + "'");
       }
       gt_origin = Georeference{values[0], values[1], values[2], "ENU"};
     }
     if (gt_origin && !options->no_align) throw InputError("--gt-origin: needs --no-align");
-    const EvaluationResult result = EvaluateModelFolder(options->model, options->ground_truth,
-                                                        options->no_align, gt_origin);
+    const EvaluationResult result =
+        EvaluateModelFolder(options->model, options->ground_truth, options->no_align, gt_origin);
     if (options->json) {
       std::cout << result.ToJson().dump(2) << std::endl;
     } else {

@@ -82,9 +82,10 @@ std::string FormatNumber(double value, const char* format) {
 
 }  // namespace
 
-EvaluationResult EvaluateReconstruction(
-    const Reconstruction& model, const std::map<std::string, GroundTruthPose>& ground_truth,
-    const std::filesystem::path& model_dir, const std::optional<Similarity3d>& fixed_gt_from_model) {
+EvaluationResult EvaluateReconstruction(const Reconstruction& model,
+                                        const std::map<std::string, GroundTruthPose>& ground_truth,
+                                        const std::filesystem::path& model_dir,
+                                        const std::optional<Similarity3d>& fixed_gt_from_model) {
   EvaluationResult result;
   AddModelStatistics(model, &result);
   const std::map<std::string, GroundTruthPose> estimated = PosesByBasename(model, model_dir);
@@ -117,8 +118,8 @@ EvaluationResult EvaluateReconstruction(
     if (!result.error.empty()) return result;
   }
 
-  result.gt_from_model = fixed_gt_from_model ? *fixed_gt_from_model
-                                             : EstimateSimilarity(centers_model, centers_gt);
+  result.gt_from_model =
+      fixed_gt_from_model ? *fixed_gt_from_model : EstimateSimilarity(centers_model, centers_gt);
   result.aligned = true;
   std::vector<double> position_errors, rotation_errors;
   for (ImageEvaluation& row : result.images) {

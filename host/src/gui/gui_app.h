@@ -192,7 +192,7 @@ class GuiApp {
   size_t frames_drawn_ = 0;
   uint64_t scene_version_ = 0;  // of the run's model last shown
   RunState last_state_ = RunState::kIdle;
-  float panel_width_ = 0;  // set when the user resized the set-up window; 0: automatic
+  float panel_width_ = 0;      // set when the user resized the set-up window; 0: automatic
   float panel_set_width_ = 0;  // the width the last frame asked for
   float panel_overflow_ = 0;
 

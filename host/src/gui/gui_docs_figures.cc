@@ -76,7 +76,8 @@ int PairFigure(const fs::path& workspace, const fs::path& images, const fs::path
   Click(&app, button->CenterX(), button->CenterY());
   const std::optional<WidgetRect> cells = app.Widget("match cells");
   if (!cells) return 1;
-  const float cell = (cells->max_x - cells->min_x) / static_cast<float>(app.scene()->cameras.size());
+  const float cell =
+      (cells->max_x - cells->min_x) / static_cast<float>(app.scene()->cameras.size());
   // Row 1, column 2: neighbouring images.
   Click(&app, cells->min_x + 1.5f * cell, cells->min_y + 0.5f * cell);
   app.SaveScreenshot(out / "gui_pair_view.png");

@@ -73,7 +73,8 @@ TEST_F(GuiModelAndRunTest, ARunThatWouldReplaceAModelAsksFirst) {
   app.Frame();
   Click(&app, "replace model");
   EXPECT_NE(app.controller().Status().state, RunState::kIdle);
-  ASSERT_TRUE(WaitFor(&app, [&] { return !app.controller().Running(); }, 120));
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return !app.controller().Running(); }, 120));
   EXPECT_EQ(app.controller().Status().state, RunState::kCompleted);
 }
 
@@ -106,7 +107,8 @@ TEST_F(GuiModelAndRunTest, TheOldModelIsClearedWhenARunStarts) {
   EXPECT_EQ(app.NumScenePoints(), 0u);
   EXPECT_EQ(CountViewPixels(during, app.ViewRect()).frustum, 0u);
   EXPECT_TRUE(app.Widget("view hint run").has_value());
-  ASSERT_TRUE(WaitFor(&app, [&] { return !app.controller().Running(); }, 120));
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return !app.controller().Running(); }, 120));
   ASSERT_EQ(app.controller().Status().state, RunState::kCompleted);
   app.Frame();
   EXPECT_GT(app.NumScenePoints(), 1000u);  // the run's model

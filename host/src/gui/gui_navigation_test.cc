@@ -29,8 +29,8 @@ class GuiNavigationTest : public GuiWindowTest {
   void SetUp() override {
     GuiWindowTest::SetUp();
     if (IsSkipped()) return;
-    model_ = tessera::testing::SharedDir() / "anchors" / "colmap-3.8" / "fountain-P11" / "sparse" /
-             "0";
+    model_ =
+        tessera::testing::SharedDir() / "anchors" / "colmap-3.8" / "fountain-P11" / "sparse" / "0";
     if (!fs::exists(model_ / "points3D.bin")) TESSERA_SKIP_OR_FAIL_IN_CI(model_ << " is missing");
   }
   fs::path model_;
@@ -137,8 +137,8 @@ TEST_F(GuiNavigationTest, GridAndAxesToggleAndTheViewSnapsToACamera) {
   EXPECT_NEAR((*at)[0], (view.min_x + view.max_x) / 2, 1.0f);
   EXPECT_NEAR((*at)[1], (view.min_y + view.max_y) / 2, 1.0f);
   // The camera's own up is up: a point below its centre in its image shows lower.
-  const auto below = app.ProjectToWindow(ahead + 0.1f * app.scene()->radius *
-                                                     camera.world_from_cam.col(1));
+  const auto below =
+      app.ProjectToWindow(ahead + 0.1f * app.scene()->radius * camera.world_from_cam.col(1));
   ASSERT_TRUE(below.has_value());
   EXPECT_GT((*below)[1], (*at)[1]);
 }

@@ -86,7 +86,8 @@ TEST_F(GuiWindowTest, MapBarMovesWithEachRegistrationAndAResumedRunSaysReused) {
   Click(&app, "run");
   app.Frame();
   Click(&app, "replace model");
-  ASSERT_TRUE(WaitFor(&app, [&] { return !app.controller().Running(); }, 120));
+  ASSERT_TRUE(WaitFor(
+      &app, [&] { return !app.controller().Running(); }, 120));
   status = app.controller().Status();
   ASSERT_EQ(status.state, RunState::kCompleted) << status.error;
   ASSERT_GE(status.stages.size(), 2u);

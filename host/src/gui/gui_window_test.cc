@@ -13,8 +13,8 @@
 
 #include "database/database.h"
 #include "gui/gui_app.h"
-#include "gui/renderer.h"
 #include "gui/gui_window_test_fixture.h"
+#include "gui/renderer.h"
 #include "gui/xvfb.h"
 #include "manifest/manifest.h"
 #include "pipeline/stage_test_util.h"

@@ -93,7 +93,8 @@ class GuiWindowTest : public ::testing::Test {
     GuiApp app(options);
     app.Frame();
     EXPECT_TRUE(app.Run());
-    EXPECT_TRUE(WaitFor(&app, [&] { return !app.controller().Running(); }, 120));
+    EXPECT_TRUE(WaitFor(
+        &app, [&] { return !app.controller().Running(); }, 120));
     EXPECT_EQ(app.controller().Status().state, RunState::kCompleted);
     return options.output;
   }

@@ -34,8 +34,8 @@ void LogPane::Draw() {
   // The lines in sight, between the scroll position and the pane's bottom.
   const float scroll = ImGui::GetScrollY();
   const float bottom = scroll + ImGui::GetWindowHeight();
-  const size_t first = static_cast<size_t>(
-      std::max<std::ptrdiff_t>(0, std::upper_bound(tops_.begin(), tops_.end(), scroll) - tops_.begin() - 1));
+  const size_t first = static_cast<size_t>(std::max<std::ptrdiff_t>(
+      0, std::upper_bound(tops_.begin(), tops_.end(), scroll) - tops_.begin() - 1));
   const float origin_y = ImGui::GetCursorPosY();
   ImGui::PushTextWrapPos(0);
   for (size_t i = first; i < lines.size() && tops_[i] < bottom; ++i) {

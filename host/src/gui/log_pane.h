@@ -24,11 +24,11 @@ class LogPane {
 
  private:
   std::shared_ptr<const LogSink> sink_;
-  size_t lines_seen_ = 0;  // when more arrive, the pane scrolls to the end
-  float wrap_width_ = -1;  // of the heights below
+  size_t lines_seen_ = 0;    // when more arrive, the pane scrolls to the end
+  float wrap_width_ = -1;    // of the heights below
   std::vector<float> tops_;  // each line's top within the pane; one more: the end
   float overflow_ = 0;
-  size_t first_line_ = 0;    // the number of lines logged before the first in tops_
+  size_t first_line_ = 0;  // the number of lines logged before the first in tops_
 };
 
 }  // namespace tessera::gui

@@ -176,8 +176,8 @@ void ManifestEditorPanel::Draw(WidgetRects* widgets) {
   if (plugins_by_kind_.empty()) FindPlugins();
   // One plugin per slot, from the plugins found on the plugin path; each dropdown shows
   // the plugin the text names now.
-  ImGui::PushItemWidth(-(ImGui::CalcTextSize("bundle_adjuster").x +
-                         ImGui::GetStyle().ItemInnerSpacing.x));
+  ImGui::PushItemWidth(
+      -(ImGui::CalcTextSize("bundle_adjuster").x + ImGui::GetStyle().ItemInnerSpacing.x));
   for (const char* kind : kSlots) DrawSlot(kind, PluginOf(kind));
   ImGui::PopItemWidth();
   if (ImGui::InputTextMultiline("##manifest json", text_.data(), text_.size(),

@@ -18,7 +18,8 @@ namespace {
 // Dark blue (a few inliers) to yellow (the most); near-black: no verified pair.
 ImU32 InlierColor(int inliers, int max_inliers) {
   if (inliers <= 0) return IM_COL32(30, 30, 45, 255);
-  const float t = max_inliers > 0 ? static_cast<float>(inliers) / static_cast<float>(max_inliers) : 0;
+  const float t =
+      max_inliers > 0 ? static_cast<float>(inliers) / static_cast<float>(max_inliers) : 0;
   return IM_COL32(static_cast<int>(40 + 215 * t), static_cast<int>(60 + 170 * t),
                   static_cast<int>(150 - 120 * t), 255);
 }

@@ -53,7 +53,8 @@ void PairView::Draw(WidgetRects* widgets) {
   const ImU32 end = show_putatives ? IM_COL32(255, 150, 40, 220) : IM_COL32(60, 255, 90, 220);
   ImDrawList* draw = ImGui::GetWindowDrawList();
   for (const size_t i : SubsampleMatches(xy1.size(), kMaxPairLines)) {
-    const ImVec2 a(left.x + xy1[i].x() * photos_[0].scale(), left.y + xy1[i].y() * photos_[0].scale());
+    const ImVec2 a(left.x + xy1[i].x() * photos_[0].scale(),
+                   left.y + xy1[i].y() * photos_[0].scale());
     const ImVec2 b(right_x + xy2[i].x() * photos_[1].scale(),
                    left.y + xy2[i].y() * photos_[1].scale());
     draw->AddLine(a, b, line);

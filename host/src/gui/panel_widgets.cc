@@ -49,7 +49,8 @@ std::string ElideToWidth(const std::string& text, float width) {
 void FitText(const std::string& text, WidgetRects* widgets, bool disabled) {
   const float width = std::max(0.0f, ImGui::GetContentRegionAvail().x);
   const std::string shown = ElideToWidth(text, width);
-  if (disabled) ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
+  if (disabled)
+    ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);
   ImGui::TextUnformatted(shown.c_str());
   if (disabled) ImGui::PopStyleColor();
   if (shown == text) return;

@@ -66,8 +66,7 @@ void Picking::Pick(float x, float y, const WidgetRect& view_rect) {
     const float depth = -(view_from_world * world.homogeneous()).z();
     return ProjectedPoint{(*pixel)[0], (*pixel)[1], depth};
   };
-  const image_t image =
-      PickCamera(*scene, view_->frustum_size * scene->radius, project, x, y);
+  const image_t image = PickCamera(*scene, view_->frustum_size * scene->radius, project, x, y);
   if (image != kInvalidImageId) {
     view_->selected_image = image;
     view_->selected_point = kInvalidPoint3DId;
@@ -135,8 +134,8 @@ void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& ima
     photo_dir_ = image_dir;
     mask_dir_ = mask_dir;
     // A third of the view wide (240 to 480 pixels): the model stays in sight beside it.
-    const int width = static_cast<int>(
-        std::clamp((view_rect.max_x - view_rect.min_x) / 3, 240.0f, 480.0f));
+    const int width =
+        static_cast<int>(std::clamp((view_rect.max_x - view_rect.min_x) / 3, 240.0f, 480.0f));
     LoadPhoto(model, image, image_dir, mask_dir, width);
   }
   if (photo_problem_.empty()) {
@@ -166,7 +165,8 @@ void Picking::LoadPhoto(const Reconstruction& model, const Image& image, const f
                         const fs::path& mask_dir, int max_width) {
   // The mask as detection finds it: MASK_DIR/NAME.png, else NAME with .png for its extension.
   const fs::path mask_file = mask_dir.empty() ? fs::path() : FindMaskFile(mask_dir, image.name);
-  const bool found = !image_dir.empty() && photo_.Load(image_dir / image.name, max_width, mask_file);
+  const bool found =
+      !image_dir.empty() && photo_.Load(image_dir / image.name, max_width, mask_file);
   const auto camera = model.cameras.find(image.camera_id);
   photo_problem_ =
       camera == model.cameras.end()

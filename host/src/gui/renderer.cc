@@ -144,8 +144,7 @@ void Renderer::Draw(const std::array<int, 4>& viewport, const Eigen::Matrix4f& w
   positions.insert(positions.end(), overlay.line_positions.begin(), overlay.line_positions.end());
   colors.insert(colors.end(), overlay.line_colors.begin(), overlay.line_colors.end());
   const size_t num_line_vertices = positions.size() / 3;
-  positions.insert(positions.end(), overlay.point_positions.begin(),
-                   overlay.point_positions.end());
+  positions.insert(positions.end(), overlay.point_positions.begin(), overlay.point_positions.end());
   colors.insert(colors.end(), overlay.point_colors.begin(), overlay.point_colors.end());
   if (!positions.empty()) {
     glBindBuffer(GL_ARRAY_BUFFER, line_buffers_[0]);

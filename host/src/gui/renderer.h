@@ -23,8 +23,8 @@ inline constexpr std::array<uint8_t, 3> kBackgroundColor = {24, 26, 32};
 // Lines and large points drawn over the model (ViewOverlay): the ground grid, the axes,
 // the selected point and its track.
 struct Overlay {
-  std::vector<float> line_positions;  // xyz, two vertices per line
-  std::vector<uint8_t> line_colors;   // rgb per vertex
+  std::vector<float> line_positions;   // xyz, two vertices per line
+  std::vector<uint8_t> line_colors;    // rgb per vertex
   std::vector<float> point_positions;  // xyz, drawn kOverlayPointScale times the size
   std::vector<uint8_t> point_colors;
 };

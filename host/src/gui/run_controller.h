@@ -94,8 +94,8 @@ class RunController {
   mutable std::mutex mutex_;
   RunStatus status_;
   std::vector<std::chrono::steady_clock::time_point> stage_starts_;
-  std::filesystem::path output_dir_;       // of the run going on
-  std::vector<size_t> registered_;         // per model of the map stage going on
+  std::filesystem::path output_dir_;  // of the run going on
+  std::vector<size_t> registered_;    // per model of the map stage going on
   std::shared_ptr<const Scene> scene_;
   uint64_t scene_version_ = 0;
   std::unique_ptr<CancellationToken> cancel_;

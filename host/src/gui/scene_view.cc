@@ -55,8 +55,9 @@ void SceneView::Draw(const std::array<int, 4>& viewport) {
   const float aspect =
       static_cast<float>(viewport[2]) / static_cast<float>(std::max(viewport[3], 1));
   const Overlay overlay =
-      scene_ == nullptr ? Overlay{}
-                        : MakeOverlay(*scene_, OverlayOptions{show_grid, show_axes, selected_point});
+      scene_ == nullptr
+          ? Overlay{}
+          : MakeOverlay(*scene_, OverlayOptions{show_grid, show_axes, selected_point});
   renderer_->Draw(viewport, camera_.ProjectionMatrix(aspect) * camera_.ViewMatrix(), point_size,
                   frustum_size, selected_image, overlay);
 }

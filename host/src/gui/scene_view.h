@@ -47,9 +47,9 @@ class SceneView {
   OrbitCamera& camera() { return camera_; }
 
   // Set by the panels' sliders and the picking.
-  float point_size = 2;        // pixels; DefaultPointSize of a model shown framed
+  float point_size = 2;            // pixels; DefaultPointSize of a model shown framed
   bool point_size_chosen = false;  // the user moved the slider: kept for every model
-  bool show_grid = false;      // the ground grid and the world axes (ViewOverlay)
+  bool show_grid = false;          // the ground grid and the world axes (ViewOverlay)
   bool show_axes = false;
   float frustum_size = 0.15f;  // frustum depth, a fraction of the model's radius
   image_t selected_image = kInvalidImageId;

@@ -6,8 +6,8 @@
 namespace tessera::gui {
 namespace {
 
-void AddLine(const Eigen::Vector3f& a, const Eigen::Vector3f& b, const std::array<uint8_t, 3>& color,
-             Overlay* overlay) {
+void AddLine(const Eigen::Vector3f& a, const Eigen::Vector3f& b,
+             const std::array<uint8_t, 3>& color, Overlay* overlay) {
   for (const Eigen::Vector3f* p : {&a, &b}) {
     overlay->line_positions.insert(overlay->line_positions.end(), {p->x(), p->y(), p->z()});
     overlay->line_colors.insert(overlay->line_colors.end(), color.begin(), color.end());

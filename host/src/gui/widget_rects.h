@@ -31,7 +31,9 @@ class WidgetRects {
   void Set(const std::string& name, const WidgetRect& rect) { rects_[name] = rect; }
   std::optional<WidgetRect> Find(const std::string& name) const;
   // The texts drawn cut short ("...") this frame, with their whole text (FitText).
-  void AddElided(const WidgetRect& rect, const std::string& text) { elided_.emplace_back(rect, text); }
+  void AddElided(const WidgetRect& rect, const std::string& text) {
+    elided_.emplace_back(rect, text);
+  }
   const std::vector<std::pair<WidgetRect, std::string>>& Elided() const { return elided_; }
   // The text of the tooltip shown this frame for an elided text; empty when none.
   void set_tooltip(const std::string& text) { tooltip_ = text; }

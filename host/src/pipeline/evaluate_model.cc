@@ -14,7 +14,9 @@ namespace {
 // frame about `to` (through WGS84, so the axes' turn between the two origins is kept).
 std::map<std::string, GroundTruthPose> IntoFrame(std::map<std::string, GroundTruthPose> poses,
                                                  const Georeference& from, const Georeference& to) {
-  const auto move = [&](const Eigen::Vector3d& x) { return EnuFromWgs84(Wgs84FromEnu(x, from), to); };
+  const auto move = [&](const Eigen::Vector3d& x) {
+    return EnuFromWgs84(Wgs84FromEnu(x, from), to);
+  };
   const Eigen::Vector3d origin = move(Eigen::Vector3d::Zero());
   Eigen::Matrix3d to_from_from;
   for (int axis = 0; axis < 3; ++axis) {

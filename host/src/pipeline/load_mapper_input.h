@@ -11,5 +11,4 @@ namespace tessera {
 // InputError naming the database when it holds no images.
 MapperInput LoadMapperInput(const Database& database);
 
-
 }  // namespace tessera

@@ -8,11 +8,11 @@
 
 #include "feature/database_feature_reader.h"
 #include "outputs/output_transaction.h"
+#include "pipeline/load_mapper_input.h"
 #include "pipeline/mapper_result_check.h"
 #include "pipeline/workspace.h"
 #include "plugin/bundle_adjuster_guard.h"
 #include "plugin/plugin_call.h"
-#include "pipeline/load_mapper_input.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/georeference_io.h"
 #include "tessera/io/model_statistics.h"
@@ -22,9 +22,8 @@
 namespace tessera {
 
 MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& input,
-                                const std::filesystem::path& sparse_dir,
-                                const std::string& mapper, const nlohmann::json& mapper_options,
-                                uint64_t seed) {
+                                const std::filesystem::path& sparse_dir, const std::string& mapper,
+                                const nlohmann::json& mapper_options, uint64_t seed) {
   MappingSummary summary;
   for (size_t index = 0; index < result.models.size(); ++index) {
     const Reconstruction& model = result.models[index];
@@ -80,7 +79,8 @@ void ExportModel(const Reconstruction& model, size_t index,
                  const std::filesystem::path& image_dir, const PluginCrashLog& crash_log,
                  OutputTransaction* outputs, std::vector<std::string>* quarantined) {
   if (settings.exporters == nullptr || settings.exporters->empty()) {
-    const std::filesystem::path dir = outputs->StageFor("tessera") / "sparse" / std::to_string(index);
+    const std::filesystem::path dir =
+        outputs->StageFor("tessera") / "sparse" / std::to_string(index);
     WriteColmapModel(model, dir, ColmapModelFormat::kBinary);
     if (georeference) WriteGeoreference(*georeference, dir);
     return;
@@ -98,8 +98,8 @@ void ExportModel(const Reconstruction& model, size_t index,
     const std::filesystem::path staged = outputs->StageFor(exporter.name(), k);
     try {
       exporter.Call(PluginStage::kExport, subject, [&](auto& plugin) {
-        plugin.Export(model, {staged, image_dir, static_cast<int>(index), settings.mask_dir,
-                              georeference});
+        plugin.Export(
+            model, {staged, image_dir, static_cast<int>(index), settings.mask_dir, georeference});
       });
     } catch (const PluginError& error) {
       outputs->Keep();
@@ -120,12 +120,11 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
                      const std::filesystem::path& image_dir, const StageControl& control,
                      MapStageSummary* summary) {
   const std::filesystem::path& output_dir = workspace.folder();
-  MappingSummary mapping =
-      SummarizeMapping(result, input, output_dir / "sparse",
-                       settings.mapper != nullptr ? settings.mapper->name() : "",
-                       settings.mapper != nullptr ? settings.mapper->EffectiveOptions()
-                                                  : nlohmann::json::object(),
-                       settings.seed);
+  MappingSummary mapping = SummarizeMapping(
+      result, input, output_dir / "sparse",
+      settings.mapper != nullptr ? settings.mapper->name() : "",
+      settings.mapper != nullptr ? settings.mapper->EffectiveOptions() : nlohmann::json::object(),
+      settings.seed);
   summary->num_models = result.models.size();
   OutputTransaction outputs(output_dir);
   outputs.Protect(image_dir);
@@ -136,8 +135,7 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
     const Reconstruction& model = result.models[index];
     ExportModel(model, index,
                 index < result.georeferences.size() ? result.georeferences[index] : std::nullopt,
-                settings, image_dir, workspace.crash_log(), &outputs,
-                &mapping.quarantined);
+                settings, image_dir, workspace.crash_log(), &outputs, &mapping.quarantined);
     summary->num_registered += model.images.size();
     summary->images_per_model.push_back(model.images.size());
     const MappingSummary::Model& entry = mapping.models[index];
@@ -231,7 +229,8 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
   const std::string subject = std::to_string(input.images.size()) + " images";
   if (workspace.crash_log().IsQuarantined(mapper.name(), PluginStage::kMap, subject)) {
     throw InputError("pipeline.mapper: mapper '" + mapper.name() + "' crashed twice mapping " +
-                     subject + " in this workspace (plugin_crashes.tsv) and is not run on them "
+                     subject +
+                     " in this workspace (plugin_crashes.tsv) and is not run on them "
                      "again; choose another mapper, or fix the plugin");
   }
   MapperResult result;

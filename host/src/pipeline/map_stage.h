@@ -38,9 +38,8 @@ struct MapSettings {
 // left out, focal lengths estimated; the mapper and its effective options; `seconds`
 // left 0.
 MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& input,
-                                const std::filesystem::path& sparse_dir,
-                                const std::string& mapper, const nlohmann::json& mapper_options,
-                                uint64_t seed);
+                                const std::filesystem::path& sparse_dir, const std::string& mapper,
+                                const nlohmann::json& mapper_options, uint64_t seed);
 
 // Maps the workspace's verified matches and writes every model: through the settings'
 // exporters, or as COLMAP binary in OUTPUT/sparse/<index>/ when there are none; then

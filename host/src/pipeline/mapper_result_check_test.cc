@@ -82,43 +82,52 @@ TEST(CheckMapperResult, RefusesEachFaultNamingIt) {
     spoil(f);
     return f.Fault();
   };
-  EXPECT_NE(fault([](Fixture& f) { f.result.models[0].images[1].name = "../x.jpg"; })
-                .find("model 0 where image 1 ('im1.jpg') comes back with another id, name or camera"),
+  EXPECT_NE(fault([](Fixture& f) {
+              f.result.models[0].images[1].name = "../x.jpg";
+            }).find("model 0 where image 1 ('im1.jpg') comes back with another id, name or camera"),
             std::string::npos);
-  EXPECT_NE(fault([](Fixture& f) { f.result.models[0].images[9] = f.result.models[0].images[1]; })
-                .find("image 9 is not an input image"),
+  EXPECT_NE(fault([](Fixture& f) {
+              f.result.models[0].images[9] = f.result.models[0].images[1];
+            }).find("image 9 is not an input image"),
             std::string::npos);
-  EXPECT_NE(fault([](Fixture& f) { f.result.models[0].images[1].registered = false; })
-                .find("not registered"),
+  EXPECT_NE(fault([](Fixture& f) {
+              f.result.models[0].images[1].registered = false;
+            }).find("not registered"),
             std::string::npos);
-  EXPECT_NE(fault([](Fixture& f) { f.result.models[0].images[1].points2D.resize(2); })
-                .find("has 2 keypoints, the input 3"),
+  EXPECT_NE(fault([](Fixture& f) {
+              f.result.models[0].images[1].points2D.resize(2);
+            }).find("has 2 keypoints, the input 3"),
             std::string::npos);
   EXPECT_NE(fault([](Fixture& f) {
               f.result.models[0].images[1].cam_from_world.translation.x() = NAN;
             }).find("pose that is not finite"),
             std::string::npos);
-  EXPECT_NE(fault([](Fixture& f) { f.result.models[0].points3D[7].track.push_back({2, 5}); })
-                .find("the track of point 7 names a keypoint that is not in the model"),
+  EXPECT_NE(fault([](Fixture& f) {
+              f.result.models[0].points3D[7].track.push_back({2, 5});
+            }).find("the track of point 7 names a keypoint that is not in the model"),
             std::string::npos);
-  EXPECT_NE(fault([](Fixture& f) { f.result.models[0].images[2].points2D[1].point3D_id = 8; })
-                .find("names point 8"),
+  EXPECT_NE(fault([](Fixture& f) {
+              f.result.models[0].images[2].points2D[1].point3D_id = 8;
+            }).find("names point 8"),
             std::string::npos);
-  EXPECT_NE(fault([](Fixture& f) { f.result.models[0].cameras[1].width = 10; })
-                .find("camera 1 is not an input camera"),
+  EXPECT_NE(fault([](Fixture& f) {
+              f.result.models[0].cameras[1].width = 10;
+            }).find("camera 1 is not an input camera"),
             std::string::npos);
-  EXPECT_NE(fault([](Fixture& f) { f.result.self_checks.clear(); }).find("1 models but 0 self-checks"),
-            std::string::npos);
-  EXPECT_NE(fault([](Fixture& f) { f.result.unregistered_reasons[1] = "?"; })
-                .find("which is in a model"),
-            std::string::npos);
+  EXPECT_NE(
+      fault([](Fixture& f) { f.result.self_checks.clear(); }).find("1 models but 0 self-checks"),
+      std::string::npos);
+  EXPECT_NE(
+      fault([](Fixture& f) { f.result.unregistered_reasons[1] = "?"; }).find("which is in a model"),
+      std::string::npos);
   EXPECT_NE(fault([](Fixture& f) {
               f.result.models.push_back(f.result.models[0]);
               f.result.self_checks.resize(2);
             }).find("in two models"),
             std::string::npos);
-  EXPECT_NE(fault([](Fixture& f) { f.result.cancelled = true; })
-                .find("plugin 'm' failed while mapping: it returned 'cancelled' without being asked"),
+  EXPECT_NE(fault([](Fixture& f) {
+              f.result.cancelled = true;
+            }).find("plugin 'm' failed while mapping: it returned 'cancelled' without being asked"),
             std::string::npos);
 }
 

@@ -60,7 +60,7 @@ struct MappingSummary {
   // 'x' skipped for model 0: it crashed twice exporting it".
   std::vector<std::string> quarantined;
   double seconds = 0;
-  std::string mapper = "incremental";  // the mapper plugin
+  std::string mapper = "incremental";                        // the mapper plugin
   nlohmann::json mapper_options = nlohmann::json::object();  // its effective options
   nlohmann::json mapper_details = nlohmann::json::object();  // MapperResult::details
   uint64_t seed = 0;

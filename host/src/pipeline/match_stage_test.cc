@@ -5,8 +5,8 @@
 #include <set>
 
 #include "pipeline/extract_stage.h"
-#include "pipeline/stage_test_util.h"
 #include "pipeline/load_mapper_input.h"
+#include "pipeline/stage_test_util.h"
 
 namespace tessera {
 namespace {

@@ -64,10 +64,10 @@ PipelineContext PipelineContext::Create(Manifest manifest) {
 }
 
 void PipelineContext::Require(const std::string& slot, const std::string& stage) const {
-  const bool present =
-      (slot == "detector" && detector) || (slot == "pair_selector" && !pair_selectors.empty()) ||
-      (slot == "matcher" && matcher) || (slot == "mapper" && mapper) ||
-      (slot == "bundle_adjuster" && bundle_adjuster);
+  const bool present = (slot == "detector" && detector) ||
+                       (slot == "pair_selector" && !pair_selectors.empty()) ||
+                       (slot == "matcher" && matcher) || (slot == "mapper" && mapper) ||
+                       (slot == "bundle_adjuster" && bundle_adjuster);
   if (!present) {
     const std::string source = manifest.file.empty() ? "manifest" : manifest.file.string();
     throw InputError(source + ": pipeline." + slot + ": missing; the " + stage + " stage needs a " +

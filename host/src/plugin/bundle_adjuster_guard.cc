@@ -25,10 +25,11 @@ std::string BundleAdjusterGuard::Subject(const BundleAdjustmentConfig& config,
 BundleAdjustmentSummary BundleAdjusterGuard::Adjust(const BundleAdjustmentConfig& config,
                                                     Reconstruction* reconstruction) const {
   const std::string subject = Subject(config, reconstruction);
-  if (crash_log_ != nullptr && crash_log_->IsQuarantined(plugin_.name(), PluginStage::kAdjust, subject)) {
+  if (crash_log_ != nullptr &&
+      crash_log_->IsQuarantined(plugin_.name(), PluginStage::kAdjust, subject)) {
     throw HostInputError("bundle adjuster '" + plugin_.name() + "' crashed twice on " + subject +
-                     " in this workspace (plugin_crashes.tsv) and is not given it again; "
-                     "choose another pipeline.bundle_adjuster, or fix the plugin");
+                         " in this workspace (plugin_crashes.tsv) and is not given it again; "
+                         "choose another pipeline.bundle_adjuster, or fix the plugin");
   }
   return plugin_.Call(PluginStage::kAdjust, subject,
                       [&](auto& plugin) { return plugin.Adjust(config, reconstruction); });

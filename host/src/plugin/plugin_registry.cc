@@ -66,8 +66,8 @@ const TesseraBuildRecord& HostBuildRecord() {
 }
 
 const std::vector<std::string>& PluginKindNames() {
-  static const std::vector<std::string> kinds = {"detector", "matcher", "pair_selector",
-                                                 "mapper", "bundle_adjuster", "exporter"};
+  static const std::vector<std::string> kinds = {"detector", "matcher",         "pair_selector",
+                                                 "mapper",   "bundle_adjuster", "exporter"};
   return kinds;
 }
 

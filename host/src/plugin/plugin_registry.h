@@ -133,8 +133,7 @@ class PluginRegistry {
   // factory throws or it rejects its options.
   template <typename Interface>
   PluginInstance<Interface> Create(const std::string& kind, const std::string& name,
-                                   const nlohmann::json& options,
-                                   const std::string& json_path,
+                                   const nlohmann::json& options, const std::string& json_path,
                                    const std::string& options_path = "") const {
     const PluginRecord& record = Resolve(kind, name, json_path);
     std::unique_ptr<Plugin> plugin = CreateObject(record, options, json_path, options_path);

@@ -7,9 +7,9 @@
 #include <cmath>
 
 #include "eval/evaluation.h"
-#include "tessera/sfm/incremental_pipeline.h"
 #include "synthetic_scene.h"
 #include "tessera/io/model_statistics.h"
+#include "tessera/sfm/incremental_pipeline.h"
 #include "test_support.h"
 
 namespace tessera {

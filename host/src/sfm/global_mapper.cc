@@ -7,15 +7,15 @@
 #include <chrono>
 #include <set>
 
+#include "tessera/io/model_statistics.h"
 #include "tessera/sfm/feature_tracks.h"
 #include "tessera/sfm/focal_length_estimation.h"
-#include "tessera/sfm/view_graph.h"
 #include "tessera/sfm/global_positioning.h"
 #include "tessera/sfm/rotation_averaging.h"
 #include "tessera/sfm/track_filtering.h"
 #include "tessera/sfm/track_selection.h"
 #include "tessera/sfm/track_triangulation.h"
-#include "tessera/io/model_statistics.h"
+#include "tessera/sfm/view_graph.h"
 #include "util/random.h"
 
 namespace tessera {
@@ -71,8 +71,8 @@ class ImageGroups {
 
 // Removes images with fewer than `min_num_observations` observations (and what that
 // leaves of their points), until none is left; records why.
-void RemoveWeakImages(size_t min_num_observations, const std::string& when,
-                      Reconstruction* model, std::map<image_t, std::string>* reasons) {
+void RemoveWeakImages(size_t min_num_observations, const std::string& when, Reconstruction* model,
+                      std::map<image_t, std::string>* reasons) {
   bool changed = true;
   while (changed) {
     changed = false;
@@ -95,10 +95,9 @@ void RemoveWeakImages(size_t min_num_observations, const std::string& when,
           }
         }
       }
-      (*reasons)[image_id] = "only " + std::to_string(num_observations) +
-                             " observations of 3D points " + when +
-                             " (min_num_observations_per_image " +
-                             std::to_string(min_num_observations) + ")";
+      (*reasons)[image_id] =
+          "only " + std::to_string(num_observations) + " observations of 3D points " + when +
+          " (min_num_observations_per_image " + std::to_string(min_num_observations) + ")";
       it = model->images.erase(it);
       changed = true;
     }
@@ -170,9 +169,8 @@ PartOutcome PositionPart(const PartRun& run, size_t part_index, const std::set<i
   positioning_options.num_threads = options.gp_num_threads;
   positioning_options.seed =
       DeriveSeed(static_cast<uint64_t>(options.seed), kPositioningStream + part_index);
-  const GlobalPositioningResult positions =
-      PositionGlobally(cameras, input.images, part_rotations, positioning_tracks,
-                       positioning_options, should_stop);
+  const GlobalPositioningResult positions = PositionGlobally(
+      cameras, input.images, part_rotations, positioning_tracks, positioning_options, should_stop);
   if (positions.cancelled || stop()) return PartOutcome::kCancelled;
   lap(&steps.positioning);
   spdlog::info(
@@ -321,8 +319,10 @@ void ExplainUnregistered(const MapperInput& input, const GlobalMapperOptions& op
       reason = "no verified pair with at least " + std::to_string(options.min_num_matches) +
                " inlier matches";
     } else if (with_rotation_pair.count(image_id) == 0) {
-      reason = "the view graph kept none of its pairs (no relative rotation, or none closing a "
-               "rotation cycle within " + Format(options.view_graph_max_cycle_error) + " deg)";
+      reason =
+          "the view graph kept none of its pairs (no relative rotation, or none closing a "
+          "rotation cycle within " +
+          Format(options.view_graph_max_cycle_error) + " deg)";
     } else if (reasons.count(image_id) > 0) {
       reason = reasons.at(image_id);
     } else {
@@ -410,9 +410,9 @@ void FinishModel(Reconstruction* model) {
 
 // The relative rotation of every edge the view graph kept, weighted by its inliers,
 // with the pair of each.
-std::vector<RelativeRotation> RelativeRotations(const ViewGraph& view_graph,
-                                                const std::vector<const MapperInput::Pair*>& pairs,
-                                                std::vector<const MapperInput::Pair*>* pair_of_rotation) {
+std::vector<RelativeRotation> RelativeRotations(
+    const ViewGraph& view_graph, const std::vector<const MapperInput::Pair*>& pairs,
+    std::vector<const MapperInput::Pair*>* pair_of_rotation) {
   std::vector<RelativeRotation> relative_rotations;
   for (size_t e = 0; e < view_graph.edges().size(); ++e) {
     const ViewGraphEdge& edge = view_graph.edges()[e];
@@ -460,7 +460,8 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   result.num_verified_pairs = pairs.size();
 
   // 2. Focal lengths of cameras without a prior, from the view graph.
-  const std::map<camera_t, Camera> cameras = CamerasWithFocalLengths(input, pairs, options, &result);
+  const std::map<camera_t, Camera> cameras =
+      CamerasWithFocalLengths(input, pairs, options, &result);
   if (stop()) return cancelled();
 
   // 3. The view graph and its rotation-cycle filtering.
@@ -471,7 +472,6 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
         view_graph.FilterByRotationCycles(options.view_graph_max_cycle_error, 3);
   }
   if (stop()) return cancelled();
-
   lap(&steps.view_graph);
 
   // 4. Rotation averaging.
@@ -506,8 +506,8 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   spdlog::info(
       "global map: {} images, {} verified pairs, {} dropped by rotation cycles, {} by rotation "
       "averaging ({} steps); {} tracks",
-      input.images.size(), pairs.size(), result.num_pairs_dropped_by_cycles,
-      rotations.num_dropped, rotations.num_iterations, result.num_tracks);
+      input.images.size(), pairs.size(), result.num_pairs_dropped_by_cycles, rotations.num_dropped,
+      rotations.num_iterations, result.num_tracks);
 
   std::map<image_t, std::string> reasons;
   const PartRun run{input, cameras, options, should_stop, &result, &reasons, lap};

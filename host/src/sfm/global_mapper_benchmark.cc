@@ -20,8 +20,8 @@
 #include <vector>
 
 #include "eval/evaluation.h"
-#include "tessera/sfm/global_mapper.h"
 #include "synthetic_scene.h"
+#include "tessera/sfm/global_mapper.h"
 #include "test_support.h"
 
 namespace tessera {

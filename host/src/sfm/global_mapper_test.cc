@@ -110,8 +110,7 @@ TEST(GlobalMapper, EstimatesAFocalLengthWithoutPrior) {
   EXPECT_EQ(result.models[0].images.size(), 20u);
   EXPECT_NEAR(result.models[0].cameras.at(1).FocalLengthX(), options.focal_length,
               0.01 * options.focal_length);
-  const EvaluationResult evaluation =
-      EvaluateReconstruction(result.models[0], scene.GroundTruth());
+  const EvaluationResult evaluation = EvaluateReconstruction(result.models[0], scene.GroundTruth());
   ASSERT_TRUE(evaluation.aligned) << evaluation.error;
   EXPECT_LT(evaluation.rotation_error_max_deg, 0.5);
 }
@@ -214,12 +213,11 @@ TEST(GlobalMapper, StopsWithinASecondOfBeingAsked) {
   for (const int stop_at : {1, 4, num_polls / 2, num_polls - 2}) {
     int polls = 0;
     std::chrono::steady_clock::time_point asked;
-    const GlobalMapperResult result =
-        GlobalMapper::Reconstruct(scene.input, Adjuster(), {}, [&] {
-          if (++polls < stop_at) return false;
-          if (polls == stop_at) asked = std::chrono::steady_clock::now();
-          return true;
-        });
+    const GlobalMapperResult result = GlobalMapper::Reconstruct(scene.input, Adjuster(), {}, [&] {
+      if (++polls < stop_at) return false;
+      if (polls == stop_at) asked = std::chrono::steady_clock::now();
+      return true;
+    });
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
     EXPECT_TRUE(result.cancelled) << stop_at;

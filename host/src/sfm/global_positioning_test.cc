@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include "geometry/similarity_transform.h"
-#include "tessera/sfm/feature_tracks.h"
 #include "synthetic_scene.h"
+#include "tessera/sfm/feature_tracks.h"
 
 namespace tessera {
 namespace {
@@ -35,7 +35,8 @@ std::map<image_t, Eigen::Matrix3d> TrueRotations(const SyntheticScene& scene) {
 
 // Largest distance between an estimated centre, aligned to the truth by a similarity,
 // and the true one.
-double MaxCenterError(const SyntheticScene& scene, const std::map<image_t, Eigen::Vector3d>& centers) {
+double MaxCenterError(const SyntheticScene& scene,
+                      const std::map<image_t, Eigen::Vector3d>& centers) {
   std::vector<Eigen::Vector3d> src, dst;
   for (const auto& [image_id, center] : centers) {
     src.push_back(center);

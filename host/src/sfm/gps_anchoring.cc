@@ -20,7 +20,8 @@ constexpr double kDegree = M_PI / 180.0;
 
 Eigen::Vector3d EcefFromWgs84(double latitude_deg, double longitude_deg, double altitude_m) {
   const double lat = latitude_deg * kDegree, lon = longitude_deg * kDegree;
-  const double n = kSemiMajorAxis / std::sqrt(1 - kEccentricitySquared * std::sin(lat) * std::sin(lat));
+  const double n =
+      kSemiMajorAxis / std::sqrt(1 - kEccentricitySquared * std::sin(lat) * std::sin(lat));
   return {(n + altitude_m) * std::cos(lat) * std::cos(lon),
           (n + altitude_m) * std::cos(lat) * std::sin(lon),
           (n * (1 - kEccentricitySquared) + altitude_m) * std::sin(lat)};
@@ -30,7 +31,7 @@ Eigen::Vector3d EcefFromWgs84(double latitude_deg, double longitude_deg, double 
 Eigen::Matrix3d EnuFromEcefRotation(const Georeference& origin) {
   const double lat = origin.latitude_deg * kDegree, lon = origin.longitude_deg * kDegree;
   Eigen::Matrix3d rotation;
-  rotation << -std::sin(lon), std::cos(lon), 0,  //
+  rotation << -std::sin(lon), std::cos(lon), 0,                                       //
       -std::sin(lat) * std::cos(lon), -std::sin(lat) * std::sin(lon), std::cos(lat),  //
       std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat);
   return rotation;
@@ -73,7 +74,8 @@ GpsPosition Wgs84FromEnu(const Eigen::Vector3d& enu, const Georeference& origin)
   double lat = std::atan2(ecef.z(), p * (1 - kEccentricitySquared));
   double altitude = 0;
   for (int i = 0; i < 10; ++i) {
-    const double n = kSemiMajorAxis / std::sqrt(1 - kEccentricitySquared * std::sin(lat) * std::sin(lat));
+    const double n =
+        kSemiMajorAxis / std::sqrt(1 - kEccentricitySquared * std::sin(lat) * std::sin(lat));
     altitude = p / std::cos(lat) - n;
     lat = std::atan2(ecef.z(), p * (1 - kEccentricitySquared * n / (n + altitude)));
   }
@@ -115,7 +117,9 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
   }
   // Positions on a line leave the rotation about it open: no anchoring from them.
   Eigen::MatrixXd spread(3, enu.size());
-  const Eigen::Vector3d mean = std::accumulate(enu.begin(), enu.end(), Eigen::Vector3d(Eigen::Vector3d::Zero())) / enu.size();
+  const Eigen::Vector3d mean =
+      std::accumulate(enu.begin(), enu.end(), Eigen::Vector3d(Eigen::Vector3d::Zero())) /
+      enu.size();
   for (size_t i = 0; i < enu.size(); ++i) spread.col(i) = enu[i] - mean;
   const Eigen::Vector3d singular = Eigen::JacobiSVD<Eigen::MatrixXd>(spread).singularValues();
   if (singular(1) < 2 * options.horizontal_sigma_m * std::sqrt(static_cast<double>(enu.size()))) {
@@ -124,8 +128,8 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
   }
 
   // The similarity most geotagged centres agree on: LO-RANSAC over triples.
-  const double threshold = options.max_error_sigmas *
-                           std::max(options.horizontal_sigma_m, options.vertical_sigma_m);
+  const double threshold =
+      options.max_error_sigmas * std::max(options.horizontal_sigma_m, options.vertical_sigma_m);
   RandomEngine random(DeriveSeed(seed, 0x6a5));
   std::uniform_int_distribution<size_t> pick(0, geotagged.size() - 1);
   std::vector<size_t> best_inliers;
@@ -139,7 +143,8 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
   for (int trial = 0; trial < options.ransac_num_trials; ++trial) {
     const size_t a = pick(random), b = pick(random), c = pick(random);
     if (a == b || b == c || a == c) continue;
-    Similarity3d sim = EstimateSimilarity({centres[a], centres[b], centres[c]}, {enu[a], enu[b], enu[c]});
+    Similarity3d sim =
+        EstimateSimilarity({centres[a], centres[b], centres[c]}, {enu[a], enu[b], enu[c]});
     if (!(sim.scale > 0) || !sim.rotation.allFinite()) continue;
     std::vector<size_t> inliers = inliers_of(sim);
     // Local optimisation: refit on the inliers once.

@@ -13,8 +13,8 @@
 #include "estimators/ransac.h"
 #include "geometry/essential_matrix.h"
 #include "geometry/triangulation.h"
-#include "tessera/sfm/camera_plausibility.h"
 #include "tessera/io/model_statistics.h"
+#include "tessera/sfm/camera_plausibility.h"
 #include "util/random.h"
 
 namespace tessera {

@@ -20,8 +20,8 @@
 #include <map>
 #include <vector>
 
-#include "tessera/sfm/incremental_pipeline.h"
 #include "synthetic_scene.h"
+#include "tessera/sfm/incremental_pipeline.h"
 #include "test_support.h"
 
 namespace tessera {

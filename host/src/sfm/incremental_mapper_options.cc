@@ -5,7 +5,7 @@
 namespace tessera {
 
 IncrementalMapperOptions IncrementalMapperOptions::FromJson(const nlohmann::json& json,
-                                                           const std::string& path) {
+                                                            const std::string& path) {
   IncrementalMapperOptions o;
   OptionReader reader(json, path);
   o.min_num_matches = reader.Get<int>("min_num_matches", o.min_num_matches, 5, 100000);
@@ -49,8 +49,8 @@ IncrementalMapperOptions IncrementalMapperOptions::FromJson(const nlohmann::json
       reader.Get<double>("max_principal_point_offset", o.max_principal_point_offset, 0.0, 0.5);
   o.ba_refine_extra_params = reader.GetBool("ba_refine_extra_params", o.ba_refine_extra_params);
   o.estimate_focal_length = reader.GetBool("estimate_focal_length", o.estimate_focal_length);
-  o.min_view_graph_focal_pairs = reader.Get<int>("min_view_graph_focal_pairs",
-                                                 o.min_view_graph_focal_pairs, 0, 1000000);
+  o.min_view_graph_focal_pairs =
+      reader.Get<int>("min_view_graph_focal_pairs", o.min_view_graph_focal_pairs, 0, 1000000);
   o.filter_view_graph = reader.GetBool("filter_view_graph", o.filter_view_graph);
   o.view_graph_max_cycle_error =
       reader.Get<double>("view_graph_max_cycle_error", o.view_graph_max_cycle_error, 0.01, 180.0);

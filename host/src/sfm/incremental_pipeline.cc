@@ -456,8 +456,7 @@ IncrementalPipeline::IncrementalPipeline(const IncrementalMapperOptions& options
 // Each model anchored to its images' GPS in a local east-north-up frame (gps_anchoring.h);
 // a model that cannot be stays in its own frame, with a warning that says why.
 void AnchorModelsToGps(const IncrementalMapperOptions& options, const MapperInput& input,
-                       const BundleAdjuster& bundle_adjuster, uint64_t seed,
-                       MapperResult* result) {
+                       const BundleAdjuster& bundle_adjuster, uint64_t seed, MapperResult* result) {
   GpsAnchoringOptions anchoring;
   anchoring.horizontal_sigma_m = options.gps_horizontal_sigma;
   anchoring.vertical_sigma_m = options.gps_vertical_sigma;
@@ -465,9 +464,9 @@ void AnchorModelsToGps(const IncrementalMapperOptions& options, const MapperInpu
   anchoring.ba_max_num_iterations = options.ba_global_max_num_iterations;
   result->georeferences.clear();
   for (size_t index = 0; index < result->models.size(); ++index) {
-    const GpsAnchoringReport report = AnchorModelToGps(input.metadata, bundle_adjuster, anchoring,
-                                                       DeriveSeed(seed, 0x69700 + index),
-                                                       &result->models[index]);
+    const GpsAnchoringReport report =
+        AnchorModelToGps(input.metadata, bundle_adjuster, anchoring,
+                         DeriveSeed(seed, 0x69700 + index), &result->models[index]);
     if (report.anchored) {
       spdlog::info(
           "map: model {}: anchored to the GPS of {} of its {} geotagged images, in an "
@@ -478,9 +477,10 @@ void AnchorModelsToGps(const IncrementalMapperOptions& options, const MapperInpu
           report.median_error_m);
       result->georeferences.push_back(report.origin);
     } else {
-      spdlog::warn("map: model {} is not georeferenced (use_gps_prior): {}; it keeps its own "
-                   "frame and scale",
-                   index, report.reason);
+      spdlog::warn(
+          "map: model {} is not georeferenced (use_gps_prior): {}; it keeps its own "
+          "frame and scale",
+          index, report.reason);
       result->georeferences.push_back(std::nullopt);
     }
   }

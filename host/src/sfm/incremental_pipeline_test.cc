@@ -6,8 +6,8 @@
 #include "geometry/essential_matrix.h"
 #include "synthetic_scene.h"
 #include "tessera/errors.h"
-#include "tessera/sfm/gps_anchoring.h"
 #include "tessera/io/model_statistics.h"
+#include "tessera/sfm/gps_anchoring.h"
 #include "test_support.h"
 
 namespace tessera {
@@ -286,9 +286,10 @@ void Geotag(SyntheticScene* scene, const Georeference& origin, double metres_per
   for (size_t k = 0; k < ids.size(); ++k) {
     const Eigen::Vector3d enu =
         metres_per_unit * scene->true_cam_from_world.at(sources[k]).Inverse().translation;
-    (*true_enu)[ids[k]] = metres_per_unit * scene->true_cam_from_world.at(ids[k]).Inverse().translation;
-    const Eigen::Vector3d noisy = enu + Eigen::Vector3d(horizontal(engine), horizontal(engine),
-                                                        vertical(engine));
+    (*true_enu)[ids[k]] =
+        metres_per_unit * scene->true_cam_from_world.at(ids[k]).Inverse().translation;
+    const Eigen::Vector3d noisy =
+        enu + Eigen::Vector3d(horizontal(engine), horizontal(engine), vertical(engine));
     scene->input.metadata[ids[k]].gps = Wgs84FromEnu(noisy, origin);
   }
 }

@@ -44,8 +44,8 @@ struct Scene {
 
 // `num_images` random rotations; pairs of images at most `max_gap` ids apart, with
 // `noise_deg` of noise about a random axis, and a fraction `outlier_ratio` of random ones.
-Scene MakeScene(int num_images, int max_gap, double noise_deg, double outlier_ratio,
-                uint64_t seed, image_t first_id = 1) {
+Scene MakeScene(int num_images, int max_gap, double noise_deg, double outlier_ratio, uint64_t seed,
+                image_t first_id = 1) {
   std::mt19937_64 engine(seed);
   std::uniform_real_distribution<double> unit(0, 1);
   std::normal_distribution<double> noise(0, noise_deg * M_PI / 180);
@@ -59,10 +59,11 @@ Scene MakeScene(int num_images, int max_gap, double noise_deg, double outlier_ra
       const bool outlier = unit(engine) < outlier_ratio;
       const Eigen::Vector3d perturbation(noise(engine), noise(engine), noise(engine));
       pair.R_cam2_from_cam1 =
-          outlier ? RandomRotation(engine)
-                  : Eigen::Matrix3d(Eigen::AngleAxisd(perturbation.norm(), perturbation.normalized()) *
-                                    scene.truth.at(pair.image_id2) *
-                                    scene.truth.at(pair.image_id1).transpose());
+          outlier
+              ? RandomRotation(engine)
+              : Eigen::Matrix3d(Eigen::AngleAxisd(perturbation.norm(), perturbation.normalized()) *
+                                scene.truth.at(pair.image_id2) *
+                                scene.truth.at(pair.image_id1).transpose());
       pair.weight = 100 + 10 * unit(engine);
       scene.pairs.push_back(pair);
       scene.is_outlier.push_back(outlier);
@@ -118,8 +119,7 @@ TEST(RotationAveraging, ComponentsAreAveragedSeparatelyLargestFirst) {
 
 TEST(RotationAveraging, StopsWhenAsked) {
   const Scene scene = MakeScene(10, 3, 1.0, 0.0, 5);
-  const RotationAveragingResult result =
-      AverageRotations(scene.pairs, {}, [] { return true; });
+  const RotationAveragingResult result = AverageRotations(scene.pairs, {}, [] { return true; });
   EXPECT_TRUE(result.cancelled);
   EXPECT_EQ(result.num_iterations, 0);
 }

@@ -67,25 +67,25 @@ size_t RemoveObservation(point3D_t point3D_id, size_t element_index, Reconstruct
 
 size_t FilterObservationsByReprojectionError(double max_error_px, Reconstruction* model) {
   const double max_squared = max_error_px * max_error_px;
-  return FilterObservations(model, [max_squared](const Image& image, const Camera& camera,
-                                                 const Eigen::Vector2d& xy,
-                                                 const Eigen::Vector3d& xyz) {
-    const Eigen::Vector3d point_in_cam = image.cam_from_world * xyz;
-    if (point_in_cam.z() <= std::numeric_limits<double>::epsilon()) return true;
-    return (camera.ImgFromCam(point_in_cam) - xy).squaredNorm() > max_squared;
-  });
+  return FilterObservations(
+      model, [max_squared](const Image& image, const Camera& camera, const Eigen::Vector2d& xy,
+                           const Eigen::Vector3d& xyz) {
+        const Eigen::Vector3d point_in_cam = image.cam_from_world * xyz;
+        if (point_in_cam.z() <= std::numeric_limits<double>::epsilon()) return true;
+        return (camera.ImgFromCam(point_in_cam) - xy).squaredNorm() > max_squared;
+      });
 }
 
 size_t FilterObservationsByAngle(double max_angle_deg, Reconstruction* model) {
   const double min_cos = std::cos(max_angle_deg * kDegToRad);
-  return FilterObservations(model, [min_cos](const Image& image, const Camera& camera,
-                                             const Eigen::Vector2d& xy,
-                                             const Eigen::Vector3d& xyz) {
-    const Eigen::Vector3d point_in_cam = image.cam_from_world * xyz;
-    if (point_in_cam.z() <= std::numeric_limits<double>::epsilon()) return true;
-    const Eigen::Vector3d ray = camera.CamFromImg(xy).homogeneous().normalized();
-    return ray.dot(point_in_cam.normalized()) < min_cos;
-  });
+  return FilterObservations(
+      model, [min_cos](const Image& image, const Camera& camera, const Eigen::Vector2d& xy,
+                       const Eigen::Vector3d& xyz) {
+        const Eigen::Vector3d point_in_cam = image.cam_from_world * xyz;
+        if (point_in_cam.z() <= std::numeric_limits<double>::epsilon()) return true;
+        const Eigen::Vector3d ray = camera.CamFromImg(xy).homogeneous().normalized();
+        return ray.dot(point_in_cam.normalized()) < min_cos;
+      });
 }
 
 size_t FilterPointsByTriangulationAngle(double min_angle_deg, Reconstruction* model) {

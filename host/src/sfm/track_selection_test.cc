@@ -12,9 +12,9 @@ Track MakeTrack(const std::vector<image_t>& image_ids) {
 }
 
 TEST(TrackSelection, LongestFirstWhileAnImageNeedsMore) {
-  const std::vector<Track> tracks = {MakeTrack({1, 2}), MakeTrack({1, 2, 3, 4}),
-                                     MakeTrack({1, 2, 3}), MakeTrack({3, 4}), MakeTrack({5, 6}),
-                                     MakeTrack({1})};
+  const std::vector<Track> tracks = {MakeTrack({1, 2}),    MakeTrack({1, 2, 3, 4}),
+                                     MakeTrack({1, 2, 3}), MakeTrack({3, 4}),
+                                     MakeTrack({5, 6}),    MakeTrack({1})};
   const std::set<image_t> images = {1, 2, 3, 4, 5, 6};
   // One per image: the 4-track covers 1-4; then only {5, 6} is needed.
   EXPECT_EQ(SelectTracks(tracks, images, 2, 1), (std::vector<size_t>{1, 4}));

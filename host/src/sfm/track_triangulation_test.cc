@@ -4,8 +4,8 @@
 
 #include <set>
 
-#include "tessera/sfm/feature_tracks.h"
 #include "synthetic_scene.h"
+#include "tessera/sfm/feature_tracks.h"
 
 namespace tessera {
 namespace {

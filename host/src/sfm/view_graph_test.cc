@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include "tessera/sfm/focal_length_estimation.h"
 #include "synthetic_scene.h"
+#include "tessera/sfm/focal_length_estimation.h"
 
 namespace tessera {
 namespace {

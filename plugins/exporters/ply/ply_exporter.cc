@@ -2,10 +2,10 @@
 // CloudCompare, Open3D and Blender open unchanged; optionally the camera centres as
 // extra vertices in their own colour.
 
-#include <cstdio>
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <opencv2/core.hpp>
@@ -93,8 +93,8 @@ class PlyExporter : public Exporter {
     const char* type = double_precision_ ? "double" : "float";
     std::string ply = "ply\nformat binary_little_endian 1.0\ncomment Tessera: " +
                       std::to_string(reconstruction.points3D.size()) + " 3D points, then " +
-                      std::to_string(centers.size()) + " camera centres\n" +
-                      FrameComment(context) + "element vertex " +
+                      std::to_string(centers.size()) + " camera centres\n" + FrameComment(context) +
+                      "element vertex " +
                       std::to_string(reconstruction.points3D.size() + centers.size()) + "\n";
     for (const char* axis : {"x", "y", "z"})
       ply += std::string("property ") + type + " " + axis + "\n";

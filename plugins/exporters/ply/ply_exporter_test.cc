@@ -87,13 +87,13 @@ TEST(PlyExporter, WritesPointsWithModelColoursAsFloats) {
   testing::Unguarded(exporter).Export(model, ContextFor(output.path()));
   const PlyFile ply = ReadPly(output.path() / "sparse" / "0" / "points3D.ply");
   const std::string n = std::to_string(model.points3D.size());
-  EXPECT_EQ(ply.header, (std::vector<std::string>{
-                            "ply", "format binary_little_endian 1.0",
-                            "comment Tessera: " + n + " 3D points, then 0 camera centres",
-                            "comment frame: arbitrary (not georeferenced)",
-                            "element vertex " + n, "property float x", "property float y",
-                            "property float z", "property uchar red", "property uchar green",
-                            "property uchar blue", "end_header"}));
+  EXPECT_EQ(ply.header,
+            (std::vector<std::string>{
+                "ply", "format binary_little_endian 1.0",
+                "comment Tessera: " + n + " 3D points, then 0 camera centres",
+                "comment frame: arbitrary (not georeferenced)", "element vertex " + n,
+                "property float x", "property float y", "property float z", "property uchar red",
+                "property uchar green", "property uchar blue", "end_header"}));
   ASSERT_EQ(ply.vertices.size(), model.points3D.size());
   size_t i = 0;
   for (const auto& [point3D_id, point3D] : model.points3D) {

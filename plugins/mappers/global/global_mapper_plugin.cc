@@ -20,7 +20,8 @@ class GlobalMapperPlugin : public Mapper {
     OptionReader reader(options);
     reg_max_rotation_error_ =
         reader.Get<double>("reg_max_rotation_error", reg_max_rotation_error_, 0.1, 180.0);
-    min_model_agreement_ = reader.Get<double>("min_model_agreement", min_model_agreement_, 0.0, 1.0);
+    min_model_agreement_ =
+        reader.Get<double>("min_model_agreement", min_model_agreement_, 0.0, 1.0);
     mapper.erase("reg_max_rotation_error");
     mapper.erase("min_model_agreement");
     options_ = GlobalMapperOptions::FromJson(mapper);
@@ -65,12 +66,13 @@ class GlobalMapperPlugin : public Mapper {
         {"num_tracks", mapped.num_tracks},
         {"num_tracks_positioned", mapped.num_tracks_positioned},
         {"num_bundle_adjustments", mapped.num_bundle_adjustments},
-        {"seconds", {{"view_graph", mapped.step_seconds.view_graph},
-                     {"rotation_averaging", mapped.step_seconds.rotation_averaging},
-                     {"tracks", mapped.step_seconds.tracks},
-                     {"positioning", mapped.step_seconds.positioning},
-                     {"bundle_adjustment", mapped.step_seconds.bundle_adjustment},
-                     {"filtering", mapped.step_seconds.filtering}}}};
+        {"seconds",
+         {{"view_graph", mapped.step_seconds.view_graph},
+          {"rotation_averaging", mapped.step_seconds.rotation_averaging},
+          {"tracks", mapped.step_seconds.tracks},
+          {"positioning", mapped.step_seconds.positioning},
+          {"bundle_adjustment", mapped.step_seconds.bundle_adjustment},
+          {"filtering", mapped.step_seconds.filtering}}}};
     if (context.control.on_progress) {
       size_t registered = 0;
       for (const Reconstruction& model : result.models) registered += model.images.size();

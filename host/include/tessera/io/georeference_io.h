@@ -11,8 +11,8 @@ namespace tessera {
 // The file beside a model that says where its frame sits on the Earth.
 constexpr const char* kGeoreferenceFileName = "georeference.json";
 
-// Writes MODEL_DIR/georeference.json atomically (MODEL_DIR made when missing): {"latitude": deg, "longitude": deg,
-// "altitude": m, "frame": "ENU"}.
+// Writes MODEL_DIR/georeference.json atomically (MODEL_DIR made when missing): {"latitude": deg,
+// "longitude": deg, "altitude": m, "frame": "ENU"}.
 TESSERA_IO_EXPORT void WriteGeoreference(const Georeference& georeference,
                                          const std::filesystem::path& model_dir);
 

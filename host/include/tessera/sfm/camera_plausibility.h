@@ -3,8 +3,8 @@
 // Checks of camera intrinsics that bundle adjustment refined: the values a
 // degenerate configuration can push the solver to, which a real lens never has.
 
-#include "tessera/sfm/export.h"
 #include "tessera/camera.h"
+#include "tessera/sfm/export.h"
 
 namespace tessera {
 

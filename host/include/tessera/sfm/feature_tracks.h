@@ -11,10 +11,10 @@
 #include <utility>
 #include <vector>
 
-#include "tessera/sfm/export.h"
 #include "tessera/features.h"
 #include "tessera/ids.h"
 #include "tessera/reconstruction.h"
+#include "tessera/sfm/export.h"
 
 namespace tessera {
 
@@ -51,6 +51,6 @@ struct TESSERA_SFM_EXPORT FeatureTracks {
 // are joined strongest first (most matches, then by image ids), so the result does not
 // depend on the input order.
 TESSERA_SFM_EXPORT FeatureTracks BuildFeatureTracks(const std::vector<ImagePairMatches>& pairs,
-                                 const std::map<image_t, size_t>& num_points2D);
+                                                    const std::map<image_t, size_t>& num_points2D);
 
 }  // namespace tessera

@@ -10,8 +10,8 @@
 #include <map>
 #include <vector>
 
-#include "tessera/sfm/export.h"
 #include "tessera/mapper.h"
+#include "tessera/sfm/export.h"
 
 namespace tessera {
 

@@ -27,11 +27,11 @@
 #include <string>
 #include <vector>
 
-#include "tessera/sfm/export.h"
-#include "tessera/mapper.h"
-#include "tessera/sfm/global_mapper_options.h"
 #include "tessera/bundle_adjuster.h"
+#include "tessera/mapper.h"
 #include "tessera/reconstruction.h"
+#include "tessera/sfm/export.h"
+#include "tessera/sfm/global_mapper_options.h"
 
 namespace tessera {
 

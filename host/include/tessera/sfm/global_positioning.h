@@ -16,19 +16,19 @@
 #include <map>
 #include <vector>
 
-#include "tessera/sfm/export.h"
 #include "tessera/camera.h"
 #include "tessera/reconstruction.h"
+#include "tessera/sfm/export.h"
 
 namespace tessera {
 
 struct GlobalPositioningOptions {
   int max_num_iterations = 100;
-  double huber_threshold = 0.1;    // on the ray residual (unit ray)
+  double huber_threshold = 0.1;  // on the ray residual (unit ray)
   // Relative cost change to stop at: the cost flattens within a few tens of iterations, then
   // only creeps along the free scale (all positions shrinking, all scales growing).
   double function_tolerance = 1e-5;
-  double init_extent = 100;        // random positions uniform in [-extent, extent]^3
+  double init_extent = 100;  // random positions uniform in [-extent, extent]^3
   uint64_t seed = 0;
   int num_threads = 1;
 };
@@ -46,11 +46,9 @@ struct GlobalPositioningResult {
 // elements in images without a rotation are ignored; a track then left with fewer than
 // two is placed nowhere useful and should not be passed). Keypoints are those of
 // `images`, made rays with `cameras`. `should_stop` is polled at each solver iteration.
-TESSERA_SFM_EXPORT GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& cameras,
-                                         const std::map<image_t, Image>& images,
-                                         const std::map<image_t, Eigen::Matrix3d>& R_cam_from_world,
-                                         const std::vector<Track>& tracks,
-                                         const GlobalPositioningOptions& options,
-                                         const std::function<bool()>& should_stop = {});
+TESSERA_SFM_EXPORT GlobalPositioningResult PositionGlobally(
+    const std::map<camera_t, Camera>& cameras, const std::map<image_t, Image>& images,
+    const std::map<image_t, Eigen::Matrix3d>& R_cam_from_world, const std::vector<Track>& tracks,
+    const GlobalPositioningOptions& options, const std::function<bool()>& should_stop = {});
 
 }  // namespace tessera

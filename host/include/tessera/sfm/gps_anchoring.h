@@ -6,12 +6,11 @@
 // as COLMAP's pose-prior mapper does. A model too few geotagged images define, or
 // whose GPS contradicts it, stays as it was, with the reason.
 
+#include <Eigen/Core>
 #include <cstddef>
 #include <cstdint>
 #include <map>
 #include <string>
-
-#include <Eigen/Core>
 
 #include "tessera/bundle_adjuster.h"
 #include "tessera/georeference.h"

@@ -26,15 +26,15 @@
 #include <utility>
 #include <vector>
 
+#include "tessera/bundle_adjuster.h"
+#include "tessera/mapper.h"
+#include "tessera/reconstruction.h"
 #include "tessera/sfm/export.h"
 #include "tessera/sfm/feature_tracks.h"
 #include "tessera/sfm/incremental_mapper_options.h"
 #include "tessera/sfm/incremental_triangulator.h"
-#include "tessera/mapper.h"
 #include "tessera/sfm/observation_manager.h"
 #include "tessera/sfm/view_graph.h"
-#include "tessera/bundle_adjuster.h"
-#include "tessera/reconstruction.h"
 
 namespace tessera {
 

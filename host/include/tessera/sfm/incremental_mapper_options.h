@@ -122,7 +122,8 @@ struct TESSERA_SFM_EXPORT IncrementalMapperOptions {
   // Reads the `incremental` mapper's options; unknown keys and out-of-range values throw
   // OptionError naming "<path>.<key>" ("<key>" when `path` is empty, as a plugin's
   // factory reads them).
-  static IncrementalMapperOptions FromJson(const nlohmann::json& json, const std::string& path = "");
+  static IncrementalMapperOptions FromJson(const nlohmann::json& json,
+                                           const std::string& path = "");
   // Every option with its value, for provenance and logs.
   nlohmann::json ToJson() const;
 };

@@ -8,9 +8,9 @@
 #include <cstdint>
 #include <string>
 
+#include "tessera/reconstruction.h"
 #include "tessera/sfm/export.h"
 #include "tessera/sfm/feature_tracks.h"
-#include "tessera/reconstruction.h"
 
 namespace tessera {
 
@@ -36,7 +36,9 @@ struct ModelMergeReport {
 // Moves `source` into `target` when they align (see above). `tracks` are the run's
 // feature tracks, before any model merged some of them: they tell which points of the
 // two models come from one track. The merged model needs a bundle adjustment.
-TESSERA_SFM_EXPORT ModelMergeReport MergeModels(const FeatureTracks& tracks, const ModelMergeOptions& options,
-                             uint64_t seed, const Reconstruction& source, Reconstruction* target);
+TESSERA_SFM_EXPORT ModelMergeReport MergeModels(const FeatureTracks& tracks,
+                                                const ModelMergeOptions& options, uint64_t seed,
+                                                const Reconstruction& source,
+                                                Reconstruction* target);
 
 }  // namespace tessera

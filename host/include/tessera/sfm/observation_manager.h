@@ -9,9 +9,9 @@
 #include <set>
 #include <vector>
 
+#include "tessera/reconstruction.h"
 #include "tessera/sfm/export.h"
 #include "tessera/sfm/feature_tracks.h"
-#include "tessera/reconstruction.h"
 
 namespace tessera {
 

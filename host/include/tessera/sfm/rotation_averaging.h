@@ -20,8 +20,8 @@
 #include <map>
 #include <vector>
 
-#include "tessera/sfm/export.h"
 #include "tessera/ids.h"
+#include "tessera/sfm/export.h"
 
 namespace tessera {
 
@@ -37,9 +37,9 @@ struct RotationAveragingOptions {
   // IRLS steps with L1 weights, then at most max_num_irls_iterations Geman-McClure ones.
   int num_l1_iterations = 5;
   int max_num_irls_iterations = 100;
-  double robust_sigma_deg = 5.0;    // Geman-McClure scale
-  double convergence_deg = 1e-3;    // stop once no rotation moves by more
-  double max_residual_deg = 10.0;   // pairs further off at the end are dropped
+  double robust_sigma_deg = 5.0;   // Geman-McClure scale
+  double convergence_deg = 1e-3;   // stop once no rotation moves by more
+  double max_residual_deg = 10.0;  // pairs further off at the end are dropped
 };
 
 struct RotationAveragingResult {
@@ -59,13 +59,13 @@ struct RotationAveragingResult {
 
 // Averages the rotations of `pairs` (a pair naming one image twice is ignored).
 // `should_stop` is polled before each step.
-TESSERA_SFM_EXPORT RotationAveragingResult AverageRotations(const std::vector<RelativeRotation>& pairs,
-                                         const RotationAveragingOptions& options,
-                                         const std::function<bool()>& should_stop = {});
+TESSERA_SFM_EXPORT RotationAveragingResult AverageRotations(
+    const std::vector<RelativeRotation>& pairs, const RotationAveragingOptions& options,
+    const std::function<bool()>& should_stop = {});
 
 // Angle (degrees) between a pair's relative rotation and that of two absolute ones.
 TESSERA_SFM_EXPORT double RelativeRotationErrorDeg(const Eigen::Matrix3d& R_cam2_from_cam1,
-                                const Eigen::Matrix3d& R_cam1_from_world,
-                                const Eigen::Matrix3d& R_cam2_from_world);
+                                                   const Eigen::Matrix3d& R_cam1_from_world,
+                                                   const Eigen::Matrix3d& R_cam2_from_world);
 
 }  // namespace tessera

@@ -11,14 +11,15 @@
 
 #include <cstddef>
 
-#include "tessera/sfm/export.h"
 #include "tessera/reconstruction.h"
+#include "tessera/sfm/export.h"
 
 namespace tessera {
 
 // Observations whose keypoint is further than max_error_px from the point's projection,
 // or that see their point behind the camera.
-TESSERA_SFM_EXPORT size_t FilterObservationsByReprojectionError(double max_error_px, Reconstruction* model);
+TESSERA_SFM_EXPORT size_t FilterObservationsByReprojectionError(double max_error_px,
+                                                                Reconstruction* model);
 
 // Observations whose ray (through the keypoint, in the world frame) is more than
 // max_angle_deg off the direction from the camera centre to the point, or that see
@@ -26,11 +27,13 @@ TESSERA_SFM_EXPORT size_t FilterObservationsByReprojectionError(double max_error
 TESSERA_SFM_EXPORT size_t FilterObservationsByAngle(double max_angle_deg, Reconstruction* model);
 
 // Points whose largest angle between two of their rays is below min_angle_deg.
-TESSERA_SFM_EXPORT size_t FilterPointsByTriangulationAngle(double min_angle_deg, Reconstruction* model);
+TESSERA_SFM_EXPORT size_t FilterPointsByTriangulationAngle(double min_angle_deg,
+                                                           Reconstruction* model);
 
 // Removes one observation (unlinked from its keypoint), and the point when fewer than
 // two remain; returns the observations removed. `element_index` indexes the track.
-TESSERA_SFM_EXPORT size_t RemoveObservation(point3D_t point3D_id, size_t element_index, Reconstruction* model);
+TESSERA_SFM_EXPORT size_t RemoveObservation(point3D_t point3D_id, size_t element_index,
+                                            Reconstruction* model);
 
 // Removes a point and unlinks its keypoints; returns its observations.
 TESSERA_SFM_EXPORT size_t RemovePoint(point3D_t point3D_id, Reconstruction* model);

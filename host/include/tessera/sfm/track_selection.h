@@ -10,15 +10,16 @@
 #include <set>
 #include <vector>
 
-#include "tessera/sfm/export.h"
 #include "tessera/reconstruction.h"
+#include "tessera/sfm/export.h"
 
 namespace tessera {
 
 // Indices into `tracks` of those chosen, in the order taken; elements in images outside
 // `images` do not count (and the tracks are returned whole).
-TESSERA_SFM_EXPORT std::vector<size_t> SelectTracks(const std::vector<Track>& tracks, const std::set<image_t>& images,
-                                 size_t min_length, size_t max_per_image);
+TESSERA_SFM_EXPORT std::vector<size_t> SelectTracks(const std::vector<Track>& tracks,
+                                                    const std::set<image_t>& images,
+                                                    size_t min_length, size_t max_per_image);
 
 // The track with only its elements in `images`.
 TESSERA_SFM_EXPORT Track RestrictTrack(const Track& track, const std::set<image_t>& images);

@@ -9,8 +9,8 @@
 #include <cstddef>
 #include <vector>
 
-#include "tessera/sfm/export.h"
 #include "tessera/reconstruction.h"
+#include "tessera/sfm/export.h"
 
 namespace tessera {
 
@@ -22,7 +22,8 @@ struct TrackTriangulationOptions {
 
 // Replaces the model's points by one per track of `tracks` that triangulates (at least
 // two observations kept), with keypoints linked; returns the number of points.
-TESSERA_SFM_EXPORT size_t TriangulateTracks(const std::vector<Track>& tracks, const TrackTriangulationOptions& options,
-                         Reconstruction* model);
+TESSERA_SFM_EXPORT size_t TriangulateTracks(const std::vector<Track>& tracks,
+                                            const TrackTriangulationOptions& options,
+                                            Reconstruction* model);
 
 }  // namespace tessera

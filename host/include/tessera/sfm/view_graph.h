@@ -12,9 +12,9 @@
 #include <map>
 #include <vector>
 
-#include "tessera/sfm/export.h"
 #include "tessera/mapper.h"
 #include "tessera/reconstruction.h"
+#include "tessera/sfm/export.h"
 
 namespace tessera {
 
@@ -86,6 +86,7 @@ struct ModelAgreement {
 };
 
 TESSERA_SFM_EXPORT ModelAgreement ComputeModelAgreement(const ViewGraph& view_graph,
-                                     const Reconstruction& reconstruction, double max_error_deg);
+                                                        const Reconstruction& reconstruction,
+                                                        double max_error_deg);
 
 }  // namespace tessera
