@@ -248,21 +248,29 @@ PartOutcome RefinePart(const PartRun& run, size_t part_index, const BundleAdjust
   config.refine_extra_params = options.ba_refine_extra_params;
   config.max_num_iterations = options.ba_max_num_iterations;
   bool failed = false;
-  const auto adjust_and_filter = [&](double max_reproj_error, const std::string& when) {
-    if (model.images.size() < 2 || model.points3D.empty()) return;
+  // Adjusts (when `adjust`), then filters; returns whether the filters changed the model.
+  const auto adjust_and_filter = [&](double max_reproj_error, const std::string& when,
+                                     bool adjust) {
+    if (model.images.size() < 2 || model.points3D.empty()) return false;
     lap(&steps.filtering);
-    const BundleAdjustmentSummary summary = bundle_adjuster.Adjust(config, &model);
-    ++result.num_bundle_adjustments;
-    lap(&steps.bundle_adjustment);
-    spdlog::info("global map: part {}: bundle adjustment {}: {}", part_index, when,
-                 summary.BriefReport());
-    if (!summary.usable) {
-      failed = true;
-      for (const auto& [image_id, image] : model.images) {
-        reasons[image_id] = "bundle adjustment failed: " + summary.message;
+    if (!adjust) {
+      spdlog::info("global map: part {}: {}: no bundle adjustment, nothing changed since the last",
+                   part_index, when);
+    } else {
+      const BundleAdjustmentSummary summary = bundle_adjuster.Adjust(config, &model);
+      ++result.num_bundle_adjustments;
+      lap(&steps.bundle_adjustment);
+      spdlog::info("global map: part {}: {}: bundle adjustment {}", part_index, when,
+                   summary.BriefReport());
+      if (!summary.usable) {
+        failed = true;
+        for (const auto& [image_id, image] : model.images) {
+          reasons[image_id] = "bundle adjustment failed: " + summary.message;
+        }
+        return false;
       }
-      return;
     }
+    const size_t num_images = model.images.size();
     const size_t num_by_error = FilterObservationsByReprojectionError(max_reproj_error, &model);
     const size_t num_by_angle =
         FilterPointsByTriangulationAngle(options.filter_min_tri_angle, &model);
@@ -272,12 +280,16 @@ PartOutcome RefinePart(const PartRun& run, size_t part_index, const BundleAdjust
         "filtered; {} images, {} points, {} observations",
         part_index, num_by_error, max_reproj_error, num_by_angle, model.images.size(),
         model.points3D.size(), NumObservationsOf(model));
+    return num_by_error + num_by_angle > 0 || model.images.size() != num_images;
   };
+  // A round whose model did not change since the last adjustment only filters (at its
+  // lower threshold): adjusting again would not move anything.
+  bool changed = true;
   for (int round = 0; round < options.ba_num_rounds && !failed; ++round) {
     if (stop()) return PartOutcome::kCancelled;
     const double factor = std::max(1, options.ba_num_rounds - round);
-    adjust_and_filter(factor * options.filter_max_reproj_error,
-                      "after bundle adjustment round " + std::to_string(round + 1));
+    changed = adjust_and_filter(factor * options.filter_max_reproj_error,
+                                "round " + std::to_string(round + 1), changed);
   }
   if (options.retriangulate && !failed) {
     if (stop()) return PartOutcome::kCancelled;
@@ -287,7 +299,9 @@ PartOutcome RefinePart(const PartRun& run, size_t part_index, const BundleAdjust
     const size_t num_points = TriangulateTracks(part_tracks, triangulation, &model);
     spdlog::info("global map: part {}: retriangulated {} of {} tracks", part_index, num_points,
                  part_tracks.size());
-    adjust_and_filter(options.filter_max_reproj_error, "after retriangulation");
+    config.max_num_iterations = options.final_ba_max_num_iterations;
+    config.function_tolerance = options.final_ba_function_tolerance;
+    adjust_and_filter(options.filter_max_reproj_error, "after retriangulation", true);
   }
   if (failed) return PartOutcome::kNoModel;
   if (model.images.size() < static_cast<size_t>(options.min_model_size)) {

@@ -45,6 +45,10 @@ GlobalMapperOptions GlobalMapperOptions::FromJson(const nlohmann::json& json) {
   o.retriangulate = reader.GetBool("retriangulate", o.retriangulate);
   o.tri_max_error = reader.Get<double>("tri_max_error", o.tri_max_error, 1e-3, 1000.0);
   o.tri_min_angle = reader.Get<double>("tri_min_angle", o.tri_min_angle, 0.0, 90.0);
+  o.final_ba_max_num_iterations =
+      reader.Get<int>("final_ba_max_num_iterations", o.final_ba_max_num_iterations, 1, 10000);
+  o.final_ba_function_tolerance =
+      reader.Get<double>("final_ba_function_tolerance", o.final_ba_function_tolerance, 1e-12, 1.0);
   o.min_model_size = reader.Get<int>("min_model_size", o.min_model_size, 2, 1000000);
   o.seed = reader.Get<int>("seed", o.seed, 0, std::numeric_limits<int>::max());
   reader.Finish();
@@ -77,6 +81,8 @@ nlohmann::json GlobalMapperOptions::ToJson() const {
           {"retriangulate", retriangulate},
           {"tri_max_error", tri_max_error},
           {"tri_min_angle", tri_min_angle},
+          {"final_ba_max_num_iterations", final_ba_max_num_iterations},
+          {"final_ba_function_tolerance", final_ba_function_tolerance},
           {"min_model_size", min_model_size},
           {"seed", seed}};
 }

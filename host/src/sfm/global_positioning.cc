@@ -105,6 +105,7 @@ GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& camer
   ceres::Solver::Options solver_options;
   solver_options.max_num_iterations = options.max_num_iterations;
   solver_options.function_tolerance = options.function_tolerance;
+  solver_options.use_nonmonotonic_steps = options.use_nonmonotonic_steps;
   solver_options.num_threads = options.num_threads;
   solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
   solver_options.linear_solver_ordering = ordering;
