@@ -424,4 +424,31 @@ inline double ScaleInvariantDistance(const Eigen::Matrix3d& A, const Eigen::Matr
   return std::min((a - b).norm(), (a + b).norm());
 }
 
+// Adds `other`'s images (ids shifted by `offset`, names prefixed, their true poses and
+// keypoints' true points with them) and pairs to `scene`. Its images take `other`'s
+// camera 1 as `camera_id` (a camera of their own unless it is 1). Nothing matches
+// across the two.
+inline void AppendScene(const SyntheticScene& other, image_t offset, const std::string& prefix,
+                        camera_t camera_id, SyntheticScene* scene) {
+  if (camera_id != 1) {
+    Camera camera = other.input.cameras.at(1);
+    camera.camera_id = camera_id;
+    scene->input.cameras[camera_id] = camera;
+  }
+  for (const auto& [image_id, image] : other.input.images) {
+    Image shifted = image;
+    shifted.image_id = image_id + offset;
+    shifted.camera_id = camera_id;
+    shifted.name = prefix + image.name;
+    scene->input.images[shifted.image_id] = shifted;
+    scene->true_cam_from_world[shifted.image_id] = other.true_cam_from_world.at(image_id);
+    scene->true_point_of_keypoint[shifted.image_id] = other.true_point_of_keypoint.at(image_id);
+  }
+  for (MapperInput::Pair pair : other.input.pairs) {
+    pair.image_id1 += offset;
+    pair.image_id2 += offset;
+    scene->input.pairs.push_back(pair);
+  }
+}
+
 }  // namespace tessera::testing

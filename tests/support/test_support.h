@@ -14,6 +14,7 @@
 
 #include "plugin/plugin_registry.h"
 #include "skip_or_fail.h"  // the skip for shared data or colmap that is absent
+#include "tessera/bundle_adjuster.h"
 
 namespace tessera::testing {
 
@@ -57,6 +58,14 @@ template <typename Interface>
 Interface& Unguarded(const PluginInstance<Interface>& plugin) {
   return plugin.Call(PluginStage::kOptions, "a test",
                      [](Interface& object) -> Interface& { return object; });
+}
+
+// The bundled `ceres` adjuster on one thread, loaded once, for the tests and benchmarks
+// that call a mapper directly.
+inline const BundleAdjuster& CeresAdjusterOnOneThread() {
+  static const auto adjuster =
+      LoadBundledPlugin<BundleAdjuster>("bundle_adjuster", "ceres", {{"num_threads", 1}});
+  return Unguarded(adjuster);
 }
 
 // A fresh empty temporary folder, removed when the object goes.

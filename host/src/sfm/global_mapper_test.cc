@@ -18,12 +18,6 @@ using testing::MakeSyntheticScene;
 using testing::SyntheticScene;
 using testing::SyntheticSceneOptions;
 
-const BundleAdjuster& Adjuster() {
-  static const auto adjuster =
-      testing::LoadBundledPlugin<BundleAdjuster>("bundle_adjuster", "ceres", {{"num_threads", 1}});
-  return testing::Unguarded(adjuster);
-}
-
 // Every point's track sees one true point, and every keypoint linked to a point is in
 // its track.
 void ExpectConsistentAndTrue(const SyntheticScene& scene, const Reconstruction& model) {
@@ -49,32 +43,14 @@ void ExpectConsistentAndTrue(const SyntheticScene& scene, const Reconstruction& 
   EXPECT_LE(num_wrong, model.points3D.size() / 500) << "points whose track mixes true points";
 }
 
-// Adds `other`'s images and pairs to `scene`, ids shifted by `offset`; nothing matches
-// across the two.
-void AppendScene(const SyntheticScene& other, image_t offset, const std::string& prefix,
-                 SyntheticScene* scene) {
-  for (const auto& [image_id, image] : other.input.images) {
-    Image shifted = image;
-    shifted.image_id = image_id + offset;
-    shifted.name = prefix + image.name;
-    scene->input.images[shifted.image_id] = shifted;
-    scene->true_cam_from_world[shifted.image_id] = other.true_cam_from_world.at(image_id);
-    scene->true_point_of_keypoint[shifted.image_id] = other.true_point_of_keypoint.at(image_id);
-  }
-  for (MapperInput::Pair pair : other.input.pairs) {
-    pair.image_id1 += offset;
-    pair.image_id2 += offset;
-    scene->input.pairs.push_back(pair);
-  }
-}
-
 TEST(GlobalMapper, MapsThirtyImagesOfASyntheticScene) {
   SyntheticSceneOptions options;
   options.num_images = 30;
   options.outlier_ratio = 0.02;
   options.seed = 11;
   const SyntheticScene scene = MakeSyntheticScene(options);
-  const GlobalMapperResult result = GlobalMapper::Reconstruct(scene.input, Adjuster(), {});
+  const GlobalMapperResult result =
+      GlobalMapper::Reconstruct(scene.input, testing::CeresAdjusterOnOneThread(), {});
   ASSERT_EQ(result.models.size(), 1u);
   const Reconstruction& model = result.models[0];
   EXPECT_EQ(model.images.size(), 30u);
@@ -105,7 +81,8 @@ TEST(GlobalMapper, EstimatesAFocalLengthWithoutPrior) {
   options.arc_deg = 90;
   options.seed = 12;
   const SyntheticScene scene = MakeSyntheticScene(options);
-  const GlobalMapperResult result = GlobalMapper::Reconstruct(scene.input, Adjuster(), {});
+  const GlobalMapperResult result =
+      GlobalMapper::Reconstruct(scene.input, testing::CeresAdjusterOnOneThread(), {});
   ASSERT_EQ(result.models.size(), 1u);
   EXPECT_EQ(result.models[0].images.size(), 20u);
   EXPECT_NEAR(result.models[0].cameras.at(1).FocalLengthX(), options.focal_length,
@@ -123,7 +100,7 @@ TEST(GlobalMapper, DisconnectedScenesBecomeTwoModelsLargestFirst) {
   large_options.num_images = 9;
   large_options.seed = 5;
   SyntheticScene scene = MakeSyntheticScene(small_options);
-  AppendScene(MakeSyntheticScene(large_options), 6, "large_", &scene);
+  testing::AppendScene(MakeSyntheticScene(large_options), 6, "large_", 1, &scene);
   // An image that matches nothing, and two that match only each other.
   Image lonely = scene.input.images.at(1);
   lonely.image_id = 100;
@@ -132,9 +109,10 @@ TEST(GlobalMapper, DisconnectedScenesBecomeTwoModelsLargestFirst) {
   SyntheticSceneOptions pair_options;
   pair_options.num_images = 2;
   pair_options.seed = 6;
-  AppendScene(MakeSyntheticScene(pair_options), 200, "pair_", &scene);
+  testing::AppendScene(MakeSyntheticScene(pair_options), 200, "pair_", 1, &scene);
 
-  const GlobalMapperResult result = GlobalMapper::Reconstruct(scene.input, Adjuster(), {});
+  const GlobalMapperResult result =
+      GlobalMapper::Reconstruct(scene.input, testing::CeresAdjusterOnOneThread(), {});
   ASSERT_EQ(result.models.size(), 2u);
   EXPECT_EQ(result.models[0].images.size(), 9u);
   EXPECT_EQ(result.models[0].images.begin()->first, 7u);
@@ -172,7 +150,8 @@ TEST(GlobalMapper, AnImageWhosePairsAllHaveWrongRotations) {
   // The rotation cycles drop all but one of its pairs (an edge whose triangles all hold
   // dropped ones stays); that one gives it a wrong rotation, which positioning and bundle
   // adjustment then correct through its points.
-  const GlobalMapperResult filtered = GlobalMapper::Reconstruct(scene.input, Adjuster(), {});
+  const GlobalMapperResult filtered =
+      GlobalMapper::Reconstruct(scene.input, testing::CeresAdjusterOnOneThread(), {});
   EXPECT_EQ(filtered.num_pairs_dropped_by_cycles, 10u);
   ASSERT_EQ(filtered.models.size(), 1u);
   EXPECT_EQ(filtered.models[0].images.size(), 12u);
@@ -183,8 +162,8 @@ TEST(GlobalMapper, AnImageWhosePairsAllHaveWrongRotations) {
   // Without them, rotation averaging drops the same pairs, with the same outcome.
   GlobalMapperOptions unfiltered_options;
   unfiltered_options.filter_view_graph = false;
-  const GlobalMapperResult unfiltered =
-      GlobalMapper::Reconstruct(scene.input, Adjuster(), unfiltered_options);
+  const GlobalMapperResult unfiltered = GlobalMapper::Reconstruct(
+      scene.input, testing::CeresAdjusterOnOneThread(), unfiltered_options);
   EXPECT_EQ(unfiltered.num_pairs_dropped_by_cycles, 0u);
   EXPECT_EQ(unfiltered.num_pairs_dropped_by_rotation_averaging, 10u);
   ASSERT_EQ(unfiltered.models.size(), 1u);
@@ -202,10 +181,11 @@ TEST(GlobalMapper, StopsWithinASecondOfBeingAsked) {
   // A whole run polls between the steps and at every step of rotation averaging and
   // global positioning.
   int num_polls = 0;
-  const GlobalMapperResult full = GlobalMapper::Reconstruct(scene.input, Adjuster(), {}, [&] {
-    ++num_polls;
-    return false;
-  });
+  const GlobalMapperResult full =
+      GlobalMapper::Reconstruct(scene.input, testing::CeresAdjusterOnOneThread(), {}, [&] {
+        ++num_polls;
+        return false;
+      });
   ASSERT_EQ(full.models.size(), 1u);
   ASSERT_GT(num_polls, 15);
   // Stopped at the first poll, in rotation averaging, in positioning, before the last
@@ -213,11 +193,12 @@ TEST(GlobalMapper, StopsWithinASecondOfBeingAsked) {
   for (const int stop_at : {1, 4, num_polls / 2, num_polls - 2}) {
     int polls = 0;
     std::chrono::steady_clock::time_point asked;
-    const GlobalMapperResult result = GlobalMapper::Reconstruct(scene.input, Adjuster(), {}, [&] {
-      if (++polls < stop_at) return false;
-      if (polls == stop_at) asked = std::chrono::steady_clock::now();
-      return true;
-    });
+    const GlobalMapperResult result =
+        GlobalMapper::Reconstruct(scene.input, testing::CeresAdjusterOnOneThread(), {}, [&] {
+          if (++polls < stop_at) return false;
+          if (polls == stop_at) asked = std::chrono::steady_clock::now();
+          return true;
+        });
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count();
     EXPECT_TRUE(result.cancelled) << stop_at;

@@ -17,15 +17,10 @@ using testing::MakeSyntheticScene;
 using testing::SyntheticScene;
 using testing::SyntheticSceneOptions;
 
-const BundleAdjuster& Adjuster() {
-  static const auto adjuster =
-      testing::LoadBundledPlugin<BundleAdjuster>("bundle_adjuster", "ceres", {{"num_threads", 1}});
-  return testing::Unguarded(adjuster);
-}
-
 MapperResult Map(const SyntheticScene& scene, IncrementalMapperOptions options = {},
                  uint64_t seed = 0) {
-  return IncrementalPipeline(options, Adjuster(), seed).Reconstruct(scene.input);
+  return IncrementalPipeline(options, testing::CeresAdjusterOnOneThread(), seed)
+      .Reconstruct(scene.input);
 }
 
 // Every observation of every point is a keypoint of one and the same true point.
@@ -149,29 +144,6 @@ TEST(IncrementalPipeline, AnImplausiblePrincipalPointIsPutBackAtTheCentre) {
   EXPECT_EQ(camera.PrincipalPointY(), 0.5 * options.height);
 }
 
-// Adds `other`'s images (ids shifted by `offset`, names prefixed), with its camera 1 as
-// `camera_id`, and its pairs to `scene`; nothing matches across the two.
-void AppendScene(const SyntheticScene& other, image_t offset, const std::string& prefix,
-                 camera_t camera_id, SyntheticScene* scene) {
-  if (camera_id != 1) {
-    Camera camera = other.input.cameras.at(1);
-    camera.camera_id = camera_id;
-    scene->input.cameras[camera_id] = camera;
-  }
-  for (const auto& [image_id, image] : other.input.images) {
-    Image shifted = image;
-    shifted.image_id = image_id + offset;
-    shifted.camera_id = camera_id;
-    shifted.name = prefix + image.name;
-    scene->input.images[shifted.image_id] = shifted;
-  }
-  for (MapperInput::Pair pair : other.input.pairs) {
-    pair.image_id1 += offset;
-    pair.image_id2 += offset;
-    scene->input.pairs.push_back(pair);
-  }
-}
-
 TEST(IncrementalPipeline, DisconnectedGroupsBecomeSeparateModelsLargestFirst) {
   // Two scenes of 5 and 8 images with no match between them: ids 1-5 and 6-13.
   SyntheticSceneOptions small_options;
@@ -181,7 +153,7 @@ TEST(IncrementalPipeline, DisconnectedGroupsBecomeSeparateModelsLargestFirst) {
   large_options.num_images = 8;
   large_options.seed = 5;
   SyntheticScene scene = MakeSyntheticScene(small_options);
-  AppendScene(MakeSyntheticScene(large_options), 5, "large_", 1, &scene);
+  testing::AppendScene(MakeSyntheticScene(large_options), 5, "large_", 1, &scene);
   // And one image that matches nothing.
   Image lonely = scene.input.images.at(1);
   lonely.image_id = 100;
@@ -244,7 +216,7 @@ TEST(IncrementalPipeline, EstimatesTheFocalLengthOfEachSceneInAMixedSet) {
   second.prior_focal_factor = 0.7;
   second.seed = 13;
   SyntheticScene scene = MakeSyntheticScene(first);
-  AppendScene(MakeSyntheticScene(second), 100, "second_", 2, &scene);
+  testing::AppendScene(MakeSyntheticScene(second), 100, "second_", 2, &scene);
   for (const int min_pairs : {10, 0}) {
     SCOPED_TRACE("min_view_graph_focal_pairs " + std::to_string(min_pairs));
     IncrementalMapperOptions options;
@@ -545,8 +517,8 @@ TEST(IncrementalPipeline, ObserverSeesTheModelGrowAndStopsIt) {
     for (const auto& [image_id, image] : model.images) n += image.registered ? 1 : 0;
     num_registered.push_back(n);
   };
-  const MapperResult full =
-      IncrementalPipeline({}, Adjuster(), 0).Reconstruct(scene.input, observer);
+  const MapperResult full = IncrementalPipeline({}, testing::CeresAdjusterOnOneThread(), 0)
+                                .Reconstruct(scene.input, observer);
   ASSERT_EQ(full.models.size(), 1u);
   EXPECT_FALSE(full.cancelled);
   const size_t num_images = scene.input.images.size();
@@ -556,8 +528,8 @@ TEST(IncrementalPipeline, ObserverSeesTheModelGrowAndStopsIt) {
   // Stopped after the third image: no model, and nothing after the stop.
   num_registered.clear();
   observer.should_stop = [&] { return num_registered.size() >= 1; };
-  const MapperResult stopped =
-      IncrementalPipeline({}, Adjuster(), 0).Reconstruct(scene.input, observer);
+  const MapperResult stopped = IncrementalPipeline({}, testing::CeresAdjusterOnOneThread(), 0)
+                                   .Reconstruct(scene.input, observer);
   EXPECT_TRUE(stopped.cancelled);
   EXPECT_TRUE(stopped.models.empty());
   EXPECT_EQ(num_registered.size(), 1u);
