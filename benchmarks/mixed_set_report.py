@@ -92,7 +92,7 @@ def verified_pairs(db):
 
 
 def main():
-    name_map, datasets, workspaces = sys.argv[1], sys.argv[2], sys.argv[3:5]
+    name_map, datasets, workspaces = sys.argv[1], sys.argv[2], sys.argv[3:]
     scene_of, original_of = {}, {}
     for line in open(name_map):
         shuffled, scene, original = line.split()
@@ -100,7 +100,10 @@ def main():
     scenes = sorted(set(scene_of.values()))
     count = {s: sum(1 for v in scene_of.values() if v == s) for s in scenes}
     results = {}
-    for label, ws in zip(["exhaustive", "retrieval"], workspaces):
+    # Each workspace is a bench row's folder, named after its manifest; the first is the
+    # baseline the others' pairs are compared with.
+    labels = [os.path.basename(os.path.normpath(ws)) for ws in workspaces]
+    for label, ws in zip(labels, workspaces):
         pairs, num_matched = verified_pairs(os.path.join(ws, "database.db"))
         models = []
         sparse = os.path.join(ws, "sparse")
@@ -142,18 +145,17 @@ def main():
                     errors = (f"| {position.mean():.4g} | {100 * position.mean() / extent:.2f} "
                               f"| {np.mean(rotation):.3f} | {np.max(rotation):.3f}")
             print(f"| {scene} | {count[scene]} | {holding} | {registered} {errors} |")
-    exhaustive_pairs, exhaustive_matched = results["exhaustive"]
-    retrieval_pairs, retrieval_matched = results["retrieval"]
-    found = sum(1 for p in exhaustive_pairs if p in retrieval_pairs)
-    strong = [p for p, r in exhaustive_pairs.items() if r >= 100]
-    found_strong = sum(1 for p in strong if p in retrieval_pairs)
-    print(f"pairs matched: retrieval {retrieval_matched} = "
-          f"{100 * retrieval_matched / max(1, exhaustive_matched):.1f}% of exhaustive's "
-          f"{exhaustive_matched}")
-    print(f"exhaustive's verified pairs found by retrieval: {found} of {len(exhaustive_pairs)} "
-          f"({100 * found / max(1, len(exhaustive_pairs)):.1f}%); with >= 100 inliers: "
-          f"{found_strong} of {len(strong)} ({100 * found_strong / max(1, len(strong)):.1f}%)")
-
+    base_pairs, base_matched = results[labels[0]]
+    strong = [p for p, r in base_pairs.items() if r >= 100]
+    for label in labels[1:]:
+        pairs, matched = results[label]
+        found = sum(1 for p in base_pairs if p in pairs)
+        found_strong = sum(1 for p in strong if p in pairs)
+        print(f"pairs matched: {label} {matched} = "
+              f"{100 * matched / max(1, base_matched):.1f}% of {labels[0]}'s {base_matched}")
+        print(f"{labels[0]}'s verified pairs found by {label}: {found} of {len(base_pairs)} "
+              f"({100 * found / max(1, len(base_pairs)):.1f}%); with >= 100 inliers: "
+              f"{found_strong} of {len(strong)} ({100 * found_strong / max(1, len(strong)):.1f}%)")
 
 if __name__ == "__main__":
     main()

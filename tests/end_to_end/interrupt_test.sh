@@ -17,6 +17,17 @@ work=$(mktemp -d)
 pid=""
 trap '[ -n "$pid" ] && kill -9 "$pid" 2> /dev/null; rm -rf "$work"' EXIT
 
+# Polls FILE every SECONDS until a line matches PATTERN or the process $pid has ended
+# (at most 60 s).
+wait_for_line() {
+  local pattern=$1 file=$2 seconds=$3 deadline=$((SECONDS + 60))
+  while [ "$SECONDS" -lt "$deadline" ]; do
+    grep -q "$pattern" "$file" && return
+    kill -0 "$pid" 2> /dev/null || return
+    sleep "$seconds"
+  done
+}
+
 "$downscale" "$source_dir/examples/fountain-P11-small/images" "$work/images" 512 90 > /dev/null ||
   fail "downscale"
 manifest="$source_dir/manifests/default.json"
@@ -24,11 +35,7 @@ manifest="$source_dir/manifests/default.json"
 "$tessera" run --images "$work/images" --output "$work/ws" --manifest "$manifest" \
   --threads 1 > "$work/first.log" 2>&1 &
 pid=$!
-for _ in $(seq 600); do
-  grep -q "match: \[" "$work/first.log" && break
-  kill -0 "$pid" 2> /dev/null || break
-  sleep 0.1
-done
+wait_for_line "match: \[" "$work/first.log" 0.1
 grep -q "match: \[" "$work/first.log" || { cat "$work/first.log"; fail "no match progress"; }
 kill -INT "$pid"
 wait "$pid"
@@ -62,11 +69,7 @@ global_manifest="$source_dir/manifests/global.json"
 "$tessera" map --output "$work/ws" --manifest "$global_manifest" --threads 1 \
   > "$work/global_first.log" 2>&1 &
 pid=$!
-for _ in $(seq 12000); do
-  grep -q "global map: 11 images, .* verified pairs" "$work/global_first.log" && break
-  kill -0 "$pid" 2> /dev/null || break
-  sleep 0.01
-done
+wait_for_line "global map: 11 images, .* verified pairs" "$work/global_first.log" 0.01
 kill -INT "$pid" 2> /dev/null
 wait "$pid"
 code=$?

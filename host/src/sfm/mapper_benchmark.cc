@@ -94,20 +94,14 @@ void BM_GlobalMapperPath(benchmark::State& state) {
   state.counters["s_ba"] = result.step_seconds.bundle_adjustment;
 }
 
-BENCHMARK(BM_IncrementalMapperPath)
-    ->Arg(100)
-    ->Arg(300)
-    ->Arg(1000)
-    ->Arg(3000)
-    ->Iterations(1)
-    ->Unit(benchmark::kSecond);
-BENCHMARK(BM_GlobalMapperPath)
-    ->Arg(100)
-    ->Arg(300)
-    ->Arg(1000)
-    ->Arg(3000)
-    ->Iterations(1)
-    ->Unit(benchmark::kSecond);
+// Both mappers on paths of 100 to 3000 images, one run each.
+void PathSizes(benchmark::internal::Benchmark* benchmark) {
+  for (const int num_images : {100, 300, 1000, 3000}) benchmark->Arg(num_images);
+  benchmark->Iterations(1)->Unit(benchmark::kSecond);
+}
+
+BENCHMARK(BM_IncrementalMapperPath)->Apply(PathSizes);
+BENCHMARK(BM_GlobalMapperPath)->Apply(PathSizes);
 
 // The console output, plus for each mapper the fit of log(CPU time) against log(n)
 // over its runs, and global's time as a share of incremental's at each size.
