@@ -348,6 +348,9 @@ bool GuiApp::SetEditorPlugin(const std::string& slot, const std::string& plugin)
 std::string GuiApp::EditorPlugin(const std::string& slot) const {
   return setup_->editor().PluginOf(slot);
 }
+std::string GuiApp::EditorPluginDescription(const std::string& slot) const {
+  return setup_->editor().DescriptionShown(slot);
+}
 
 bool GuiApp::OpenMatchMatrix(const fs::path& path) { return match_matrix_->Open(path); }
 const std::string& GuiApp::MatchError() const { return match_matrix_->Error(); }

@@ -110,12 +110,14 @@ class GuiApp {
   // manifest field names its file and the editor holds its text. False with the message
   // in SetupError when there is no such recipe.
   bool ChooseRecipe(const std::string& name);
-  // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "bundle_adjuster")
-  // in the editor's JSON, with no options.
+  // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "mapper",
+  // "bundle_adjuster") in the editor's JSON, with no options.
   bool SetEditorPlugin(const std::string& slot, const std::string& plugin);
-  // The plugin a slot's dropdown shows: the one the editor's JSON names ("(none)" when
-  // the slot is absent).
+  // The plugin a slot's dropdown shows: the one the editor's JSON names (when the slot is
+  // absent, the mapper's default "incremental", else "(none)").
   std::string EditorPlugin(const std::string& slot) const;
+  // The description drawn under a slot's dropdown in the last frame; empty when none.
+  std::string EditorPluginDescription(const std::string& slot) const;
   // Opens the match matrix of the workspace `path` (its database.db); false with the
   // message in MatchError when it cannot.
   bool OpenMatchMatrix(const std::filesystem::path& path);

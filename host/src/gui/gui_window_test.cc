@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <regex>
 
@@ -444,6 +445,58 @@ TEST_F(GuiWindowTest, PluginDropdownsShowTheEditorsPlugins) {
   if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
   app.SetEditorText("{\"pipeline\": ");
   EXPECT_EQ(app.EditorPlugin("matcher"), "(invalid JSON)");
+}
+
+// The mapper's dropdown (issue 30 item 2 for the sixth plugin kind): a manifest without
+// pipeline.mapper shows the default, "incremental", with its description; "global"
+// picked with the mouse is what the text names and the description follows. An older
+// manifest's top-level "mapper" options go when a mapper is picked (it would be refused
+// beside pipeline.mapper).
+TEST_F(GuiWindowTest, MapperDropdownShowsAndSetsTheMapper) {
+  const std::string slots = R"("detector": {"plugin": "orb"},
+      "pair_selector": {"plugin": "exhaustive"}, "matcher": {"plugin": "brute_force"},
+      "bundle_adjuster": {"plugin": "ceres"})";
+  manifest_ = dir_.path() / "m.json";
+  std::ofstream(manifest_) << "{\"pipeline\": {" + slots + "}}";
+  GuiOptions options;
+  options.manifest = manifest_;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  Click(&app, "manifest editor");
+  app.Frame();
+  EXPECT_EQ(app.EditorPlugin("mapper"), "incremental");
+  EXPECT_EQ(app.EditorPluginDescription("mapper").rfind("Incremental mapping after COLMAP", 0), 0u)
+      << app.EditorPluginDescription("mapper");
+  const auto pick_global = [&] {
+    Click(&app, "slot mapper");
+    app.Frame();
+    Click(&app, "plugin mapper global");
+    app.Frame();
+  };
+  pick_global();
+  EXPECT_EQ(app.EditorPlugin("mapper"), "global");
+  EXPECT_EQ(app.EditorPluginDescription("mapper").rfind("Global mapping after GLOMAP", 0), 0u)
+      << app.EditorPluginDescription("mapper");
+  const nlohmann::json picked = nlohmann::json::parse(app.EditorText());
+  EXPECT_EQ(picked["pipeline"]["mapper"], nlohmann::json({{"plugin", "global"}}));
+  EXPECT_EQ(picked["pipeline"]["detector"]["plugin"], "orb");  // the other slots kept
+  EXPECT_TRUE(app.CheckEditedManifest()) << app.EditorError();
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
+  // An older manifest: the incremental mapper's options at the top level.
+  app.SetEditorText("{\"mapper\": {\"init_min_num_inliers\": 50}, \"pipeline\": {" + slots + "}}");
+  app.Frame();
+  EXPECT_EQ(app.EditorPlugin("mapper"), "incremental");
+  pick_global();
+  EXPECT_EQ(app.EditorPlugin("mapper"), "global");
+  EXPECT_FALSE(nlohmann::json::parse(app.EditorText()).contains("mapper"));
+  EXPECT_TRUE(app.CheckEditedManifest()) << app.EditorError();
+  // Picked back: the text names "incremental", no longer the default.
+  Click(&app, "slot mapper");
+  app.Frame();
+  Click(&app, "plugin mapper incremental");
+  app.Frame();
+  EXPECT_EQ(nlohmann::json::parse(app.EditorText())["pipeline"]["mapper"]["plugin"], "incremental");
 }
 
 // Once the editor is open, Run runs its text, saved or not: a bad manifest file fixed in
