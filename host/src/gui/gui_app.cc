@@ -331,6 +331,9 @@ void GuiApp::SaveScreenshot(const fs::path& file) {
 bool GuiApp::OpenModel(const fs::path& path) { return model_panel_->Open(path); }
 const std::string& GuiApp::ModelError() const { return model_panel_->Error(); }
 const std::string& GuiApp::SetupError() const { return setup_->Error(); }
+const std::string& GuiApp::FieldError(const std::string& field) const {
+  return setup_->FieldError(field);
+}
 std::string GuiApp::ImagesField() const { return setup_->ImagesField(); }
 std::string GuiApp::OutputField() const { return setup_->OutputField(); }
 std::string GuiApp::ManifestField() const { return setup_->ManifestField(); }

@@ -93,6 +93,8 @@ class GuiApp {
   bool OpenModel(const std::filesystem::path& path);
   const std::string& ModelError() const;
   const std::string& SetupError() const;
+  // The message beside the set-up field "images" or "manifest"; empty when none.
+  const std::string& FieldError(const std::string& field) const;
   // The manifest editor: loads the manifest field's file (empty: the default manifest)
   // into the editor; checks the editor's JSON as `tessera run` does (parsed, every plugin
   // created with its options); saves it to `file` (after checking) and makes it the

@@ -351,6 +351,71 @@ TEST_F(GuiWindowTest, BadInputIsShownInThePanel) {
   app.Frame();
 }
 
+// Issue 30 item 4: a field's red message goes as soon as the field changes (typed,
+// chosen in the browser, or the editor's text edited), before the next Run; the message
+// under Run taken from that field goes with it, the other fields' stay.
+TEST_F(GuiWindowTest, ErrorsClearWhenTheirFieldChanges) {
+  tessera::testing::WriteSampleImages(dir_.path() / "images", 2);
+  fs::create_directories(dir_.path() / "recipes");
+  const fs::path bad_manifest = dir_.path() / "recipes" / "bad.json";
+  const std::string bad_text = R"({"pipeline": {"detector": {"plugin": "orb", "options": []}}})";
+  std::ofstream(bad_manifest) << bad_text;
+  std::ofstream(dir_.path() / "recipes" / "good.json")
+      << R"({"pipeline": {"detector": {"plugin": "orb"}}})";
+  GuiOptions options;
+  options.manifest = bad_manifest;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  Click(&app, "run");  // no images, no output, a bad manifest
+  EXPECT_EQ(app.FieldError("images"), "choose the folder of images");
+  EXPECT_NE(app.FieldError("manifest").find("pipeline.detector.options"), std::string::npos)
+      << app.FieldError("manifest");
+  EXPECT_EQ(app.SetupError(), "choose an output folder (the workspace)");
+  // The images typed: their message goes; the others stay.
+  Click(&app, "images");
+  Type(&app, (dir_.path() / "images").string());
+  app.Frame();
+  EXPECT_EQ(app.FieldError("images"), "");
+  EXPECT_NE(app.FieldError("manifest"), "");
+  EXPECT_EQ(app.SetupError(), "choose an output folder (the workspace)");
+  Click(&app, "output");
+  Type(&app, (dir_.path() / "out").string());
+  app.Frame();
+  EXPECT_EQ(app.SetupError(), "");
+  // Now the manifest's message is also the one under Run; a file chosen in the browser
+  // clears both.
+  Click(&app, "run");
+  ASSERT_FALSE(app.controller().Running());
+  EXPECT_NE(app.SetupError().find("pipeline.detector.options"), std::string::npos)
+      << app.SetupError();
+  Click(&app, "browse manifest");
+  app.Frame();
+  Click(&app, "file good.json");
+  app.Frame();
+  EXPECT_EQ(app.ManifestField(), (dir_.path() / "recipes" / "good.json").string());
+  EXPECT_EQ(app.FieldError("manifest"), "");
+  EXPECT_EQ(app.SetupError(), "");
+  // The editor's text is Run's manifest once loaded: an error in it, then fixed there.
+  Click(&app, "manifest editor");
+  app.Frame();
+  ASSERT_TRUE(app.controller().Status().state == RunState::kIdle);
+  app.SetEditorText(bad_text);
+  app.Frame();  // the editor's "loaded" line has gone: Run moved up
+  Click(&app, "run");
+  ASSERT_FALSE(app.controller().Running());
+  EXPECT_NE(app.FieldError("manifest").find("pipeline.detector.options"), std::string::npos)
+      << app.FieldError("manifest");
+  EXPECT_NE(app.EditorError(), "");
+  EXPECT_NE(app.SetupError(), "");
+  app.SetEditorText(R"({"pipeline": {"detector": {"plugin": "orb"}}})");
+  app.Frame();
+  EXPECT_EQ(app.FieldError("manifest"), "");
+  EXPECT_EQ(app.EditorError(), "");
+  EXPECT_EQ(app.SetupError(), "");
+  EXPECT_EQ(app.controller().Status().state, RunState::kIdle);  // no run was started
+}
+
 TEST_F(GuiWindowTest, BadManifestAndPluginThatFailsToLoad) {
   tessera::testing::WriteSampleImages(dir_.path() / "images", 2);
   const fs::path bad_manifest = dir_.path() / "bad.json";

@@ -40,6 +40,11 @@ ManifestEditorPanel::ManifestEditorPanel(PathField* manifest_field)
     : manifest_field_(manifest_field) {}
 
 void ManifestEditorPanel::SetText(const std::string& text) {
+  // As typing does: a message about the old text no longer describes it.
+  if (text != text_.data()) {
+    error_.clear();
+    status_.clear();
+  }
   const size_t size = std::min(text.size(), text_.size() - 1);
   std::copy(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(size), text_.begin());
   text_[size] = '\0';

@@ -54,6 +54,7 @@ class ManifestEditorPanel {
   // Whether the editor holds a manifest (it is loaded when first opened).
   bool Loaded() const { return text_[0] != '\0'; }
 
+  // Replaces the text; as typing does, a new text clears the messages about the old.
   void SetText(const std::string& text);
   std::string Text() const { return text_.data(); }
   const std::string& Error() const { return error_; }
