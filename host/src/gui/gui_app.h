@@ -224,6 +224,11 @@ struct GuiCommandOptions {
 };
 int RunGui(const GuiCommandOptions& options);
 
+// The interactive window's start: given --images and --output and no --model, the run
+// starts at once, as the Run button does (GuiApp::RequestRun: asking first in the window
+// when it would replace a model of the output folder). Returns whether it was requested.
+bool StartCommandLineRun(const GuiOptions& options, GuiApp* app);
+
 // The set-up window's width before the user resizes it: about a third of the window,
 // at least 30 and at most 48 lines of text high, and never more than half the window.
 float PanelAutoWidth(float window_width, float font_size);
