@@ -60,7 +60,18 @@ void MatchMatrixPanel::Draw(const WidgetRect& view_rect, const fs::path& image_d
   const float cell = std::clamp(360.0f / static_cast<float>(std::max<size_t>(n, 1)), 2.0f, 24.0f);
   DrawCells(cell, image_dir, widgets);
   DrawLegend(widgets);
-  if (pair_row_ >= 0) pair_view_.Draw(widgets);
+  if (pair_row_ >= 0) {
+    // The photographs fit in the 3D view's rectangle, 10 pixels in from its edges.
+    const ImVec2 padding = ImGui::GetStyle().WindowPadding;
+    const ImVec2 at = ImGui::GetCursorScreenPos();
+    pair_view_.Draw(view_rect.max_x - 10 - padding.x - at.x,
+                    view_rect.max_y - 10 - padding.y - at.y - ImGui::GetFrameHeightWithSpacing() -
+                        ImGui::GetTextLineHeightWithSpacing(),
+                    widgets);
+  }
+  widgets->Set("match matrix window", {ImGui::GetWindowPos().x, ImGui::GetWindowPos().y,
+                                       ImGui::GetWindowPos().x + ImGui::GetWindowSize().x,
+                                       ImGui::GetWindowPos().y + ImGui::GetWindowSize().y});
   ImGui::End();
 }
 
