@@ -330,6 +330,7 @@ void GuiApp::SaveScreenshot(const fs::path& file) {
 
 bool GuiApp::OpenModel(const fs::path& path) { return model_panel_->Open(path); }
 const std::string& GuiApp::ModelError() const { return model_panel_->Error(); }
+std::string GuiApp::ModelField() const { return model_panel_->ModelField(); }
 const std::string& GuiApp::SetupError() const { return setup_->Error(); }
 const std::string& GuiApp::FieldError(const std::string& field) const {
   return setup_->FieldError(field);

@@ -92,6 +92,8 @@ class GuiApp {
   // panel (and returned by ModelError) when it cannot.
   bool OpenModel(const std::filesystem::path& path);
   const std::string& ModelError() const;
+  // The "Open a model" field: the model opened, or the workspace of the run shown.
+  std::string ModelField() const;
   const std::string& SetupError() const;
   // The message beside the set-up field "images" or "manifest"; empty when none.
   const std::string& FieldError(const std::string& field) const;

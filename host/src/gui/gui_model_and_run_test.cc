@@ -94,7 +94,8 @@ namespace tessera::gui {
 namespace {
 
 // Issue 30 item 11: the model shown is cleared when a run starts (the view follows the
-// run), not to be taken for the run's model, until the run's own model arrives.
+// run), not to be taken for the run's model, until the run's own model arrives; the
+// model field then names the run's workspace.
 TEST_F(GuiModelAndRunTest, TheOldModelIsClearedWhenARunStarts) {
   const std::filesystem::path workspace = FinishedWorkspace();
   GuiOptions options;
@@ -108,6 +109,7 @@ TEST_F(GuiModelAndRunTest, TheOldModelIsClearedWhenARunStarts) {
   app.Frame(nullptr, &before);
   ASSERT_GT(app.NumScenePoints(), 1000u);
   EXPECT_GT(CountViewPixels(before, app.ViewRect()).frustum, 0u);
+  EXPECT_EQ(app.ModelField(), workspace.string());
   Click(&app, "run");
   ASSERT_NE(app.controller().Status().state, RunState::kIdle) << app.SetupError();
   // Extraction has barely begun: nothing registered yet.
@@ -120,7 +122,8 @@ TEST_F(GuiModelAndRunTest, TheOldModelIsClearedWhenARunStarts) {
       &app, [&] { return !app.controller().Running(); }, 120));
   ASSERT_EQ(app.controller().Status().state, RunState::kCompleted);
   app.Frame();
-  EXPECT_GT(app.NumScenePoints(), 1000u);  // the run's model
+  EXPECT_GT(app.NumScenePoints(), 1000u);                // the run's model
+  EXPECT_EQ(app.ModelField(), options.output.string());  // not the model opened before
 }
 
 }  // namespace

@@ -32,6 +32,7 @@ void ModelPanel::ShowRunModels(const fs::path& output_dir) {
   // The written model has the points' colours; show it (and offer any others).
   try {
     folders_ = FindModelFolders(output_dir);
+    SetPathField(output_dir, &path_);
     const bool moved = view_->user_moved_camera;
     LoadFolder(0);
     view_->user_moved_camera = moved;
