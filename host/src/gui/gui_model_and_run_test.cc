@@ -66,12 +66,14 @@ TEST_F(GuiModelAndRunTest, ARunThatWouldReplaceAModelAsksFirst) {
   EXPECT_EQ(app.OverwriteQuestion(),
             workspace.string() + " holds a model (0); this run maps again and replaces it.");
   ASSERT_TRUE(app.Widget("replace model").has_value());
+  EXPECT_FALSE(app.Widget("view hint").has_value());  // not half under the question
   if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
   // "Keep it": no run, the model untouched.
   Click(&app, "keep model");
   app.Frame();
   EXPECT_EQ(app.OverwriteQuestion(), "");
   EXPECT_FALSE(app.Widget("keep model").has_value());
+  EXPECT_TRUE(app.Widget("view hint").has_value());
   EXPECT_FALSE(app.controller().Running());
   EXPECT_EQ(app.controller().Status().state, RunState::kIdle);
   EXPECT_EQ(fs::last_write_time(model_file), written);
