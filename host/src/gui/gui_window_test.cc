@@ -414,6 +414,14 @@ TEST_F(GuiWindowTest, ErrorsClearWhenTheirFieldChanges) {
   EXPECT_EQ(app.EditorError(), "");
   EXPECT_EQ(app.SetupError(), "");
   EXPECT_EQ(app.controller().Status().state, RunState::kIdle);  // no run was started
+  // The model field's message, once it is typed in.
+  EXPECT_FALSE(app.OpenModel(dir_.path() / "recipes"));
+  EXPECT_NE(app.ModelError(), "");
+  app.Frame();
+  Click(&app, "model");
+  Type(&app, "/");
+  app.Frame();
+  EXPECT_EQ(app.ModelError(), "");
 }
 
 TEST_F(GuiWindowTest, BadManifestAndPluginThatFailsToLoad) {

@@ -59,8 +59,11 @@ void ModelPanel::LoadFolder(size_t index) {
 
 void ModelPanel::Draw(WidgetRects* widgets) {
   FitText("Open a model", widgets);
-  ImGui::InputTextWithHint("##model", "COLMAP folder, workspace or database.db", path_.data(),
-                           path_.size());
+  // The message is about the path that was opened: editing the field clears it.
+  if (ImGui::InputTextWithHint("##model", "COLMAP folder, workspace or database.db", path_.data(),
+                               path_.size())) {
+    error_.clear();
+  }
   widgets->RecordLastItem("model");
   ImGui::SameLine();
   if (ImGui::Button("Open")) Open(fs::path(path_.data()));
