@@ -88,5 +88,22 @@ TEST_F(GuiWindowTest, PairViewTogglesInliersAndPutativesWithAxesAndLegend) {
   EXPECT_GT(app.PairLinesDrawn(), 0u);
 }
 
+// At twice the font size the cells grow too: each row keeps its name.
+TEST_F(GuiWindowTest, MatchMatrixCellsGrowWithTheUiScale) {
+  const std::filesystem::path workspace = FinishedWorkspace();
+  GuiOptions options;
+  options.images = dir_.path() / "images";
+  options.output = workspace;
+  options.width = 1920;
+  options.height = 1080;
+  options.ui_scale = 2;
+  GuiApp app(options);
+  app.Frame();
+  Click(&app, "match matrix");
+  app.Frame();
+  const WidgetRect cells = app.Widget("match cells").value();
+  EXPECT_GE((cells.max_x - cells.min_x) / 8, 2 * 13.0f);  // a line of 26 px text per row
+}
+
 }  // namespace
 }  // namespace tessera::gui

@@ -57,7 +57,10 @@ void MatchMatrixPanel::Draw(const WidgetRect& view_rect, const fs::path& image_d
   ImGui::Begin("Match matrix", &show_, ImGuiWindowFlags_AlwaysAutoResize);
   const size_t n = matrix_->size();
   ImGui::Text("%zu images; colour: verified inliers. Click a cell.", n);
-  const float cell = std::clamp(360.0f / static_cast<float>(std::max<size_t>(n, 1)), 2.0f, 24.0f);
+  // The cells grow with the UI scale (13 px text: 1), so that each row keeps its label.
+  const float ui_scale = ImGui::GetFontSize() / 13.0f;
+  const float cell = std::clamp(360.0f * ui_scale / static_cast<float>(std::max<size_t>(n, 1)),
+                                2.0f, 24.0f * ui_scale);
   DrawCells(cell, image_dir, widgets);
   DrawLegend(widgets);
   if (pair_row_ >= 0) {
