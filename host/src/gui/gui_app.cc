@@ -272,6 +272,7 @@ void GuiApp::DrawSetupWindow(const RunStatus& status) {
   const ImGuiWindow* window = ImGui::GetCurrentWindow();
   panel_overflow_ = std::max(0.0f, window->DC.CursorMaxPos.x - window->WorkRect.Max.x);
   log_pane_->Draw();
+  widgets_.RecordLastItem("log");
   panel_overflow_ = std::max(panel_overflow_, log_pane_->overflow());
   ImGui::End();
 }

@@ -42,6 +42,9 @@ class GuiLayoutTest : public GuiWindowTest {
     EXPECT_EQ(app.ViewRect().min_x, panel);
     EXPECT_EQ(app.Widget("setup window")->max_x, panel);
     EXPECT_EQ(app.PanelOverflow(), 0.0f);
+    // The log under the open editor: 6 lines high at least, never a sliver.
+    const WidgetRect log = app.Widget("log").value();
+    EXPECT_GE(log.max_y - log.min_y, 6 * font);
     CheckTooltips(&app, height);
   }
 
