@@ -59,6 +59,10 @@ void ModelPanel::LoadFolder(size_t index) {
 
 void ModelPanel::Draw(WidgetRects* widgets) {
   FitText("Open a model", widgets);
+  // The field takes the width the Open button leaves (its hint whole at 1024 px).
+  const ImGuiStyle& style = ImGui::GetStyle();
+  ImGui::SetNextItemWidth(
+      -(ImGui::CalcTextSize("Open").x + 2 * style.FramePadding.x + style.ItemSpacing.x));
   // The message is about the path that was opened: editing the field clears it.
   if (ImGui::InputTextWithHint("##model", "COLMAP folder, workspace or database.db", path_.data(),
                                path_.size())) {
