@@ -34,7 +34,8 @@ CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions&) {
                   "camera window darkens what they mask out");
   sub->add_option("--screenshot", options->screenshot,
                   "Write a PNG of the window and exit: of --model (no run), else after a run "
-                  "of --images into --output");
+                  "of --images into --output (replacing a model there without asking, as "
+                  "tessera run does)");
   sub->add_option("--frames", options->frames, "Frames drawn before the screenshot (at least 2)")
       ->check(AtLeast(1));
   sub->add_option("--width", options->width, "Window width")->check(CLI::Range(200, 8192));

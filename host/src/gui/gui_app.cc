@@ -227,9 +227,10 @@ void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
     match_matrix_->Draw(view, images, &widgets_);
   }
   picking_->HandleMouse(view);
-  if (view_->scene() == nullptr && !options_.view_only) {
+  if (view_->scene() == nullptr && !options_.view_only && OverwriteQuestion().empty()) {
     // An empty view says what fills it: the run's model (until the mapper registers its
-    // first images), or what to do first.
+    // first images), or what to do first; not while the window asks before a run (its
+    // question would cover it half).
     const bool running = status.state == RunState::kRunning && setup_->follow_run();
     const char* hint = running ? "the run's model appears here as its images register"
                                : "choose a folder of images and press Run, or open a model";
@@ -271,6 +272,7 @@ void GuiApp::DrawSetupWindow(const RunStatus& status) {
   const ImGuiWindow* window = ImGui::GetCurrentWindow();
   panel_overflow_ = std::max(0.0f, window->DC.CursorMaxPos.x - window->WorkRect.Max.x);
   log_pane_->Draw();
+  widgets_.RecordLastItem("log");
   panel_overflow_ = std::max(panel_overflow_, log_pane_->overflow());
   ImGui::End();
 }
@@ -330,7 +332,11 @@ void GuiApp::SaveScreenshot(const fs::path& file) {
 
 bool GuiApp::OpenModel(const fs::path& path) { return model_panel_->Open(path); }
 const std::string& GuiApp::ModelError() const { return model_panel_->Error(); }
+std::string GuiApp::ModelField() const { return model_panel_->ModelField(); }
 const std::string& GuiApp::SetupError() const { return setup_->Error(); }
+const std::string& GuiApp::FieldError(const std::string& field) const {
+  return setup_->FieldError(field);
+}
 std::string GuiApp::ImagesField() const { return setup_->ImagesField(); }
 std::string GuiApp::OutputField() const { return setup_->OutputField(); }
 std::string GuiApp::ManifestField() const { return setup_->ManifestField(); }
@@ -347,6 +353,9 @@ bool GuiApp::SetEditorPlugin(const std::string& slot, const std::string& plugin)
 }
 std::string GuiApp::EditorPlugin(const std::string& slot) const {
   return setup_->editor().PluginOf(slot);
+}
+std::string GuiApp::EditorPluginDescription(const std::string& slot) const {
+  return setup_->editor().DescriptionShown(slot);
 }
 
 bool GuiApp::OpenMatchMatrix(const fs::path& path) { return match_matrix_->Open(path); }

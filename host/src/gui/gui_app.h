@@ -92,7 +92,11 @@ class GuiApp {
   // panel (and returned by ModelError) when it cannot.
   bool OpenModel(const std::filesystem::path& path);
   const std::string& ModelError() const;
+  // The "Open a model" field: the model opened, or the workspace of the run shown.
+  std::string ModelField() const;
   const std::string& SetupError() const;
+  // The message beside the set-up field "images" or "manifest"; empty when none.
+  const std::string& FieldError(const std::string& field) const;
   // The manifest editor: loads the manifest field's file (empty: the default manifest)
   // into the editor; checks the editor's JSON as `tessera run` does (parsed, every plugin
   // created with its options); saves it to `file` (after checking) and makes it the
@@ -110,12 +114,14 @@ class GuiApp {
   // manifest field names its file and the editor holds its text. False with the message
   // in SetupError when there is no such recipe.
   bool ChooseRecipe(const std::string& name);
-  // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "bundle_adjuster")
-  // in the editor's JSON, with no options.
+  // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "mapper",
+  // "bundle_adjuster") in the editor's JSON, with no options.
   bool SetEditorPlugin(const std::string& slot, const std::string& plugin);
-  // The plugin a slot's dropdown shows: the one the editor's JSON names ("(none)" when
-  // the slot is absent).
+  // The plugin a slot's dropdown shows: the one the editor's JSON names (when the slot is
+  // absent, the mapper's default "incremental", else "(none)").
   std::string EditorPlugin(const std::string& slot) const;
+  // The description drawn under a slot's dropdown in the last frame; empty when none.
+  std::string EditorPluginDescription(const std::string& slot) const;
   // Opens the match matrix of the workspace `path` (its database.db); false with the
   // message in MatchError when it cannot.
   bool OpenMatchMatrix(const std::filesystem::path& path);
@@ -219,6 +225,11 @@ struct GuiCommandOptions {
   int frames = 3;
 };
 int RunGui(const GuiCommandOptions& options);
+
+// The interactive window's start: given --images and --output and no --model, the run
+// starts at once, as the Run button does (GuiApp::RequestRun: asking first in the window
+// when it would replace a model of the output folder). Returns whether it was requested.
+bool StartCommandLineRun(const GuiOptions& options, GuiApp* app);
 
 // The set-up window's width before the user resizes it: about a third of the window,
 // at least 30 and at most 48 lines of text high, and never more than half the window.

@@ -30,6 +30,9 @@ class GuiLayoutTest : public GuiWindowTest {
     app.Frame();
     CheckTooltips(&app, height);
     EXPECT_EQ(app.PanelOverflow(), 0.0f);
+    // The model field and its Open button take the panel's width (the field's hint was
+    // cut at 1024 px, with room to spare right of the button).
+    EXPECT_LE(app.PanelWidth() - app.Widget("open")->max_x, 24 * ui_scale);
     Click(&app, "manifest editor");
     app.Frame();
     app.Frame();
@@ -42,6 +45,9 @@ class GuiLayoutTest : public GuiWindowTest {
     EXPECT_EQ(app.ViewRect().min_x, panel);
     EXPECT_EQ(app.Widget("setup window")->max_x, panel);
     EXPECT_EQ(app.PanelOverflow(), 0.0f);
+    // The log under the open editor: 6 lines high at least, never a sliver.
+    const WidgetRect log = app.Widget("log").value();
+    EXPECT_GE(log.max_y - log.min_y, 6 * font);
     CheckTooltips(&app, height);
   }
 

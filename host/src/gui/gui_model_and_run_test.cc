@@ -4,6 +4,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cstdlib>
 #include <string>
 
 #include "gui/gui_window_test_fixture.h"
@@ -35,7 +36,9 @@ TEST_F(GuiModelAndRunTest, ModelWithImagesAndOutputOpensItAndStartsNoRun) {
 
   // The window: the model shown, the images field its photographs, no run.
   GuiOptions options = command.gui;
+  options.output = workspace;
   GuiApp app(options);
+  EXPECT_FALSE(StartCommandLineRun(options, &app));
   app.Frame();
   app.Frame();
   EXPECT_EQ(app.controller().Status().state, RunState::kIdle);
@@ -44,6 +47,8 @@ TEST_F(GuiModelAndRunTest, ModelWithImagesAndOutputOpensItAndStartsNoRun) {
   EXPECT_EQ(app.ImageFolderWarning(), "");
 }
 
+// As `tessera gui --images I --output ws` (the run the command line starts), then the Run
+// button: each asks first.
 TEST_F(GuiModelAndRunTest, ARunThatWouldReplaceAModelAsksFirst) {
   const fs::path workspace = FinishedWorkspace();
   const fs::path model_file = workspace / "sparse" / "0" / "images.bin";
@@ -53,24 +58,30 @@ TEST_F(GuiModelAndRunTest, ARunThatWouldReplaceAModelAsksFirst) {
   options.output = workspace;
   options.manifest = manifest_;
   GuiApp app(options);
+  ASSERT_TRUE(StartCommandLineRun(options, &app));  // before the first frame, as RunGui
   app.Frame();
-  app.Frame();
-  Click(&app, "run");
   app.Frame();
   EXPECT_FALSE(app.controller().Running());
-  EXPECT_NE(app.OverwriteQuestion().find("holds a model (0)"), std::string::npos)
-      << app.OverwriteQuestion();
+  EXPECT_EQ(app.controller().Status().state, RunState::kIdle);
+  EXPECT_EQ(app.OverwriteQuestion(),
+            workspace.string() + " holds a model (0); this run maps again and replaces it.");
+  ASSERT_TRUE(app.Widget("replace model").has_value());
+  EXPECT_FALSE(app.Widget("view hint").has_value());  // not half under the question
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
   // "Keep it": no run, the model untouched.
   Click(&app, "keep model");
   app.Frame();
   EXPECT_EQ(app.OverwriteQuestion(), "");
   EXPECT_FALSE(app.Widget("keep model").has_value());
+  EXPECT_TRUE(app.Widget("view hint").has_value());
   EXPECT_FALSE(app.controller().Running());
   EXPECT_EQ(app.controller().Status().state, RunState::kIdle);
   EXPECT_EQ(fs::last_write_time(model_file), written);
-  // "Run and replace": the run goes.
+  // The Run button asks again; "Run and replace": the run goes.
   Click(&app, "run");
   app.Frame();
+  EXPECT_FALSE(app.controller().Running());
+  EXPECT_NE(app.OverwriteQuestion(), "");
   Click(&app, "replace model");
   EXPECT_NE(app.controller().Status().state, RunState::kIdle);
   ASSERT_TRUE(WaitFor(
@@ -85,7 +96,8 @@ namespace tessera::gui {
 namespace {
 
 // Issue 30 item 11: the model shown is cleared when a run starts (the view follows the
-// run), not to be taken for the run's model, until the run's own model arrives.
+// run), not to be taken for the run's model, until the run's own model arrives; the
+// model field then names the run's workspace.
 TEST_F(GuiModelAndRunTest, TheOldModelIsClearedWhenARunStarts) {
   const std::filesystem::path workspace = FinishedWorkspace();
   GuiOptions options;
@@ -99,6 +111,7 @@ TEST_F(GuiModelAndRunTest, TheOldModelIsClearedWhenARunStarts) {
   app.Frame(nullptr, &before);
   ASSERT_GT(app.NumScenePoints(), 1000u);
   EXPECT_GT(CountViewPixels(before, app.ViewRect()).frustum, 0u);
+  EXPECT_EQ(app.ModelField(), workspace.string());
   Click(&app, "run");
   ASSERT_NE(app.controller().Status().state, RunState::kIdle) << app.SetupError();
   // Extraction has barely begun: nothing registered yet.
@@ -111,7 +124,8 @@ TEST_F(GuiModelAndRunTest, TheOldModelIsClearedWhenARunStarts) {
       &app, [&] { return !app.controller().Running(); }, 120));
   ASSERT_EQ(app.controller().Status().state, RunState::kCompleted);
   app.Frame();
-  EXPECT_GT(app.NumScenePoints(), 1000u);  // the run's model
+  EXPECT_GT(app.NumScenePoints(), 1000u);                // the run's model
+  EXPECT_EQ(app.ModelField(), options.output.string());  // not the model opened before
 }
 
 }  // namespace

@@ -28,6 +28,7 @@ TEST(StageOverlay, ReadsDoneTotalRateTimeLeftOrReused) {
   map.rate_per_s = 0.5;
   map.remaining_s = 10;
   EXPECT_EQ(StageOverlay(map), "3/8 images registered  0.50/s, 10 s left");
+  EXPECT_EQ(StageOverlay(map, /*with_rate=*/false), "3/8 images registered, 10 s left");
   EXPECT_FLOAT_EQ(StageFraction(map), 3.0f / 8);
   map.finished = true;
   map.done = 7;
@@ -41,6 +42,10 @@ TEST_F(GuiWindowTest, MapBarMovesWithEachRegistrationAndAResumedRunSaysReused) {
   options.images = dir_.path() / "images";
   options.output = dir_.path() / "out";
   options.manifest = manifest_;
+  // A small window with a larger font: the map bar's text is wider than the bar.
+  options.width = 1024;
+  options.height = 640;
+  options.ui_scale = 1.5f;
   GuiApp app(options);
   app.Frame();
   app.Frame();
@@ -48,6 +53,7 @@ TEST_F(GuiWindowTest, MapBarMovesWithEachRegistrationAndAResumedRunSaysReused) {
   // Frames as the event loop draws them; the map bar's readings while mapping.
   std::set<size_t> map_done;
   std::set<std::string> map_overlays;
+  std::string map_elided;  // the map bar's whole text, when it was cut short
   size_t map_total = 0;
   ASSERT_TRUE(WaitFor(
       &app,
@@ -58,6 +64,9 @@ TEST_F(GuiWindowTest, MapBarMovesWithEachRegistrationAndAResumedRunSaysReused) {
           map_done.insert(status.stages.back().done);
           map_overlays.insert(StageOverlay(status.stages.back()));
           map_total = status.stages.back().total;
+        }
+        for (const auto& [rect, text] : app.ElidedTexts()) {
+          if (text.rfind("map: ", 0) == 0) map_elided = text;
         }
         return !app.controller().Running();
       },
@@ -73,6 +82,8 @@ TEST_F(GuiWindowTest, MapBarMovesWithEachRegistrationAndAResumedRunSaysReused) {
   for (const size_t done : map_done) between += done > 0 && done < map_total ? 1 : 0;
   EXPECT_GE(between, 2u) << seen;
   EXPECT_NE(seen.find(" left"), std::string::npos) << seen;
+  // Cut at its end (the count kept), the whole text recorded for its tooltip.
+  EXPECT_NE(map_elided.find(" left"), std::string::npos) << map_elided;
   const StageProgress& map = status.stages.at(2);
   ASSERT_EQ(map.stage, "map");
   EXPECT_TRUE(map.finished);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <regex>
 
@@ -350,6 +351,79 @@ TEST_F(GuiWindowTest, BadInputIsShownInThePanel) {
   app.Frame();
 }
 
+// Issue 30 item 4: a field's red message goes as soon as the field changes (typed,
+// chosen in the browser, or the editor's text edited), before the next Run; the message
+// under Run taken from that field goes with it, the other fields' stay.
+TEST_F(GuiWindowTest, ErrorsClearWhenTheirFieldChanges) {
+  tessera::testing::WriteSampleImages(dir_.path() / "images", 2);
+  fs::create_directories(dir_.path() / "recipes");
+  const fs::path bad_manifest = dir_.path() / "recipes" / "bad.json";
+  const std::string bad_text = R"({"pipeline": {"detector": {"plugin": "orb", "options": []}}})";
+  std::ofstream(bad_manifest) << bad_text;
+  std::ofstream(dir_.path() / "recipes" / "good.json")
+      << R"({"pipeline": {"detector": {"plugin": "orb"}}})";
+  GuiOptions options;
+  options.manifest = bad_manifest;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  Click(&app, "run");  // no images, no output, a bad manifest
+  EXPECT_EQ(app.FieldError("images"), "choose the folder of images");
+  EXPECT_NE(app.FieldError("manifest").find("pipeline.detector.options"), std::string::npos)
+      << app.FieldError("manifest");
+  EXPECT_EQ(app.SetupError(), "choose an output folder (the workspace)");
+  // The images typed: their message goes; the others stay.
+  Click(&app, "images");
+  Type(&app, (dir_.path() / "images").string());
+  app.Frame();
+  EXPECT_EQ(app.FieldError("images"), "");
+  EXPECT_NE(app.FieldError("manifest"), "");
+  EXPECT_EQ(app.SetupError(), "choose an output folder (the workspace)");
+  Click(&app, "output");
+  Type(&app, (dir_.path() / "out").string());
+  app.Frame();
+  EXPECT_EQ(app.SetupError(), "");
+  // Now the manifest's message is also the one under Run; a file chosen in the browser
+  // clears both.
+  Click(&app, "run");
+  ASSERT_FALSE(app.controller().Running());
+  EXPECT_NE(app.SetupError().find("pipeline.detector.options"), std::string::npos)
+      << app.SetupError();
+  Click(&app, "browse manifest");
+  app.Frame();
+  Click(&app, "file good.json");
+  app.Frame();
+  EXPECT_EQ(app.ManifestField(), (dir_.path() / "recipes" / "good.json").string());
+  EXPECT_EQ(app.FieldError("manifest"), "");
+  EXPECT_EQ(app.SetupError(), "");
+  // The editor's text is Run's manifest once loaded: an error in it, then fixed there.
+  Click(&app, "manifest editor");
+  app.Frame();
+  ASSERT_TRUE(app.controller().Status().state == RunState::kIdle);
+  app.SetEditorText(bad_text);
+  app.Frame();  // the editor's "loaded" line has gone: Run moved up
+  Click(&app, "run");
+  ASSERT_FALSE(app.controller().Running());
+  EXPECT_NE(app.FieldError("manifest").find("pipeline.detector.options"), std::string::npos)
+      << app.FieldError("manifest");
+  EXPECT_NE(app.EditorError(), "");
+  EXPECT_NE(app.SetupError(), "");
+  app.SetEditorText(R"({"pipeline": {"detector": {"plugin": "orb"}}})");
+  app.Frame();
+  EXPECT_EQ(app.FieldError("manifest"), "");
+  EXPECT_EQ(app.EditorError(), "");
+  EXPECT_EQ(app.SetupError(), "");
+  EXPECT_EQ(app.controller().Status().state, RunState::kIdle);  // no run was started
+  // The model field's message, once it is typed in.
+  EXPECT_FALSE(app.OpenModel(dir_.path() / "recipes"));
+  EXPECT_NE(app.ModelError(), "");
+  app.Frame();
+  Click(&app, "model");
+  Type(&app, "/");
+  app.Frame();
+  EXPECT_EQ(app.ModelError(), "");
+}
+
 TEST_F(GuiWindowTest, BadManifestAndPluginThatFailsToLoad) {
   tessera::testing::WriteSampleImages(dir_.path() / "images", 2);
   const fs::path bad_manifest = dir_.path() / "bad.json";
@@ -444,6 +518,58 @@ TEST_F(GuiWindowTest, PluginDropdownsShowTheEditorsPlugins) {
   if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
   app.SetEditorText("{\"pipeline\": ");
   EXPECT_EQ(app.EditorPlugin("matcher"), "(invalid JSON)");
+}
+
+// The mapper's dropdown (issue 30 item 2 for the sixth plugin kind): a manifest without
+// pipeline.mapper shows the default, "incremental", with its description; "global"
+// picked with the mouse is what the text names and the description follows. An older
+// manifest's top-level "mapper" options go when a mapper is picked (it would be refused
+// beside pipeline.mapper).
+TEST_F(GuiWindowTest, MapperDropdownShowsAndSetsTheMapper) {
+  const std::string slots = R"("detector": {"plugin": "orb"},
+      "pair_selector": {"plugin": "exhaustive"}, "matcher": {"plugin": "brute_force"},
+      "bundle_adjuster": {"plugin": "ceres"})";
+  manifest_ = dir_.path() / "m.json";
+  std::ofstream(manifest_) << "{\"pipeline\": {" + slots + "}}";
+  GuiOptions options;
+  options.manifest = manifest_;
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  Click(&app, "manifest editor");
+  app.Frame();
+  EXPECT_EQ(app.EditorPlugin("mapper"), "incremental");
+  EXPECT_EQ(app.EditorPluginDescription("mapper").rfind("Incremental mapping after COLMAP", 0), 0u)
+      << app.EditorPluginDescription("mapper");
+  const auto pick_global = [&] {
+    Click(&app, "slot mapper");
+    app.Frame();
+    Click(&app, "plugin mapper global");
+    app.Frame();
+  };
+  pick_global();
+  EXPECT_EQ(app.EditorPlugin("mapper"), "global");
+  EXPECT_EQ(app.EditorPluginDescription("mapper").rfind("Global mapping after GLOMAP", 0), 0u)
+      << app.EditorPluginDescription("mapper");
+  const nlohmann::json picked = nlohmann::json::parse(app.EditorText());
+  EXPECT_EQ(picked["pipeline"]["mapper"], nlohmann::json({{"plugin", "global"}}));
+  EXPECT_EQ(picked["pipeline"]["detector"]["plugin"], "orb");  // the other slots kept
+  EXPECT_TRUE(app.CheckEditedManifest()) << app.EditorError();
+  if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
+  // An older manifest: the incremental mapper's options at the top level.
+  app.SetEditorText("{\"mapper\": {\"init_min_num_inliers\": 50}, \"pipeline\": {" + slots + "}}");
+  app.Frame();
+  EXPECT_EQ(app.EditorPlugin("mapper"), "incremental");
+  pick_global();
+  EXPECT_EQ(app.EditorPlugin("mapper"), "global");
+  EXPECT_FALSE(nlohmann::json::parse(app.EditorText()).contains("mapper"));
+  EXPECT_TRUE(app.CheckEditedManifest()) << app.EditorError();
+  // Picked back: the text names "incremental", no longer the default.
+  Click(&app, "slot mapper");
+  app.Frame();
+  Click(&app, "plugin mapper incremental");
+  app.Frame();
+  EXPECT_EQ(nlohmann::json::parse(app.EditorText())["pipeline"]["mapper"]["plugin"], "incremental");
 }
 
 // Once the editor is open, Run runs its text, saved or not: a bad manifest file fixed in

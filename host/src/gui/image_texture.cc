@@ -54,9 +54,9 @@ bool ImageTexture::Load(const fs::path& file, int max_width, const fs::path& mas
   return true;
 }
 
-void ImageTexture::Draw() const {
+void ImageTexture::Draw(float zoom) const {
   ImGui::Image(reinterpret_cast<ImTextureID>(static_cast<intptr_t>(id_)),
-               ImVec2(static_cast<float>(width_), static_cast<float>(height_)));
+               ImVec2(static_cast<float>(width_) * zoom, static_cast<float>(height_) * zoom));
 }
 
 }  // namespace tessera::gui

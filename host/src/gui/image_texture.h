@@ -22,8 +22,8 @@ class ImageTexture {
   // mask_problem().
   bool Load(const std::filesystem::path& file, int max_width,
             const std::filesystem::path& mask_file = {});
-  // Draws the texture at its own size as an ImGui item.
-  void Draw() const;
+  // Draws the texture at its own size times `zoom` as an ImGui item.
+  void Draw(float zoom = 1) const;
 
   bool empty() const { return width_ == 0; }
   int width() const { return width_; }

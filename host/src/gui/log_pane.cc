@@ -9,7 +9,10 @@ namespace tessera::gui {
 
 void LogPane::Draw() {
   ImGui::TextUnformatted("Log");
-  ImGui::BeginChild("log", ImVec2(0, 0), true);
+  // Never a sliver under a long set-up window (the manifest editor open, a small window).
+  const float height =
+      std::max(ImGui::GetContentRegionAvail().y, 6 * ImGui::GetTextLineHeightWithSpacing());
+  ImGui::BeginChild("log", ImVec2(0, height), true);
   size_t version = 0;
   const std::vector<LogLine> lines = sink_->Lines(&version);
   const float width = std::max(1.0f, ImGui::GetContentRegionAvail().x);

@@ -17,7 +17,8 @@ class LogPane {
  public:
   explicit LogPane(std::shared_ptr<const LogSink> sink) : sink_(std::move(sink)) {}
 
-  // The "Log" heading and a child window filling the rest of the window.
+  // The "Log" heading and a child window filling the rest of the window, at least 6 lines
+  // high (the set-up window then scrolls to it).
   void Draw();
   // How far the last frame's lines reached past the pane's visible width (0: none).
   float overflow() const { return overflow_; }

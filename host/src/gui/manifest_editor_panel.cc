@@ -18,7 +18,13 @@ namespace fs = std::filesystem;
 namespace {
 
 // The slots in pipeline order, as the dropdowns list them.
-constexpr const char* kSlots[] = {"detector", "pair_selector", "matcher", "bundle_adjuster"};
+constexpr const char* kSlots[] = {"detector", "pair_selector", "matcher", "mapper",
+                                  "bundle_adjuster"};
+
+// The plugin a run uses for a slot the manifest leaves out; empty: no such stage.
+std::string DefaultPlugin(const std::string& slot) {
+  return slot == "mapper" ? Manifest().mapper.plugin : "";
+}
 
 // The plugin named by one slot's JSON ({"plugin": NAME, ...}); "?" when it names none.
 std::string PluginNamed(const nlohmann::json& slot) {
@@ -34,6 +40,11 @@ ManifestEditorPanel::ManifestEditorPanel(PathField* manifest_field)
     : manifest_field_(manifest_field) {}
 
 void ManifestEditorPanel::SetText(const std::string& text) {
+  // As typing does: a message about the old text no longer describes it.
+  if (text != text_.data()) {
+    error_.clear();
+    status_.clear();
+  }
   const size_t size = std::min(text.size(), text_.size() - 1);
   std::copy(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(size), text_.begin());
   text_[size] = '\0';
@@ -107,6 +118,9 @@ bool ManifestEditorPanel::SetPlugin(const std::string& slot, const std::string& 
   try {
     nlohmann::json json = nlohmann::json::parse(std::string(text_.data()));
     json["pipeline"][slot] = {{"plugin", plugin}};
+    // A top-level "mapper" (the incremental mapper's options before mappers were plugins)
+    // next to pipeline.mapper is refused; the plugin is set with no options anyway.
+    if (slot == "mapper") json.erase("mapper");
     SetText(json.dump(2));
     return true;
   } catch (const nlohmann::json::exception& error) {
@@ -116,11 +130,19 @@ bool ManifestEditorPanel::SetPlugin(const std::string& slot, const std::string& 
 }
 
 std::string ManifestEditorPanel::PluginOf(const std::string& slot) const {
+  bool is_default = false;
+  return PluginOf(slot, &is_default);
+}
+
+std::string ManifestEditorPanel::PluginOf(const std::string& slot, bool* is_default) const {
+  *is_default = false;
   const nlohmann::json json = nlohmann::json::parse(text_.data(), nullptr, false);
   if (json.is_discarded()) return "(invalid JSON)";
   if (!json.is_object() || !json.contains("pipeline") || !json["pipeline"].is_object() ||
       !json["pipeline"].contains(slot)) {
-    return "(none)";
+    const std::string default_plugin = DefaultPlugin(slot);
+    *is_default = !default_plugin.empty();
+    return *is_default ? default_plugin : "(none)";
   }
   const nlohmann::json& value = json["pipeline"][slot];
   if (!value.is_array()) return PluginNamed(value);
@@ -150,12 +172,19 @@ void ManifestEditorPanel::FindPlugins() {
   }
 }
 
-void ManifestEditorPanel::DrawSlot(const std::string& kind, const std::string& current) {
+void ManifestEditorPanel::DrawSlot(const std::string& kind, WidgetRects* widgets) {
+  bool is_default = false;
+  const std::string current = PluginOf(kind, &is_default);
   const auto& plugins = plugins_by_kind_[kind];
   const std::string label = kind + "##slot";
-  if (ImGui::BeginCombo(label.c_str(), current.c_str())) {
+  // A slot the text leaves out but a run fills (the mapper) says so.
+  const std::string preview = is_default ? current + " (default)" : current;
+  const bool open = ImGui::BeginCombo(label.c_str(), preview.c_str());
+  widgets->RecordLastItem("slot " + kind);
+  if (open) {
     for (const auto& [name, description] : plugins) {
       if (ImGui::Selectable(name.c_str(), name == current)) SetPlugin(kind, name);
+      widgets->RecordLastItem("plugin " + kind + " " + name);
       if (ImGui::IsItemHovered() && !description.empty()) {
         ImGui::SetTooltip("%s", description.c_str());
       }
@@ -163,22 +192,28 @@ void ManifestEditorPanel::DrawSlot(const std::string& kind, const std::string& c
     ImGui::EndCombo();
   }
   // The description of the plugin now named, so that it follows a new choice.
+  std::string& shown = descriptions_shown_[kind];
+  shown.clear();
   for (const auto& [name, description] : plugins) {
-    if (name == current) HintText(description);
+    if (name == current) shown = description;
   }
+  HintText(shown);
 }
 
 void ManifestEditorPanel::Draw(WidgetRects* widgets) {
   const bool open = ImGui::CollapsingHeader("Pipeline: plugins and options (manifest editor)");
   widgets->RecordLastItem("manifest editor");  // recorded closed too, to be clicked open
-  if (!open) return;
+  if (!open) {
+    descriptions_shown_.clear();
+    return;
+  }
   if (!Loaded()) Load();
   if (plugins_by_kind_.empty()) FindPlugins();
   // One plugin per slot, from the plugins found on the plugin path; each dropdown shows
   // the plugin the text names now.
   ImGui::PushItemWidth(
       -(ImGui::CalcTextSize("bundle_adjuster").x + ImGui::GetStyle().ItemInnerSpacing.x));
-  for (const char* kind : kSlots) DrawSlot(kind, PluginOf(kind));
+  for (const char* kind : kSlots) DrawSlot(kind, widgets);
   ImGui::PopItemWidth();
   if (ImGui::InputTextMultiline("##manifest json", text_.data(), text_.size(),
                                 ImVec2(-1, ImGui::GetTextLineHeight() * 12))) {

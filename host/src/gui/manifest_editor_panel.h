@@ -31,13 +31,22 @@ class ManifestEditorPanel {
   bool Check();
   // Saves the editor's JSON to `file` (after checking) and sets the manifest field to it.
   bool Save(const std::filesystem::path& file);
-  // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "bundle_adjuster")
-  // in the editor's JSON, with no options.
+  // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "mapper",
+  // "bundle_adjuster") in the editor's JSON, with no options (for the mapper, a top-level
+  // "mapper" object of an older manifest is removed: it would be refused beside it).
   bool SetPlugin(const std::string& slot, const std::string& plugin);
-  // The plugin the editor's JSON names for a slot, as its dropdown shows it: "(none)"
-  // when the slot is absent (a run then has no such stage), "(invalid JSON)" when the
-  // text does not parse; several pair selectors are joined with " + ".
+  // The plugin the editor's JSON names for a slot, as its dropdown shows it: when the
+  // slot is absent, the plugin a run uses then (the mapper: "incremental", its dropdown
+  // reading "incremental (default)") or "(none)" (a run has no such stage);
+  // "(invalid JSON)" when the text does not parse; several pair selectors are joined
+  // with " + ".
   std::string PluginOf(const std::string& slot) const;
+  // The description drawn under a slot's dropdown in the last frame (of the plugin it
+  // shows); empty when none was.
+  std::string DescriptionShown(const std::string& slot) const {
+    const auto found = descriptions_shown_.find(slot);
+    return found == descriptions_shown_.end() ? "" : found->second;
+  }
 
   // Reloads the editor when the manifest field no longer names the file it was loaded
   // from, clearing the messages of the old file.
@@ -45,6 +54,7 @@ class ManifestEditorPanel {
   // Whether the editor holds a manifest (it is loaded when first opened).
   bool Loaded() const { return text_[0] != '\0'; }
 
+  // Replaces the text; as typing does, a new text clears the messages about the old.
   void SetText(const std::string& text);
   std::string Text() const { return text_.data(); }
   const std::string& Error() const { return error_; }
@@ -56,9 +66,11 @@ class ManifestEditorPanel {
  private:
   // The plugins of each slot's kind on the plugin path, found once.
   void FindPlugins();
-  // A slot's dropdown, its preview the plugin `json` names, and that plugin's
-  // description beneath it.
-  void DrawSlot(const std::string& kind, const std::string& current);
+  // PluginOf, and whether the plugin is the slot's default (the text names none).
+  std::string PluginOf(const std::string& slot, bool* is_default) const;
+  // A slot's dropdown (recorded as "slot KIND", its entries as "plugin KIND NAME"), its
+  // preview the plugin the text names, and that plugin's description beneath it.
+  void DrawSlot(const std::string& kind, WidgetRects* widgets);
 
   PathField* manifest_field_;
   std::vector<char> text_ = std::vector<char>(1 << 16, '\0');
@@ -67,6 +79,7 @@ class ManifestEditorPanel {
   std::string loaded_from_;  // the manifest field's value when last loaded or saved
   // Per kind: each plugin's name and description.
   std::map<std::string, std::vector<std::pair<std::string, std::string>>> plugins_by_kind_;
+  std::map<std::string, std::string> descriptions_shown_;  // per slot, DescriptionShown
 };
 
 }  // namespace tessera::gui

@@ -57,10 +57,24 @@ void MatchMatrixPanel::Draw(const WidgetRect& view_rect, const fs::path& image_d
   ImGui::Begin("Match matrix", &show_, ImGuiWindowFlags_AlwaysAutoResize);
   const size_t n = matrix_->size();
   ImGui::Text("%zu images; colour: verified inliers. Click a cell.", n);
-  const float cell = std::clamp(360.0f / static_cast<float>(std::max<size_t>(n, 1)), 2.0f, 24.0f);
+  // The cells grow with the UI scale (13 px text: 1), so that each row keeps its label.
+  const float ui_scale = ImGui::GetFontSize() / 13.0f;
+  const float cell = std::clamp(360.0f * ui_scale / static_cast<float>(std::max<size_t>(n, 1)),
+                                2.0f, 24.0f * ui_scale);
   DrawCells(cell, image_dir, widgets);
   DrawLegend(widgets);
-  if (pair_row_ >= 0) pair_view_.Draw(widgets);
+  if (pair_row_ >= 0) {
+    // The photographs fit in the 3D view's rectangle, 10 pixels in from its edges.
+    const ImVec2 padding = ImGui::GetStyle().WindowPadding;
+    const ImVec2 at = ImGui::GetCursorScreenPos();
+    pair_view_.Draw(view_rect.max_x - 10 - padding.x - at.x,
+                    view_rect.max_y - 10 - padding.y - at.y - ImGui::GetFrameHeightWithSpacing() -
+                        ImGui::GetTextLineHeightWithSpacing(),
+                    widgets);
+  }
+  widgets->Set("match matrix window", {ImGui::GetWindowPos().x, ImGui::GetWindowPos().y,
+                                       ImGui::GetWindowPos().x + ImGui::GetWindowSize().x,
+                                       ImGui::GetWindowPos().y + ImGui::GetWindowSize().y});
   ImGui::End();
 }
 

@@ -32,6 +32,7 @@ void ModelPanel::ShowRunModels(const fs::path& output_dir) {
   // The written model has the points' colours; show it (and offer any others).
   try {
     folders_ = FindModelFolders(output_dir);
+    SetPathField(output_dir, &path_);
     const bool moved = view_->user_moved_camera;
     LoadFolder(0);
     view_->user_moved_camera = moved;
@@ -58,8 +59,15 @@ void ModelPanel::LoadFolder(size_t index) {
 
 void ModelPanel::Draw(WidgetRects* widgets) {
   FitText("Open a model", widgets);
-  ImGui::InputTextWithHint("##model", "COLMAP folder, workspace or database.db", path_.data(),
-                           path_.size());
+  // The field takes the width the Open button leaves (its hint whole at 1024 px).
+  const ImGuiStyle& style = ImGui::GetStyle();
+  ImGui::SetNextItemWidth(
+      -(ImGui::CalcTextSize("Open").x + 2 * style.FramePadding.x + style.ItemSpacing.x));
+  // The message is about the path that was opened: editing the field clears it.
+  if (ImGui::InputTextWithHint("##model", "COLMAP folder, workspace or database.db", path_.data(),
+                               path_.size())) {
+    error_.clear();
+  }
   widgets->RecordLastItem("model");
   ImGui::SameLine();
   if (ImGui::Button("Open")) Open(fs::path(path_.data()));

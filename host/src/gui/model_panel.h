@@ -24,8 +24,9 @@ class ModelPanel {
   // Opens a model folder, workspace or database.db (its first model); false with the
   // message in Error() (also logged) when it cannot.
   bool Open(const std::filesystem::path& path);
-  // A run completed: shows the first model it wrote in `output_dir`, the camera left
-  // where the user moved it; keeps the model shown when it wrote no COLMAP model.
+  // A run completed: shows the first model it wrote in `output_dir` (the model field then
+  // names `output_dir`, not a model opened before), the camera left where the user moved
+  // it; keeps the model shown when it wrote no COLMAP model.
   void ShowRunModels(const std::filesystem::path& output_dir);
   // A run starts: the models opened are no longer the ones shown.
   void ForgetModels() { folders_.clear(); }

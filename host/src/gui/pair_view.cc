@@ -2,6 +2,7 @@
 
 #include <imgui.h>
 
+#include <algorithm>
 #include <utility>
 
 namespace tessera::gui {
@@ -21,7 +22,7 @@ void PairView::Show(PairInliers pair, const std::filesystem::path& image_dir) {
   photos_[1].Load(image_dir / pair_.name2, 360);
 }
 
-void PairView::Draw(WidgetRects* widgets) {
+void PairView::Draw(float max_width, float max_height, WidgetRects* widgets) {
   lines_drawn_ = 0;
   ImGui::Text("%s - %s: %zu inlier matches of %zu putative", pair_.name1.c_str(),
               pair_.name2.c_str(), pair_.xy1.size(), pair_.putative_xy1.size());
@@ -41,22 +42,28 @@ void PairView::Draw(WidgetRects* widgets) {
     return;
   }
   const ImVec2 left = ImGui::GetCursorScreenPos();
+  const float spacing = ImGui::GetStyle().ItemSpacing.x;
+  const float width = static_cast<float>(photos_[0].width() + photos_[1].width());
+  const float height = static_cast<float>(std::max(photos_[0].height(), photos_[1].height()));
+  // Shrunk to the room left (a small window: 1024x640), never below a third.
+  const float zoom = std::clamp(
+      std::min((max_width - spacing) / width, max_height / std::max(height, 1.0f)), 1 / 3.0f, 1.0f);
   for (const ImageTexture& photo : photos_) {
-    photo.Draw();
+    photo.Draw(zoom);
     ImGui::SameLine();
   }
   ImGui::NewLine();
-  const float right_x =
-      left.x + static_cast<float>(photos_[0].width()) + ImGui::GetStyle().ItemSpacing.x;
+  widgets->Set("pair photos",
+               {left.x, left.y, left.x + width * zoom + spacing, left.y + height * zoom});
+  const float right_x = left.x + static_cast<float>(photos_[0].width()) * zoom + spacing;
   // Inliers green, putatives orange; translucent, the ends opaque.
   const ImU32 line = show_putatives ? IM_COL32(255, 150, 40, 70) : IM_COL32(60, 255, 90, 70);
   const ImU32 end = show_putatives ? IM_COL32(255, 150, 40, 220) : IM_COL32(60, 255, 90, 220);
   ImDrawList* draw = ImGui::GetWindowDrawList();
   for (const size_t i : SubsampleMatches(xy1.size(), kMaxPairLines)) {
-    const ImVec2 a(left.x + xy1[i].x() * photos_[0].scale(),
-                   left.y + xy1[i].y() * photos_[0].scale());
-    const ImVec2 b(right_x + xy2[i].x() * photos_[1].scale(),
-                   left.y + xy2[i].y() * photos_[1].scale());
+    const float scale1 = photos_[0].scale() * zoom, scale2 = photos_[1].scale() * zoom;
+    const ImVec2 a(left.x + xy1[i].x() * scale1, left.y + xy1[i].y() * scale1);
+    const ImVec2 b(right_x + xy2[i].x() * scale2, left.y + xy2[i].y() * scale2);
     draw->AddLine(a, b, line);
     draw->AddCircleFilled(a, 1.5f, end, 6);
     draw->AddCircleFilled(b, 1.5f, end, 6);

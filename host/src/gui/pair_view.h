@@ -26,8 +26,9 @@ class PairView {
   void Show(PairInliers pair, const std::filesystem::path& image_dir);
   void Clear() { pair_ = {}; }
   // The names, the counts, the toggle (recorded as "show inliers" and "show putatives")
-  // and the photographs with the lines.
-  void Draw(WidgetRects* widgets);
+  // and the photographs with the lines (recorded as "pair photos"), shrunk when needed to
+  // fit max_width x max_height pixels (the room left in the window), at most to a third.
+  void Draw(float max_width, float max_height, WidgetRects* widgets);
 
   const PairInliers& pair() const { return pair_; }
   bool show_putatives = false;

@@ -10,6 +10,13 @@
 
 namespace tessera::gui {
 
+bool StartCommandLineRun(const GuiOptions& options, GuiApp* app) {
+  // --model opens a model (with --images, its photographs) and starts no run.
+  if (!options.model.empty() || options.images.empty() || options.output.empty()) return false;
+  app->RequestRun();
+  return true;
+}
+
 int RunGui(const GuiCommandOptions& options) {
   if (!options.screenshot.empty() && options.gui.model.empty() && options.gui.images.empty()) {
     throw InputError("gui: --screenshot needs --model or --images");
@@ -20,16 +27,13 @@ int RunGui(const GuiCommandOptions& options) {
   GuiApp app(options.gui);
   // OpenModel has logged the one-line message.
   if (!options.gui.model.empty() && !app.ModelError().empty()) return kExitBadInput;
-  // --model opens a model (with --images, its photographs) and starts no run; without
-  // it, --images and --output start one (asking first in the window before replacing a
-  // model of the output folder).
-  const bool run = options.gui.model.empty() && !options.gui.images.empty();
   if (options.screenshot.empty()) {
-    if (run && !options.gui.output.empty()) app.RequestRun();
+    StartCommandLineRun(options.gui, &app);
     while (!app.ShouldClose()) app.Step(1.0);
     return kExitSuccess;
   }
-  if (run) {
+  // The screenshot mode's run (no one to ask: it replaces a model there, as `tessera run`).
+  if (options.gui.model.empty() && !options.gui.images.empty()) {
     if (!app.Run()) throw InputError(app.SetupError());
     while (app.controller().Running()) app.Step(0.1);
     app.controller().Join();

@@ -46,8 +46,13 @@ SetupPanel::SetupPanel(const RunRequest& fields, bool follow_run, RunController*
 
 bool SetupPanel::CheckFields() {
   error_.clear();
+  error_field_ = ErrorField::kNone;
   images_error_.clear();
   manifest_error_.clear();
+  checked_images_ = images_.data();
+  checked_output_ = output_.data();
+  checked_manifest_ = manifest_.data();
+  checked_editor_text_ = editor_.Loaded() ? editor_.Text() : "";
   const fs::path images(images_.data());
   const fs::path manifest(manifest_.data());
   std::error_code error;
@@ -58,7 +63,10 @@ bool SetupPanel::CheckFields() {
   } else if (!HasImageFile(images)) {
     images_error_ = images.string() + ": no images in this folder (JPEG, PNG, TIFF, BMP, WebP)";
   }
-  if (output_[0] == '\0') error_ = "choose an output folder (the workspace)";
+  if (output_[0] == '\0') {
+    error_ = "choose an output folder (the workspace)";
+    error_field_ = ErrorField::kOutput;
+  }
   if (editor_.Loaded()) {
     // The editor's text is the run's manifest: checked as `tessera run` would.
     if (!editor_.Check()) manifest_error_ = editor_.Error();
@@ -75,8 +83,12 @@ bool SetupPanel::CheckFields() {
 bool SetupPanel::Run() {
   if (!CheckFields()) {
     // The first field's message, unless the output folder is missing.
-    for (const std::string* message : {&images_error_, &manifest_error_}) {
-      if (!message->empty() && error_.empty()) error_ = *message;
+    if (error_.empty() && !images_error_.empty()) {
+      error_ = images_error_;
+      error_field_ = ErrorField::kImages;
+    } else if (error_.empty()) {
+      error_ = manifest_error_;
+      error_field_ = ErrorField::kManifest;
     }
     spdlog::error("{}", error_);
     return false;
@@ -87,6 +99,7 @@ bool SetupPanel::Run() {
   if (editor_.Loaded()) request.manifest_json = editor_.Text();
   if (!controller_->Start(request)) {
     error_ = "a run is going on";
+    error_field_ = ErrorField::kNone;
     return false;
   }
   return true;
@@ -144,6 +157,7 @@ bool SetupPanel::ChooseRecipe(const std::string& name) {
   const Recipe* recipe = recipes_.Find(name);
   if (recipe == nullptr) {
     error_ = "no recipe '" + name + "' in " + recipes_.folder().string();
+    error_field_ = ErrorField::kNone;
     return false;
   }
   SetPathField(recipe->file, &manifest_);
@@ -152,16 +166,38 @@ bool SetupPanel::ChooseRecipe(const std::string& name) {
   // Loaded now, so that the editor (Run's manifest once loaded) holds the recipe.
   if (!editor_.Load()) {
     error_ = editor_.Error();
+    error_field_ = ErrorField::kNone;
     return false;
   }
   return true;
 }
 
+void SetupPanel::ClearStaleErrors() {
+  const bool images_changed = checked_images_ != images_.data();
+  const bool output_changed = checked_output_ != output_.data();
+  // The editor's text (when it was Run's manifest) is compared only while there is a
+  // message to clear.
+  const bool manifest_changed =
+      (!manifest_error_.empty() || error_field_ == ErrorField::kManifest) &&
+      (checked_manifest_ != manifest_.data() ||
+       (!checked_editor_text_.empty() && checked_editor_text_ != editor_.Text()));
+  if (images_changed) images_error_.clear();
+  if (manifest_changed) manifest_error_.clear();
+  if ((error_field_ == ErrorField::kImages && images_changed) ||
+      (error_field_ == ErrorField::kOutput && output_changed) ||
+      (error_field_ == ErrorField::kManifest && manifest_changed)) {
+    error_.clear();
+    error_field_ = ErrorField::kNone;
+  }
+}
+
 void SetupPanel::Draw(const RunStatus& status, WidgetRects* widgets) {
   const bool running = controller_->Running();
   ImGui::TextUnformatted("Reconstruct");
+  ClearStaleErrors();
   DrawFields(widgets);
   editor_.Draw(widgets);
+  ClearStaleErrors();  // after this frame's typing and choices
   DrawRunButtons(status, running, widgets);
   DrawStageProgress(status.stages, widgets);
   DrawOverwriteQuestion(widgets);

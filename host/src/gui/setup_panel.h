@@ -42,12 +42,19 @@ class SetupPanel {
   // in Error() when there is no such recipe or it cannot be read.
   bool ChooseRecipe(const std::string& name);
   // A failed run's message, shown in place of a field's.
-  void ShowRunError(const std::string& message) { error_ = message; }
+  void ShowRunError(const std::string& message) {
+    error_ = message;
+    error_field_ = ErrorField::kNone;
+  }
 
   // The section; `status` is the run's, read once for the frame.
   void Draw(const RunStatus& status, WidgetRects* widgets);
 
   const std::string& Error() const { return error_; }
+  // The message shown beside the field "images" or "manifest"; empty when none.
+  const std::string& FieldError(const std::string& field) const {
+    return field == "images" ? images_error_ : manifest_error_;
+  }
   std::string ImagesField() const { return images_.data(); }
   std::string OutputField() const { return output_.data(); }
   std::string ManifestField() const { return manifest_.data(); }
@@ -57,6 +64,10 @@ class SetupPanel {
  private:
   // Sets the fields' messages; true when all are empty.
   bool CheckFields();
+  // Clears the messages about a field (and the one under Run taken from it) once the field
+  // no longer holds what was checked: typed, browsed, chosen from the recipes or, for the
+  // manifest, edited in the editor.
+  void ClearStaleErrors();
   void DrawFields(WidgetRects* widgets);
   // Run and Cancel (one of them enabled, by `running`), the state and the message.
   void DrawRunButtons(const RunStatus& status, bool running, WidgetRects* widgets);
@@ -67,6 +78,10 @@ class SetupPanel {
   std::function<void()> before_start_;
   PathField images_{}, output_{}, manifest_{};
   std::string error_, images_error_, manifest_error_;
+  // The field error_ was taken from; kNone: not a field's (a failed run's, say).
+  enum class ErrorField { kNone, kImages, kOutput, kManifest } error_field_ = ErrorField::kNone;
+  // What the last CheckFields read: the fields and, when loaded, the editor's text.
+  std::string checked_images_, checked_output_, checked_manifest_, checked_editor_text_;
   std::string overwrite_question_;
   bool overwrite_popup_open_ = false;
   bool follow_run_ = true;

@@ -21,7 +21,7 @@ float StageFraction(const StageProgress& stage) {
   return std::min(1.0f, static_cast<float>(stage.done) / static_cast<float>(stage.total));
 }
 
-std::string StageOverlay(const StageProgress& stage) {
+std::string StageOverlay(const StageProgress& stage, bool with_rate) {
   if (stage.total == 0) {
     // Extract and match of a resumed run: everything was done by an earlier run.
     return stage.stage == "extract" || stage.stage == "match" ? "reused" : "nothing to do";
@@ -32,7 +32,7 @@ std::string StageOverlay(const StageProgress& stage) {
   if (stage.rate_per_s > 0) {
     char rate[64];
     std::snprintf(rate, sizeof(rate), "  %.2f/s", stage.rate_per_s);
-    overlay += rate;
+    if (with_rate) overlay += rate;
     if (stage.done < stage.total) overlay += ", " + FormatSeconds(stage.remaining_s) + " left";
   }
   return overlay;
@@ -42,10 +42,26 @@ void DrawStageProgress(const std::vector<StageProgress>& stages, WidgetRects* wi
   for (const StageProgress& stage : stages) {
     const std::string overlay = StageOverlay(stage);
     const float name_width = ImGui::GetFontSize() * 6;
-    ImGui::ProgressBar(StageFraction(stage), ImVec2(-name_width, 0), overlay.c_str());
+    // An overlay wider than the bar is shortened at its end, keeping the count: ImGui
+    // would cut its start. The whole of it in a tooltip.
+    const float room =
+        ImGui::GetContentRegionAvail().x - name_width - 2 * ImGui::GetStyle().ItemInnerSpacing.x;
+    // Too wide: first without the rate, then cut.
+    std::string shown = overlay;
+    if (ImGui::CalcTextSize(shown.c_str()).x > room) {
+      shown = ElideToWidth(StageOverlay(stage, /*with_rate=*/false), room);
+    }
+    ImGui::ProgressBar(StageFraction(stage), ImVec2(-name_width, 0), shown.c_str());
     widgets->RecordLastItem("progress " + stage.stage);
-    // The overlay is cut at the bar's ends: the whole of it in a tooltip.
-    if (ImGui::IsItemHovered()) ImGui::SetTooltip("%s: %s", stage.stage.c_str(), overlay.c_str());
+    const std::string whole = stage.stage + ": " + overlay;
+    if (shown != overlay) {
+      const ImVec2 min = ImGui::GetItemRectMin(), max = ImGui::GetItemRectMax();
+      widgets->AddElided({min.x, min.y, max.x, max.y}, whole);
+    }
+    if (ImGui::IsItemHovered()) {
+      ImGui::SetTooltip("%s", whole.c_str());
+      if (shown != overlay) widgets->set_tooltip(whole);
+    }
     ImGui::SameLine();
     FitText(stage.stage, widgets);
   }

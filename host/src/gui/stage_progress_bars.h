@@ -12,15 +12,17 @@
 
 namespace tessera::gui {
 
-// The text over a stage's bar.
-std::string StageOverlay(const StageProgress& stage);
+// The text over a stage's bar; without the rate ("3/8 images registered, 10 s left")
+// when `with_rate` is false, for a narrow bar.
+std::string StageOverlay(const StageProgress& stage, bool with_rate = true);
 // How full the bar is, 0 to 1 (a stage with nothing to do, or finished: 1).
 float StageFraction(const StageProgress& stage);
 // "45 s", "2 min 5 s"; "?" for a negative time.
 std::string FormatSeconds(double seconds);
 
 // The bars, each named by its stage; the rectangle of each is recorded as
-// "progress <stage>".
+// "progress <stage>". A text wider than its bar is cut at its end, recorded as elided
+// ("<stage>: <text>", WidgetRects::Elided) and shown whole in a tooltip.
 void DrawStageProgress(const std::vector<StageProgress>& stages, WidgetRects* widgets);
 
 }  // namespace tessera::gui
