@@ -247,6 +247,7 @@ PartOutcome RefinePart(const PartRun& run, size_t part_index, const BundleAdjust
   config.refine_principal_point = options.ba_refine_principal_point;
   config.refine_extra_params = options.ba_refine_extra_params;
   config.max_num_iterations = options.ba_max_num_iterations;
+  config.function_tolerance = options.ba_function_tolerance;
   bool failed = false;
   // Adjusts (when `adjust`), then filters; returns whether the filters changed the model.
   const auto adjust_and_filter = [&](double max_reproj_error, const std::string& when,

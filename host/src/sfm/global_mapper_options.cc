@@ -38,6 +38,8 @@ GlobalMapperOptions GlobalMapperOptions::FromJson(const nlohmann::json& json) {
   o.ba_num_rounds = reader.Get<int>("ba_num_rounds", o.ba_num_rounds, 1, 100);
   o.ba_max_num_iterations =
       reader.Get<int>("ba_max_num_iterations", o.ba_max_num_iterations, 1, 10000);
+  o.ba_function_tolerance =
+      reader.Get<double>("ba_function_tolerance", o.ba_function_tolerance, 1e-12, 1.0);
   o.ba_refine_focal_length = reader.GetBool("ba_refine_focal_length", o.ba_refine_focal_length);
   o.ba_refine_principal_point =
       reader.GetBool("ba_refine_principal_point", o.ba_refine_principal_point);
@@ -75,6 +77,7 @@ nlohmann::json GlobalMapperOptions::ToJson() const {
           {"min_num_observations_per_image", min_num_observations_per_image},
           {"ba_num_rounds", ba_num_rounds},
           {"ba_max_num_iterations", ba_max_num_iterations},
+          {"ba_function_tolerance", ba_function_tolerance},
           {"ba_refine_focal_length", ba_refine_focal_length},
           {"ba_refine_principal_point", ba_refine_principal_point},
           {"ba_refine_extra_params", ba_refine_extra_params},

@@ -55,6 +55,11 @@ struct TESSERA_SFM_EXPORT GlobalMapperOptions {
   // ba_max_num_iterations; what the adjuster may refine.
   int ba_num_rounds = 3;
   int ba_max_num_iterations = 100;
+  // A round's adjustment also stops once an iteration lowers the cost by less than this
+  // fraction (as the incremental mapper's global BA does). On lego-100 with retrieval
+  // pairs the three rounds took 31 iterations in 2.3 s instead of 130 in 9.8 s at the
+  // adjuster's 1e-6, with the same cameras (0.13% of the extent, 0.14 degrees).
+  double ba_function_tolerance = 1e-4;
   bool ba_refine_focal_length = true;
   bool ba_refine_principal_point = false;
   bool ba_refine_extra_params = true;
