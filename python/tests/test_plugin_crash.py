@@ -40,13 +40,16 @@ def test_a_crashing_detector_raises_and_is_quarantined_as_in_the_cli(
     (two / "0001.jpg").write_bytes((source / "0001.jpg").read_bytes())
     output = tmp_path / "out"
     manifest = crash_manifest(1024)
+    calls = []
     for _ in range(2):
         with pytest.raises(tessera.PluginCrashError) as raised:
-            tessera.extract(images=two, output=output, manifest=manifest, threads=1)
+            tessera.extract(images=two, output=output, manifest=manifest, threads=1,
+                            progress=lambda *call: calls.append(call))
         assert str(raised.value).startswith(
             "plugin 'failing_detector' crashed (SIGSEGV) while detecting image 0001.jpg; "
             "what was finished is kept and the same call resumes"), str(raised.value)
     assert raised.value.exit_code == 4
+    assert calls == [("extract", 1, 2)]  # the first call's 0000.jpg; the second's reused
     assert isinstance(raised.value, tessera.Error)
     # The third call, as the CLI's third run: the image that crashed the detector twice
     # is skipped, the other was kept from the first call.
@@ -70,3 +73,15 @@ def test_the_interpreter_runs_normal_stages_after_a_crash(sample, tmp_path, fail
                               threads=2)
     assert summary["num_detected"] == 11
 
+
+
+def test_an_exporter_that_crashes_raises_naming_it(sample, tmp_path, failing_plugins):
+    _, _, cli_output = sample
+    with pytest.raises(tessera.PluginCrashError,
+                       match=r"^plugin 'failing_exporter' crashed \(SIGSEGV\) while exporting"):
+        tessera.export(model=cli_output / "sparse" / "0", format="failing_exporter",
+                       output=tmp_path / "x", options={"fail": "segv"})
+    summary = tessera.export(model=cli_output / "sparse" / "0", format="colmap_text",
+                             output=tmp_path / "text")
+    assert summary["num_points3D"] == len(tessera.Reconstruction(cli_output / "sparse" / "0")
+                                          .points3D)
