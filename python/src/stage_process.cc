@@ -312,9 +312,18 @@ nlohmann::json RunInChildProcess(const std::string& verb, const py::object& prog
   int status = 0;
   {
     const py::gil_scoped_release release;
-    watch.Run();
-    while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    const auto reap = [&] {
+      while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+      }
+    };
+    try {
+      watch.Run();
+    } catch (...) {
+      kill(pid, SIGKILL);  // a line the parent could not take: no child is left behind
+      reap();
+      throw;
     }
+    reap();
   }
   const std::string record = ReadCrashRecord(crash_read.get());
 
