@@ -7,7 +7,7 @@
 
 namespace tessera::python {
 
-// tessera.Error, InputError, OptionError, NoModelError and the translation of the
+// tessera.Error, InputError, NoModelError, PluginCrashError and the translation of the
 // host's C++ exceptions into them (errors.cc).
 void BindErrors(pybind11::module_& module);
 

@@ -5,12 +5,14 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 #include "bindings.h"
 #include "json_objects.h"
 #include "manifest/manifest.h"
 #include "plugin/plugin_registry.h"
+#include "stage_process.h"
 #include "tessera/errors.h"
 #include "util/paths.h"
 
@@ -22,24 +24,29 @@ void BindPlugins(py::module_& module) {
   module.def(
       "plugins",
       [](const py::object& manifest) {
-        std::vector<std::filesystem::path> manifest_paths;
-        if (!manifest.is_none()) {
-          manifest_paths = Manifest::Load(manifest.cast<std::filesystem::path>()).plugin_paths;
-        }
-        const PluginRegistry registry = PluginRegistry::Discover(PluginSearchPath(manifest_paths));
-        nlohmann::json json = registry.ToJson();
-        for (size_t i = 0; i < registry.records().size(); ++i) {
-          const PluginRecord& record = registry.records()[i];
-          if (!record.usable()) continue;
-          try {
-            json["plugins"][i]["options"] = registry.DefaultOptions(record);
-          } catch (const InputError& error) {
-            // A plugin that needs an option to start has no defaults to show.
-            json["plugins"][i]["options"] = nullptr;
-            json["plugins"][i]["options_error"] = error.what();
+        const std::optional<std::filesystem::path> manifest_file =
+            manifest.is_none() ? std::nullopt
+                               : std::optional(manifest.cast<std::filesystem::path>());
+        // In a child process: a plugin whose factory crashes must not end the interpreter.
+        return ToPython(RunInChildProcess("plugins", py::none(), [&](const StageControl&) {
+          std::vector<std::filesystem::path> manifest_paths;
+          if (manifest_file) manifest_paths = Manifest::Load(*manifest_file).plugin_paths;
+          const PluginRegistry registry =
+              PluginRegistry::Discover(PluginSearchPath(manifest_paths));
+          nlohmann::json json = registry.ToJson();
+          for (size_t i = 0; i < registry.records().size(); ++i) {
+            const PluginRecord& record = registry.records()[i];
+            if (!record.usable()) continue;
+            try {
+              json["plugins"][i]["options"] = registry.DefaultOptions(record);
+            } catch (const InputError& error) {
+              // A plugin that needs an option to start has no defaults to show.
+              json["plugins"][i]["options"] = nullptr;
+              json["plugins"][i]["options_error"] = error.what();
+            }
           }
-        }
-        return ToPython(json);
+          return json;
+        }));
       },
       py::arg("manifest") = py::none(),
       "The plugins found on the search path (manifest: also its plugin_paths), as `tessera "

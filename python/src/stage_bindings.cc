@@ -1,7 +1,8 @@
 // tessera.run, extract, match, map and export: the CLI's verbs with its arguments as
 // keywords (--camera-K as camera_K), built by the same functions the CLI calls
 // (pipeline/stage_arguments.h, pipeline/run_pipeline.h, pipeline/export_model.h). Each
-// returns its part of the run summary (run: all of run_summary.json) as a dict.
+// returns its part of the run summary (run: all of run_summary.json) as a dict; each runs
+// in a child process (stage_process.h), which a crashing plugin ends, not the interpreter.
 
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -18,7 +19,7 @@
 #include "pipeline/export_model.h"
 #include "pipeline/run_pipeline.h"
 #include "pipeline/stage_arguments.h"
-#include "python_stage_control.h"
+#include "stage_process.h"
 #include "tessera/errors.h"
 
 namespace py = pybind11;
@@ -73,7 +74,8 @@ const char* const kCommonDoc =
     " manifest: a file or a dict (default: default.json); camera_K: a K.txt file; threads: "
     "0 for the manifest's; progress(stage, done, total): called with the GIL held, an "
     "exception from it (KeyboardInterrupt) cancels the stage, keeping what was finished "
-    "for the same call to resume, and propagates. The GIL is released while it runs.";
+    "for the same call to resume, and propagates. The GIL is released while it runs, in a "
+    "child process: a plugin that crashes raises PluginCrashError naming it.";
 py::arg_v ImagesArg() { return py::arg("images") = py::none(); }
 py::arg_v ManifestArg() { return py::arg("manifest") = py::none(); }
 py::arg_v CameraKArg() { return py::arg("camera_K") = py::none(); }
@@ -88,16 +90,15 @@ void BindImageStages(py::module_& module) {
       "run",
       [](const OptionalPath& images, const std::filesystem::path& output,
          const py::object& manifest, const OptionalPath& camera_K, const OptionalPath& masks,
-         const std::vector<std::filesystem::path>& videos, int threads, py::object progress) {
+         const std::vector<std::filesystem::path>& videos, int threads,
+         const py::object& progress) {
         const RunOptions options = MakeRunOptions(images, output, videos, true);
-        const PipelineContext context =
-            LoadPipelineContext(MakeArguments(manifest, camera_K, masks, videos, threads));
-        RunResult run;
-        PythonStageControl(std::move(progress)).Run([&](const StageControl& control) {
-          run = RunPipeline(context, options, control);
-        });
-        CheckModels(run.summary.map, output);
-        return ToPython(run.summary.ToJson());
+        const StageArguments arguments = MakeArguments(manifest, camera_K, masks, videos, threads);
+        return ToPython(RunInChildProcess("run", progress, [&](const StageControl& control) {
+          const RunResult run = RunPipeline(LoadPipelineContext(arguments), options, control);
+          if (!control.Cancelled()) CheckModels(run.summary.map, output);
+          return run.summary.ToJson();
+        }));
       },
       ImagesArg(), py::arg("output"), ManifestArg(), CameraKArg(), MasksArg(), VideosArg(),
       ThreadsArg(), ProgressArg(),
@@ -110,15 +111,15 @@ void BindImageStages(py::module_& module) {
       "extract",
       [](const OptionalPath& images, const std::filesystem::path& output,
          const py::object& manifest, const OptionalPath& camera_K, const OptionalPath& masks,
-         const std::vector<std::filesystem::path>& videos, int threads, py::object progress) {
+         const std::vector<std::filesystem::path>& videos, int threads,
+         const py::object& progress) {
         const RunOptions options = MakeRunOptions(images, output, videos, true);
-        const PipelineContext context =
-            LoadPipelineContext(MakeArguments(manifest, camera_K, masks, videos, threads));
-        RunSummary summary;
-        PythonStageControl(std::move(progress)).Run([&](const StageControl& control) {
-          summary.extract = RunExtract(context, options, control);
-        });
-        return ToPython(StageJson("extract", summary));
+        const StageArguments arguments = MakeArguments(manifest, camera_K, masks, videos, threads);
+        return ToPython(RunInChildProcess("extract", progress, [&](const StageControl& control) {
+          RunSummary summary;
+          summary.extract = RunExtract(LoadPipelineContext(arguments), options, control);
+          return StageJson("extract", summary);
+        }));
       },
       ImagesArg(), py::arg("output"), ManifestArg(), CameraKArg(), MasksArg(), VideosArg(),
       ThreadsArg(), ProgressArg(),
@@ -133,14 +134,13 @@ void BindWorkspaceStages(py::module_& module) {
   module.def(
       "match",
       [](const std::filesystem::path& output, const py::object& manifest,
-         const OptionalPath& camera_K, int threads, py::object progress) {
-        const PipelineContext context =
-            LoadPipelineContext(MakeArguments(manifest, camera_K, {}, {}, threads));
-        RunSummary summary;
-        PythonStageControl(std::move(progress)).Run([&](const StageControl& control) {
-          summary.match = RunMatch(context, RunOptions({}, output), control);
-        });
-        return ToPython(StageJson("match", summary));
+         const OptionalPath& camera_K, int threads, const py::object& progress) {
+        const StageArguments arguments = MakeArguments(manifest, camera_K, {}, {}, threads);
+        return ToPython(RunInChildProcess("match", progress, [&](const StageControl& control) {
+          RunSummary summary;
+          summary.match = RunMatch(LoadPipelineContext(arguments), RunOptions({}, output), control);
+          return StageJson("match", summary);
+        }));
       },
       py::arg("output"), ManifestArg(), CameraKArg(), ThreadsArg(), ProgressArg(),
       (std::string("Matches and verifies the workspace's pairs (`tessera match`); returns "
@@ -152,16 +152,15 @@ void BindWorkspaceStages(py::module_& module) {
       "map",
       [](const std::filesystem::path& output, const OptionalPath& images,
          const py::object& manifest, const OptionalPath& camera_K, int threads,
-         py::object progress) {
-        const PipelineContext context =
-            LoadPipelineContext(MakeArguments(manifest, camera_K, {}, {}, threads));
-        RunSummary summary;
-        PythonStageControl(std::move(progress)).Run([&](const StageControl& control) {
-          summary.map = RunMap(
-              context, RunOptions(images.value_or(std::filesystem::path()), output), control);
-        });
-        CheckModels(summary.map, output);
-        return ToPython(StageJson("map", summary));
+         const py::object& progress) {
+        const StageArguments arguments = MakeArguments(manifest, camera_K, {}, {}, threads);
+        const RunOptions options(images.value_or(std::filesystem::path()), output);
+        return ToPython(RunInChildProcess("map", progress, [&](const StageControl& control) {
+          RunSummary summary;
+          summary.map = RunMap(LoadPipelineContext(arguments), options, control);
+          if (!control.Cancelled()) CheckModels(summary.map, output);
+          return StageJson("map", summary);
+        }));
       },
       py::arg("output"), ImagesArg(), ManifestArg(), CameraKArg(), ThreadsArg(), ProgressArg(),
       (std::string("Maps a workspace into models (`tessera map`); returns the summary's "
@@ -188,20 +187,19 @@ void BindStages(py::module_& module) {
         if (!options.is_none()) arguments.options = ToJson(options);
         arguments.model_index = model_index;
         arguments.masks = masks.value_or(std::filesystem::path());
-        ExportSummary summary;
-        {
-          const py::gil_scoped_release release;
-          summary = ExportModel(arguments);
-        }
-        return ToPython({{"exporter", summary.exporter},
-                         {"num_images", summary.num_images},
-                         {"num_points3D", summary.num_points3D},
-                         {"num_observations", summary.num_observations},
-                         {"seconds", summary.seconds}});
+        return ToPython(RunInChildProcess("export", py::none(), [&](const StageControl&) {
+          const ExportSummary summary = ExportModel(arguments);
+          return nlohmann::json{{"exporter", summary.exporter},
+                                {"num_images", summary.num_images},
+                                {"num_points3D", summary.num_points3D},
+                                {"num_observations", summary.num_observations},
+                                {"seconds", summary.seconds}};
+        }));
       },
       py::arg("model"), py::arg("format"), py::arg("output"), py::arg("images") = py::none(),
       py::arg("options") = py::none(), py::arg("model_index") = 0, py::arg("masks") = py::none(),
-      "Writes a COLMAP model with an exporter plugin (`tessera export`); options: a dict.");
+      "Writes a COLMAP model with an exporter plugin (`tessera export`), in a child process; "
+      "options: a dict.");
 }
 
 }  // namespace tessera::python

@@ -32,6 +32,7 @@ __attribute__((tls_model("initial-exec"))) thread_local CallRecord t_record;
 std::atomic<CallRecord*> g_last_started{nullptr};
 
 char g_crash_file[4096] = {};
+volatile sig_atomic_t g_crash_report_fd = -1;
 volatile sig_atomic_t g_crash_exit_code = 4;
 
 // An alternate signal stack per thread that makes plugin calls, so that a stack
@@ -108,9 +109,21 @@ CallRecord* ActiveRecord() {
   return last != nullptr && last->active ? last : nullptr;
 }
 
+// Writes "CAUSE\tplugin\tstage\tsubject\n" to `fd`. Async-signal-safe.
+void WriteCrashRecord(int fd, const CallRecord* record, const char* cause) {
+  WriteAll(fd, cause);
+  WriteAll(fd, "\t");
+  WriteAll(fd, record->plugin);
+  WriteAll(fd, "\t");
+  WriteAll(fd, record->stage);
+  WriteAll(fd, "\t");
+  WriteAll(fd, record->subject);
+  WriteAll(fd, "\n");
+}
+
 // Writes "[error] plugin 'X' crashed (SIGSEGV) while detecting image Y" (or "ended the
 // process (exit)") to stderr, appends "CAUSE\tplugin\tstage\tsubject" to the crash file
-// and ends the process with the crash exit code. Async-signal-safe.
+// (and the report fd) and ends the process with the crash exit code. Async-signal-safe.
 [[noreturn]] void ReportPluginCrash(const CallRecord* record, const char* what, const char* cause) {
   static std::atomic<int> entered{0};
   if (entered.fetch_add(1) != 0) {
@@ -132,17 +145,11 @@ CallRecord* ActiveRecord() {
   if (g_crash_file[0] != '\0') {
     const int fd = open(g_crash_file, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
     if (fd >= 0) {
-      WriteAll(fd, cause);
-      WriteAll(fd, "\t");
-      WriteAll(fd, record->plugin);
-      WriteAll(fd, "\t");
-      WriteAll(fd, record->stage);
-      WriteAll(fd, "\t");
-      WriteAll(fd, record->subject);
-      WriteAll(fd, "\n");
+      WriteCrashRecord(fd, record, cause);
       close(fd);
     }
   }
+  if (g_crash_report_fd >= 0) WriteCrashRecord(g_crash_report_fd, record, cause);
   _exit(g_crash_exit_code);
 }
 
@@ -346,6 +353,8 @@ void UninstallPluginCrashHandler() {
   g_exit_guard_armed = false;
   for (const int signal_number : kFatalSignals) signal(signal_number, SIG_DFL);
 }
+
+void SetPluginCrashReportFd(int fd) { g_crash_report_fd = fd; }
 
 void SetPluginCrashFile(const std::string& file) {
   g_crash_file[0] = '\0';

@@ -154,4 +154,9 @@ void UninstallPluginCrashHandler();
 // Empty: nowhere.
 void SetPluginCrashFile(const std::string& file);
 
+// A file descriptor the crash handler also writes that record line to, -1 for none: a
+// pipe to the parent of a process that runs stages for it (the Python module's child
+// process), so that the parent names the plugin whatever the stage's crash file was.
+void SetPluginCrashReportFd(int fd);
+
 }  // namespace tessera

@@ -16,9 +16,14 @@ constexpr PluginStage kStages[] = {
 
 bool IsSignal(const std::string& cause) { return cause.rfind("SIG", 0) == 0; }
 
-// Lines "CAUSE\tplugin\tstage\tsubject", CAUSE a signal ("SIGSEGV") or how the plugin
-// ended the process ("exit", "quick_exit"); a line cut short by a crash is skipped.
-std::vector<PluginCrash> ParseCrashes(const std::string& text) {
+std::string FormatCrash(const PluginCrash& crash) {
+  return crash.signal + "\t" + crash.plugin + "\t" + crash.stage + "\t" + crash.subject + "\n";
+}
+
+}  // namespace
+
+// CAUSE: a signal ("SIGSEGV") or how the plugin ended the process ("exit", "quick_exit").
+std::vector<PluginCrash> ParsePluginCrashes(const std::string& text) {
   std::vector<PluginCrash> crashes;
   std::istringstream stream(text);
   std::string line;
@@ -30,12 +35,6 @@ std::vector<PluginCrash> ParseCrashes(const std::string& text) {
   }
   return crashes;
 }
-
-std::string FormatCrash(const PluginCrash& crash) {
-  return crash.signal + "\t" + crash.plugin + "\t" + crash.stage + "\t" + crash.subject + "\n";
-}
-
-}  // namespace
 
 std::string PluginCrash::Describe() const {
   std::string activity = "being called (" + stage + ")";
@@ -62,7 +61,7 @@ PluginCrashLog PluginCrashLog::ReadHistory(const std::filesystem::path& folder,
   const std::filesystem::path history = HistoryFile(folder, stem);
   std::error_code error;
   if (std::filesystem::exists(history, error)) {
-    log.history_ = ParseCrashes(ReadFileContents(history));
+    log.history_ = ParsePluginCrashes(ReadFileContents(history));
   }
   return log;
 }
@@ -78,9 +77,9 @@ PluginCrashLog PluginCrashLog::Open(const std::filesystem::path& folder, const s
   std::error_code error;
   std::string history_text;
   if (std::filesystem::exists(history, error)) history_text = ReadFileContents(history);
-  log.history_ = ParseCrashes(history_text);
+  log.history_ = ParsePluginCrashes(history_text);
   if (std::filesystem::exists(pending, error)) {
-    log.new_crashes_ = ParseCrashes(ReadFileContents(pending));
+    log.new_crashes_ = ParsePluginCrashes(ReadFileContents(pending));
     for (const PluginCrash& crash : log.new_crashes_) {
       history_text += FormatCrash(crash);
       log.history_.push_back(crash);

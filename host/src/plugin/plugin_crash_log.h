@@ -25,6 +25,10 @@ struct PluginCrash {
   std::string Describe() const;
 };
 
+// The crashes in crash records' lines, "CAUSE\tplugin\tstage\tsubject" (the crash file's,
+// or SetPluginCrashReportFd's); a line cut short by a crash is skipped.
+std::vector<PluginCrash> ParsePluginCrashes(const std::string& text);
+
 class PluginCrashLog {
  public:
   // A subject that crashed a plugin this often in one stage is skipped from then on.
