@@ -2,8 +2,14 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <atomic>
+#include <exception>
 #include <map>
+#include <mutex>
 #include <opencv2/core.hpp>
+#include <string>
+#include <thread>
+#include <utility>
 
 #include "tessera/errors.h"
 #include "tessera/io/image_io.h"
@@ -31,44 +37,94 @@ Eigen::Vector3d InterpolateRgb(const cv::Mat& image, const Eigen::Vector2d& xy) 
   return rgb;
 }
 
+// The colour samples of one image's observations, or why it has none.
+struct ImageSamples {
+  std::vector<std::pair<point3D_t, Eigen::Vector3d>> samples;
+  std::string warning;
+};
+
+ImageSamples SampleImage(const std::filesystem::path& image_dir, const Image& image,
+                         const Reconstruction& reconstruction) {
+  ImageSamples result;
+  const std::filesystem::path path = image_dir / image.name;
+  cv::Mat bgr;
+  try {
+    bgr = ReadColorImage(path);
+  } catch (const InputError& error) {
+    result.warning = error.what();
+    return result;
+  }
+  const auto camera_it = reconstruction.cameras.find(image.camera_id);
+  if (camera_it != reconstruction.cameras.end() &&
+      (static_cast<size_t>(bgr.cols) != camera_it->second.width ||
+       static_cast<size_t>(bgr.rows) != camera_it->second.height)) {
+    result.warning = path.string() + ": the image is " + std::to_string(bgr.cols) + "x" +
+                     std::to_string(bgr.rows) + " but its camera " +
+                     std::to_string(image.camera_id) + " is " +
+                     std::to_string(camera_it->second.width) + "x" +
+                     std::to_string(camera_it->second.height) + "; colours cannot be sampled";
+    return result;
+  }
+  for (const Point2D& point2D : image.points2D) {
+    if (!point2D.HasPoint3D() || reconstruction.points3D.count(point2D.point3D_id) == 0) {
+      continue;
+    }
+    result.samples.emplace_back(point2D.point3D_id, InterpolateRgb(bgr, point2D.xy));
+  }
+  return result;
+}
+
+// SampleImage for each image, on up to `num_threads` threads (0: one per core; decoding
+// is most of the time); results in the order of `images`.
+std::vector<ImageSamples> SampleImages(const std::filesystem::path& image_dir,
+                                       const std::vector<const Image*>& images,
+                                       const Reconstruction& reconstruction, int num_threads) {
+  std::vector<ImageSamples> results(images.size());
+  std::atomic<size_t> next{0};
+  std::exception_ptr failure;
+  std::mutex failure_mutex;
+  const auto work = [&] {
+    for (size_t k = next++; k < images.size(); k = next++) {
+      try {
+        results[k] = SampleImage(image_dir, *images[k], reconstruction);
+      } catch (...) {
+        const std::lock_guard<std::mutex> lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+      }
+    }
+  };
+  const size_t max_threads = num_threads > 0 ? static_cast<size_t>(num_threads)
+                                             : std::max(1u, std::thread::hardware_concurrency());
+  std::vector<std::thread> threads;
+  for (size_t t = 1; t < std::min(images.size(), max_threads); ++t) threads.emplace_back(work);
+  work();
+  for (std::thread& thread : threads) thread.join();
+  if (failure) std::rethrow_exception(failure);
+  return results;
+}
+
 }  // namespace
 
 std::vector<std::string> ColorPointsFromImages(const std::filesystem::path& image_dir,
-                                               Reconstruction* reconstruction) {
+                                               Reconstruction* reconstruction, int num_threads) {
+  std::vector<const Image*> images;
+  for (const auto& [image_id, image] : reconstruction->images) {
+    if (image.registered &&
+        std::any_of(image.points2D.begin(), image.points2D.end(),
+                    [](const Point2D& point2D) { return point2D.HasPoint3D(); })) {
+      images.push_back(&image);
+    }
+  }
+  // Summed in image order, as one thread would: the colours do not depend on the threads.
   std::vector<std::string> warnings;
   std::map<point3D_t, std::pair<Eigen::Vector3d, int>> sums;
-  for (const auto& [image_id, image] : reconstruction->images) {
-    if (!image.registered ||
-        std::none_of(image.points2D.begin(), image.points2D.end(),
-                     [](const Point2D& point2D) { return point2D.HasPoint3D(); })) {
-      continue;
-    }
-    const std::filesystem::path path = image_dir / image.name;
-    cv::Mat bgr;
-    try {
-      bgr = ReadColorImage(path);
-    } catch (const InputError& error) {
-      warnings.push_back(error.what());
-      continue;
-    }
-    const auto camera_it = reconstruction->cameras.find(image.camera_id);
-    if (camera_it != reconstruction->cameras.end() &&
-        (static_cast<size_t>(bgr.cols) != camera_it->second.width ||
-         static_cast<size_t>(bgr.rows) != camera_it->second.height)) {
-      warnings.push_back(path.string() + ": the image is " + std::to_string(bgr.cols) + "x" +
-                         std::to_string(bgr.rows) + " but its camera " +
-                         std::to_string(image.camera_id) + " is " +
-                         std::to_string(camera_it->second.width) + "x" +
-                         std::to_string(camera_it->second.height) + "; colours cannot be sampled");
-      continue;
-    }
-    for (const Point2D& point2D : image.points2D) {
-      if (!point2D.HasPoint3D() || reconstruction->points3D.count(point2D.point3D_id) == 0) {
-        continue;
-      }
+  for (const ImageSamples& image_samples :
+       SampleImages(image_dir, images, *reconstruction, num_threads)) {
+    if (!image_samples.warning.empty()) warnings.push_back(image_samples.warning);
+    for (const auto& [point3D_id, rgb] : image_samples.samples) {
       // Eigen leaves a default-constructed vector uninitialised: start from zero.
-      auto [it, inserted] = sums.try_emplace(point2D.point3D_id, Eigen::Vector3d::Zero(), 0);
-      it->second.first += InterpolateRgb(bgr, point2D.xy);
+      auto [it, inserted] = sums.try_emplace(point3D_id, Eigen::Vector3d::Zero(), 0);
+      it->second.first += rgb;
       ++it->second.second;
     }
   }

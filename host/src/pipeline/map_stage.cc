@@ -255,7 +255,8 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
     spdlog::warn("map: the image folder is unknown (pass --images); points are not coloured");
   } else {
     for (Reconstruction& model : result.models) {
-      for (const std::string& warning : ColorPointsFromImages(image_dir, &model)) {
+      for (const std::string& warning :
+           ColorPointsFromImages(image_dir, &model, settings.num_threads)) {
         spdlog::warn("map: {}", warning);
       }
     }

@@ -14,7 +14,9 @@ namespace tessera {
 // images are read from `image_dir` by their names; one that cannot be read, or whose
 // size is not its camera's, is left out and named in the returned warnings (one line
 // each, starting with the file). Points seen by no usable image keep their colour.
+// Images are decoded on `num_threads` threads at once (0: one per core); the colours do
+// not depend on it.
 TESSERA_IO_EXPORT std::vector<std::string> ColorPointsFromImages(
-    const std::filesystem::path& image_dir, Reconstruction* reconstruction);
+    const std::filesystem::path& image_dir, Reconstruction* reconstruction, int num_threads = 0);
 
 }  // namespace tessera
