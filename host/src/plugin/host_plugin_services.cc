@@ -1,6 +1,11 @@
 #include "plugin/host_plugin_services.h"
 
-#include "plugin/guarded_plugins.h"
+#include "plugin/guarded_bundle_adjuster.h"
+#include "plugin/guarded_detector.h"
+#include "plugin/guarded_exporter.h"
+#include "plugin/guarded_mapper.h"
+#include "plugin/guarded_matcher.h"
+#include "plugin/guarded_pair_selector.h"
 #include "tessera/sdk.h"
 
 namespace tessera {

@@ -8,7 +8,7 @@
 namespace tessera {
 
 // The host's side of Plugin::host(): makes plugins from a copy of the registry and
-// hands them out inside a guard of their kind (guarded_plugins.h), so that every call
+// hands them out inside a guard of their kind (guarded_detector.h, ...), so that every call
 // into them goes through CallPlugin, named after them.
 class HostPluginServices : public PluginServices,
                            public std::enable_shared_from_this<HostPluginServices> {
