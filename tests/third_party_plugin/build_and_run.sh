@@ -175,6 +175,14 @@ rc=0
 "$tessera" map --output "$work/ba_crash" --manifest "$work/crash.json" 2> "$work/ba_crash.log" || rc=$?
 [ "$rc" = 4 ] && grep -q "\[error\] plugin 'failing_bundle_adjuster' crashed (SIGSEGV) while adjusting a bundle of" \
   "$work/ba_crash.log" || { cat "$work/ba_crash.log"; echo "the wrapped crash: exit $rc, not named"; exit 1; }
+# Its second crash on that bundle, then the bundle refused to it by name (exit code 2).
+rc=0
+"$tessera" map --output "$work/ba_crash" --manifest "$work/crash.json" 2> "$work/ba_crash.log" || rc=$?
+[ "$rc" = 4 ] || { cat "$work/ba_crash.log"; echo "the second wrapped crash: exit $rc"; exit 1; }
+rc=0
+"$tessera" map --output "$work/ba_crash" --manifest "$work/crash.json" 2> "$work/ba_crash.log" || rc=$?
+[ "$rc" = 2 ] && grep -q "\[error\] bundle adjuster 'failing_bundle_adjuster' crashed twice on a bundle of .* is not given it again" \
+  "$work/ba_crash.log" || { cat "$work/ba_crash.log"; echo "the quarantined wrapped adjuster: exit $rc"; exit 1; }
 for case in '{"adjuster": "cerez"}|no bundle_adjuster plugin '"'cerez'"'; did you mean '"'ceres'"'?' \
             '{"adjuster": "akaze"}|is a detector, not a bundle_adjuster' \
             '{"adjuster": "ceres", "options": {"loss": "l2"}}|bundle_adjuster.options.loss: '; do
@@ -185,7 +193,7 @@ for case in '{"adjuster": "cerez"}|no bundle_adjuster plugin '"'cerez'"'; did yo
   [ "$rc" = 2 ] && [[ "$line" == *"plugin 'pass_through'"* ]] ||
     { cat "$work/bad.log"; echo "expected exit code 2 and one line with '${case#*|}' naming pass_through, got $rc"; exit 1; }
 done
-echo "pass_through: the wrapped adjuster's crash named, a bad name, kind or option refused in one line"
+echo "pass_through: the wrapped adjuster's crash named, refused after two, a bad name, kind or option refused in one line"
 
 # One bench: a row of bundled plugins next to a row of the five out-of-tree ones.
 cat > "$work/bundled.json" <<JSON

@@ -12,7 +12,8 @@
 namespace tessera {
 
 // Its calls are named by their bundle ("a bundle of 6 images (2 fixed) and 812
-// points"), as the mapper's adjuster's are.
+// points"), as the mapper's adjuster's are, and a bundle that crashed it twice in the
+// workspace (CurrentPluginCrashLog) is refused, as the mapper's adjuster refuses it.
 class GuardedBundleAdjuster : public BundleAdjuster {
  public:
   explicit GuardedBundleAdjuster(PluginInstance<BundleAdjuster> plugin);
