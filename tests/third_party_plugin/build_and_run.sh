@@ -75,12 +75,12 @@ found = {(p["kind"], p["name"]): p for p in plugins if p["usable"]}
 assert ("detector", "sift") in found, "bundled sift not found by the installed binary"
 for kind, name in [("detector", "akaze"), ("matcher", "symmetric_ratio"),
                    ("pair_selector", "window_stride"), ("mapper", "strict"),
-                   ("bundle_adjuster", "cauchy"),
-                   ("exporter", "bundler")]:
+                   ("bundle_adjuster", "cauchy"), ("bundle_adjuster", "robust"),
+                   ("bundle_adjuster", "pass_through"), ("exporter", "bundler")]:
     assert (kind, name) in found, "%s %s not listed as usable" % (kind, name)
     folder = os.path.dirname(os.path.realpath(found[(kind, name)]["file"]))
     assert folder == os.path.realpath(sys.argv[2]), (kind, name, folder)
-print("plugins --json lists the six out-of-tree plugins")
+print("plugins --json lists the eight out-of-tree plugins")
 PY
 
 mkdir -p "$work/images"
@@ -122,6 +122,78 @@ for case in "mapper_bad:pipeline.mapper.options.incremental.max_reg_trials" \
     echo "expected exit code 2 and '${case#*:}', got $rc:"; cat "$work/bad.log"; exit 1; }
 done
 grep -qF "is a detector, not a mapper" "$work/bad.log" || { cat "$work/bad.log"; exit 1; }
+
+# Two bundle adjusters in the default pipeline, on 4 images of the sample: `robust`, on
+# the installed building blocks (Tessera::ceres) with the Huber loss chosen through their
+# loss hook, and `pass_through`, which wraps the bundled `ceres` made through the host's
+# services (Plugin::host()) and so must give the model `ceres` gives, byte for byte.
+mkdir -p "$work/four"
+cp "$examples/0004.jpg" "$examples/0005.jpg" "$examples/0006.jpg" "$examples/0007.jpg" "$work/four/"
+adjuster() {  # adjuster NAME BUNDLE_ADJUSTER_JSON [PLUGIN_FOLDER]: $work/NAME.json, the
+  # installed default manifest with this bundle adjuster
+  python3 - "$work/prefix/share/tessera/manifests/default.json" "$work/$1.json" "$2" "${3:-}" <<'PY'
+import json, sys
+manifest = json.load(open(sys.argv[1]))
+manifest["plugin_paths"] = ["build/plugins"] + ([sys.argv[4]] if sys.argv[4] else [])
+manifest["pipeline"]["bundle_adjuster"] = json.loads(sys.argv[3])
+json.dump(manifest, open(sys.argv[2], "w"))
+PY
+}
+adjuster ceres '{"plugin": "ceres"}'
+adjuster robust '{"plugin": "robust", "options": {"loss": "huber", "loss_scale": 2.0}}'
+adjuster pass_through '{"plugin": "pass_through", "options": {"adjuster": "ceres"}}'
+"$tessera" run --images "$work/four" --output "$work/ba_ceres" --manifest "$work/ceres.json" \
+  2> "$work/ba_ceres.log" || { cat "$work/ba_ceres.log"; exit 1; }
+for name in robust pass_through; do
+  cp -r "$work/ba_ceres" "$work/ba_$name"
+  "$tessera" map -v --output "$work/ba_$name" --manifest "$work/$name.json" \
+    2> "$work/ba_$name.log" || { cat "$work/ba_$name.log"; exit 1; }
+  python3 - "$work/ba_$name/mapping_summary.json" "$name" <<'PY' || { cat "$work/ba_$name.log"; exit 1; }
+import json, sys
+summary = json.load(open(sys.argv[1]))
+registered = summary["models"][0]["num_images"]
+assert registered == 4, "%s registered %d of 4 images" % (sys.argv[2], registered)
+PY
+done
+grep -Eq "\[debug\] robust \(a bundle of [0-9]+ images.*\): huber loss: usable" "$work/ba_robust.log" ||
+  { cat "$work/ba_robust.log"; echo "robust did not adjust with the Huber loss"; exit 1; }
+grep -Eq "\[debug\] pass_through \(a bundle of [0-9]+ images.*\): passed on: usable" \
+  "$work/ba_pass_through.log" || { cat "$work/ba_pass_through.log"; echo "pass_through did not log"; exit 1; }
+for file in cameras.bin images.bin points3D.bin; do
+  cmp "$work/ba_ceres/sparse/0/$file" "$work/ba_pass_through/sparse/0/$file" ||
+    { echo "pass_through around ceres gave another $file than ceres"; exit 1; }
+done
+echo "robust (Tessera::ceres, Huber) registers 4 of 4; pass_through around ceres gives ceres' model"
+
+# Through the host's services a crash in the wrapped adjuster is named as the host names
+# a crash of its own plugins (exit code 4), and a wrong name, kind or option is one line
+# naming both plugins (exit code 2), before any image is read.
+adjuster crash '{"plugin": "pass_through", "options": {"adjuster": "failing_bundle_adjuster", "options": {"fail": "segv"}}}' \
+  "$(cd "$build_dir" && pwd)/test_plugins/failing"
+cp -r "$work/ba_ceres" "$work/ba_crash"
+rc=0
+"$tessera" map --output "$work/ba_crash" --manifest "$work/crash.json" 2> "$work/ba_crash.log" || rc=$?
+[ "$rc" = 4 ] && grep -q "\[error\] plugin 'failing_bundle_adjuster' crashed (SIGSEGV) while adjusting a bundle of" \
+  "$work/ba_crash.log" || { cat "$work/ba_crash.log"; echo "the wrapped crash: exit $rc, not named"; exit 1; }
+# Its second crash on that bundle, then the bundle refused to it by name (exit code 2).
+rc=0
+"$tessera" map --output "$work/ba_crash" --manifest "$work/crash.json" 2> "$work/ba_crash.log" || rc=$?
+[ "$rc" = 4 ] || { cat "$work/ba_crash.log"; echo "the second wrapped crash: exit $rc"; exit 1; }
+rc=0
+"$tessera" map --output "$work/ba_crash" --manifest "$work/crash.json" 2> "$work/ba_crash.log" || rc=$?
+[ "$rc" = 2 ] && grep -q "\[error\] bundle adjuster 'failing_bundle_adjuster' crashed twice on a bundle of .* is not given it again" \
+  "$work/ba_crash.log" || { cat "$work/ba_crash.log"; echo "the quarantined wrapped adjuster: exit $rc"; exit 1; }
+for case in '{"adjuster": "cerez"}|no bundle_adjuster plugin '"'cerez'"'; did you mean '"'ceres'"'?' \
+            '{"adjuster": "akaze"}|is a detector, not a bundle_adjuster' \
+            '{"adjuster": "ceres", "options": {"loss": "l2"}}|bundle_adjuster.options.loss: '; do
+  adjuster bad "{\"plugin\": \"pass_through\", \"options\": ${case%%|*}}"
+  rc=0
+  "$tessera" map --output "$work/ba_crash" --manifest "$work/bad.json" 2> "$work/bad.log" || rc=$?
+  line=$(grep -F "${case#*|}" "$work/bad.log" || true)
+  [ "$rc" = 2 ] && [[ "$line" == *"plugin 'pass_through'"* ]] ||
+    { cat "$work/bad.log"; echo "expected exit code 2 and one line with '${case#*|}' naming pass_through, got $rc"; exit 1; }
+done
+echo "pass_through: the wrapped adjuster's crash named, refused after two, a bad name, kind or option refused in one line"
 
 # One bench: a row of bundled plugins next to a row of the five out-of-tree ones.
 cat > "$work/bundled.json" <<JSON

@@ -92,6 +92,8 @@ inline std::string BundleAdjustmentSummary::BriefReport() const {
 // - A throw ends the map stage (InputError: exit code 2, else 1); a crash ends the run
 //   (exit code 4), and a bundle that crashed the adjuster twice is refused (exit code 2).
 // - Log with log() (tessera/log.h), never to stdout or stderr; never call exit().
+// Tessera::ceres (tessera/ceres/) is these rules as code: the reprojection costs, the
+// problem (BundleAdjustmentProblem, with a hook for the loss), the solve and write-back.
 class TESSERA_API BundleAdjuster : public Plugin {
  public:
   virtual BundleAdjustmentSummary Adjust(const BundleAdjustmentConfig& config,

@@ -3,7 +3,8 @@
 // The plugin ABI. Every plugin is a shared object exporting, through Boost.DLL
 // aliases, two symbols:
 //   tessera_plugin_info    -> const TesseraPluginInfo  (what the plugin is)
-//   tessera_plugin_create  -> tessera::PluginFactory   (makes it from JSON options)
+//   tessera_plugin_create  -> tessera::PluginFactory   (makes it from JSON options and
+//                                                       the host's services)
 // TESSERA_PLUGIN() below defines both. Host and plugins must be built with the same
 // compiler and standard library, since C++ objects cross the boundary.
 
@@ -17,6 +18,7 @@
 
 #include "tessera/export.h"
 #include "tessera/log.h"
+#include "tessera/plugin_services.h"
 
 // Bumped whenever TesseraPluginInfo, a plugin interface, a type that crosses the
 // boundary or the API of Tessera::io (tessera/io/) changes; the host refuses a plugin
@@ -89,6 +91,9 @@ constexpr uint32_t kPluginAbiVersion = TESSERA_PLUGIN_ABI_VERSION;
 // Base of every plugin object.
 class TESSERA_API Plugin {
  public:
+  // Takes the host's services from the factory (TESSERA_PLUGIN), so that a
+  // constructor can use host().
+  Plugin() : services_(detail::ServicesUnderConstruction()) {}
   virtual ~Plugin() = default;
 
   // The options in effect, defaults filled in. The host records them with the
@@ -102,15 +107,26 @@ class TESSERA_API Plugin {
   // For the host: connects log() to the host's log.
   void SetLogSink(LogSink sink) { log_.SetSink(std::move(sink)); }
 
+  // The host's services (tessera/plugin_services.h): another plugin by kind, name and
+  // options, guarded as the host guards its own. Usable from the constructor on;
+  // outside a host every request throws InputError.
+  const PluginServices& host() const {
+    static const detail::NoHostServices no_host;
+    return services_ ? *services_ : no_host;
+  }
+
  protected:
   nlohmann::json effective_options_ = nlohmann::json::object();
 
  private:
   Logger log_;
+  std::shared_ptr<const PluginServices> services_;
 };
 
-// Makes a plugin from its options. Throws tessera::OptionError for invalid options.
-using PluginFactory = std::unique_ptr<Plugin>(const nlohmann::json& options);
+// Makes a plugin from its options, with the host's services (null: none). Throws
+// tessera::OptionError for invalid options.
+using PluginFactory = std::unique_ptr<Plugin>(const nlohmann::json& options,
+                                              std::shared_ptr<const PluginServices> services);
 
 }  // namespace tessera
 
@@ -119,16 +135,17 @@ using PluginFactory = std::unique_ptr<Plugin>(const nlohmann::json& options);
 // interface and has a constructor taking `const nlohmann::json& options`.
 //
 //   TESSERA_PLUGIN(detector, SiftDetector, "sift", "1.0.0", "SIFT (OpenCV)")
-#define TESSERA_PLUGIN(KIND, CLASS, NAME, VERSION, DESCRIPTION)                             \
-  static_assert(std::is_base_of_v<::tessera::plugin_kinds::KIND, CLASS>,                    \
-                #CLASS " must derive from the " #KIND " interface");                        \
-  extern "C" {                                                                              \
-  const TesseraPluginInfo tessera_plugin_info_record = {                                    \
-      TESSERA_PLUGIN_ABI_VERSION, #KIND, NAME, VERSION, DESCRIPTION, TESSERA_BUILD_RECORD}; \
-  }                                                                                         \
-  static std::unique_ptr<::tessera::Plugin> tessera_plugin_create_impl(                     \
-      const nlohmann::json& options) {                                                      \
-    return std::make_unique<CLASS>(options);                                                \
-  }                                                                                         \
-  BOOST_DLL_ALIAS(tessera_plugin_info_record, tessera_plugin_info)                          \
+#define TESSERA_PLUGIN(KIND, CLASS, NAME, VERSION, DESCRIPTION)                                   \
+  static_assert(std::is_base_of_v<::tessera::plugin_kinds::KIND, CLASS>,                          \
+                #CLASS " must derive from the " #KIND " interface");                              \
+  extern "C" {                                                                                    \
+  const TesseraPluginInfo tessera_plugin_info_record = {                                          \
+      TESSERA_PLUGIN_ABI_VERSION, #KIND, NAME, VERSION, DESCRIPTION, TESSERA_BUILD_RECORD};       \
+  }                                                                                               \
+  static std::unique_ptr<::tessera::Plugin> tessera_plugin_create_impl(                           \
+      const nlohmann::json& options, std::shared_ptr<const ::tessera::PluginServices> services) { \
+    const ::tessera::detail::ServicesUnderConstructionScope scope(std::move(services));           \
+    return std::make_unique<CLASS>(options);                                                      \
+  }                                                                                               \
+  BOOST_DLL_ALIAS(tessera_plugin_info_record, tessera_plugin_info)                                \
   BOOST_DLL_ALIAS(tessera_plugin_create_impl, tessera_plugin_create)

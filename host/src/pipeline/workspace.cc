@@ -35,6 +35,7 @@ Workspace::~Workspace() {
   database_.reset();
   // Crashes after this point are no longer this workspace's.
   SetPluginCrashFile("");
+  if (CurrentPluginCrashLog() == &crash_log_) SetCurrentPluginCrashLog(nullptr);
 }
 
 std::unique_ptr<Workspace> Workspace::Open(const std::filesystem::path& folder,
@@ -50,6 +51,7 @@ std::unique_ptr<Workspace> Workspace::Open(const std::filesystem::path& folder,
         folder.string(), stale);
   }
   workspace->crash_log_ = PluginCrashLog::Open(folder);
+  SetCurrentPluginCrashLog(&workspace->crash_log_);
   ReportNewCrashes(workspace->crash_log_);
   const std::filesystem::path database_file = workspace->DatabaseFile();
   std::error_code error;
@@ -70,6 +72,7 @@ std::unique_ptr<Workspace> Workspace::OpenShard(
   workspace->crash_log_ = PluginCrashLog::Open(shards, shard_name + ".plugin_crashes");
   ReportNewCrashes(workspace->crash_log_);
   workspace->crash_log_.IncludeHistory(PluginCrashLog::ReadHistory(folder));
+  SetCurrentPluginCrashLog(&workspace->crash_log_);
   workspace->database_ = open_database();
   return workspace;
 }

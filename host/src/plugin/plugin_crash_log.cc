@@ -1,5 +1,6 @@
 #include "plugin/plugin_crash_log.h"
 
+#include <atomic>
 #include <fstream>
 #include <sstream>
 
@@ -141,5 +142,13 @@ size_t PluginCrashLog::NumCrashes(const std::string& plugin, PluginStage stage,
   }
   return count;
 }
+
+namespace {
+std::atomic<const PluginCrashLog*> g_current_crash_log{nullptr};
+}  // namespace
+
+void SetCurrentPluginCrashLog(const PluginCrashLog* log) { g_current_crash_log = log; }
+
+const PluginCrashLog* CurrentPluginCrashLog() { return g_current_crash_log; }
 
 }  // namespace tessera

@@ -75,4 +75,10 @@ class PluginCrashLog {
   std::vector<PluginCrash> new_crashes_;
 };
 
+// The crash log of the workspace this process works in, set by the workspace while it
+// is open; nullptr outside one. For the guards that no stage hands a log: those of the
+// plugins made for other plugins (Plugin::host()).
+void SetCurrentPluginCrashLog(const PluginCrashLog* log);
+const PluginCrashLog* CurrentPluginCrashLog();
+
 }  // namespace tessera

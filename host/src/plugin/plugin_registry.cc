@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <set>
 
+#include "plugin/host_plugin_services.h"
 #include "plugin/plugin_probe.h"
 
 namespace tessera {
@@ -180,6 +181,8 @@ PluginRegistry PluginRegistry::Discover(const std::vector<std::filesystem::path>
       registry.records_.push_back(std::move(record));
     }
   }
+  registry.own_services_ = HostPluginServices::Make(registry);
+  registry.services_ = registry.own_services_;
   return registry;
 }
 
@@ -255,7 +258,7 @@ std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
   std::unique_ptr<Plugin> plugin;
   try {
     const PluginCallScope scope(record.name, PluginStage::kCreate, "from " + record.file.string());
-    plugin = factory(options);
+    plugin = factory(options, services_.lock());
   } catch (const OptionError& error) {
     // Plugins report paths relative to their options; anchor them in the manifest.
     const std::string path = (options_path.empty() ? json_path + ".options" : options_path) +

@@ -102,6 +102,8 @@ const TesseraBuildRecord& HostBuildRecord();
 // recorded in `refusal` as one sentence naming the file.
 PluginRecord InspectPluginFile(const std::filesystem::path& file);
 
+class HostPluginServices;
+
 // Every plugin found on a search path.
 class PluginRegistry {
  public:
@@ -147,6 +149,8 @@ class PluginRegistry {
   }
 
  private:
+  friend class HostPluginServices;
+
   const PluginRecord& Resolve(const std::string& kind, const std::string& name,
                               const std::string& json_path) const;
   std::unique_ptr<Plugin> CreateObject(const PluginRecord& record, const nlohmann::json& options,
@@ -155,6 +159,11 @@ class PluginRegistry {
 
   std::vector<std::filesystem::path> search_paths_;
   std::vector<PluginRecord> records_;
+  // The services every plugin made here gets (Plugin::host()): a copy of this registry
+  // that makes guarded plugins. Owned here (and by each plugin made with them); the
+  // copy inside them refers to them weakly, so that nothing owns itself.
+  std::shared_ptr<const PluginServices> own_services_;
+  std::weak_ptr<const PluginServices> services_;
 };
 
 }  // namespace tessera
