@@ -7,7 +7,9 @@
 #     the log names each camera's folder;
 #  2. the same workspace without the flag: the cameras are re-created (logged, naming
 #     camera.per_folder) as one camera, and the model is byte for byte that of a fresh
-#     workspace without the flag.
+#     workspace without the flag;
+#  3. the folders at two image sizes (512 and 480 px), as the issue's test names it: a
+#     camera per folder, at its folder's size.
 # usage: camera_per_folder_test.sh TESSERA DOWNSCALE SOURCE_DIR
 set -uo pipefail
 tessera=$1
@@ -90,3 +92,25 @@ tess "$work/2f.log" "$work/fresh"
 [ "$(cat "$work"/out/sparse/0/*.txt | md5sum)" = "$(cat "$work"/fresh/sparse/0/*.txt | md5sum)" ] ||
   fail "without the flag: the model differs from a fresh workspace's"
 echo "without the flag: the cameras re-created as one, the model of a fresh workspace"
+
+# 3. Folders of different image sizes.
+"$downscale" "$source_dir/examples/fountain-P11-small/images" "$work/all480" 480 90 > /dev/null ||
+  fail "downscale to 480 px"
+mkdir -p "$work/sizes/a" "$work/sizes/b"
+cp "$work"/images/a/*.jpg "$work/sizes/a/"
+for i in 1 3 5; do cp "$work/all480/000$i.jpg" "$work/sizes/b/"; done
+if ! "$tessera" run --images "$work/sizes" --output "$work/sizes_out" --manifest "$work/m.json" \
+  --threads 2 --camera-per-folder > "$work/3.log" 2>&1; then
+  tail -30 "$work/3.log"
+  fail "run of two sizes"
+fi
+[ "$(cameras_of "$work/sizes_out" | awk '{ print $1, $3, $4 }')" = "1 512 342
+2 480 320" ] || {
+  cameras_of "$work/sizes_out"
+  fail "two sizes: not camera 1 at 512x342 and camera 2 at 480x320"
+}
+[ "$(image_cameras_of "$work/sizes_out")" = "$expected" ] || {
+  image_cameras_of "$work/sizes_out"
+  fail "two sizes: an image is not on its folder's camera (or is not registered)"
+}
+echo "two folders of different sizes: a camera each, at its folder's size"
