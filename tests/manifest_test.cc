@@ -28,7 +28,11 @@ TEST(Manifest, ParsesSlotsCameraVerificationAndPaths) {
        {{"detector", {{"plugin", "sift"}, {"options", {{"max_num_features", 100}}}}},
         {"matcher", {{"plugin", "flann"}}},
         {"exporters", {{{"plugin", "ply"}}}}}},
-      {"camera", {{"model", "OPENCV"}, {"single_camera", false}, {"K", {1000, 1001, 320, 240}}}},
+      {"camera",
+       {{"model", "OPENCV"},
+        {"single_camera", false},
+        {"per_folder", true},
+        {"K", {1000, 1001, 320, 240}}}},
       {"verification", {{"max_error_px", 2.5}}}};
   const Manifest manifest = Manifest::FromJson(json, "/base", "m.json");
   EXPECT_EQ(manifest.plugin_paths, (std::vector<std::filesystem::path>{"/base/plugins", "/abs"}));
@@ -43,6 +47,8 @@ TEST(Manifest, ParsesSlotsCameraVerificationAndPaths) {
   EXPECT_EQ(manifest.exporters[0].json_path, "pipeline.exporters[0]");
   EXPECT_EQ(manifest.camera.model, "OPENCV");
   EXPECT_FALSE(manifest.camera.single_camera);
+  EXPECT_TRUE(manifest.camera.per_folder);
+  EXPECT_FALSE(Manifest::FromJson(nlohmann::json::object(), "/base", "m.json").camera.per_folder);
   ASSERT_TRUE(manifest.camera.known_intrinsics);
   EXPECT_EQ((*manifest.camera.known_intrinsics)(1), 1001);
   EXPECT_EQ(manifest.verification.max_error_px, 2.5);
@@ -88,6 +94,8 @@ TEST(Manifest, UnknownKeysNameTheirPathAndTheClosestKey) {
             "m.json: pipeline.matchr: unknown key; did you mean 'matcher'?");
   EXPECT_EQ(ErrorOf({{"pipeline", {{"matcher", {{"plugn", "flann"}}}}}}),
             "m.json: pipeline.matcher: missing key 'plugin'");
+  EXPECT_EQ(ErrorOf({{"camera", {{"per_folder", "yes"}}}}),
+            "m.json: camera.per_folder: expected true or false, got a string");
   EXPECT_EQ(ErrorOf({{"camera", {{"modle", "PINHOLE"}}}}),
             "m.json: camera.modle: unknown key; did you mean 'model'?");
   EXPECT_EQ(ErrorOf({{"camera", {{"model", "PINHOL"}}}}),

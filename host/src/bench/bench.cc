@@ -260,6 +260,7 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
       workspace.string(),           "--manifest", manifest_file};
   if (options.threads > 0) argv.insert(argv.end(), {"--threads", std::to_string(options.threads)});
   if (!options.camera_K.empty()) argv.insert(argv.end(), {"--camera-K", options.camera_K});
+  if (options.camera_per_folder) argv.push_back("--camera-per-folder");
   spdlog::info("bench: {} ({}) ...", name, row.plugins);
   const ChildResult child = RunChild(argv, workspace / "run.log");
   row.exit_code = child.exit_code;
@@ -308,8 +309,9 @@ BenchRow RunColmap(const BenchOptions& options, const GroundTruth* ground_truth,
   const std::string threads = std::to_string(options.threads > 0 ? options.threads : -1);
   const std::vector<std::vector<std::string>> steps = {
       {"colmap", "feature_extractor", "--database_path", database, "--image_path", options.images,
-       "--ImageReader.single_camera", "1", "--SiftExtraction.use_gpu", "0",
-       "--SiftExtraction.num_threads", threads},
+       options.camera_per_folder ? "--ImageReader.single_camera_per_folder"
+                                 : "--ImageReader.single_camera",
+       "1", "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", threads},
       {"colmap", "exhaustive_matcher", "--database_path", database, "--SiftMatching.use_gpu", "0",
        "--SiftMatching.num_threads", threads},
       {"colmap", "mapper", "--database_path", database, "--image_path", options.images,

@@ -16,6 +16,7 @@ struct BenchOptions {
   std::string csv_file;
   std::string chart_file;
   std::string camera_K;
+  bool camera_per_folder = false;  // every run with --camera-per-folder, COLMAP's per folder
   bool with_colmap = false;
   int threads = 0;
   std::vector<std::string> manifests;

@@ -22,6 +22,8 @@ CommandRegistration RegisterBenchCommand(CLI::App& app, const GlobalOptions&) {
   sub->add_option("--chart", options->chart_file,
                   "Also draw time per stage and position error per row as SVG (gnuplot)");
   sub->add_option("--camera-K", options->camera_K, "Known intrinsics for every manifest");
+  sub->add_flag("--camera-per-folder", options->camera_per_folder,
+                "One camera per subfolder of the images, in every run (and COLMAP's row)");
   sub->add_option("--threads", options->threads, "Worker threads of every run (default: all)")
       ->check(CLI::Range(0, 1024));
   sub->add_flag("--with-colmap", options->with_colmap,

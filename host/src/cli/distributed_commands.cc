@@ -29,6 +29,7 @@ struct SlurmCommandOptions {
   std::string output;
   std::string manifest;
   std::string camera_K;
+  bool camera_per_folder = false;
   int workers = 0;
   int threads = 0;
   std::string partition;
@@ -103,6 +104,8 @@ CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions&) {
   sub->add_option("--manifest", options->manifest, "Pipeline manifest (default: default.json)");
   sub->add_option("--camera-K", options->camera_K,
                   "Known intrinsics: a text file with the 3x3 matrix K (overrides EXIF)");
+  sub->add_flag("--camera-per-folder", options->camera_per_folder,
+                "Images in different subfolders never share a camera (camera.per_folder)");
   sub->add_option("--threads", options->threads, "Threads per task (--cpus-per-task)")
       ->check(CLI::Range(0, 1024));
   sub->add_option("--partition", options->partition, "Slurm partition");
@@ -132,6 +135,7 @@ CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions&) {
             slurm.output_dir = Absolute(options->output);
             slurm.manifest = Absolute(options->manifest);
             slurm.camera_K = Absolute(options->camera_K);
+            slurm.camera_per_folder = options->camera_per_folder;
             slurm.workers = options->workers;
             slurm.threads = options->threads;
             slurm.partition = options->partition;
@@ -145,6 +149,7 @@ CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions&) {
               context.manifest.camera.known_intrinsics =
                   Eigen::Vector4d(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
             }
+            if (options->camera_per_folder) context.manifest.camera.per_folder = true;
             const RunOptions run{slurm.image_dir, slurm.output_dir};
             SlurmPlan plan;
             plan.extract_shards =

@@ -24,7 +24,7 @@ namespace {
 struct StageOptions {
   std::string images;
   std::string output;
-  StageArguments arguments;  // --manifest, --camera-K, --masks, --video, --threads
+  StageArguments arguments;  // --manifest, --camera-K, --masks, --video, --threads, ...
   std::string shard;         // extract and match: "K/N", one shard (distributed/)
 };
 
@@ -56,6 +56,8 @@ void AddCommonOptions(CLI::App* sub, StageOptions* options, bool needs_images) {
   if (needs_images) {
     sub->add_option("--masks", options->arguments.masks,
                     "Folder of image masks, IMAGE.png per image (black: no features)");
+    sub->add_flag("--camera-per-folder", options->arguments.camera_per_folder,
+                  "Images in different subfolders never share a camera (camera.per_folder)");
   }
   sub->add_option("--threads", options->arguments.threads,
                   "Worker threads (default: manifest, else all cores)")

@@ -107,7 +107,8 @@ std::vector<SlurmScript> MakeSlurmScripts(const SlurmOptions& options, const Slu
   const std::string n = std::to_string(options.workers);
   const std::string common = CommonArgs(options);
   const std::string camera_K =
-      options.camera_K.empty() ? "" : " --camera-K " + ShellQuote(options.camera_K.string());
+      (options.camera_K.empty() ? "" : " --camera-K " + ShellQuote(options.camera_K.string())) +
+      (options.camera_per_folder ? " --camera-per-folder" : "");
   const std::string shard = " --shard \"$SLURM_ARRAY_TASK_ID/" + n + "\"";
   std::vector<SlurmScript> scripts;
   const auto add = [&](const std::string& name, bool array, const std::vector<int>& indices,

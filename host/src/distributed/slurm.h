@@ -20,6 +20,7 @@ struct SlurmOptions {
   std::filesystem::path output_dir;
   std::filesystem::path manifest;        // empty: the default manifest
   std::filesystem::path camera_K;        // empty: none
+  bool camera_per_folder = false;        // extract --camera-per-folder
   int workers = 1;                       // N, the shards of each stage
   int threads = 0;                       // per task (--cpus-per-task); 0: Slurm's default
   std::string partition;                 // empty: the cluster's default

@@ -94,6 +94,7 @@ TEST(Slurm, PathsWithSpacesQuotesAndDollarsStayOneWord) {
   options.image_dir = "/shared/my photos/it's $HOME `id` \"q\" \\ #1";
   options.output_dir = "/shared/out $(id) 100%";
   options.camera_K = "/shared/K file.txt";
+  options.camera_per_folder = true;
   const std::string extract = Named(MakeSlurmScripts(options, {{0, 1}, {0, 1}}), "extract").text;
   EXPECT_TRUE(
       Has(extract, "#SBATCH --output=\"/shared/out $(id) 100%%/slurm/logs/extract-%a-%j.log\"\n"))
@@ -108,7 +109,7 @@ TEST(Slurm, PathsWithSpacesQuotesAndDollarsStayOneWord) {
   EXPECT_EQ(printed.output, "extract\n--images\n" + options.image_dir.string() + "\n--output\n" +
                                 options.output_dir.string() +
                                 "\n--manifest\n/shared/m.json\n--threads\n8\n--camera-K\n"
-                                "/shared/K file.txt\n--shard\n1/4\n");
+                                "/shared/K file.txt\n--camera-per-folder\n--shard\n1/4\n");
   EXPECT_EQ(SbatchQuote("cpu"), "cpu");
   EXPECT_EQ(SbatchQuote("a b\"c\\d#"), "\"a b\\\"c\\\\d#\"");
   EXPECT_EQ(SbatchQuote(""), "\"\"");

@@ -172,6 +172,11 @@ std::optional<FocalLengthPrior> EstimateFocalLengthPrior(const ImageEntry& image
   return std::nullopt;
 }
 
+std::string ImageFolder(const std::string& image_name) {
+  const size_t slash = image_name.rfind('/');
+  return slash == std::string::npos ? "" : image_name.substr(0, slash);
+}
+
 std::string FisheyeLensHint(const std::vector<ImageEntry>& images, const CameraSettings& settings) {
   if (settings.model.find("FISHEYE") != std::string::npos) return "";
   size_t count = 0;
@@ -236,7 +241,7 @@ CameraAssignment AssignCameras(const std::vector<ImageEntry>& images,
   }
 
   // Groups of images sharing a camera, in order of their first image.
-  using GroupKey = std::tuple<int, int, std::string, std::string>;
+  using GroupKey = std::tuple<std::string, int, int, std::string, std::string>;
   std::map<GroupKey, size_t> group_of_key;
   std::vector<std::vector<size_t>> groups;
   for (size_t i = 0; i < images.size(); ++i) {
@@ -247,7 +252,8 @@ CameraAssignment AssignCameras(const std::vector<ImageEntry>& images,
     }
     // Known intrinsics describe one physical camera whatever the EXIF says.
     const bool by_make = !uses_known[i];
-    const GroupKey key(image.width, image.height, by_make ? image.exif.make : "",
+    const GroupKey key(settings.per_folder ? ImageFolder(image.name) : "", image.width,
+                       image.height, by_make ? image.exif.make : "",
                        by_make ? image.exif.model : "");
     const auto [it, inserted] = group_of_key.emplace(key, groups.size());
     if (inserted) groups.emplace_back();
@@ -300,6 +306,43 @@ CameraAssignment AssignCameras(const std::vector<ImageEntry>& images,
     assignment.cameras.push_back(std::move(camera));
   }
   return assignment;
+}
+
+std::map<camera_t, std::string> CameraFolders(const std::vector<ImageEntry>& images,
+                                              const CameraAssignment& assignment) {
+  std::map<camera_t, std::string> folders;
+  for (size_t i = 0; i < images.size() && i < assignment.image_camera_ids.size(); ++i) {
+    folders.emplace(assignment.image_camera_ids[i], ImageFolder(images[i].name));
+  }
+  return folders;
+}
+
+std::map<camera_t, std::string> CameraFolders(const std::vector<Image>& images) {
+  std::map<camera_t, std::string> folders;
+  std::vector<camera_t> mixed;
+  for (const Image& image : images) {
+    const auto [it, inserted] = folders.emplace(image.camera_id, ImageFolder(image.name));
+    if (!inserted && it->second != ImageFolder(image.name)) mixed.push_back(image.camera_id);
+  }
+  for (const camera_t id : mixed) folders.erase(id);
+  return folders;
+}
+
+std::string DescribeCameraFolders(const std::map<camera_t, std::string>& folders) {
+  constexpr size_t kMaxShown = 20;
+  std::string text = std::to_string(folders.size()) +
+                     (folders.size() == 1 ? " camera" : " cameras") +
+                     " by folder (camera.per_folder): ";
+  size_t shown = 0;
+  for (const auto& [id, folder] : folders) {
+    if (shown == kMaxShown) {
+      text += " and " + std::to_string(folders.size() - kMaxShown) + " more";
+      break;
+    }
+    text += (shown++ > 0 ? ", camera " : "camera ") + std::to_string(id) +
+            (folder.empty() ? " from the top level" : " from '" + folder + "'");
+  }
+  return text;
 }
 
 }  // namespace tessera

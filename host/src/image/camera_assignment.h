@@ -3,6 +3,7 @@
 // Initial intrinsics of the images: known calibration, EXIF focal length priors or a
 // default, and the grouping of images into cameras.
 
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "image/camera_settings.h"
 #include "image/image_entry.h"
 #include "tessera/camera.h"
+#include "tessera/reconstruction.h"
 
 namespace tessera {
 
@@ -20,6 +22,10 @@ namespace tessera {
 // some action cameras write, falls outside.
 constexpr double kMinPlausibleFieldOfViewDeg = 1;
 constexpr double kMaxPlausibleFieldOfViewDeg = 150;
+
+// The folder of an image, relative to the image folder ("a/b" for "a/b/c.jpg"); empty
+// for an image at the top level.
+std::string ImageFolder(const std::string& image_name);
 
 struct FocalLengthPrior {
   double focal_px;
@@ -64,12 +70,25 @@ std::string FisheyeLensHint(const std::vector<ImageEntry>& images, const CameraS
 //    the principal point lies outside an image (a K for another resolution).
 //  - else the EXIF prior (has_prior_focal_length);
 //  - else default_focal_length_factor x longer side (kDefault, no prior).
-// single_camera: one camera per distinct (width, height, make, model), with the median
+// single_camera: one camera per distinct (width, height, make, model) and, with
+// per_folder, per folder (ImageFolder), with the median
 // of the group's priors (the default when no image of the group has one); otherwise one
 // camera per image. Camera ids follow the first image of each camera. The model is
 // settings.model; principal point at the image centre (unless known); distortion 0.
 // Throws InputError for an unknown model name.
 CameraAssignment AssignCameras(const std::vector<ImageEntry>& images,
                                const CameraSettings& settings);
+
+// The folder (ImageFolder) of each camera of `assignment`, made for `images`.
+std::map<camera_t, std::string> CameraFolders(const std::vector<ImageEntry>& images,
+                                              const CameraAssignment& assignment);
+
+// The folder of each camera of `images` (a workspace's); a camera whose images lie in
+// more than one folder is left out.
+std::map<camera_t, std::string> CameraFolders(const std::vector<Image>& images);
+
+// The log line of camera.per_folder: "3 cameras by folder (camera.per_folder):
+// camera 1 from 'left', camera 2 from 'right', camera 3 from the top level".
+std::string DescribeCameraFolders(const std::map<camera_t, std::string>& folders);
 
 }  // namespace tessera

@@ -221,6 +221,62 @@ TEST(AssignCameras, OneCameraPerImageWhenNotSingle) {
   EXPECT_FALSE(assignment.cameras[2].has_prior_focal_length);
 }
 
+TEST(AssignCameras, PerFolderGivesEachFolderItsOwnCameraWithItsOwnPrior) {
+  CameraSettings settings;
+  settings.per_folder = true;
+  // Two folders of same-size images of one make and model, interleaved; without
+  // per_folder they would share one camera.
+  const std::vector<ImageEntry> images = {
+      With35mm(Entry("left/0.jpg", 3000, 2000), 36),   // 3000 px
+      With35mm(Entry("right/0.jpg", 3000, 2000), 24),  // 2000 px
+      With35mm(Entry("left/1.jpg", 3000, 2000), 36),
+      With35mm(Entry("right/1.jpg", 3000, 2000), 24)};
+  const CameraAssignment assignment = AssignCameras(images, settings);
+  ASSERT_EQ(assignment.cameras.size(), 2u);
+  const std::vector<camera_t> expected_ids = {1, 2, 1, 2};
+  EXPECT_EQ(assignment.image_camera_ids, expected_ids);
+  EXPECT_DOUBLE_EQ(assignment.cameras[0].FocalLengthX(), 3000);
+  EXPECT_DOUBLE_EQ(assignment.cameras[1].FocalLengthX(), 2000);
+
+  settings.per_folder = false;
+  EXPECT_EQ(AssignCameras(images, settings).cameras.size(), 1u);
+  // single_camera false: one camera per image, per_folder or not.
+  settings.single_camera = false;
+  settings.per_folder = true;
+  EXPECT_EQ(AssignCameras(images, settings).cameras.size(), 4u);
+}
+
+TEST(AssignCameras, PerFolderKeepsTopLevelImagesApartAndGroupsBySizeWithinAFolder) {
+  CameraSettings settings;
+  settings.per_folder = true;
+  const std::vector<ImageEntry> images = {
+      Entry("top.jpg", 640, 480),      Entry("a/b/small.jpg", 320, 240),
+      Entry("a/big.jpg", 640, 480),    Entry("a/b/big.jpg", 640, 480),
+      Entry("a/b/big2.jpg", 640, 480), Entry("top2.jpg", 640, 480)};
+  const CameraAssignment assignment = AssignCameras(images, settings);
+  // The top level, "a/b" at two sizes, "a": a subfolder is a folder of its own.
+  ASSERT_EQ(assignment.cameras.size(), 4u);
+  const std::vector<camera_t> expected_ids = {1, 2, 3, 4, 4, 1};
+  EXPECT_EQ(assignment.image_camera_ids, expected_ids);
+  EXPECT_EQ(assignment.cameras[1].width, 320);
+  EXPECT_EQ(assignment.cameras[3].width, 640);
+  EXPECT_EQ(ImageFolder("a/b/c.jpg"), "a/b");
+  EXPECT_EQ(ImageFolder("c.jpg"), "");
+  EXPECT_EQ(DescribeCameraFolders(CameraFolders(images, assignment)),
+            "4 cameras by folder (camera.per_folder): camera 1 from the top level, camera 2 "
+            "from 'a/b', camera 3 from 'a', camera 4 from 'a/b'");
+  // A workspace's camera shared by two folders is no folder's.
+  std::vector<Image> workspace(3);
+  workspace[0].name = "a/x.jpg";
+  workspace[0].camera_id = 1;
+  workspace[1].name = "b/x.jpg";
+  workspace[1].camera_id = 1;
+  workspace[2].name = "b/y.jpg";
+  workspace[2].camera_id = 2;
+  const std::map<camera_t, std::string> expected = {{2, "b"}};
+  EXPECT_EQ(CameraFolders(workspace), expected);
+}
+
 TEST(AssignCameras, KnownIntrinsicsOverrideExif) {
   CameraSettings settings;
   settings.known_intrinsics = Eigen::Vector4d(2905.88, 2900, 1416, 1064);

@@ -14,6 +14,10 @@ struct CameraSettings {
   std::string model = "SIMPLE_RADIAL";
   // One camera for all images of the same size (true) or one per image (false).
   bool single_camera = true;
+  // With single_camera: images in different subfolders of the image folder never share
+  // a camera (COLMAP's ImageReader.single_camera_per_folder); the images at the top
+  // level form a folder of their own.
+  bool per_folder = false;
   // Focal length, in pixels, when EXIF gives none: factor x the longer image side.
   double default_focal_length_factor = 1.2;
   // Known intrinsics (fx, fy, cx, cy in full-resolution pixels), overriding EXIF.

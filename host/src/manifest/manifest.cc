@@ -65,6 +65,7 @@ CameraSettings ParseCamera(const nlohmann::json& json, const std::filesystem::pa
   for (const CameraModelId id : AllCameraModelIds()) models.push_back(CameraModelIdToName(id));
   camera.model = reader.GetString("model", camera.model, models);
   camera.single_camera = reader.GetBool("single_camera", camera.single_camera);
+  camera.per_folder = reader.GetBool("per_folder", camera.per_folder);
   camera.default_focal_length_factor = reader.Get<double>(
       "default_focal_length_factor", camera.default_focal_length_factor, 0.1, 10);
   const nlohmann::json K = reader.GetJson("K", nullptr);

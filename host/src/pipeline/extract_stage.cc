@@ -109,13 +109,27 @@ std::vector<Image> RegisterImages(const ImageScan& scan, const CameraSettings& s
   for (const auto& note : assignment.notes) spdlog::info("extract: {}", note);
   // With one camera per image size, an image added to a workspace (new, or ingested
   // again after a change) joins the workspace's camera identical to its own.
+  // With per_folder, only a camera of the same folder.
   std::vector<Camera> existing_cameras;
   if (settings.single_camera) existing_cameras = database->ReadAllCameras();
+  const std::map<camera_t, std::string> existing_folders =
+      settings.per_folder ? CameraFolders(database->ReadAllImages())
+                          : std::map<camera_t, std::string>();
+  const std::map<camera_t, std::string> new_folders = settings.per_folder
+                                                          ? CameraFolders(new_entries, assignment)
+                                                          : std::map<camera_t, std::string>();
   Database::Transaction transaction(database);
   std::map<camera_t, camera_t> database_camera_ids;
   for (const Camera& camera : assignment.cameras) {
     const auto same =
         std::find_if(existing_cameras.begin(), existing_cameras.end(), [&](const Camera& existing) {
+          if (settings.per_folder) {
+            const auto folder = existing_folders.find(existing.camera_id);
+            if (folder == existing_folders.end() ||
+                folder->second != new_folders.at(camera.camera_id)) {
+              return false;
+            }
+          }
           return existing.model_id == camera.model_id && existing.width == camera.width &&
                  existing.height == camera.height && existing.params == camera.params &&
                  existing.has_prior_focal_length == camera.has_prior_focal_length &&
@@ -131,6 +145,11 @@ std::vector<Image> RegisterImages(const ImageScan& scan, const CameraSettings& s
     spdlog::info("camera {}: {} {}x{} focal {:.1f} px ({})", id, camera.ModelName(), camera.width,
                  camera.height, camera.MeanFocalLength(),
                  CalibrationSourceName(camera.calibration_source));
+  }
+  if (settings.per_folder) {
+    std::map<camera_t, std::string> folders;
+    for (const auto& [id, folder] : new_folders) folders[database_camera_ids.at(id)] = folder;
+    spdlog::info("extract: {}", DescribeCameraFolders(folders));
   }
   for (size_t k = 0; k < new_entries.size(); ++k) {
     Image image;
@@ -152,6 +171,7 @@ nlohmann::json CameraSettingsRecord(const CameraSettings& settings) {
   if (const auto& k = settings.known_intrinsics) K = {(*k)(0), (*k)(1), (*k)(2), (*k)(3)};
   return {{"model", settings.model},
           {"single_camera", settings.single_camera},
+          {"per_folder", settings.per_folder},
           {"default_focal_length_factor", settings.default_focal_length_factor},
           {"K", K},
           {"params", settings.known_params}};
@@ -255,8 +275,11 @@ bool SameCameras(const std::vector<Image*>& images, const std::map<camera_t, Cam
 void UpdateCameras(const ImageScan& scan, const CameraSettings& settings,
                    std::vector<Image>* images, Database* database) {
   const nlohmann::json record = CameraSettingsRecord(settings);
-  const std::optional<nlohmann::json> stored =
-      database->ReadStageProvenance(Database::kCamerasStage);
+  std::optional<nlohmann::json> stored = database->ReadStageProvenance(Database::kCamerasStage);
+  // Workspaces made before camera.per_folder existed made their cameras without it.
+  if (stored && stored->is_object() && !stored->contains("per_folder")) {
+    (*stored)["per_folder"] = false;
+  }
   if (stored == record) return;
   std::vector<ImageEntry> entries;
   std::vector<Image*> registered;  // in scan order, as a new workspace numbers cameras
@@ -285,6 +308,9 @@ void UpdateCameras(const ImageScan& scan, const CameraSettings& settings,
     transaction.Commit();
     for (size_t k = 0; k < registered.size(); ++k) {
       registered[k]->camera_id = assignment.image_camera_ids[k];
+    }
+    if (settings.per_folder) {
+      spdlog::info("extract: {}", DescribeCameraFolders(CameraFolders(entries, assignment)));
     }
     spdlog::info(
         "extract: {}; re-created the cameras of {} images as {}; {} two-view geometries that "

@@ -200,5 +200,47 @@ TEST(ExtractStage, ChangedCameraSettingsRecreateTheCamerasAndWhatUsedThem) {
   EXPECT_EQ(CamerasOfImages(database), CamerasOfImages(fresh->database()));
 }
 
+// camera.per_folder: two folders of same-size images get a camera each; an image added
+// later joins its own folder's camera, never the other folder's identical one; turned
+// off, the folders share one camera again.
+TEST(ExtractStage, PerFolderCamerasKeepFoldersApartAsImagesAreAdded) {
+  namespace fs = std::filesystem;
+  const testing::TemporaryDir dir;
+  const fs::path images = dir.path() / "images";
+  testing::WriteSampleImages(dir.path() / "sample", 4);  // 400x266, no EXIF
+  fs::create_directories(images / "a");
+  fs::create_directories(images / "b");
+  fs::copy_file(dir.path() / "sample" / "0000.jpg", images / "a" / "0000.jpg");
+  fs::copy_file(dir.path() / "sample" / "0001.jpg", images / "a" / "0001.jpg");
+  fs::copy_file(dir.path() / "sample" / "0002.jpg", images / "b" / "0002.jpg");
+  const testing::CheapPlugins plugins;
+  const auto workspace = Workspace::Open(dir.path() / "out");
+  const Database& database = workspace->database();
+  Manifest manifest = testing::CheapManifest(2);
+  manifest.camera.per_folder = true;
+  ExtractFeatures(*workspace, plugins.Extract(images, manifest));
+  const auto camera_of = [&]() {
+    std::map<std::string, camera_t> cameras;
+    for (const Image& image : database.ReadAllImages()) cameras[image.name] = image.camera_id;
+    return cameras;
+  };
+  ASSERT_EQ(database.NumCameras(), 2u);
+  std::map<std::string, camera_t> cameras = camera_of();
+  EXPECT_EQ(cameras.at("a/0000.jpg"), cameras.at("a/0001.jpg"));
+  EXPECT_NE(cameras.at("a/0000.jpg"), cameras.at("b/0002.jpg"));
+
+  fs::copy_file(dir.path() / "sample" / "0003.jpg", images / "b" / "0003.jpg");
+  ExtractFeatures(*workspace, plugins.Extract(images, manifest));
+  EXPECT_EQ(database.NumCameras(), 2u);
+  cameras = camera_of();
+  EXPECT_EQ(cameras.at("b/0003.jpg"), cameras.at("b/0002.jpg"));
+
+  manifest.camera.per_folder = false;
+  ExtractFeatures(*workspace, plugins.Extract(images, manifest));
+  EXPECT_EQ(database.NumCameras(), 1u);
+  cameras = camera_of();
+  EXPECT_EQ(cameras.at("a/0000.jpg"), cameras.at("b/0003.jpg"));
+}
+
 }  // namespace
 }  // namespace tessera

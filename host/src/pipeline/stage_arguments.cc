@@ -30,6 +30,7 @@ PipelineContext LoadPipelineContext(const StageArguments& arguments) {
     context.manifest.camera.known_intrinsics_source = arguments.camera_K;
   }
   if (!arguments.masks.empty()) context.manifest.camera.mask_path = arguments.masks;
+  if (arguments.camera_per_folder) context.manifest.camera.per_folder = true;
   context.LimitLibraryThreads();
   return context;
 }

@@ -1,8 +1,8 @@
 #pragma once
 
 // The arguments every pipeline verb shares (`--manifest`, `--camera-K`, `--masks`,
-// `--threads`, `--video`) and the PipelineContext made from them: one definition for
-// the CLI and the Python module, so that both build a run the same way.
+// `--camera-per-folder`, `--threads`, `--video`) and the PipelineContext made from them: one
+// definition for the CLI and the Python module, so that both build a run the same way.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -21,6 +21,7 @@ struct StageArguments {
   std::optional<nlohmann::json> manifest_json;
   std::string camera_K;             // a K.txt file: known intrinsics, overriding EXIF
   std::string masks;                // folder of IMAGE.png masks
+  bool camera_per_folder = false;   // sets camera.per_folder (false: the manifest's)
   std::vector<std::string> videos;  // video input instead of an image folder
   int threads = 0;                  // 0: the manifest's, else all cores
 };
