@@ -34,7 +34,8 @@ std::string PathText(const OptionalPath& path) { return path ? path->string() : 
 // (the manifest's JSON, relative paths from the working folder).
 StageArguments MakeArguments(const py::object& manifest, const OptionalPath& camera_K,
                              const OptionalPath& masks,
-                             const std::vector<std::filesystem::path>& videos, int threads) {
+                             const std::vector<std::filesystem::path>& videos, int threads,
+                             bool camera_per_folder = false) {
   StageArguments arguments;
   if (py::isinstance<py::dict>(manifest)) {
     arguments.manifest_json = ToJson(manifest);
@@ -43,6 +44,7 @@ StageArguments MakeArguments(const py::object& manifest, const OptionalPath& cam
   }
   arguments.camera_K = PathText(camera_K);
   arguments.masks = PathText(masks);
+  arguments.camera_per_folder = camera_per_folder;
   for (const auto& video : videos) arguments.videos.push_back(video.string());
   if (threads < 0 || threads > 1024) {
     throw InputError("threads: " + std::to_string(threads) + " is not in 0..1024");
@@ -71,7 +73,9 @@ void CheckModels(const MapStageSummary& summary, const std::filesystem::path& ou
 
 // The keywords the verbs share, in the CLI's terms, and what the docstrings say of them.
 const char* const kCommonDoc =
-    " manifest: a file or a dict (default: default.json); camera_K: a K.txt file; threads: "
+    " manifest: a file or a dict (default: default.json); camera_K: a K.txt file; "
+    "camera_per_folder (run, extract): images in different subfolders never share a camera; "
+    "threads: "
     "0 for the manifest's; progress(stage, done, total): called with the GIL held, an "
     "exception from it (KeyboardInterrupt) cancels the stage, keeping what was finished "
     "for the same call to resume, and propagates. The GIL is released while it runs, in a "
@@ -80,6 +84,7 @@ py::arg_v ImagesArg() { return py::arg("images") = py::none(); }
 py::arg_v ManifestArg() { return py::arg("manifest") = py::none(); }
 py::arg_v CameraKArg() { return py::arg("camera_K") = py::none(); }
 py::arg_v MasksArg() { return py::arg("masks") = py::none(); }
+py::arg_v CameraPerFolderArg() { return py::arg("camera_per_folder") = false; }
 py::arg_v VideosArg() { return py::arg("videos") = std::vector<std::filesystem::path>(); }
 py::arg_v ThreadsArg() { return py::arg("threads") = 0; }
 py::arg_v ProgressArg() { return py::arg("progress") = py::none(); }
@@ -90,10 +95,11 @@ void BindImageStages(py::module_& module) {
       "run",
       [](const OptionalPath& images, const std::filesystem::path& output,
          const py::object& manifest, const OptionalPath& camera_K, const OptionalPath& masks,
-         const std::vector<std::filesystem::path>& videos, int threads,
-         const py::object& progress) {
+         const std::vector<std::filesystem::path>& videos, int threads, const py::object& progress,
+         bool camera_per_folder) {
         const RunOptions options = MakeRunOptions(images, output, videos, true);
-        const StageArguments arguments = MakeArguments(manifest, camera_K, masks, videos, threads);
+        const StageArguments arguments =
+            MakeArguments(manifest, camera_K, masks, videos, threads, camera_per_folder);
         return ToPython(RunInChildProcess("run", progress, [&](const StageControl& control) {
           const RunResult run = RunPipeline(LoadPipelineContext(arguments), options, control);
           if (!control.Cancelled()) CheckModels(run.summary.map, output);
@@ -101,7 +107,7 @@ void BindImageStages(py::module_& module) {
         }));
       },
       ImagesArg(), py::arg("output"), ManifestArg(), CameraKArg(), MasksArg(), VideosArg(),
-      ThreadsArg(), ProgressArg(),
+      ThreadsArg(), ProgressArg(), CameraPerFolderArg(),
       (std::string("Every stage, images in, models out (`tessera run`); returns "
                    "run_summary.json as a dict, NoModelError when no model was built.") +
        kCommonDoc)
@@ -111,10 +117,11 @@ void BindImageStages(py::module_& module) {
       "extract",
       [](const OptionalPath& images, const std::filesystem::path& output,
          const py::object& manifest, const OptionalPath& camera_K, const OptionalPath& masks,
-         const std::vector<std::filesystem::path>& videos, int threads,
-         const py::object& progress) {
+         const std::vector<std::filesystem::path>& videos, int threads, const py::object& progress,
+         bool camera_per_folder) {
         const RunOptions options = MakeRunOptions(images, output, videos, true);
-        const StageArguments arguments = MakeArguments(manifest, camera_K, masks, videos, threads);
+        const StageArguments arguments =
+            MakeArguments(manifest, camera_K, masks, videos, threads, camera_per_folder);
         return ToPython(RunInChildProcess("extract", progress, [&](const StageControl& control) {
           RunSummary summary;
           summary.extract = RunExtract(LoadPipelineContext(arguments), options, control);
@@ -122,7 +129,7 @@ void BindImageStages(py::module_& module) {
         }));
       },
       ImagesArg(), py::arg("output"), ManifestArg(), CameraKArg(), MasksArg(), VideosArg(),
-      ThreadsArg(), ProgressArg(),
+      ThreadsArg(), ProgressArg(), CameraPerFolderArg(),
       (std::string("Ingests images and detects features (`tessera extract`); returns the "
                    "summary's 'extract' part.") +
        kCommonDoc)

@@ -42,6 +42,24 @@ def test_stages_one_by_one_with_a_dict_manifest_give_the_cli_model(sample, tmp_p
     assert model_digests(output) == model_digests(cli_output)
 
 
+def test_camera_per_folder_gives_each_subfolder_its_camera(sample, tmp_path):
+    images, _, _ = sample
+    folders = tmp_path / "images"
+    for k, image in enumerate(sorted(pathlib.Path(images).iterdir())[:6]):
+        (folders / ("a" if k % 2 else "b")).mkdir(parents=True, exist_ok=True)
+        (folders / ("a" if k % 2 else "b") / image.name).write_bytes(image.read_bytes())
+    tessera.extract(images=folders, output=tmp_path / "per_folder", manifest=MANIFEST,
+                    threads=2, camera_per_folder=True)
+    database = tessera.Database(tmp_path / "per_folder" / "database.db")
+    assert len(database.cameras) == 2
+    folder_of_camera = {}
+    for image in database.images.values():
+        folder_of_camera.setdefault(image.camera_id, set()).add(image.name.split("/")[0])
+    assert sorted(folder_of_camera.values()) == [{"a"}, {"b"}]
+    tessera.extract(images=folders, output=tmp_path / "shared", manifest=MANIFEST, threads=2)
+    assert len(tessera.Database(tmp_path / "shared" / "database.db").cameras) == 1
+
+
 def test_an_exception_in_progress_cancels_and_the_same_call_resumes(sample, tmp_path):
     images, manifest, cli_output = sample
     output = tmp_path / "py"
