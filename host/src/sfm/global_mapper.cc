@@ -348,11 +348,13 @@ void ExplainUnregistered(const MapperInput& input, const GlobalMapperOptions& op
   }
 }
 
-// The verified pairs with at least min_num_matches inliers between two input images; the
-// images they join into `in_verified_pair`.
+// The verified pairs with at least min_num_matches inliers between two input images, and
+// at least min_relative_pair_strength of the inliers of the strongest pair of each image
+// (the others are counted in `num_weak`); the images they join into `in_verified_pair`.
 std::vector<const MapperInput::Pair*> PairsThatMap(const MapperInput& input,
                                                    const GlobalMapperOptions& options,
-                                                   std::set<image_t>* in_verified_pair) {
+                                                   std::set<image_t>* in_verified_pair,
+                                                   size_t* num_weak) {
   std::vector<const MapperInput::Pair*> pairs;
   for (const MapperInput::Pair& pair : input.pairs) {
     if (!IsVerified(pair.geometry) ||
@@ -362,10 +364,28 @@ std::vector<const MapperInput::Pair*> PairsThatMap(const MapperInput& input,
       continue;
     }
     pairs.push_back(&pair);
-    in_verified_pair->insert(pair.image_id1);
-    in_verified_pair->insert(pair.image_id2);
   }
-  return pairs;
+  // Weak pairs set aside (GlobalMapperOptions::min_relative_pair_strength).
+  std::map<image_t, size_t> strongest;
+  for (const MapperInput::Pair* pair : pairs) {
+    const size_t n = pair->geometry.inlier_matches.size();
+    strongest[pair->image_id1] = std::max(strongest[pair->image_id1], n);
+    strongest[pair->image_id2] = std::max(strongest[pair->image_id2], n);
+  }
+  std::vector<const MapperInput::Pair*> strong;
+  for (const MapperInput::Pair* pair : pairs) {
+    const double weaker_image_strongest =
+        static_cast<double>(std::min(strongest.at(pair->image_id1), strongest.at(pair->image_id2)));
+    if (static_cast<double>(pair->geometry.inlier_matches.size()) <
+        options.min_relative_pair_strength * weaker_image_strongest) {
+      ++*num_weak;
+      continue;
+    }
+    strong.push_back(pair);
+    in_verified_pair->insert(pair->image_id1);
+    in_verified_pair->insert(pair->image_id2);
+  }
+  return strong;
 }
 
 // The input's cameras, those without a prior with the focal length the view graph gives
@@ -470,9 +490,11 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
 
   // 1. The pairs that map.
   std::set<image_t> in_verified_pair;
+  size_t num_weak_pairs = 0;
   const std::vector<const MapperInput::Pair*> pairs =
-      PairsThatMap(input, options, &in_verified_pair);
+      PairsThatMap(input, options, &in_verified_pair, &num_weak_pairs);
   result.num_verified_pairs = pairs.size();
+  result.num_weak_pairs_set_aside = num_weak_pairs;
 
   // 2. Focal lengths of cameras without a prior, from the view graph.
   const std::map<camera_t, Camera> cameras =
@@ -519,9 +541,11 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   result.num_tracks = tracks.tracks.size();
   lap(&steps.tracks);
   spdlog::info(
-      "global map: {} images, {} verified pairs, {} dropped by rotation cycles, {} by rotation "
-      "averaging ({} steps); {} tracks",
-      input.images.size(), pairs.size(), result.num_pairs_dropped_by_cycles, rotations.num_dropped,
+      "global map: {} images, {} verified pairs: {} weaker than {:g} of their images' "
+      "strongest set aside, {} dropped by rotation cycles, {} by rotation averaging ({} "
+      "steps); {} tracks",
+      input.images.size(), pairs.size() + num_weak_pairs, num_weak_pairs,
+      options.min_relative_pair_strength, result.num_pairs_dropped_by_cycles, rotations.num_dropped,
       rotations.num_iterations, result.num_tracks);
 
   std::map<image_t, std::string> reasons;

@@ -49,6 +49,8 @@ TEST(GlobalMapperOptions, RangeErrorsNameTheKey) {
   EXPECT_EQ(ErrorPath({{"tracks_max_per_image", 0}}), "tracks_max_per_image");
   EXPECT_EQ(ErrorPath({{"retriangulate", 1}}), "retriangulate");
   EXPECT_EQ(ErrorPath({{"ba_num_rounds", 1.5}}), "ba_num_rounds");
+  EXPECT_EQ(ErrorPath({{"min_relative_pair_strength", -0.1}}), "min_relative_pair_strength");
+  EXPECT_EQ(ErrorPath({{"min_relative_pair_strength", 1.5}}), "min_relative_pair_strength");
 }
 
 TEST(GlobalMapperOptions, UnknownKeysAreRefused) {

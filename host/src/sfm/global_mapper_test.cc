@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <set>
 
@@ -172,6 +173,44 @@ TEST(GlobalMapper, AnImageWhosePairsAllHaveWrongRotations) {
       EvaluateReconstruction(unfiltered.models[0], scene.GroundTruth());
   ASSERT_TRUE(evaluation.aligned) << evaluation.error;
   EXPECT_LT(evaluation.rotation_error_max_deg, 0.5);
+}
+
+// Pairs of far-apart views with few matches and wrong rotations, as around an object
+// with symmetric structure: set aside next to the strong pairs of neighbouring views.
+TEST(GlobalMapper, WeakPairsWithWrongRotationsAreSetAside) {
+  SyntheticSceneOptions options;
+  options.num_images = 16;
+  options.seed = 14;
+  SyntheticScene scene = MakeSyntheticScene(options);
+  size_t num_tampered = 0;
+  for (MapperInput::Pair& pair : scene.input.pairs) {
+    if (pair.image_id2 - pair.image_id1 < 6) continue;
+    // A tenth of the matches, and a rotation 40 degrees off.
+    pair.geometry.inlier_matches.resize(
+        std::max<size_t>(pair.geometry.inlier_matches.size() / 10, 15));
+    const Eigen::Quaterniond turn(Eigen::AngleAxisd(40 * M_PI / 180, Eigen::Vector3d::UnitY()));
+    pair.geometry.cam2_from_cam1.rotation = turn * pair.geometry.cam2_from_cam1.rotation;
+    pair.geometry.E = EssentialMatrixFromPose(pair.geometry.cam2_from_cam1);
+    ++num_tampered;
+  }
+  ASSERT_GT(num_tampered, 20u);
+  const GlobalMapperResult result =
+      GlobalMapper::Reconstruct(scene.input, testing::CeresAdjusterOnOneThread(), {});
+  EXPECT_EQ(result.num_weak_pairs_set_aside, num_tampered);
+  EXPECT_EQ(result.num_verified_pairs, scene.input.pairs.size() - num_tampered);
+  ASSERT_EQ(result.models.size(), 1u);
+  EXPECT_EQ(result.models[0].images.size(), 16u);
+  const EvaluationResult evaluation = EvaluateReconstruction(result.models[0], scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  EXPECT_LT(evaluation.rotation_error_max_deg, 0.5);
+
+  // 0: every pair takes part.
+  GlobalMapperOptions every_pair;
+  every_pair.min_relative_pair_strength = 0;
+  const GlobalMapperResult all =
+      GlobalMapper::Reconstruct(scene.input, testing::CeresAdjusterOnOneThread(), every_pair);
+  EXPECT_EQ(all.num_weak_pairs_set_aside, 0u);
+  EXPECT_EQ(all.num_verified_pairs, scene.input.pairs.size());
 }
 
 TEST(GlobalMapper, StopsWithinASecondOfBeingAsked) {

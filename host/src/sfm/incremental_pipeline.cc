@@ -10,6 +10,7 @@
 #include <set>
 #include <utility>
 
+#include "tessera/sfm/first_model_calibration.h"
 #include "tessera/sfm/focal_length_estimation.h"
 #include "tessera/sfm/gps_anchoring.h"
 #include "tessera/sfm/model_merger.h"
@@ -22,11 +23,6 @@ namespace {
 // Seed streams, so that no two random choices of a run share a seed (see
 // MapperRansacOptions for the mapper's own).
 constexpr uint64_t kMergeStream = 3;
-// The first model that calibrates cameras without a focal prior: it needs this many
-// images at least, and grows to this many at most (its bundle adjustment determines
-// the focal length well long before, at a fraction of a whole model's cost).
-constexpr size_t kMinCalibrationImages = 5;
-constexpr size_t kMaxCalibrationImages = 20;
 // A view-graph focal length whose mean robust cost per pair is above this has no clear
 // minimum (FocalLengthEstimate::cost): it needs a first model however many pairs it rests
 // on (a 512 px ORB copy of the sample: 221 px from 17 pairs at cost 0.15, the truth 460).
@@ -238,14 +234,13 @@ void MergeAlignedModels(const IncrementalMapperOptions& options,
   SortModels(models);
 }
 
-// A first model of at most kMaxCalibrationImages images from `pairs`, with `cameras`, for
-// the focal lengths its bundle adjustments refine; empty when no pair initialises one.
+// A first model of at most kMaxFirstModelImages images from `pairs`, with `run.cameras`,
+// for the focal lengths its bundle adjustments refine; empty when no pair initialises one.
 Reconstruction MapFirstModel(const IncrementalMapperOptions& options, const MapperRunState& run,
-                             const std::map<camera_t, Camera>& cameras,
                              const std::vector<const MapperInput::Pair*>& pairs) {
   MapperRunState calibration(run.input, run.bundle_adjuster, run.seed);
   calibration.ransac = run.ransac;
-  calibration.cameras = cameras;
+  calibration.cameras = run.cameras;
   const spdlog::level::level_enum level = spdlog::get_level();
   if (level > spdlog::level::debug) spdlog::set_level(spdlog::level::warn);
   calibration.Prepare(options, pairs);
@@ -255,7 +250,7 @@ Reconstruction MapFirstModel(const IncrementalMapperOptions& options, const Mapp
     // Global bundle adjustments as it grew refined the focal length; the final rounds
     // of refinement would cost as much again for little more.
     RunControl no_observer;
-    Grow(&mapper, &no_observer, kMaxCalibrationImages);
+    Grow(&mapper, &no_observer, kMaxFirstModelImages);
     model = mapper.TakeModel();
   }
   spdlog::set_level(level);
@@ -317,42 +312,24 @@ void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
     }
     unrefined.insert(camera_id);
   }
-  std::vector<const MapperInput::Pair*> pairs = verified_pairs;
-  while (!unrefined.empty() && !pairs.empty()) {
-    const Reconstruction model = MapFirstModel(options, run, *cameras, pairs);
-    for (auto& [camera_id, report] : by_camera) {
-      const auto it = model.cameras.find(camera_id);
-      if (unrefined.count(camera_id) == 0 || model.images.size() < kMinCalibrationImages ||
-          it == model.cameras.end()) {
-        continue;
-      }
-      unrefined.erase(camera_id);
-      const Camera& camera = cameras->at(camera_id);
-      const double side = static_cast<double>(std::max(camera.width, camera.height));
-      const double focal = it->second.MeanFocalLength();
-      if (!(focal > 0.25 * side && focal < 5 * side)) continue;
-      cameras->at(camera_id).SetFocalLength(focal);
-      report.estimated = focal;
-      report.method = report.method.empty() ? "first model" : report.method + ", first model";
-      report.num_images = model.images.size();
-    }
-    // The pairs among images of the cameras still to refine; the same pairs as before
-    // (nothing refined) would give the same model again.
-    std::vector<const MapperInput::Pair*> remaining;
-    for (const MapperInput::Pair* pair : pairs) {
-      if (unrefined.count(run.input.images.at(pair->image_id1).camera_id) > 0 &&
-          unrefined.count(run.input.images.at(pair->image_id2).camera_id) > 0) {
-        remaining.push_back(pair);
-      }
-    }
-    if (remaining.size() == pairs.size()) break;
-    pairs = std::move(remaining);
+  MapperRunState calibration(run.input, run.bundle_adjuster, run.seed);
+  calibration.ransac = run.ransac;
+  calibration.cameras = *cameras;
+  for (const auto& [camera_id, refined] :
+       FocalLengthsFromFirstModels(options, calibration, unrefined, verified_pairs)) {
+    unrefined.erase(camera_id);
+    if (refined.focal_length == 0) continue;  // implausible: the real pass refines it
+    cameras->at(camera_id).SetFocalLength(refined.focal_length);
+    FocalLengthReport& report = by_camera.at(camera_id);
+    report.estimated = refined.focal_length;
+    report.method = report.method.empty() ? "first model" : report.method + ", first model";
+    report.num_images = refined.num_images;
   }
   for (const camera_t camera_id : unrefined) {
     spdlog::info(
         "map: camera {}: no first model of {} images or more to refine its focal length "
         "from; mapping starts from {:.1f} px",
-        camera_id, kMinCalibrationImages, by_camera.at(camera_id).estimated);
+        camera_id, kMinFirstModelImages, by_camera.at(camera_id).estimated);
   }
   for (const auto& [camera_id, report] : by_camera) {
     if (report.method.empty()) continue;
@@ -444,6 +421,36 @@ std::map<image_t, std::string> UnregisteredReasons(const IncrementalMapperOption
 }
 
 }  // namespace
+
+std::map<camera_t, FirstModelFocalLength> FocalLengthsFromFirstModels(
+    const IncrementalMapperOptions& options, const MapperRunState& run,
+    std::set<camera_t> to_refine, std::vector<const MapperInput::Pair*> pairs) {
+  std::map<camera_t, FirstModelFocalLength> refined;
+  while (!to_refine.empty() && !pairs.empty()) {
+    const Reconstruction model = MapFirstModel(options, run, pairs);
+    if (model.images.size() >= kMinFirstModelImages) {
+      for (const auto& [camera_id, camera] : model.cameras) {
+        if (to_refine.erase(camera_id) == 0) continue;
+        const double side = static_cast<double>(std::max(camera.width, camera.height));
+        const double focal = camera.MeanFocalLength();
+        refined[camera_id] = {focal > 0.25 * side && focal < 5 * side ? focal : 0.0,
+                              model.images.size()};
+      }
+    }
+    // The pairs among images of the cameras still to refine; the same pairs as before
+    // (nothing refined) would give the same model again.
+    std::vector<const MapperInput::Pair*> remaining;
+    for (const MapperInput::Pair* pair : pairs) {
+      if (to_refine.count(run.input.images.at(pair->image_id1).camera_id) > 0 &&
+          to_refine.count(run.input.images.at(pair->image_id2).camera_id) > 0) {
+        remaining.push_back(pair);
+      }
+    }
+    if (remaining.size() == pairs.size()) break;
+    pairs = std::move(remaining);
+  }
+  return refined;
+}
 
 IncrementalPipeline::IncrementalPipeline(const IncrementalMapperOptions& options,
                                          const BundleAdjuster& bundle_adjuster, uint64_t seed,

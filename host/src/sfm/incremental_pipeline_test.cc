@@ -7,6 +7,7 @@
 #include "synthetic_scene.h"
 #include "tessera/errors.h"
 #include "tessera/io/model_statistics.h"
+#include "tessera/sfm/first_model_calibration.h"
 #include "tessera/sfm/gps_anchoring.h"
 #include "test_support.h"
 
@@ -242,6 +243,33 @@ TEST(IncrementalPipeline, EstimatesTheFocalLengthOfEachSceneInAMixedSet) {
       EXPECT_NEAR(camera.FocalLengthX(), truth, 0.005 * truth);
     }
   }
+}
+
+// The building block both mappers calibrate with: a first model of at most 20 images
+// refines the focal length of the cameras asked for, here each scene's own.
+TEST(FirstModelCalibration, RefinesTheFocalLengthOfEachCameraAskedFor) {
+  SyntheticSceneOptions first;
+  first.focal_prior = false;
+  first.prior_focal_factor = 1.3;
+  first.seed = 11;
+  SyntheticSceneOptions second = first;
+  second.focal_length = 1400;
+  second.prior_focal_factor = 0.9;
+  second.seed = 13;
+  SyntheticScene scene = MakeSyntheticScene(first);
+  testing::AppendScene(MakeSyntheticScene(second), 100, "second_", 2, &scene);
+  std::vector<const MapperInput::Pair*> pairs;
+  for (const MapperInput::Pair& pair : scene.input.pairs) pairs.push_back(&pair);
+  MapperRunState run(scene.input, testing::CeresAdjusterOnOneThread(), 7);
+  const std::map<camera_t, FirstModelFocalLength> refined =
+      FocalLengthsFromFirstModels(IncrementalMapperOptions(), run, {1, 2}, pairs);
+  ASSERT_EQ(refined.size(), 2u);
+  EXPECT_NEAR(refined.at(1).focal_length, first.focal_length, 0.02 * first.focal_length);
+  EXPECT_NEAR(refined.at(2).focal_length, second.focal_length, 0.02 * second.focal_length);
+  EXPECT_GE(refined.at(1).num_images, kMinFirstModelImages);
+  EXPECT_LE(refined.at(1).num_images, kMaxFirstModelImages);
+  // Only the cameras asked for.
+  EXPECT_EQ(FocalLengthsFromFirstModels(IncrementalMapperOptions(), run, {2}, pairs).count(1), 0u);
 }
 
 // GPS for each image of `scene`: its true centre, scaled to metres, in an east-north-up

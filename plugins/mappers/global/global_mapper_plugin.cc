@@ -2,16 +2,39 @@
 // calibration, rotation averaging, global positioning of cameras and points from a
 // random start, bundle adjustment with filtering and retriangulation) behind the mapper
 // interface, with the same self-check against the view graph as the incremental one.
+// Where the view graph does not determine a camera's focal length (images around an
+// object), a first model of a few images does, before rotation averaging: relative
+// rotations from a focal length far off are wrong.
 // Its options are GlobalMapperOptions (tessera/sfm/global_mapper_options.h) and the
 // self-check's two.
 
+#include <algorithm>
+#include <optional>
+#include <set>
 #include <string>
+#include <vector>
 
 #include "tessera/sdk.h"
+#include "tessera/sfm/first_model_calibration.h"
+#include "tessera/sfm/focal_length_estimation.h"
 #include "tessera/sfm/global_mapper.h"
 #include "tessera/sfm/view_graph.h"
 
 namespace tessera {
+namespace {
+
+// A view-graph focal length whose mean robust cost per pair is above this has no clear
+// minimum (FocalLengthEstimate::cost), as the incremental mapper also judges.
+constexpr double kClearFocalMinimumCost = 0.05;
+
+// Configurations whose matches are correspondences of one 3D point.
+bool IsVerified(int config) {
+  return config == TwoViewGeometry::CALIBRATED || config == TwoViewGeometry::UNCALIBRATED ||
+         config == TwoViewGeometry::PLANAR || config == TwoViewGeometry::PANORAMIC ||
+         config == TwoViewGeometry::PLANAR_OR_PANORAMIC;
+}
+
+}  // namespace
 
 class GlobalMapperPlugin : public Mapper {
  public:
@@ -36,16 +59,33 @@ class GlobalMapperPlugin : public Mapper {
     }
     GlobalMapperOptions options = options_;
     options.seed = static_cast<int>(context.seed & 0x7fffffff);
-    const GlobalMapperResult mapped = GlobalMapper::Reconstruct(
-        input, *context.bundle_adjuster, options, context.control.should_stop);
     MapperResult result;
+    const std::optional<MapperInput> calibrated =
+        WithFirstModelFocalLengths(input, context, &result.focal_lengths);
+    if (context.control.should_stop && context.control.should_stop()) {
+      result.cancelled = true;
+      return result;
+    }
+    const GlobalMapperResult mapped =
+        GlobalMapper::Reconstruct(calibrated ? *calibrated : input, *context.bundle_adjuster,
+                                  options, context.control.should_stop);
     if (mapped.cancelled) {
+      result = MapperResult();
       result.cancelled = true;
       return result;
     }
     result.models = mapped.models;
+    for (Reconstruction& model : result.models) {
+      for (auto& [camera_id, camera] : model.cameras) {
+        camera.has_prior_focal_length = input.cameras.at(camera_id).has_prior_focal_length;
+      }
+    }
     result.unregistered_reasons = mapped.unregistered_reasons;
     for (const auto& [camera_id, focal] : mapped.estimated_focal_lengths) {
+      if (std::any_of(result.focal_lengths.begin(), result.focal_lengths.end(),
+                      [id = camera_id](const FocalLengthReport& r) { return r.camera_id == id; })) {
+        continue;
+      }
       FocalLengthReport report;
       report.camera_id = camera_id;
       report.initial = input.cameras.at(camera_id).MeanFocalLength();
@@ -61,6 +101,7 @@ class GlobalMapperPlugin : public Mapper {
     result.self_checks = SelfChecks(input, context.seed, result.models);
     result.details = {
         {"num_verified_pairs", mapped.num_verified_pairs},
+        {"num_weak_pairs_set_aside", mapped.num_weak_pairs_set_aside},
         {"num_pairs_dropped_by_cycles", mapped.num_pairs_dropped_by_cycles},
         {"num_pairs_dropped_by_rotation_averaging", mapped.num_pairs_dropped_by_rotation_averaging},
         {"num_tracks", mapped.num_tracks},
@@ -82,6 +123,62 @@ class GlobalMapperPlugin : public Mapper {
   }
 
  private:
+  // `input` with the focal lengths that first models refine, for the cameras without a
+  // prior whose focal length the view graph does not determine; nullopt when there are
+  // none. Each refined camera is reported in `reports`.
+  std::optional<MapperInput> WithFirstModelFocalLengths(
+      const MapperInput& input, const MapperContext& context,
+      std::vector<FocalLengthReport>* reports) const {
+    if (!options_.estimate_focal_length) return std::nullopt;
+    std::vector<const MapperInput::Pair*> pairs;
+    for (const MapperInput::Pair& pair : input.pairs) {
+      if (static_cast<int>(pair.geometry.inlier_matches.size()) >= options_.min_num_matches &&
+          IsVerified(pair.geometry.config) && input.images.count(pair.image_id1) > 0 &&
+          input.images.count(pair.image_id2) > 0) {
+        pairs.push_back(&pair);
+      }
+    }
+    const std::map<camera_t, FocalLengthEstimate> from_view_graph =
+        EstimateFocalLengths(input, pairs, FocalLengthEstimationOptions());
+    std::set<camera_t> undetermined;
+    for (const auto& [camera_id, camera] : input.cameras) {
+      const auto it = from_view_graph.find(camera_id);
+      if (!camera.has_prior_focal_length &&
+          (it == from_view_graph.end() || it->second.at_search_bound ||
+           it->second.cost > kClearFocalMinimumCost)) {
+        undetermined.insert(camera_id);
+      }
+    }
+    if (undetermined.empty() || pairs.empty()) return std::nullopt;
+    MapperRunState run(input, *context.bundle_adjuster, context.seed);
+    const std::map<camera_t, FirstModelFocalLength> refined =
+        FocalLengthsFromFirstModels(IncrementalMapperOptions(), run, undetermined, pairs);
+    std::optional<MapperInput> calibrated;
+    for (const auto& [camera_id, first_model] : refined) {
+      if (first_model.focal_length == 0) continue;
+      if (!calibrated) calibrated = input;
+      Camera& camera = calibrated->cameras.at(camera_id);
+      FocalLengthReport report;
+      report.camera_id = camera_id;
+      report.initial = camera.MeanFocalLength();
+      report.estimated = first_model.focal_length;
+      report.method = "first model";
+      report.num_images = first_model.num_images;
+      camera.SetFocalLength(first_model.focal_length);
+      // Known now: the global mapper's view-graph estimate must not replace it. The
+      // models say again that it had no prior (Map).
+      camera.has_prior_focal_length = true;
+      log().Info("camera " + std::to_string(camera_id) +
+                 ": the view graph does not determine its focal length; a first model of " +
+                 std::to_string(first_model.num_images) + " images gives " +
+                 std::to_string(static_cast<int>(first_model.focal_length + 0.5)) +
+                 " px (the default was " + std::to_string(static_cast<int>(report.initial + 0.5)) +
+                 " px)");
+      reports->push_back(report);
+    }
+    return calibrated;
+  }
+
   // Each model against the view graph of its verified pairs, with its own cameras: the
   // incremental mapper's self-check (tessera/sfm/view_graph.h).
   std::vector<ModelSelfCheck> SelfChecks(const MapperInput& input, uint64_t seed,

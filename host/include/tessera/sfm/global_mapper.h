@@ -43,7 +43,8 @@ struct GlobalMapperResult {
   std::map<image_t, std::string> unregistered_reasons;
   // Cameras without a prior whose focal length the view graph gave (px).
   std::map<camera_t, double> estimated_focal_lengths;
-  size_t num_verified_pairs = 0;
+  size_t num_verified_pairs = 0;        // that took part
+  size_t num_weak_pairs_set_aside = 0;  // by min_relative_pair_strength
   size_t num_pairs_dropped_by_cycles = 0;
   size_t num_pairs_dropped_by_rotation_averaging = 0;
   size_t num_tracks = 0;             // over the pairs kept

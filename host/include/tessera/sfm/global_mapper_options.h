@@ -12,6 +12,12 @@ namespace tessera {
 struct TESSERA_SFM_EXPORT GlobalMapperOptions {
   // Pairs with fewer verified inliers do not take part.
   int min_num_matches = 15;
+  // ... nor pairs with fewer inliers than this share of the strongest pair of either of
+  // their images (each image keeps its strongest pair). Around an object, pairs of
+  // far-apart views hold wrong matches (symmetric or repeated structure) whose relative
+  // rotations, half of fox's pairs, overwhelm rotation averaging; they are weak next to
+  // the pairs of neighbouring views. 0: every pair.
+  double min_relative_pair_strength = 0.2;
   // Focal lengths of cameras without a prior from the view graph (its fundamental
   // matrices), where the pairs determine them.
   bool estimate_focal_length = true;

@@ -1,0 +1,42 @@
+#pragma once
+
+// Focal lengths refined in a first model: where the image pairs do not determine a
+// camera's focal length (every camera aiming at one point, as around an object), a
+// small incremental model of a few images does, by bundle adjustment. Both bundled
+// mappers start from it: the incremental one before its real pass, the global one
+// (its plugin) before rotation averaging, whose relative rotations need the right focal
+// length.
+
+#include <cstddef>
+#include <map>
+#include <set>
+#include <vector>
+
+#include "tessera/mapper.h"
+#include "tessera/sfm/export.h"
+#include "tessera/sfm/incremental_mapper.h"
+#include "tessera/sfm/incremental_mapper_options.h"
+
+namespace tessera {
+
+struct FirstModelFocalLength {
+  double focal_length = 0;  // px
+  size_t num_images = 0;    // of the first model that refined it
+};
+
+// A first model needs this many images at least, and grows to this many at most (its
+// bundle adjustment determines the focal length well long before, at a fraction of a
+// whole model's cost).
+constexpr size_t kMinFirstModelImages = 5;
+constexpr size_t kMaxFirstModelImages = 20;
+
+// Maps first models of at most kMaxFirstModelImages images from `pairs` with `run.cameras`, until
+// each camera of `to_refine` is in one of kMinFirstModelImages images or more, or no pair is left
+// among the images of cameras still to refine (several scenes in one folder get a first model
+// each). Returns the refined focal length of each camera a first model reached, 0 where it is
+// implausible (below a quarter or above five times the image's larger side).
+TESSERA_SFM_EXPORT std::map<camera_t, FirstModelFocalLength> FocalLengthsFromFirstModels(
+    const IncrementalMapperOptions& options, const MapperRunState& run,
+    std::set<camera_t> to_refine, std::vector<const MapperInput::Pair*> pairs);
+
+}  // namespace tessera
