@@ -4,8 +4,9 @@
 # examples/fountain-P11-small (in the repository), with ORB for speed:
 #  1. malformed JSON, two reference cameras, a bad rotation: exit 2 before an image is
 #     read (no workspace is made);
-#  2. `run --rig` naming a camera folder with no images: exit 2 from the map stage,
-#     naming cameras[1].folder;
+#  2. `run --rig` naming a camera folder that is not there: exit 2 before an image is
+#     read; one that has no images: exit 2 from the map stage; both naming
+#     cameras[1].folder;
 #  3. `map --rig` on that workspace, the two cameras' folders with different image
 #     counts: exit 2 naming the moment that one camera has no image of.
 # usage: rig_file_test.sh TESSERA DOWNSCALE SOURCE_DIR
@@ -67,9 +68,13 @@ expect_exit_2 "$work/bad_rotation.json" \
   "cameras[1].cam_from_rig.rotation_wxyz: must be an array of 4 numbers" run --images "$work/images"
 [ ! -e "$work/out/database.db" ] || fail "a bad rig file: the workspace was made all the same"
 
-# 2. A camera folder with no images.
+# 2. A camera folder that is not there (before an image is read), then one with no images.
 echo '{"cameras": [{"folder": "left", "reference": true}, {"folder": "center"}]}' \
   > "$work/no_images.json"
+expect_exit_2 "$work/no_images.json" "cameras[1].folder: 'center' is not a folder of" \
+  run --images "$work/images"
+[ ! -e "$work/out/database.db" ] || fail "a rig folder that is not there: the workspace was made"
+mkdir "$work/images/center"
 expect_exit_2 "$work/no_images.json" "cameras[1].folder: 'center' has no images" \
   run --images "$work/images"
 

@@ -177,6 +177,16 @@ std::string RigFile::FramesDescription() const {
   return pattern_text_ ? "pattern " + *pattern_text_ : "same_name";
 }
 
+void RigFile::CheckFolders(const std::filesystem::path& image_dir) const {
+  for (size_t k = 0; k < cameras_.size(); ++k) {
+    std::error_code error;
+    if (!std::filesystem::is_directory(image_dir / cameras_[k].folder, error)) {
+      throw InputError(Field("cameras[" + std::to_string(k) + "].folder") + "'" +
+                       cameras_[k].folder + "' is not a folder of " + image_dir.string());
+    }
+  }
+}
+
 std::string RigFile::Field(const std::string& field) const {
   return path_.string() + ": " + field + ": ";
 }

@@ -46,6 +46,9 @@ class RigFile {
   const std::string& digest() const { return digest_; }
   // "same_name", or the pattern.
   std::string FramesDescription() const;
+  // Throws InputError naming the file and field for a camera whose folder is not a
+  // folder of `image_dir` (before any image is read; an empty one is MakeCameraRig's).
+  void CheckFolders(const std::filesystem::path& image_dir) const;
 
   // The rig over a workspace's images: each rig camera is the one camera of the images
   // of its folder, and a frame is every camera's image of one moment, frames in the

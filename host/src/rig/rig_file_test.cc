@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "tessera/errors.h"
+#include "test_support.h"
 
 namespace tessera {
 namespace {
@@ -112,6 +113,21 @@ TEST(RigFile, BadFilesNameTheFileAndField) {
               "frames": "by_time"})j"),
             "rig.json: frames: must be \"same_name\" or {\"pattern\": \"REGEX with one capture "
             "group\"}");
+}
+
+TEST(RigFile, AFolderThatIsNotThereIsNamedBeforeAnyImageIsRead) {
+  const testing::TemporaryDir dir;
+  std::filesystem::create_directories(dir.path() / "left");
+  const RigFile rig = RigFile::Parse(kStereo, "rig.json");
+  try {
+    rig.CheckFolders(dir.path());
+    FAIL() << "no error for a missing folder";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "rig.json: cameras[1].folder: 'right' is not a folder of " + dir.path().string());
+  }
+  std::filesystem::create_directories(dir.path() / "right");
+  EXPECT_NO_THROW(rig.CheckFolders(dir.path()));
 }
 
 TEST(RigFile, ImagesThatDoNotMakeTheRigNameTheField) {
