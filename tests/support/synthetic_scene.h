@@ -20,6 +20,7 @@
 #include <cmath>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -81,6 +82,10 @@ struct SyntheticSceneOptions {
   double symmetric_fraction = 0;
   double mirror_min_offset_deg = 15;
   double mirror_max_offset_deg = 60;
+  // A two-camera rig: each of the num_images positions is a frame of two images, image
+  // 2i+1 of camera 1 (the reference) at the position and image 2i+2 of camera 2 at
+  // rig_cam_from_rig times it; input.rigs holds the rig, cam_from_rig to be estimated.
+  std::optional<Rigid3d> rig_cam_from_rig;
   uint64_t seed = 1;
 };
 
@@ -128,6 +133,14 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
   for (const int idx : extra_idx) prior_camera.params[idx] = 0;
   prior_camera.has_prior_focal_length = options.focal_prior;
   scene.input.cameras[1] = prior_camera;
+  if (options.rig_cam_from_rig) {
+    scene.input.cameras[2] = prior_camera;
+    scene.input.cameras[2].camera_id = 2;
+    CameraRig rig;
+    rig.reference_camera = 1;
+    rig.cam_from_rig = {{1, Rigid3d()}, {2, Rigid3d()}};
+    scene.input.rigs.push_back(rig);
+  }
 
   const bool path = options.layout == SyntheticSceneOptions::Layout::kPath;
   // kPath: the slab reaches past both ends of the path by what the first and last
@@ -168,7 +181,6 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
   std::map<image_t, double> viewing_angle_deg;
 
   for (int i = 0; i < options.num_images; ++i) {
-    const image_t image_id = static_cast<image_t>(i + 1);
     const double angle =
         (options.arc_deg * M_PI / 180) *
         (options.num_images > 1 ? static_cast<double>(i) / (options.num_images - 1) - 0.5 : 0);
@@ -183,45 +195,57 @@ inline SyntheticScene MakeSyntheticScene(const SyntheticSceneOptions& options) {
                                -options.radius * std::cos(angle));
       z_axis = (-center + Eigen::Vector3d(0.2 * unit(engine), 0.2 * unit(engine), 0)).normalized();
     }
-    viewing_angle_deg[image_id] = path ? 0.0 : angle * 180 / M_PI;
     const Eigen::Vector3d x_axis = Eigen::Vector3d::UnitY().cross(z_axis).normalized();
     const Eigen::Vector3d y_axis = z_axis.cross(x_axis);
     Eigen::Matrix3d world_from_cam;
     world_from_cam << x_axis, y_axis, z_axis;
     const Eigen::Quaterniond cam_from_world_rotation(world_from_cam.transpose());
-    const Rigid3d cam_from_world(cam_from_world_rotation, cam_from_world_rotation * -center);
-    scene.true_cam_from_world[image_id] = cam_from_world;
+    const Rigid3d position_from_world(cam_from_world_rotation, cam_from_world_rotation * -center);
+    for (int k = 0; k < (options.rig_cam_from_rig ? 2 : 1); ++k) {
+      const image_t image_id = options.rig_cam_from_rig ? static_cast<image_t>(2 * i + 1 + k)
+                                                        : static_cast<image_t>(i + 1);
+      const Rigid3d cam_from_world =
+          k == 0 ? position_from_world : *options.rig_cam_from_rig * position_from_world;
+      const Eigen::Vector3d image_center = cam_from_world.Inverse().translation;
+      if (options.rig_cam_from_rig) {
+        scene.input.rigs.front().frames.resize(i + 1);
+        scene.input.rigs.front().frames[i][static_cast<camera_t>(k + 1)] = image_id;
+      }
+      scene.true_cam_from_world[image_id] = cam_from_world;
+      viewing_angle_deg[image_id] = path ? 0.0 : angle * 180 / M_PI;
 
-    Image image;
-    image.image_id = image_id;
-    image.camera_id = 1;
-    image.name = "synthetic_" + std::to_string(image_id) + ".png";
-    std::vector<std::pair<Eigen::Vector2d, int>> keypoints;
-    for (int p = 0; p < num_all_points; ++p) {
-      if (!visible_from(scene.true_points3D[p], center)) continue;
-      const Eigen::Vector3d point_in_cam = cam_from_world * scene.true_points3D[p];
-      if (point_in_cam.z() <= 0.1) continue;
-      Eigen::Vector2d xy = true_camera.ImgFromCam(point_in_cam);
-      xy += Eigen::Vector2d(noise(engine), noise(engine));
-      if (xy.x() < 0 || xy.y() < 0 || xy.x() >= options.width || xy.y() >= options.height) continue;
-      keypoints.emplace_back(xy, p);
+      Image image;
+      image.image_id = image_id;
+      image.camera_id = static_cast<camera_t>(k + 1);
+      image.name = "synthetic_" + std::to_string(image_id) + ".png";
+      std::vector<std::pair<Eigen::Vector2d, int>> keypoints;
+      for (int p = 0; p < num_all_points; ++p) {
+        if (!visible_from(scene.true_points3D[p], image_center)) continue;
+        const Eigen::Vector3d point_in_cam = cam_from_world * scene.true_points3D[p];
+        if (point_in_cam.z() <= 0.1) continue;
+        Eigen::Vector2d xy = true_camera.ImgFromCam(point_in_cam);
+        xy += Eigen::Vector2d(noise(engine), noise(engine));
+        if (xy.x() < 0 || xy.y() < 0 || xy.x() >= options.width || xy.y() >= options.height)
+          continue;
+        keypoints.emplace_back(xy, p);
+      }
+      // Clutter: keypoints of nothing, a tenth as many.
+      const size_t num_clutter = keypoints.size() / 10;
+      for (size_t c = 0; c < num_clutter; ++c) {
+        keypoints.emplace_back(Eigen::Vector2d((unit(engine) + 0.5) * options.width,
+                                               (unit(engine) + 0.5) * options.height),
+                               -1);
+      }
+      std::shuffle(keypoints.begin(), keypoints.end(), engine);
+      std::vector<int>& true_point = scene.true_point_of_keypoint[image_id];
+      for (const auto& [xy, p] : keypoints) {
+        Point2D point2D;
+        point2D.xy = xy;
+        image.points2D.push_back(point2D);
+        true_point.push_back(p);
+      }
+      scene.input.images[image_id] = image;
     }
-    // Clutter: keypoints of nothing, a tenth as many.
-    const size_t num_clutter = keypoints.size() / 10;
-    for (size_t c = 0; c < num_clutter; ++c) {
-      keypoints.emplace_back(Eigen::Vector2d((unit(engine) + 0.5) * options.width,
-                                             (unit(engine) + 0.5) * options.height),
-                             -1);
-    }
-    std::shuffle(keypoints.begin(), keypoints.end(), engine);
-    std::vector<int>& true_point = scene.true_point_of_keypoint[image_id];
-    for (const auto& [xy, p] : keypoints) {
-      Point2D point2D;
-      point2D.xy = xy;
-      image.points2D.push_back(point2D);
-      true_point.push_back(p);
-    }
-    scene.input.images[image_id] = image;
   }
 
   for (const auto& [image_id1, image1] : scene.input.images) {

@@ -80,7 +80,8 @@ inline std::string BundleAdjustmentSummary::BriefReport() const {
 //   config.constant_points and the poses of config.constant_poses.
 // - Gauge: with fix_gauge and no constant pose in the problem, hold the pose of the
 //   lowest image id with observations and the largest-magnitude translation
-//   coordinate of the next one; with a constant pose, fix nothing else.
+//   coordinate of the next one (a rig frame with a constant cam_from_rig gives the
+//   scale instead); with a constant pose, fix nothing else.
 // - Intrinsics move only as the refine_* flags say; max_num_iterations > 0 caps the
 //   adjuster's own, function_tolerance >= 0 replaces it.
 // - Write back only a usable result, and only what could move (constant values stay

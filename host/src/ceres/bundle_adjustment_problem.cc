@@ -2,13 +2,125 @@
 
 #include <ceres/manifold.h>
 
+#include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "tessera/ceres/position_prior_cost.h"
 #include "tessera/ceres/reprojection_cost.h"
 #include "tessera/io/model_statistics.h"
 
 namespace tessera {
+namespace {
+
+// The reprojection residual of an image of a rig camera. Its camera's parameter block
+// carries the camera's cam_from_rig (kPoseBlockSize values) after the intrinsics: one
+// block per rig camera, shared by all its images as the rig's relative pose is. With
+// `compose`, the pose block is the frame's rig_from_world (its reference image's pose)
+// and cam_from_world = cam_from_rig * rig_from_world; without, the pose block is the
+// image's own cam_from_world (an image of the camera outside a frame of the problem).
+template <typename CameraModel>
+class RigReprojectionErrorCostFunctor {
+ public:
+  RigReprojectionErrorCostFunctor(const Eigen::Vector2d& point2D, bool compose)
+      : observed_x_(point2D.x()), observed_y_(point2D.y()), compose_(compose) {}
+
+  static ceres::CostFunction* Create(const Eigen::Vector2d& point2D, bool compose) {
+    return new ceres::AutoDiffCostFunction<RigReprojectionErrorCostFunctor<CameraModel>, 2,
+                                           kPoseBlockSize, 3,
+                                           CameraModel::kNumParams + kPoseBlockSize>(
+        new RigReprojectionErrorCostFunctor(point2D, compose));
+  }
+
+  template <typename T>
+  bool operator()(const T* const pose, const T* const point3D, const T* const camera_and_rig,
+                  T* residuals) const {
+    T point_in_pose[3];
+    ceres::AngleAxisRotatePoint(pose, point3D, point_in_pose);
+    for (int i = 0; i < 3; ++i) point_in_pose[i] += pose[kPoseTranslationOffset + i];
+    T point_in_cam[3] = {point_in_pose[0], point_in_pose[1], point_in_pose[2]};
+    if (compose_) {
+      const T* const cam_from_rig = camera_and_rig + CameraModel::kNumParams;
+      ceres::AngleAxisRotatePoint(cam_from_rig, point_in_pose, point_in_cam);
+      for (int i = 0; i < 3; ++i) point_in_cam[i] += cam_from_rig[kPoseTranslationOffset + i];
+    }
+    T x, y;
+    CameraModel::ImgFromCam(camera_and_rig, point_in_cam[0], point_in_cam[1], point_in_cam[2], &x,
+                            &y);
+    residuals[0] = x - T(observed_x_);
+    residuals[1] = y - T(observed_y_);
+    return true;
+  }
+
+ private:
+  const double observed_x_;
+  const double observed_y_;
+  const bool compose_;
+};
+
+// A composed residual as the problem holds it: it names its image, so that WriteBack
+// finds the images whose pose is cam_from_rig * rig_from_world, and where both are.
+class ComposedRigResidual final : public ceres::CostFunction {
+ public:
+  ComposedRigResidual(image_t image_id, int num_intrinsics, ceres::CostFunction* reprojection)
+      : image_id_(image_id), num_intrinsics_(num_intrinsics), reprojection_(reprojection) {
+    set_num_residuals(reprojection->num_residuals());
+    *mutable_parameter_block_sizes() = reprojection->parameter_block_sizes();
+  }
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    return reprojection_->Evaluate(parameters, residuals, jacobians);
+  }
+  image_t image_id() const { return image_id_; }
+  // Where cam_from_rig starts in the camera's parameter block.
+  int num_intrinsics() const { return num_intrinsics_; }
+
+ private:
+  const image_t image_id_;
+  const int num_intrinsics_;
+  const std::unique_ptr<ceres::CostFunction> reprojection_;
+};
+
+// What the configuration's rigs make of the images of a problem.
+struct RigLayout {
+  // Images whose pose is cam_from_rig * rig_from_world: each with its frame's reference
+  // image, whose pose block is rig_from_world.
+  std::map<image_t, image_t> reference_image_of;
+  // The non-reference cameras of those images, with their cam_from_rig.
+  std::map<camera_t, Rigid3d> cam_from_rig;
+};
+
+// An image of a frame is composed when its camera is not the reference, the frame's
+// reference image is in the problem, and its own pose is not held constant (a constant
+// pose stays what it is).
+RigLayout LayOutRigs(const BundleAdjustmentConfig& config, const std::set<image_t>& image_ids) {
+  RigLayout layout;
+  for (const CameraRig& rig : config.rigs) {
+    for (const auto& frame : rig.frames) {
+      const auto reference = frame.find(rig.reference_camera);
+      if (reference == frame.end() || image_ids.count(reference->second) == 0) continue;
+      for (const auto& [camera_id, image_id] : frame) {
+        if (camera_id == rig.reference_camera || image_ids.count(image_id) == 0 ||
+            config.constant_poses.count(image_id) > 0) {
+          continue;
+        }
+        layout.reference_image_of[image_id] = reference->second;
+        layout.cam_from_rig[camera_id] = rig.cam_from_rig.at(camera_id);
+      }
+    }
+  }
+  return layout;
+}
+
+// Whether a rig camera's cam_from_rig stays as it is.
+bool RigPoseConstant(const BundleAdjustmentConfig& config, camera_t camera_id) {
+  for (const CameraRig& rig : config.rigs) {
+    if (rig.cam_from_rig.count(camera_id) > 0) return rig.poses_known || !config.refine_rig_poses;
+  }
+  return true;
+}
+
+}  // namespace
 
 BundleAdjustmentProblem::BundleAdjustmentProblem(const BundleAdjustmentConfig& config,
                                                  const Reconstruction& reconstruction,
@@ -18,10 +130,67 @@ BundleAdjustmentProblem::BundleAdjustmentProblem(const BundleAdjustmentConfig& c
   if (error_.empty()) error_ = CollectObservations(reconstruction);
   if (!error_.empty()) return;
 
-  // The loss is shared by every reprojection residual and owned by the problem.
-  AddResiduals(reconstruction, make_loss ? make_loss() : nullptr);
   error_ = RefuseRigs(config);
-  if (error_.empty()) error_ = AddPositionPriors(config);
+  if (!error_.empty()) return;
+
+  // The loss is shared by every reprojection residual and owned by the problem.
+  ceres::LossFunction* loss_function = make_loss ? make_loss() : nullptr;
+  const RigLayout rigs = LayOutRigs(config, image_ids_);
+  if (rigs.reference_image_of.empty()) {
+    AddResiduals(reconstruction, loss_function);
+  } else {
+    // A rig camera's block carries its cam_from_rig after the intrinsics.
+    for (const auto& [camera_id, cam_from_rig] : rigs.cam_from_rig) {
+      std::vector<double> block = reconstruction.cameras.at(camera_id).params;
+      const PoseBlock pose = PoseToBlock(cam_from_rig);
+      block.insert(block.end(), pose.begin(), pose.end());
+      cameras_.emplace(camera_id, std::move(block));
+    }
+    for (const Observation& observation : observations_) {
+      const Image& image = reconstruction.images.at(observation.image_id);
+      const auto reference = rigs.reference_image_of.find(observation.image_id);
+      const image_t pose_image =
+          reference != rigs.reference_image_of.end() ? reference->second : observation.image_id;
+      auto pose_it = poses_.find(pose_image);
+      if (pose_it == poses_.end()) {
+        pose_it = poses_
+                      .emplace(pose_image,
+                               PoseToBlock(reconstruction.images.at(pose_image).cam_from_world))
+                      .first;
+      }
+      auto camera_it = cameras_.find(image.camera_id);
+      if (camera_it == cameras_.end()) {
+        camera_it =
+            cameras_.emplace(image.camera_id, reconstruction.cameras.at(image.camera_id).params)
+                .first;
+      }
+      auto point_it = points_.find(observation.point3D_id);
+      if (point_it == points_.end()) {
+        point_it = points_
+                       .emplace(observation.point3D_id,
+                                reconstruction.points3D.at(observation.point3D_id).xyz)
+                       .first;
+      }
+      const Camera& camera = reconstruction.cameras.at(image.camera_id);
+      ceres::CostFunction* cost_function = nullptr;
+      if (rigs.cam_from_rig.count(image.camera_id) == 0) {
+        cost_function = CreateReprojectionErrorCostFunction(camera.model_id, observation.xy);
+      } else {
+        const bool compose = reference != rigs.reference_image_of.end();
+        VisitCameraModel(camera.model_id, [&](auto model) {
+          cost_function =
+              RigReprojectionErrorCostFunctor<decltype(model)>::Create(observation.xy, compose);
+        });
+        if (compose) {
+          cost_function = new ComposedRigResidual(
+              observation.image_id, static_cast<int>(camera.params.size()), cost_function);
+        }
+      }
+      problem_.AddResidualBlock(cost_function, loss_function, pose_it->second.data(),
+                                point_it->second.data(), camera_it->second.data());
+    }
+  }
+  error_ = AddPositionPriors(config);
   if (!error_.empty()) return;
   HoldPoints(config);
   HoldPosesAndGauge(config);
@@ -123,15 +292,23 @@ void BundleAdjustmentProblem::AddResiduals(const Reconstruction& rec,
   }
 }
 
-// A rig frame with an image in the problem: these blocks do not keep rigs rigid, and
-// must not pretend to.
+// Rigs the problem cannot keep: a frame's camera without a cam_from_rig, a camera in
+// two rigs.
 std::string BundleAdjustmentProblem::RefuseRigs(const BundleAdjustmentConfig& config) const {
-  for (const CameraRig& rig : config.rigs) {
+  std::map<camera_t, size_t> rig_of_camera;
+  for (size_t r = 0; r < config.rigs.size(); ++r) {
+    const CameraRig& rig = config.rigs[r];
+    for (const auto& [camera_id, cam_from_rig] : rig.cam_from_rig) {
+      if (!rig_of_camera.emplace(camera_id, r).second) {
+        return "camera " + std::to_string(camera_id) + " belongs to rigs " +
+               std::to_string(rig_of_camera.at(camera_id)) + " and " + std::to_string(r);
+      }
+    }
     for (const auto& frame : rig.frames) {
       for (const auto& [camera_id, image_id] : frame) {
-        if (poses_.count(image_id) > 0) {
-          return "image " + std::to_string(image_id) +
-                 " belongs to a camera rig, and the ceres adjuster does not hold rigs rigid";
+        if (rig.cam_from_rig.count(camera_id) == 0) {
+          return "image " + std::to_string(image_id) + " of a frame of rig " + std::to_string(r) +
+                 " has camera " + std::to_string(camera_id) + ", which the rig has no pose of";
         }
       }
     }
@@ -169,7 +346,8 @@ void BundleAdjustmentProblem::HoldPoints(const BundleAdjustmentConfig& config) {
 
 // Holds the configuration's constant poses; without any, with no position prior and with
 // fix_gauge, the gauge's 7 degrees of freedom: the first pose (6) and the scale through
-// one translation coordinate of the second, its largest so that the scale is well defined.
+// one translation coordinate of the second, its largest so that the scale is well defined,
+// unless a rig frame of the problem holds the scale with a constant cam_from_rig.
 void BundleAdjustmentProblem::HoldPosesAndGauge(const BundleAdjustmentConfig& config) {
   for (auto& [image_id, pose] : poses_) {
     if (config.constant_poses.count(image_id) > 0) {
@@ -182,7 +360,13 @@ void BundleAdjustmentProblem::HoldPosesAndGauge(const BundleAdjustmentConfig& co
     auto pose_it = poses_.begin();
     problem_.SetParameterBlockConstant(pose_it->second.data());
     fixed_poses_.insert(pose_it->first);
-    if (++pose_it != poses_.end()) {
+    // A constant cam_from_rig with a translation gives the scale itself.
+    bool rig_holds_scale = false;
+    for (const auto& [camera_id, cam_from_rig] : LayOutRigs(config, image_ids_).cam_from_rig) {
+      rig_holds_scale |=
+          RigPoseConstant(config, camera_id) && cam_from_rig.translation.squaredNorm() > 0;
+    }
+    if (++pose_it != poses_.end() && !rig_holds_scale) {
       int largest = 0;
       for (int i = 1; i < 3; ++i) {
         if (std::abs(pose_it->second[kPoseTranslationOffset + i]) >
@@ -211,6 +395,12 @@ void BundleAdjustmentProblem::ParametrizeIntrinsics(const BundleAdjustmentConfig
     hold(config.refine_focal_length, camera.FocalIdx());
     hold(config.refine_principal_point, camera.PrincipalPointIdx());
     hold(config.refine_extra_params, camera.ExtraParamsIdx());
+    // A rig camera's block: cam_from_rig after the intrinsics.
+    if (params.size() > camera.params.size() && RigPoseConstant(config, camera_id)) {
+      for (size_t i = camera.params.size(); i < params.size(); ++i) {
+        constant_params.push_back(static_cast<int>(i));
+      }
+    }
     if (constant_params.size() == params.size()) {
       problem_.SetParameterBlockConstant(params.data());
     } else {
@@ -229,8 +419,34 @@ void BundleAdjustmentProblem::WriteBack(Reconstruction* reconstruction) const {
     if (fixed_poses_.count(image_id) > 0) continue;
     reconstruction->images.at(image_id).cam_from_world = BlockToPose(pose);
   }
+  // The images of rig frames: cam_from_rig * rig_from_world, from the blocks their
+  // residuals hold. Only a problem with rigs has camera blocks longer than the intrinsics.
+  bool has_rigs = false;
+  for (const auto& [camera_id, params] : cameras_) {
+    has_rigs |= params.size() > reconstruction->cameras.at(camera_id).params.size();
+  }
+  if (has_rigs) {
+    std::vector<ceres::ResidualBlockId> residual_blocks;
+    problem_.GetResidualBlocks(&residual_blocks);
+    std::set<image_t> composed;
+    for (const ceres::ResidualBlockId residual_block : residual_blocks) {
+      const auto* residual = dynamic_cast<const ComposedRigResidual*>(
+          problem_.GetCostFunctionForResidualBlock(residual_block));
+      if (residual == nullptr || !composed.insert(residual->image_id()).second) continue;
+      std::vector<double*> blocks;
+      problem_.GetParameterBlocksForResidualBlock(residual_block, &blocks);
+      PoseBlock rig_from_world, cam_from_rig;
+      std::copy(blocks[0], blocks[0] + kPoseBlockSize, rig_from_world.begin());
+      std::copy(blocks[2] + residual->num_intrinsics(),
+                blocks[2] + residual->num_intrinsics() + kPoseBlockSize, cam_from_rig.begin());
+      reconstruction->images.at(residual->image_id()).cam_from_world =
+          BlockToPose(cam_from_rig) * BlockToPose(rig_from_world);
+    }
+  }
   for (const camera_t camera_id : variable_cameras_) {
-    reconstruction->cameras.at(camera_id).params = cameras_.at(camera_id);
+    std::vector<double>& params = reconstruction->cameras.at(camera_id).params;
+    const std::vector<double>& block = cameras_.at(camera_id);
+    params.assign(block.begin(), block.begin() + static_cast<std::ptrdiff_t>(params.size()));
   }
   for (const auto& [point3D_id, xyz] : points_) {
     if (!problem_.IsParameterBlockConstant(xyz.data())) {

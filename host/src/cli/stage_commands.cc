@@ -64,6 +64,13 @@ void AddCommonOptions(CLI::App* sub, StageOptions* options, bool needs_images) {
       ->check(CLI::Range(0, 1024));
 }
 
+// `--rig` (map and run): the mapper keeps each moment's images in their rig's poses.
+void AddRigOption(CLI::App* sub, StageOptions* options) {
+  sub->add_option("--rig", options->arguments.rig,
+                  "Rig file: cameras (subfolders), reference, poses, frames; implies "
+                  "--camera-per-folder");
+}
+
 PipelineContext LoadContext(const StageOptions& options) {
   return LoadPipelineContext(options.arguments);
 }
@@ -88,6 +95,7 @@ CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
   auto options = std::make_shared<StageOptions>();
   CLI::App* sub = app.add_subcommand("map", "Reconstruct cameras and points from a workspace");
   AddCommonOptions(sub, options.get(), /*needs_images=*/false);
+  AddRigOption(sub, options.get());
   return {sub, [options]() {
             const PipelineContext context = LoadContext(*options);
             const MapStageSummary summary =
@@ -152,6 +160,7 @@ CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions&) {
   auto options = std::make_shared<StageOptions>();
   CLI::App* sub = app.add_subcommand("run", "Run every stage: images in, model out");
   AddCommonOptions(sub, options.get(), /*needs_images=*/true);
+  AddRigOption(sub, options.get());
   return {sub, [options]() {
             const PipelineContext context = LoadContext(*options);
             const RunResult run =

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "feature/database_feature_reader.h"
+#include "image/camera_assignment.h"
 #include "outputs/output_transaction.h"
 #include "pipeline/load_mapper_input.h"
 #include "pipeline/mapper_result_check.h"
@@ -70,6 +71,37 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
   return summary;
 }
 
+// The mapping summary's rig section: which file, which content, which camera is which
+// folder.
+nlohmann::json SummarizeRig(const RigFile& file, const CameraRig& rig, const MapperInput& input) {
+  std::map<std::string, camera_t> camera_of_folder;
+  for (const auto& [image_id, image] : input.images) {
+    camera_of_folder.emplace(ImageFolder(image.name), image.camera_id);
+  }
+  nlohmann::json cameras = nlohmann::json::array();
+  for (const RigFileCamera& camera : file.cameras()) {
+    cameras.push_back({{"folder", camera.folder},
+                       {"camera_id", camera_of_folder.at(camera.folder)},
+                       {"reference", camera.reference}});
+  }
+  return {{"file", file.path().string()},       {"digest", file.digest()},
+          {"frames", file.FramesDescription()}, {"poses_known", rig.poses_known},
+          {"num_frames", rig.frames.size()},    {"cameras", cameras}};
+}
+
+// The workspace's mapper input, with the camera rig of `rig` (may be null) over its
+// images.
+MapperInput LoadMapperInputWithRig(const Database& database, const RigFile* rig) {
+  MapperInput input = LoadMapperInput(database);
+  if (rig == nullptr) return input;
+  input.rigs.push_back(rig->MakeCameraRig(input.images));
+  spdlog::info("map: rig {} (digest {}): {} cameras, {} frames ({}), cam_from_rig {}",
+               rig->path().string(), rig->digest(), input.rigs.back().cam_from_rig.size(),
+               input.rigs.back().frames.size(), rig->FramesDescription(),
+               input.rigs.back().poses_known ? "given" : "estimated");
+  return input;
+}
+
 // Writes model `index` into the transaction: with each exporter in its own staging
 // folder, or as COLMAP binary in sparse/<index> when there is none. A failing exporter
 // stops the set: its error is thrown, the earlier outputs stay whole, and what this run
@@ -125,6 +157,9 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
       settings.mapper != nullptr ? settings.mapper->name() : "",
       settings.mapper != nullptr ? settings.mapper->EffectiveOptions() : nlohmann::json::object(),
       settings.seed);
+  if (settings.rig != nullptr && !input.rigs.empty()) {
+    mapping.rig = SummarizeRig(*settings.rig, input.rigs.front(), input);
+  }
   summary->num_models = result.models.size();
   OutputTransaction outputs(output_dir);
   outputs.Protect(image_dir);
@@ -169,7 +204,7 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
     throw std::logic_error("MapWorkspace: no mapper or bundle adjuster, or a scope it cannot map");
   }
   Database* database = &workspace.database();
-  const MapperInput input = LoadMapperInput(*database);
+  const MapperInput input = LoadMapperInputWithRig(*database, settings.rig);
   const std::filesystem::path image_dir = ImageFolder(settings.image_dir, *database);
   const auto cancelled = [&] {
     if (!control.Cancelled()) return false;

@@ -13,6 +13,7 @@
 #include "pipeline/stage_scope.h"
 #include "pipeline/workspace.h"
 #include "plugin/plugin_registry.h"
+#include "rig/rig_file.h"
 #include "tessera/mapper.h"
 
 namespace tessera {
@@ -32,6 +33,8 @@ struct MapSettings {
   std::filesystem::path image_dir;
   // The mask folder, if any: like the image folder, never written or deleted in.
   std::filesystem::path mask_dir;
+  // A camera rig over the workspace's images (`--rig`), or null; must outlive the stage.
+  const RigFile* rig = nullptr;
 };
 
 // The mapping summary of a mapper result: models (sparse_dir/<index>), why images were

@@ -64,6 +64,9 @@ struct MappingSummary {
   nlohmann::json mapper_options = nlohmann::json::object();  // its effective options
   nlohmann::json mapper_details = nlohmann::json::object();  // MapperResult::details
   uint64_t seed = 0;
+  // The camera rig of `--rig` ({"file", "digest", "frames", "poses_known", "num_frames",
+  // "cameras": [{"folder", "camera_id", "reference"}]}); null without one.
+  nlohmann::json rig;
 
   // The file's JSON, keys as documented in the README.
   nlohmann::json ToJson() const;

@@ -63,6 +63,17 @@ TEST(MappingSummary, RoundTripThroughAFile) {
   EXPECT_EQ(back.quarantined, summary.quarantined);
 }
 
+// `rig` is written only with a rig (json.size() above counts without), and read back.
+TEST(MappingSummary, RigSectionRoundTrips) {
+  const testing::TemporaryDir dir;
+  MappingSummary summary = Example();
+  summary.rig = {{"file", "rig.json"}, {"digest", "0123456789abcdef"}, {"poses_known", false}};
+  summary.Write(dir.path() / "mapping_summary.json");
+  const MappingSummary back = MappingSummary::Read(dir.path() / "mapping_summary.json");
+  EXPECT_EQ(back.rig.at("digest"), "0123456789abcdef");
+  EXPECT_EQ(back.ToJson().size(), 13u);
+}
+
 TEST(MappingSummary, AFileThatIsNoSummaryIsRefusedNamingIt) {
   const testing::TemporaryDir dir;
   const std::filesystem::path file = dir.path() / "mapping_summary.json";

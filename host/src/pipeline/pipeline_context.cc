@@ -128,6 +128,7 @@ MapSettings PipelineContext::MakeMapSettings(const std::filesystem::path& image_
   settings.seed = manifest.seed;
   settings.image_dir = image_dir;
   settings.mask_dir = manifest.camera.mask_path;
+  settings.rig = rig ? &*rig : nullptr;
   return settings;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,7 @@
 #include "pipeline/match_stage.h"
 #include "pipeline/workspace.h"
 #include "plugin/plugin_registry.h"
+#include "rig/rig_file.h"
 #include "tessera/sdk.h"
 #include "video/video_frames.h"
 
@@ -30,6 +32,7 @@ struct PipelineContext {
   PluginInstance<BundleAdjuster> bundle_adjuster;
   std::vector<PluginInstance<Exporter>> exporters;
   VideoFrameOptions video_options;  // the manifest's "video", checked
+  std::optional<RigFile> rig;       // `--rig`: the map stage's camera rig
 
   // `manifest_file` empty: the default manifest. Throws InputError on any problem.
   static PipelineContext Create(const std::filesystem::path& manifest_file);

@@ -86,6 +86,8 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
                             [](auto& plugin) { return plugin.Metric(); }),
       0);
   CheckImageFolderApart(options.image_dir, options.output_dir);
+  // A rig camera's folder that is not there fails before any image is read.
+  if (context.rig && options.videos.empty()) context.rig->CheckFolders(options.image_dir);
   const auto workspace = Workspace::Open(options.output_dir);
   context.UseWorkspaceCaches(*workspace);
   const std::filesystem::path image_dir = InputImages(context, options);

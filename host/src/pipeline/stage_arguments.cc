@@ -31,6 +31,11 @@ PipelineContext LoadPipelineContext(const StageArguments& arguments) {
   }
   if (!arguments.masks.empty()) context.manifest.camera.mask_path = arguments.masks;
   if (arguments.camera_per_folder) context.manifest.camera.per_folder = true;
+  // Each camera of a rig is the camera of one subfolder.
+  if (!arguments.rig.empty()) {
+    context.rig = RigFile::Read(arguments.rig);
+    context.manifest.camera.per_folder = true;
+  }
   context.LimitLibraryThreads();
   return context;
 }

@@ -1,8 +1,8 @@
 #pragma once
 
 // The arguments every pipeline verb shares (`--manifest`, `--camera-K`, `--masks`,
-// `--camera-per-folder`, `--threads`, `--video`) and the PipelineContext made from them: one
-// definition for the CLI and the Python module, so that both build a run the same way.
+// `--camera-per-folder`, `--rig`, `--threads`, `--video`) and the PipelineContext made from them:
+// one definition for the CLI and the Python module, so that both build a run the same way.
 
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -22,6 +22,7 @@ struct StageArguments {
   std::string camera_K;             // a K.txt file: known intrinsics, overriding EXIF
   std::string masks;                // folder of IMAGE.png masks
   bool camera_per_folder = false;   // sets camera.per_folder (false: the manifest's)
+  std::string rig;                  // a rig file (rig/rig_file.h); sets camera.per_folder
   std::vector<std::string> videos;  // video input instead of an image folder
   int threads = 0;                  // 0: the manifest's, else all cores
 };

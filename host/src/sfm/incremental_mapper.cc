@@ -13,6 +13,7 @@
 #include "estimators/ransac.h"
 #include "geometry/essential_matrix.h"
 #include "geometry/triangulation.h"
+#include "sfm/rig_poses.h"
 #include "tessera/io/model_statistics.h"
 #include "tessera/sfm/camera_plausibility.h"
 #include "util/random.h"
@@ -54,6 +55,46 @@ IncrementalTriangulatorOptions TriangulatorOptions(const IncrementalMapperOption
   triangulator.min_angle = options.tri_min_angle;
   triangulator.max_num_pairs = ransac.tri_max_num_pairs;
   return triangulator;
+}
+
+// Registers `image_id` with the pose its rig frame gives it (rig_poses.h), when a
+// registered image of the frame and the rig's cam_from_rig give one and at least
+// `min_num_inliers` of its 2D-3D correspondences reproject within `max_error_px`;
+// returns whether it did, and logs it.
+bool RegisterByRigFrame(const std::vector<CameraRig>& rigs, image_t image_id, int min_num_inliers,
+                        double max_error_px, ObservationManager* obs) {
+  image_t source = kInvalidImageId;
+  const std::optional<Rigid3d> cam_from_world =
+      RigPoseOfImage(rigs, obs->model(), image_id, &source);
+  if (!cam_from_world) return false;
+  const Reconstruction& rec = obs->model();
+  const Image& image = rec.images.at(image_id);
+  const Camera& camera = rec.cameras.at(image.camera_id);
+  std::vector<std::pair<point2D_t, point3D_t>> consistent;
+  size_t num_correspondences = 0;
+  for (point2D_t idx = 0; idx < image.points2D.size(); ++idx) {
+    const point3D_t point3D_id = obs->PointOfKeypoint(image_id, idx);
+    if (point3D_id == kInvalidPoint3DId) continue;
+    ++num_correspondences;
+    const Eigen::Vector3d point_in_cam = *cam_from_world * rec.points3D.at(point3D_id).xyz;
+    if (point_in_cam.z() <= 0) continue;
+    if ((camera.ImgFromCam(point_in_cam) - image.points2D[idx].xy).norm() <= max_error_px) {
+      consistent.emplace_back(idx, point3D_id);
+    }
+  }
+  if (consistent.size() < static_cast<size_t>(min_num_inliers)) return false;
+  obs->RegisterImage(image_id, *cam_from_world);
+  for (const auto& [idx, point3D_id] : consistent) {
+    if (!ObservationManager::TrackHasImage(obs->model().points3D.at(point3D_id), image_id)) {
+      obs->AddObservation(point3D_id, {image_id, idx});
+    }
+  }
+  spdlog::info(
+      "map: registered {} ({} images): posed by its rig frame with {}, {} of {} 2D-3D "
+      "correspondences agree",
+      image.name, obs->registered_images().size(), rec.images.at(source).name, consistent.size(),
+      num_correspondences);
+  return true;
 }
 
 }  // namespace
@@ -357,6 +398,14 @@ IncrementalMapper::Status IncrementalMapper::Fail(image_t image_id, Status statu
 }
 
 IncrementalMapper::Status IncrementalMapper::RegisterImage(image_t image_id) {
+  // A frame's image follows its rig, where the rig's pose agrees with what it sees.
+  if (run_.used_images.count(image_id) == 0 &&
+      RegisterByRigFrame(run_.input.rigs, image_id, options_.abs_pose_min_num_inliers,
+                         options_.abs_pose_max_error, &obs_)) {
+    run_.failure_reasons.erase(image_id);
+    changed_since_global_ba_ = true;
+    return Status::kSuccess;
+  }
   const Reconstruction& rec = obs_.model();
   const Image& image = rec.images.at(image_id);
   const Camera& camera = rec.cameras.at(image.camera_id);
@@ -619,6 +668,8 @@ BundleAdjustmentConfig IncrementalMapper::MakeBundleAdjustmentConfig() const {
   config.refine_principal_point = refine_principal_point_;
   config.refine_extra_params = options_.ba_refine_extra_params;
   config.fix_gauge = true;
+  // Rigs whose cam_from_rig is given, or estimated from enough of the model's frames.
+  config.rigs = RigsForAdjustment(run_.input.rigs, obs_.model());
   return config;
 }
 
@@ -669,6 +720,8 @@ IncrementalMapper::Status IncrementalMapper::LocalBundleAdjustment(image_t image
     }
   }
   config.constant_poses = constant_images;
+  // An estimated cam_from_rig moves in global adjustments only, where every frame holds it.
+  config.refine_rig_poses = false;
   config.max_num_iterations = options_.ba_local_max_num_iterations;
   config.function_tolerance = options_.ba_local_function_tolerance;
   for (const point3D_t point3D_id : local_points)

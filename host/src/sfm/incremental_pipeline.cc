@@ -10,6 +10,7 @@
 #include <set>
 #include <utility>
 
+#include "sfm/rig_poses.h"
 #include "tessera/sfm/first_model_calibration.h"
 #include "tessera/sfm/focal_length_estimation.h"
 #include "tessera/sfm/gps_anchoring.h"
@@ -45,6 +46,8 @@ struct RunControl {
   const MapperControl* observer = nullptr;
   size_t model_index = 0;
   size_t num_images = 0;  // of the input, for progress
+  // The input's camera rigs: a registered image's frame follows it (null: none).
+  const std::vector<CameraRig>* rigs = nullptr;
   bool cancelled = false;
 
   // Asks the observer; once true, stays true.
@@ -78,6 +81,18 @@ void Grow(IncrementalMapper* mapper, RunControl* control,
     }
     refined_since_failure = false;
     mapper->TriangulateImage(next_image);
+    // The rest of its frame, in the pose the rig gives it, once the rig's poses are known.
+    if (control->rigs != nullptr) {
+      for (const image_t mate : FrameMates(*control->rigs, next_image)) {
+        if (mapper->observations().IsRegistered(mate) ||
+            !RigPoseOfImage(*control->rigs, mapper->model(), mate)) {
+          continue;
+        }
+        if (mapper->RegisterImage(mate) == IncrementalMapper::Status::kSuccess) {
+          mapper->TriangulateImage(mate);
+        }
+      }
+    }
     if (control->observer != nullptr && control->observer->on_model_changed) {
       control->observer->on_model_changed(control->model_index, mapper->model());
     }
@@ -420,6 +435,18 @@ std::map<image_t, std::string> UnregisteredReasons(const IncrementalMapperOption
   return reasons;
 }
 
+// Each model's rigs (rig_poses.h: DescribeRigs), each camera's cam_from_rig logged.
+nlohmann::json DescribeModelRigs(const std::vector<CameraRig>& rigs,
+                                 const std::vector<Reconstruction>& models) {
+  nlohmann::json described = nlohmann::json::array();
+  for (size_t index = 0; index < models.size(); ++index) {
+    std::vector<std::string> lines;
+    described.push_back({{"model", index}, {"rigs", DescribeRigs(rigs, models[index], &lines)}});
+    for (const std::string& line : lines) spdlog::info("map: model {}: {}", index, line);
+  }
+  return described;
+}
+
 }  // namespace
 
 std::map<camera_t, FirstModelFocalLength> FocalLengthsFromFirstModels(
@@ -501,6 +528,7 @@ MapperResult IncrementalPipeline::Reconstruct(const MapperInput& input,
   RunControl control;
   control.observer = &observer;
   control.num_images = input.images.size();
+  control.rigs = &input.rigs;
   const auto should_stop = [&control] { return control.ShouldStop(); };
   MapperResult result;
 
@@ -561,6 +589,7 @@ MapperResult IncrementalPipeline::Reconstruct(const MapperInput& input,
   }
   result.self_checks = SelfCheckModels(options_, input, run.view_graph, result.models);
   if (options_.use_gps_prior) AnchorModelsToGps(options_, input, bundle_adjuster_, seed_, &result);
+  if (!input.rigs.empty()) result.details["rigs"] = DescribeModelRigs(input.rigs, result.models);
   result.num_registrations_refused = run.num_registrations_refused;
   result.unregistered_reasons = UnregisteredReasons(options_, input, run, result.models);
   result.num_global_ba = run.num_global_ba;

@@ -57,6 +57,13 @@ class GlobalMapperPlugin : public Mapper {
     if (context.bundle_adjuster == nullptr) {
       throw InputError("the global mapper needs a bundle adjuster (pipeline.bundle_adjuster)");
     }
+    if (!input.rigs.empty()) {
+      // Said, never silently dropped: the images are mapped, the rig is not held rigid.
+      log().Warn("the global mapper does not hold camera rigs rigid: the " +
+                 std::to_string(input.rigs.size()) +
+                 " rig(s) of --rig are ignored and their images mapped one by one; the "
+                 "incremental mapper keeps them");
+    }
     GlobalMapperOptions options = options_;
     options.seed = static_cast<int>(context.seed & 0x7fffffff);
     MapperResult result;

@@ -20,10 +20,11 @@ class IncrementalMapperPlugin : public Mapper {
     }
     const IncrementalPipeline pipeline(options_, *context.bundle_adjuster, context.seed);
     MapperResult result = pipeline.Reconstruct(input, context.control);
-    result.details = {{"num_tracks", result.num_tracks},
-                      {"num_refused_matches", result.num_refused_matches},
-                      {"num_global_ba", result.num_global_ba},
-                      {"num_local_ba", result.num_local_ba}};
+    // Added to the pipeline's own (each model's rigs).
+    result.details["num_tracks"] = result.num_tracks;
+    result.details["num_refused_matches"] = result.num_refused_matches;
+    result.details["num_global_ba"] = result.num_global_ba;
+    result.details["num_local_ba"] = result.num_local_ba;
     log().Debug(std::to_string(result.models.size()) + " model(s), " +
                 std::to_string(result.num_global_ba) + " global and " +
                 std::to_string(result.num_local_ba) + " local bundle adjustments");

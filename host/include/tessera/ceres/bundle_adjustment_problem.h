@@ -16,9 +16,17 @@
 //   so that it still constrains its image);
 // - the gauge: with fix_gauge, no constant pose and no position prior in the problem,
 //   the pose of the lowest image id with observations and the largest-magnitude
-//   translation coordinate of the next one;
+//   translation coordinate of the next one (not that one when a rig frame of the problem
+//   has a constant cam_from_rig with a translation: the rig gives the scale);
 // - intrinsics refined as the refine_* flags say, the others held (a SubsetManifold, or
 //   the whole block constant).
+// - rigs (config.rigs): an image of a frame whose reference image is in the problem, of
+//   another camera and with a pose not held constant, has no pose block of its own: its
+//   residuals take cam_from_world = cam_from_rig * rig_from_world, rig_from_world being
+//   the reference image's pose block and cam_from_rig kept after the intrinsics in its
+//   camera's block (one per rig camera), constant when the rig's poses are known or
+//   refine_rig_poses is false. Such an image takes no position prior; WriteBack sets its
+//   pose from the two.
 // The parameter blocks are copies of the reconstruction's values; WriteBack copies back
 // what could move. The bundled `ceres` adjuster is built on this class.
 
@@ -48,8 +56,9 @@ class TESSERA_CERES_EXPORT BundleAdjustmentProblem {
  public:
   // Sets the problem up; when `reconstruction` and `config` make no valid problem (no
   // registered image, an image of config.images missing or not registered, a missing or
-  // invalid camera, a track element past its image's keypoints, no observation, an image
-  // of a rig, a position prior whose sigma is not positive and finite, nothing variable),
+  // invalid camera, a track element past its image's keypoints, no observation, a rig
+  // frame's camera without a cam_from_rig or a camera in two rigs, a position prior whose
+  // sigma is not positive and finite, nothing variable),
   // error() says why in a sentence and the problem must not be solved.
   BundleAdjustmentProblem(const BundleAdjustmentConfig& config,
                           const Reconstruction& reconstruction,
