@@ -11,7 +11,9 @@
 #include "distributed/shard_database.h"
 #include "distributed/sharded_stages.h"
 #include "distributed/slurm.h"
+#include "partition/merge_map_stage.h"
 #include "pipeline/pipeline_context.h"
+#include "pipeline/stage_arguments.h"
 #include "pipeline/workspace.h"
 #include "util/exit_codes.h"
 
@@ -22,6 +24,8 @@ struct MergeCommandOptions {
   std::string output;
   std::string stage;
   int shards = 0;
+  StageArguments arguments;  // --stage map: the manifest (mapper, adjuster, exporters)
+  std::string images;        // --stage map: the image folder (default: extract's)
 };
 
 struct SlurmCommandOptions {
@@ -47,13 +51,29 @@ std::filesystem::path Absolute(const std::string& path) {
 
 CommandRegistration RegisterMergeCommand(CLI::App& app, const GlobalOptions&) {
   auto options = std::make_shared<MergeCommandOptions>();
-  CLI::App* sub = app.add_subcommand("merge", "Fold finished shards into OUTPUT/database.db");
-  sub->add_option("--output", options->output, "Workspace folder holding shards/")->required();
+  CLI::App* sub = app.add_subcommand(
+      "merge",
+      "Fold finished shards into OUTPUT/database.db, or cluster models into OUTPUT/sparse");
+  sub->add_option("--output", options->output, "Workspace folder holding shards/ or clusters/")
+      ->required();
   sub->add_option("--stage", options->stage,
-                  "extract or match (default: the extraction shards, then the matching ones)")
-      ->check(CLI::IsMember({kExtractStage, kMatchStage}));
+                  "extract, match or map (default: the extraction shards, then the matching "
+                  "ones; map: the models of OUTPUT/clusters/K)")
+      ->check(CLI::IsMember(std::vector<std::string>{kExtractStage, kMatchStage, "map"}));
   sub->add_option("--shards", options->shards, "N, the number of shards (default: as found)");
+  sub->add_option("--manifest", options->arguments.manifest,
+                  "--stage map: pipeline manifest (default: default.json)");
+  sub->add_option("--images", options->images,
+                  "--stage map: folder of input images (default: the one extract recorded)");
   return {sub, [options]() {
+            if (options->stage == "map") {
+              const PipelineContext context = LoadPipelineContext(options->arguments);
+              const MapStageSummary summary =
+                  MergeClusterMaps(context, {options->images, options->output});
+              if (summary.num_models > 0) return static_cast<int>(kExitSuccess);
+              spdlog::error("merge: no cluster of {} holds a model", options->output);
+              return static_cast<int>(kExitNoModel);
+            }
             std::vector<std::string> stages = {options->stage};
             if (options->stage.empty()) {
               stages.clear();

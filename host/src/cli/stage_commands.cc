@@ -10,6 +10,7 @@
 #include "cli/interrupt.h"
 #include "distributed/shard_plan.h"
 #include "distributed/sharded_stages.h"
+#include "partition/cluster_map.h"
 #include "pipeline/extract_stage.h"
 #include "pipeline/match_stage.h"
 #include "pipeline/pipeline_context.h"
@@ -26,6 +27,7 @@ struct StageOptions {
   std::string output;
   StageArguments arguments;  // --manifest, --camera-K, --masks, --video, --threads, ...
   std::string shard;         // extract and match: "K/N", one shard (distributed/)
+  int cluster = -1;          // map: one cluster of OUTPUT/clusters.json (partition/)
 };
 
 void AddShardOption(CLI::App* sub, StageOptions* options) {
@@ -88,10 +90,17 @@ CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
   auto options = std::make_shared<StageOptions>();
   CLI::App* sub = app.add_subcommand("map", "Reconstruct cameras and points from a workspace");
   AddCommonOptions(sub, options.get(), /*needs_images=*/false);
-  return {sub, [options]() {
+  const CLI::Option* cluster =
+      sub->add_option("--cluster", options->cluster,
+                      "K: only cluster K of OUTPUT/clusters.json (tessera partition), into "
+                      "OUTPUT/clusters/K/ (`tessera merge --stage map` merges the clusters)");
+  return {sub, [options, cluster]() {
             const PipelineContext context = LoadContext(*options);
             const MapStageSummary summary =
-                RunMap(context, {options->images, options->output}, InterruptibleControl());
+                cluster->count() > 0
+                    ? MapCluster(context, {options->images, options->output}, options->cluster,
+                                 InterruptibleControl())
+                    : RunMap(context, {options->images, options->output}, InterruptibleControl());
             return MappingExitCode(summary, std::filesystem::path(options->output) / "database.db");
           }};
 }

@@ -46,6 +46,7 @@ nlohmann::json MappingSummary::ToJson() const {
   json["mapper_options"] = mapper_options;
   json["mapper_details"] = mapper_details;
   json["seed"] = seed;
+  if (!partition.is_null()) json["partition"] = partition;
   return json;
 }
 
@@ -97,6 +98,7 @@ MappingSummary MappingSummary::FromJson(const nlohmann::json& json) {
   summary.mapper_options = json.at("mapper_options");
   summary.mapper_details = json.value("mapper_details", nlohmann::json::object());
   summary.seed = json.at("seed").get<uint64_t>();
+  summary.partition = json.value("partition", nlohmann::json());
   return summary;
 }
 

@@ -64,6 +64,10 @@ struct MappingSummary {
   nlohmann::json mapper_options = nlohmann::json::object();  // its effective options
   nlohmann::json mapper_details = nlohmann::json::object();  // MapperResult::details
   uint64_t seed = 0;
+  // Partitioned mapping (partition/): a cluster's model set says which cluster of which
+  // clusters.json it is ({"cluster", "clusters_json"}); the merged set lists every
+  // merge decision ({"clusters_json", "merges": [...]}). Null otherwise.
+  nlohmann::json partition;
 
   // The file's JSON, keys as documented in the README.
   nlohmann::json ToJson() const;
