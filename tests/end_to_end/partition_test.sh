@@ -7,6 +7,7 @@
 #     `--cluster` outside the clusters is exit 2;
 #  3. `merge --stage map` merges them: one model with all 11 images, every merge
 #     decision in mapping_summary.json;
+#  3b. `map --hierarchical` does all three on one host, and reuses them when run again;
 #  4. clusters.json of another manifest is exit 2 naming it; a truncated cluster model is
 #     exit 2 naming its folder, and the merged model is left untouched.
 # usage: partition_test.sh TESSERA DOWNSCALE SOURCE_DIR
@@ -84,6 +85,17 @@ assert len(merges) == int(sys.argv[2]) - 1 and all(m["merged"] for m in merges),
 assert all(m["shared_images"] >= 3 for m in merges), merges' \
   "$out/mapping_summary.json" "$num_clusters" || fail "mapping_summary.json"
 [ -f "$out/sparse/0/points3D.bin" ] || fail "no merged model in $out/sparse/0"
+
+# 3b. The same on one host: `map --hierarchical` partitions, maps the clusters in a pool
+# of 2 processes and merges them; run again, it reuses clusters.json and every cluster.
+mkdir -p "$work/hier"
+cp "$out/database.db" "$work/hier/"
+expect_exit 0 "$work/hier.log" "merge: $num_clusters clusters into 1 model(s), 11 of 11 images" \
+  "$tessera" map --hierarchical --jobs 2 --threads 1 --output "$work/hier" --manifest "$work/m.json"
+expect_exit 0 "$work/hier2.log" "map: cluster 0 is already mapped for this clusters.json" \
+  "$tessera" map --hierarchical --jobs 2 --threads 1 --output "$work/hier" --manifest "$work/m.json"
+grep -qF "clusters.json is current: $num_clusters clusters" "$work/hier2.log" ||
+  fail "map --hierarchical again: clusters.json not reused"
 
 # 4. Bad input.
 expect_exit 2 "$work/foreign.log" "$out/clusters.json: made with another manifest" \
