@@ -121,6 +121,25 @@ TEST(ViewGraphPartitioner, ALongPathFitsTheSizesAndEveryCutIsBridged) {
   check(partition.tree);
 }
 
+TEST(ViewGraphPartitioner, ALargeGraphIsCutOnACoarsenedGraphAsWell) {
+  // 2,000 images of an ordered capture, each paired with its next 8: over the dense
+  // solver's limit, so the first cuts are found on a coarsened graph.
+  std::vector<WeightedEdge> edges;
+  for (size_t i = 0; i < 2000; ++i) {
+    for (size_t d = 1; d <= 8 && i + d < 2000; ++d) edges.push_back({i, i + d, 400.0 / d});
+  }
+  const ViewGraphPartition partition = PartitionViewGraph(2000, edges, {300, 40});
+  EXPECT_EQ(Covered(partition).size(), 2000u);
+  for (const auto& cluster : partition.clusters) {
+    EXPECT_LE(cluster.nodes.size(), 300u);
+    EXPECT_LE(cluster.core.size(), 220u);
+  }
+  // A path is cut where it must be: few clusters, little weight.
+  EXPECT_LE(partition.clusters.size(), 16u);
+  EXPECT_LT(partition.cut_weight, 0.03 * partition.total_weight);
+  ExpectSame(partition, PartitionViewGraph(2000, edges, {300, 40}));
+}
+
 TEST(ViewGraphPartitioner, ComponentsAreSeparateSubtrees) {
   std::vector<WeightedEdge> edges = {{0, 1, 50}, {1, 2, 50}, {3, 4, 50}};
   const ViewGraphPartition partition = PartitionViewGraph(6, edges, {30, 10});
