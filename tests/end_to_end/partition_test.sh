@@ -8,6 +8,7 @@
 #  3. `merge --stage map` merges them: one model with all 11 images, every merge
 #     decision in mapping_summary.json;
 #  3b. `map --hierarchical` does all three on one host, and reuses them when run again;
+#  3c. so do `map --cluster-shard K/2` for K = 0, 1 and the merge (the Slurm array's tasks);
 #  4. clusters.json of another manifest is exit 2 naming it; a truncated cluster model is
 #     exit 2 naming its folder, and the merged model is left untouched.
 # usage: partition_test.sh TESSERA DOWNSCALE SOURCE_DIR
@@ -96,6 +97,19 @@ expect_exit 0 "$work/hier2.log" "map: cluster 0 is already mapped for this clust
   "$tessera" map --hierarchical --jobs 2 --threads 1 --output "$work/hier" --manifest "$work/m.json"
 grep -qF "clusters.json is current: $num_clusters clusters" "$work/hier2.log" ||
   fail "map --hierarchical again: clusters.json not reused"
+
+# 3c. As `tessera slurm --partitioned` runs it: partition, a mapping array of 2 shards
+# (--cluster-shard K/2), the merge.
+mkdir -p "$work/sharded"
+cp "$out/database.db" "$work/sharded/"
+expect_exit 0 "$work/sharded-partition.log" "" \
+  "$tessera" partition --output "$work/sharded" --manifest "$work/m.json"
+for k in 0 1; do
+  expect_exit 0 "$work/sharded$k.log" "map: shard $k/2: " \
+    "$tessera" map --output "$work/sharded" --manifest "$work/m.json" --threads 2 --cluster-shard "$k/2"
+done
+expect_exit 0 "$work/sharded-merge.log" "merge: $num_clusters clusters into 1 model(s), 11 of 11 images" \
+  "$tessera" merge --stage map --output "$work/sharded" --manifest "$work/m.json"
 
 # 4. Bad input.
 expect_exit 2 "$work/foreign.log" "$out/clusters.json: made with another manifest" \

@@ -40,6 +40,7 @@ struct SlurmCommandOptions {
   std::string time;
   std::vector<std::string> sbatch_args;
   bool dry_run = false;
+  bool partitioned = false;
 };
 
 std::filesystem::path Absolute(const std::string& path) {
@@ -134,6 +135,8 @@ CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions&) {
                   "More sbatch options for every job, e.g. --sbatch-arg=--account=foo")
       ->allow_extra_args(false);
   sub->add_flag("--dry-run", options->dry_run, "Only write the scripts into OUTPUT/slurm/");
+  sub->add_flag("--partitioned", options->partitioned,
+                "Map as clusters: a partition job, N cluster mapping jobs, the merge");
   return {sub, [options]() {
             if (options->workers < 1) {
               throw InputError("--workers " + std::to_string(options->workers) +
@@ -161,6 +164,7 @@ CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions&) {
             slurm.partition = options->partition;
             slurm.time = options->time;
             slurm.sbatch_args = options->sbatch_args;
+            slurm.partitioned = options->partitioned;
             CheckSlurmOptions(slurm);  // before anything is read or written
             // The whole manifest and every plugin are checked here, not on the cluster.
             PipelineContext context = PipelineContext::Create(slurm.manifest);

@@ -124,16 +124,26 @@ CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
   CLI::Option* hierarchical =
       sub->add_flag("--hierarchical",
                     "Partition, map the clusters in a pool of processes, merge them (one host)");
+  CLI::Option* cluster_shard = sub->add_option(
+      "--cluster-shard", options->shard,
+      "K/N: the clusters c with c mod N = K, one after the other (a Slurm array task)");
   sub->add_option("--jobs", *jobs,
                   "--hierarchical: cluster processes at once (default: half the cores)")
       ->check(CLI::Range(0, 1024));
-  return {sub, [options, cluster, hierarchical, jobs]() {
-            if (cluster->count() > 0 && hierarchical->count() > 0) {
-              throw InputError("--cluster and --hierarchical: give one or the other");
+  return {sub, [options, cluster, hierarchical, cluster_shard, jobs]() {
+            if (cluster->count() + hierarchical->count() + cluster_shard->count() > 1) {
+              throw InputError("--cluster, --cluster-shard and --hierarchical: give one at most");
             }
             const PipelineContext context = LoadContext(*options);
             const RunOptions run{options->images, options->output};
             MapStageSummary summary;
+            if (cluster_shard->count() > 0) {
+              const MapStageSummary shard =
+                  MapClusterShard(context, run, ParseShard(options->shard), InterruptibleControl());
+              // A cluster without a model is the merge's to report, not the array's.
+              return shard.status == StageStatus::kCancelled ? ReportInterrupted("map")
+                                                             : static_cast<int>(kExitSuccess);
+            }
             if (cluster->count() > 0) {
               summary = MapCluster(context, run, options->cluster, InterruptibleControl());
             } else if (hierarchical->count() > 0) {

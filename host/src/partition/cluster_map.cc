@@ -130,4 +130,27 @@ MapStageSummary MapCluster(const PipelineContext& context, const RunOptions& opt
   return MapWorkspace(*workspace, settings, {}, control, target);
 }
 
+MapStageSummary MapClusterShard(const PipelineContext& context, const RunOptions& options,
+                                const Shard& shard, const StageControl& control) {
+  const ClustersFile clusters = ClustersFile::Read(ClustersFilePath(options.output_dir));
+  MapStageSummary total;
+  for (int cluster = shard.index; cluster < static_cast<int>(clusters.clusters.size());
+       cluster += shard.count) {
+    const MapStageSummary summary = MapCluster(context, options, cluster, control);
+    total.num_models += summary.num_models;
+    total.num_registered += summary.num_registered;
+    total.num_images += summary.num_images;
+    total.seconds += summary.seconds;
+    if (summary.status == StageStatus::kCancelled) {
+      total.status = StageStatus::kCancelled;
+      break;
+    }
+  }
+  spdlog::info("map: shard {}/{}: {} of {} clusters, {} models", shard.index, shard.count,
+               (clusters.clusters.size() + static_cast<size_t>(shard.count - shard.index) - 1) /
+                   static_cast<size_t>(shard.count),
+               clusters.clusters.size(), total.num_models);
+  return total;
+}
+
 }  // namespace tessera

@@ -7,6 +7,7 @@
 
 #include <filesystem>
 
+#include "distributed/shard_plan.h"
 #include "pipeline/pipeline_context.h"
 #include "pipeline/run_pipeline.h"
 #include "pipeline/stage_control.h"
@@ -28,5 +29,11 @@ MapperInput RestrictMapperInput(const MapperInput& input, const std::vector<std:
 // clusters.
 MapStageSummary MapCluster(const PipelineContext& context, const RunOptions& options, int cluster,
                            const StageControl& control = {});
+
+// Every cluster c with c mod N == K (`shard` K/N), one after the other: a task of the
+// Slurm mapping array, whose size is fixed before partition has counted the clusters.
+// A shard with no cluster maps nothing. Stops at the first cancelled cluster.
+MapStageSummary MapClusterShard(const PipelineContext& context, const RunOptions& options,
+                                const Shard& shard, const StageControl& control = {});
 
 }  // namespace tessera
