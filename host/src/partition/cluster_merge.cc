@@ -86,6 +86,7 @@ std::vector<std::string> FilterObservations(double max_error, Reconstruction* mo
     Track kept;
     for (const TrackElement& element : it->second.track) {
       Point2D* observation = ObservationOf(model, element);
+      if (observation == nullptr) continue;  // names no keypoint of the model: dropped
       const Image& image = model->images.at(element.image_id);
       const Eigen::Vector3d in_cam = image.cam_from_world * it->second.xyz;
       const bool good =
