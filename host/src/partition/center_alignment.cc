@@ -195,6 +195,14 @@ CenterAlignment AlignByCameraCenters(const Reconstruction& source, const Reconst
                     std::to_string(options.min_shared_images) + ")";
     return result;
   }
+  if (static_cast<double>(best.size()) <
+      options.min_inlier_ratio * static_cast<double>(shared.size())) {
+    result.success = false;
+    result.reason = "share " + std::to_string(shared.size()) + " registered images, of which " +
+                    std::to_string(best.size()) + " agree on one similarity (need " +
+                    std::to_string(static_cast<int>(100 * options.min_inlier_ratio)) + "%)";
+    return result;
+  }
   result.rms_center_error = std::sqrt(best_error / static_cast<double>(best.size()));
   return result;
 }

@@ -25,6 +25,9 @@ struct CenterAlignmentOptions {
   // ... and its orientations differ by at most this many degrees.
   double max_rotation_error_deg = 5;
   size_t max_num_hypotheses = 5000;  // pairs of shared images tried at most
+  // Fewer of the shared images agreeing: no alignment (one of the models is likely
+  // wrong, folded or drifted, and a merge would bend the other).
+  double min_inlier_ratio = 0.7;
 };
 
 struct CenterAlignment {

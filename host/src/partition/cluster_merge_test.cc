@@ -161,6 +161,14 @@ TEST(CenterAlignment, RecoversASimilarityDespiteAWrongImage) {
   EXPECT_NEAR(alignment.target_from_source.scale, 1 / 2.5, 1e-9);
   EXPECT_LT(alignment.rms_center_error, 1e-9);
   EXPECT_FALSE(alignment.degenerate);
+  // Half the shared images elsewhere (a folded or drifted model): no alignment.
+  for (image_t id = 1; id <= 30; ++id) {
+    moved.images.at(id).cam_from_world.translation += Eigen::Vector3d(0, 5.0 + id, 0);
+  }
+  const CenterAlignment weak = AlignByCameraCenters(moved, truth, {}, 0);
+  EXPECT_FALSE(weak.success);
+  EXPECT_EQ(weak.reason,
+            "share 60 registered images, of which 30 agree on one similarity (need 70%)");
 }
 
 }  // namespace
