@@ -139,9 +139,14 @@ MapStageSummary MergeClusterMaps(const PipelineContext& context, const RunOption
   MapStageSummary summary = PlaceMapResult(*workspace, context.MakeMapSettings(options.image_dir),
                                            result, input, target, control);
   summary.seconds = timer.ElapsedSeconds();
+  // Leftover models may hold the same images: each counted once.
+  std::set<std::string> registered;
+  for (const Reconstruction& model : result.models) {
+    for (const auto& [image_id, image] : model.images) registered.insert(image.name);
+  }
   spdlog::info("merge: {} clusters into {} model(s), {} of {} images registered, {:.2f} s",
-               clusters.clusters.size(), summary.num_models, summary.num_registered,
-               summary.num_images, summary.seconds);
+               clusters.clusters.size(), summary.num_models, registered.size(), summary.num_images,
+               summary.seconds);
   return summary;
 }
 
