@@ -274,4 +274,22 @@ TEST(Manifest, ADuplicateKeyIsRefusedNamingItsPathAndTheFile) {
 }
 
 }  // namespace
+TEST(Manifest, DistributedClusterSizesDefaultAndAreChecked) {
+  const Manifest plain = Manifest::FromJson(nlohmann::json::object(), "/base", "m.json");
+  EXPECT_EQ(plain.distributed.cluster_max_images, 300);
+  EXPECT_EQ(plain.distributed.cluster_overlap, 40);
+  const Manifest small = Manifest::FromJson(
+      {{"distributed", {{"cluster_max_images", 30}, {"cluster_overlap", 10}}}}, "/base", "m.json");
+  EXPECT_EQ(small.distributed.cluster_max_images, 30);
+  EXPECT_EQ(small.distributed.cluster_overlap, 10);
+  const std::string too_small =
+      ErrorOf({{"distributed", {{"cluster_max_images", 29}, {"cluster_overlap", 10}}}});
+  EXPECT_NE(too_small.find("m.json: distributed.cluster_max_images"), std::string::npos)
+      << too_small;
+  EXPECT_NE(too_small.find("3 times distributed.cluster_overlap (10)"), std::string::npos)
+      << too_small;
+  EXPECT_NE(ErrorOf({{"distributed", {{"cluster_size", 30}}}}).find("distributed.cluster_size"),
+            std::string::npos);
+}
+
 }  // namespace tessera

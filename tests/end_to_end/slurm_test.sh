@@ -4,7 +4,8 @@
 # folder): 3 workers on a 512 px copy of the sample examples/fountain-P11-small with the
 # default manifest must give the same pairs, matches and geometries as a single-process
 # run and a byte-identical model. Then a failed shard: its database made unwritable,
-# the submission fails, and submitting again reruns only that shard. Every daemon
+# the submission fails, and submitting again reruns only that shard. Then --partitioned:
+# the clusters mapped as a job array and merged into one model of all 11 images. Every daemon
 # started here is stopped by process id. Skips (exit 77) with the reason where Slurm
 # cannot start (not root, packages missing, daemons not coming up).
 # usage: slurm_test.sh TESSERA DOWNSCALE SOURCE_DIR
@@ -180,6 +181,34 @@ for file in cameras.bin images.bin points3D.bin; do
 done
 [ "$(rows "$work/single" matches)" = "$(rows "$out" matches)" ] || fail "matches after the rerun"
 echo "a failed shard: named with host and path; the rerun ran it alone; same model"
+
+# Partitioned mapping (--partitioned): a partition job, a mapping array of 3 tasks and the
+# merge instead of the map job; clusters of at most 9 images (3 shared with each neighbour).
+python3 -c '
+import json, sys
+manifest = json.load(open(sys.argv[1]))
+manifest["distributed"] = {"cluster_max_images": 9, "cluster_overlap": 3}
+json.dump(manifest, open(sys.argv[2], "w"))' "$source_dir/manifests/default.json" \
+  "$work/partitioned.json" ||
+  fail "the partitioned manifest"
+part=$work/partitioned
+ids=$("$tessera" slurm --images "$work/images" --output "$part" --workers 3 --partitioned \
+  --manifest "$work/partitioned.json" 2> "$work/slurm4.log") ||
+  { cat "$work/slurm4.log"; fail "tessera slurm --partitioned"; }
+read -r -a job_ids <<< "$ids"
+[ ${#job_ids[@]} -eq 7 ] || { cat "$work/slurm4.log"; fail "7 job ids expected, got '$ids'"; }
+grep -q -- '--array=0-2' "$part/slurm/map.sh" || fail "the mapping array is not 0-2"
+wait_jobs "${job_ids[@]}"
+python3 -c '
+import json, sys
+clusters = json.load(open(sys.argv[1] + "/clusters.json"))["clusters"]
+summary = json.load(open(sys.argv[1] + "/mapping_summary.json"))
+assert len(clusters) >= 3, len(clusters)
+assert [m["num_images"] for m in summary["models"]] == [11], summary["models"]
+assert len(summary["partition"]["merges"]) == len(clusters) - 1, summary["partition"]
+print(len(clusters), "clusters")' "$part" > "$work/partitioned.txt" ||
+  { cat "$part"/slurm/logs/*; fail "--partitioned: not one model of 11 images"; }
+echo "--partitioned: $(cat "$work/partitioned.txt") mapped as an array and merged into one model of 11 images"
 
 stop_daemons
 echo "PASS"

@@ -10,8 +10,9 @@ std::vector<CommandRegistration> RegisterCommands(CLI::App& app, const GlobalOpt
           RegisterMatchCommand(app, global),  RegisterMapCommand(app, global),
           RegisterExportCommand(app, global), RegisterEvalCommand(app, global),
           RegisterBenchCommand(app, global),  RegisterPluginsCommand(app, global),
-          RegisterVocabCommand(app, global),  RegisterMergeCommand(app, global),
-          RegisterSlurmCommand(app, global),  RegisterGuiCommand(app, global)};
+          RegisterVocabCommand(app, global),  RegisterPartitionCommand(app, global),
+          RegisterMergeCommand(app, global),  RegisterSlurmCommand(app, global),
+          RegisterGuiCommand(app, global)};
 }
 
 CLI::Validator AtLeast(int64_t minimum) {

@@ -35,6 +35,7 @@ CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions& glob
 CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterBenchCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterVocabCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterPartitionCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterMergeCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions& global);

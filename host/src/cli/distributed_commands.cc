@@ -11,7 +11,9 @@
 #include "distributed/shard_database.h"
 #include "distributed/sharded_stages.h"
 #include "distributed/slurm.h"
+#include "partition/merge_map_stage.h"
 #include "pipeline/pipeline_context.h"
+#include "pipeline/stage_arguments.h"
 #include "pipeline/workspace.h"
 #include "util/exit_codes.h"
 
@@ -22,6 +24,8 @@ struct MergeCommandOptions {
   std::string output;
   std::string stage;
   int shards = 0;
+  StageArguments arguments;  // --stage map: the manifest (mapper, adjuster, exporters)
+  std::string images;        // --stage map: the image folder (default: extract's)
 };
 
 struct SlurmCommandOptions {
@@ -36,6 +40,7 @@ struct SlurmCommandOptions {
   std::string time;
   std::vector<std::string> sbatch_args;
   bool dry_run = false;
+  bool partitioned = false;
 };
 
 std::filesystem::path Absolute(const std::string& path) {
@@ -47,13 +52,29 @@ std::filesystem::path Absolute(const std::string& path) {
 
 CommandRegistration RegisterMergeCommand(CLI::App& app, const GlobalOptions&) {
   auto options = std::make_shared<MergeCommandOptions>();
-  CLI::App* sub = app.add_subcommand("merge", "Fold finished shards into OUTPUT/database.db");
-  sub->add_option("--output", options->output, "Workspace folder holding shards/")->required();
+  CLI::App* sub = app.add_subcommand(
+      "merge",
+      "Fold finished shards into OUTPUT/database.db, or cluster models into OUTPUT/sparse");
+  sub->add_option("--output", options->output, "Workspace folder holding shards/ or clusters/")
+      ->required();
   sub->add_option("--stage", options->stage,
-                  "extract or match (default: the extraction shards, then the matching ones)")
-      ->check(CLI::IsMember({kExtractStage, kMatchStage}));
+                  "extract, match or map (default: the extraction shards, then the matching "
+                  "ones; map: the models of OUTPUT/clusters/K)")
+      ->check(CLI::IsMember(std::vector<std::string>{kExtractStage, kMatchStage, "map"}));
   sub->add_option("--shards", options->shards, "N, the number of shards (default: as found)");
+  sub->add_option("--manifest", options->arguments.manifest,
+                  "--stage map: pipeline manifest (default: default.json)");
+  sub->add_option("--images", options->images,
+                  "--stage map: folder of input images (default: the one extract recorded)");
   return {sub, [options]() {
+            if (options->stage == "map") {
+              const PipelineContext context = LoadPipelineContext(options->arguments);
+              const MapStageSummary summary =
+                  MergeClusterMaps(context, {options->images, options->output});
+              if (summary.num_models > 0) return static_cast<int>(kExitSuccess);
+              spdlog::error("merge: no cluster of {} holds a model", options->output);
+              return static_cast<int>(kExitNoModel);
+            }
             std::vector<std::string> stages = {options->stage};
             if (options->stage.empty()) {
               stages.clear();
@@ -114,6 +135,8 @@ CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions&) {
                   "More sbatch options for every job, e.g. --sbatch-arg=--account=foo")
       ->allow_extra_args(false);
   sub->add_flag("--dry-run", options->dry_run, "Only write the scripts into OUTPUT/slurm/");
+  sub->add_flag("--partitioned", options->partitioned,
+                "Map as clusters: a partition job, N cluster mapping jobs, the merge");
   return {sub, [options]() {
             if (options->workers < 1) {
               throw InputError("--workers " + std::to_string(options->workers) +
@@ -141,6 +164,7 @@ CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions&) {
             slurm.partition = options->partition;
             slurm.time = options->time;
             slurm.sbatch_args = options->sbatch_args;
+            slurm.partitioned = options->partitioned;
             CheckSlurmOptions(slurm);  // before anything is read or written
             // The whole manifest and every plugin are checked here, not on the cluster.
             PipelineContext context = PipelineContext::Create(slurm.manifest);

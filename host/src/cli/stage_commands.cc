@@ -4,12 +4,16 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <memory>
+#include <thread>
 
 #include "cli/commands.h"
 #include "cli/interrupt.h"
 #include "distributed/shard_plan.h"
 #include "distributed/sharded_stages.h"
+#include "partition/cluster_map.h"
+#include "partition/hierarchical_map.h"
 #include "pipeline/extract_stage.h"
 #include "pipeline/match_stage.h"
 #include "pipeline/pipeline_context.h"
@@ -26,6 +30,7 @@ struct StageOptions {
   std::string output;
   StageArguments arguments;  // --manifest, --camera-K, --masks, --video, --threads, ...
   std::string shard;         // extract and match: "K/N", one shard (distributed/)
+  int cluster = -1;          // map: one cluster of OUTPUT/clusters.json (partition/)
 };
 
 void AddShardOption(CLI::App* sub, StageOptions* options) {
@@ -91,15 +96,76 @@ int MappingExitCode(const MapStageSummary& summary, const std::filesystem::path&
 
 }  // namespace
 
+// `map --hierarchical`: the arguments each cluster process gets, and how many run at once
+// (--jobs, else half the cores), each with its share of the cores unless --threads.
+HierarchicalMapOptions HierarchicalOptions(const StageOptions& options, int jobs) {
+  HierarchicalMapOptions hierarchical;
+  hierarchical.tessera = std::filesystem::canonical("/proc/self/exe").string();
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  hierarchical.jobs = jobs > 0 ? jobs : std::max(1, cores / 2);
+  const int threads = options.arguments.threads > 0 ? options.arguments.threads
+                                                    : std::max(1, cores / hierarchical.jobs);
+  hierarchical.cluster_arguments = {"--output", options.output, "--threads",
+                                    std::to_string(threads)};
+  const std::pair<const char*, const std::string*> passed[] = {
+      {"--manifest", &options.arguments.manifest},
+      {"--camera-K", &options.arguments.camera_K},
+      {"--images", &options.images}};
+  for (const auto& [flag, value] : passed) {
+    if (value->empty()) continue;
+    hierarchical.cluster_arguments.push_back(flag);
+    hierarchical.cluster_arguments.push_back(*value);
+  }
+  return hierarchical;
+}
+
 CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
   auto options = std::make_shared<StageOptions>();
+  auto jobs = std::make_shared<int>(0);
   CLI::App* sub = app.add_subcommand("map", "Reconstruct cameras and points from a workspace");
   AddCommonOptions(sub, options.get(), /*needs_images=*/false);
   AddRigOption(sub, options.get());
-  return {sub, [options]() {
+  CLI::Option* cluster =
+      sub->add_option("--cluster", options->cluster,
+                      "K: only cluster K of OUTPUT/clusters.json (tessera partition), into "
+                      "OUTPUT/clusters/K/ (`tessera merge --stage map` merges the clusters)");
+  CLI::Option* hierarchical =
+      sub->add_flag("--hierarchical",
+                    "Partition, map the clusters in a pool of processes, merge them (one host)");
+  CLI::Option* cluster_shard = sub->add_option(
+      "--cluster-shard", options->shard,
+      "K/N: the clusters c with c mod N = K, one after the other (a Slurm array task)");
+  sub->add_option("--jobs", *jobs,
+                  "--hierarchical: cluster processes at once (default: half the cores)")
+      ->check(CLI::Range(0, 1024));
+  return {sub, [options, cluster, hierarchical, cluster_shard, jobs]() {
+            if (cluster->count() + hierarchical->count() + cluster_shard->count() > 1) {
+              throw InputError("--cluster, --cluster-shard and --hierarchical: give one at most");
+            }
+            if (!options->arguments.rig.empty() &&
+                cluster->count() + hierarchical->count() + cluster_shard->count() > 0) {
+              throw InputError(
+                  "--rig: partitioned mapping (--cluster, --cluster-shard, --hierarchical) "
+                  "does not hold rigs yet; map without them");
+            }
             const PipelineContext context = LoadContext(*options);
-            const MapStageSummary summary =
-                RunMap(context, {options->images, options->output}, InterruptibleControl());
+            const RunOptions run{options->images, options->output};
+            MapStageSummary summary;
+            if (cluster_shard->count() > 0) {
+              const MapStageSummary shard =
+                  MapClusterShard(context, run, ParseShard(options->shard), InterruptibleControl());
+              // A cluster without a model is the merge's to report, not the array's.
+              return shard.status == StageStatus::kCancelled ? ReportInterrupted("map")
+                                                             : static_cast<int>(kExitSuccess);
+            }
+            if (cluster->count() > 0) {
+              summary = MapCluster(context, run, options->cluster, InterruptibleControl());
+            } else if (hierarchical->count() > 0) {
+              summary = MapHierarchically(context, run, HierarchicalOptions(*options, *jobs),
+                                          InterruptibleControl());
+            } else {
+              summary = RunMap(context, run, InterruptibleControl());
+            }
             return MappingExitCode(summary, std::filesystem::path(options->output) / "database.db");
           }};
 }

@@ -131,7 +131,23 @@ std::vector<SlurmScript> MakeSlurmScripts(const SlurmOptions& options, const Slu
   }
   add("merge_match", false, {},
       "merge --output " + ShellQuote(options.output_dir.string()) + " --stage match --shards " + n);
-  add("map", false, {}, "map --images " + images + common);
+  if (!options.partitioned) {
+    add("map", false, {}, "map --images " + images + common);
+    return scripts;
+  }
+  // The number of clusters is known only once partition has run: shard K of N maps
+  // clusters K, K+N, ..., each skipped when already mapped, so a rerun maps what is left.
+  std::string manifest;
+  if (!options.manifest.empty()) manifest = " --manifest " + ShellQuote(options.manifest.string());
+  add("partition", false, {},
+      "partition --output " + ShellQuote(options.output_dir.string()) + manifest);
+  std::vector<int> all(static_cast<size_t>(options.workers));
+  for (int k = 0; k < options.workers; ++k) all[static_cast<size_t>(k)] = k;
+  add("map", true, all,
+      "map --images " + images + common + " --cluster-shard \"$SLURM_ARRAY_TASK_ID/" + n + "\"");
+  add("merge_map", false, {},
+      "merge --stage map --images " + images + " --output " +
+          ShellQuote(options.output_dir.string()) + manifest);
   return scripts;
 }
 

@@ -4,7 +4,9 @@
 // OUTPUT/slurm/ and submitted with sbatch as dependent jobs (afterok):
 //   1. extract.sh, a job array of extraction shards;   2. merge_extract.sh;
 //   3. match.sh, a job array of matching shards;       4. merge_match.sh;
-//   5. map.sh, mapping and the exporters.
+//   5. map.sh, mapping and the exporters; or, partitioned (docs/distributed_mapping.md):
+//      partition.sh, map.sh (a job array: shard K maps clusters K, K+N, ...) and
+//      merge_map.sh (the merge of the cluster models and the exporters).
 // Only unfinished shards are in the arrays, so submitting again after a failure reruns
 // only those. OUTPUT must be on a filesystem every node sees.
 
@@ -26,6 +28,7 @@ struct SlurmOptions {
   std::string partition;                 // empty: the cluster's default
   std::string time;                      // empty: the partition's default
   std::vector<std::string> sbatch_args;  // more #SBATCH lines, e.g. --account=foo
+  bool partitioned = false;              // mapping as clusters (partition/)
 };
 
 // The jobs to submit; an empty array is left out (its stage is done).

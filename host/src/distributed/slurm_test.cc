@@ -148,6 +148,27 @@ TEST(Slurm, FiveScriptsInOrderWithArraysAndOptions) {
   EXPECT_FALSE(Has(Named(scripts, "map").text, "--array"));
 }
 
+TEST(Slurm, PartitionedMappingIsAPartitionJobAClusterArrayAndTheMerge) {
+  SlurmOptions options = Options();
+  options.partitioned = true;
+  const std::vector<SlurmScript> scripts = MakeSlurmScripts(options, {{}, {}});
+  std::vector<std::string> names;
+  for (const SlurmScript& script : scripts) names.push_back(script.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"merge_extract", "merge_match", "partition", "map",
+                                             "merge_map"}));
+  EXPECT_TRUE(Has(Named(scripts, "partition").text,
+                  "partition --output '/shared/out' --manifest '/shared/m.json'\n"));
+  const std::string& map = Named(scripts, "map").text;
+  EXPECT_TRUE(Has(map, "#SBATCH --array=0-3\n")) << map;
+  EXPECT_TRUE(Has(map,
+                  "map --images '/shared/photos' --output '/shared/out' --manifest "
+                  "'/shared/m.json' --threads 8 --cluster-shard \"$SLURM_ARRAY_TASK_ID/4\""))
+      << map;
+  EXPECT_TRUE(Has(Named(scripts, "merge_map").text,
+                  "merge --stage map --images '/shared/photos' --output '/shared/out' --manifest "
+                  "'/shared/m.json'\n"));
+}
+
 TEST(Slurm, ARerunHasOnlyTheUnfinishedShards) {
   const std::vector<SlurmScript> scripts = MakeSlurmScripts(Options(), {{}, {1, 3}});
   ASSERT_EQ(scripts.size(), 4u);

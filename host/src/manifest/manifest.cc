@@ -197,6 +197,22 @@ VerificationSettings ParseVerification(const nlohmann::json& json) {
   return s;
 }
 
+DistributedSettings ParseDistributed(const nlohmann::json& json) {
+  OptionReader reader(json, "distributed");
+  DistributedSettings s;
+  s.cluster_max_images = reader.Get<int>("cluster_max_images", s.cluster_max_images, 2, 1000000);
+  s.cluster_overlap = reader.Get<int>("cluster_overlap", s.cluster_overlap, 1, 1000000);
+  reader.Finish();
+  // A cluster must hold more than the overlaps with its neighbours on either side.
+  if (s.cluster_max_images < 3 * s.cluster_overlap) {
+    throw OptionError("distributed.cluster_max_images",
+                      std::to_string(s.cluster_max_images) +
+                          " is less than 3 times distributed.cluster_overlap (" +
+                          std::to_string(s.cluster_overlap) + ")");
+  }
+  return s;
+}
+
 }  // namespace
 
 Eigen::Matrix3d ReadCalibrationMatrixFile(const std::filesystem::path& file) {
@@ -304,6 +320,7 @@ Manifest Manifest::FromJson(const nlohmann::json& json, const std::filesystem::p
     const nlohmann::json camera = top.GetJson("camera", nlohmann::json::object());
     const nlohmann::json verification = top.GetJson("verification", nlohmann::json::object());
     const nlohmann::json legacy_mapper = top.GetJson("mapper", nullptr);
+    const nlohmann::json distributed = top.GetJson("distributed", nlohmann::json::object());
     manifest.video = top.GetJson("video", nlohmann::json::object());
     top.GetJson("description", "");
     top.Finish();
@@ -343,6 +360,7 @@ Manifest Manifest::FromJson(const nlohmann::json& json, const std::filesystem::p
 
     manifest.camera = ParseCamera(camera, base_dir);
     manifest.verification = ParseVerification(verification);
+    manifest.distributed = ParseDistributed(distributed);
     if (!legacy_mapper.is_null()) {
       if (!legacy_mapper.is_object()) throw OptionError("mapper", "expected a JSON object");
       if (pipeline.is_object() && pipeline.contains("mapper")) {

@@ -24,6 +24,15 @@ struct PluginSlot {
   std::string options_path;
 };
 
+// `distributed`: how `tessera partition` cuts the view graph into clusters that are
+// mapped apart and merged (docs/distributed_mapping.md).
+struct DistributedSettings {
+  // A cluster holds at most this many images, overlap included.
+  int cluster_max_images = 300;
+  // Images a cluster shares with each neighbour (the strongest edges across the cut).
+  int cluster_overlap = 40;
+};
+
 // The whole run configuration. Parsed and checked completely before any image is
 // read; an error names the JSON path and suggests the closest valid key.
 struct Manifest {
@@ -47,6 +56,7 @@ struct Manifest {
 
   CameraSettings camera;
   VerificationSettings verification;
+  DistributedSettings distributed;
   // The manifest gave the incremental mapper's options as a top-level "mapper" object
   // (before mappers were plugins); they are read as pipeline.mapper's options, and the
   // run says how to move them.

@@ -73,8 +73,8 @@ void RenameSwap(const fs::path& from, const fs::path& to) {
     const fs::path aside = from.string() + ".old";
     if (rename(to.c_str(), aside.c_str()) == 0 && rename(from.c_str(), to.c_str()) == 0) return;
   }
-  throw InputError(to.string() + ": cannot replace it with the new output: " +
-                   std::strerror(errno));
+  throw InputError(to.string() +
+                   ": cannot replace it with the new output: " + std::strerror(errno));
 }
 
 // .NAME.tmp-PID, the temporary of an atomic write, of a process that is gone.
@@ -104,8 +104,9 @@ void RemoveLeftoverTemporaries(const fs::path& folder) {
 }  // namespace
 
 bool IsWorkspaceFile(const std::string& name) {
-  static const std::set<std::string> kFolders = {"cache", "shards", "slurm", "video_frames"};
-  static const std::set<std::string> kFiles = {"frames.json", "run_summary.json"};
+  static const std::set<std::string> kFolders = {"cache", "clusters", "shards", "slurm",
+                                                 "video_frames"};
+  static const std::set<std::string> kFiles = {"clusters.json", "frames.json", "run_summary.json"};
   return kFolders.count(name) != 0 || kFiles.count(name) != 0 ||
          name.rfind("database.db", 0) == 0 || name.rfind(".tessera", 0) == 0 ||
          name.rfind("plugin_crashes", 0) == 0;
@@ -298,12 +299,11 @@ OutputTransaction::Result OutputTransaction::Commit() {
   Plan(set, "", &placements, &refusals);
   if (!refusals.empty()) {
     keep_ = true;
-    throw InputError(refusals.front() +
-                     (refusals.size() > 1 ? " (and " + std::to_string(refusals.size() - 1) +
-                                                " more)"
-                                          : "") +
-                     "; nothing was replaced, and this run's outputs are kept in " +
-                     staging_.string() + " until the next run");
+    throw InputError(
+        refusals.front() +
+        (refusals.size() > 1 ? " (and " + std::to_string(refusals.size() - 1) + " more)" : "") +
+        "; nothing was replaced, and this run's outputs are kept in " + staging_.string() +
+        " until the next run");
   }
   // The new set, digested where it lies; then recorded beside the old before it moves.
   OutputLedger placed;
@@ -401,7 +401,8 @@ std::vector<std::string> OutputTransaction::ShadowWarnings(const OutputLedger& p
           TypeOf(output_ / sibling) != fs::file_type::not_found) {
         warnings.push_back((output_ / sibling).string() +
                            " was not written by Tessera; readers of the model may read it in "
-                           "place of " + (output_ / path).string());
+                           "place of " +
+                           (output_ / path).string());
       }
     }
   }

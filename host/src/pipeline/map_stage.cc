@@ -15,6 +15,7 @@
 #include "plugin/bundle_adjuster_guard.h"
 #include "plugin/plugin_call.h"
 #include "tessera/io/colmap_model_io.h"
+#include "tessera/io/file_io.h"
 #include "tessera/io/georeference_io.h"
 #include "tessera/io/model_statistics.h"
 #include "tessera/io/point_colors.h"
@@ -150,8 +151,9 @@ void ExportModel(const Reconstruction& model, size_t index,
 bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
                      const MapperResult& result, const MapperInput& input,
                      const std::filesystem::path& image_dir, const StageControl& control,
-                     MapStageSummary* summary) {
-  const std::filesystem::path& output_dir = workspace.folder();
+                     const MapTarget& target, MapStageSummary* summary) {
+  const std::filesystem::path output_dir =
+      target.output_dir.empty() ? workspace.folder() : target.output_dir;
   MappingSummary mapping = SummarizeMapping(
       result, input, output_dir / "sparse",
       settings.mapper != nullptr ? settings.mapper->name() : "",
@@ -160,7 +162,9 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
   if (settings.rig != nullptr && !input.rigs.empty()) {
     mapping.rig = SummarizeRig(*settings.rig, input.rigs.front(), input);
   }
+  mapping.partition = target.partition;
   summary->num_models = result.models.size();
+  CreateFolder(output_dir);
   OutputTransaction outputs(output_dir);
   outputs.Protect(image_dir);
   outputs.Protect(settings.mask_dir);
@@ -196,15 +200,33 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
   return true;
 }
 
+MapStageSummary PlaceMapResult(const Workspace& workspace, const MapSettings& settings,
+                               const MapperResult& result, const MapperInput& input,
+                               const MapTarget& target, const StageControl& control) {
+  const Timer timer;
+  MapStageSummary summary;
+  summary.num_images = input.images.size();
+  const std::filesystem::path image_dir = ImageFolder(settings.image_dir, workspace.database());
+  if (!PlaceMapOutputs(workspace, settings, result, input, image_dir, control, target, &summary)) {
+    summary.status = StageStatus::kCancelled;
+  }
+  summary.seconds = timer.ElapsedSeconds();
+  return summary;
+}
+
 MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& settings,
-                             const StageScope& scope, const StageControl& control) {
+                             const StageScope& scope, const StageControl& control,
+                             const MapTarget& target) {
   const Timer timer;
   MapStageSummary summary;
   if (settings.mapper == nullptr || settings.bundle_adjuster == nullptr || !scope.IsWhole()) {
     throw std::logic_error("MapWorkspace: no mapper or bundle adjuster, or a scope it cannot map");
   }
   Database* database = &workspace.database();
-  const MapperInput input = LoadMapperInputWithRig(*database, settings.rig);
+  MapperInput loaded;
+  const MapperInput& input = target.input != nullptr
+                                 ? *target.input
+                                 : (loaded = LoadMapperInputWithRig(*database, settings.rig));
   const std::filesystem::path image_dir = ImageFolder(settings.image_dir, *database);
   const auto cancelled = [&] {
     if (!control.Cancelled()) return false;
@@ -224,7 +246,7 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
                   database->path().string(), database->NumMatchedPairs());
     summary.num_images = database->NumImages();
     summary.seconds = timer.ElapsedSeconds();
-    if (!PlaceMapOutputs(workspace, settings, {}, input, image_dir, control, &summary)) {
+    if (!PlaceMapOutputs(workspace, settings, {}, input, image_dir, control, target, &summary)) {
       cancelled();
     }
     return summary;
@@ -297,7 +319,7 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
     }
   }
   summary.seconds = timer.ElapsedSeconds();
-  if (!PlaceMapOutputs(workspace, settings, result, input, image_dir, control, &summary)) {
+  if (!PlaceMapOutputs(workspace, settings, result, input, image_dir, control, target, &summary)) {
     cancelled();
     return summary;
   }

@@ -44,6 +44,14 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
                                 const std::filesystem::path& sparse_dir, const std::string& mapper,
                                 const nlohmann::json& mapper_options, uint64_t seed);
 
+// What MapWorkspace maps and where, when it is not the whole workspace into OUTPUT: one
+// cluster's images and pairs into OUTPUT/clusters/K (partition/).
+struct MapTarget {
+  const MapperInput* input = nullptr;  // null: the workspace's (LoadMapperInput)
+  std::filesystem::path output_dir;    // empty: the workspace folder
+  nlohmann::json partition;            // MappingSummary::partition
+};
+
 // Maps the workspace's verified matches and writes every model: through the settings'
 // exporters, or as COLMAP binary in OUTPUT/sparse/<index>/ when there are none; then
 // OUTPUT/mapping_summary.json. The models, their exports and the summary are one set
@@ -65,6 +73,15 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
 // written; `control.model_changed` sees the model grow. Cancelled:
 // nothing of the old output is touched, nothing new is placed. Status kCancelled.
 MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& settings,
-                             const StageScope& scope = {}, const StageControl& control = {});
+                             const StageScope& scope = {}, const StageControl& control = {},
+                             const MapTarget& target = {});
+
+// Places `result`, made elsewhere from `input`'s images (the merge of cluster models),
+// as MapWorkspace places its own: the settings' exporters, else COLMAP binary in
+// sparse/<index>, and mapping_summary.json, as one set. Only the images' names of
+// `input` are read.
+MapStageSummary PlaceMapResult(const Workspace& workspace, const MapSettings& settings,
+                               const MapperResult& result, const MapperInput& input,
+                               const MapTarget& target, const StageControl& control = {});
 
 }  // namespace tessera

@@ -47,6 +47,7 @@ nlohmann::json MappingSummary::ToJson() const {
   json["mapper_details"] = mapper_details;
   json["seed"] = seed;
   if (!rig.is_null()) json["rig"] = rig;
+  if (!partition.is_null()) json["partition"] = partition;
   return json;
 }
 
@@ -99,6 +100,7 @@ MappingSummary MappingSummary::FromJson(const nlohmann::json& json) {
   summary.mapper_details = json.value("mapper_details", nlohmann::json::object());
   summary.seed = json.at("seed").get<uint64_t>();
   summary.rig = json.value("rig", nlohmann::json());
+  summary.partition = json.value("partition", nlohmann::json());
   return summary;
 }
 

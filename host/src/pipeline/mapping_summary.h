@@ -67,6 +67,10 @@ struct MappingSummary {
   // The camera rig of `--rig` ({"file", "digest", "frames", "poses_known", "num_frames",
   // "cameras": [{"folder", "camera_id", "reference"}]}); null without one.
   nlohmann::json rig;
+  // Partitioned mapping (partition/): a cluster's model set says which cluster of which
+  // clusters.json it is ({"cluster", "clusters_json"}); the merged set lists every
+  // merge decision ({"clusters_json", "merges": [...]}). Null otherwise.
+  nlohmann::json partition;
 
   // The file's JSON, keys as documented in the README.
   nlohmann::json ToJson() const;

@@ -1,0 +1,52 @@
+#pragma once
+
+// The similarity between the frames of two models of overlapping clusters, from the
+// images both registered: a RANSAC over pairs of shared images (the rotation from one
+// image's two orientations, scale and translation from the two centres), inliers whose
+// centre lands within a tolerance relative to the scene's size and whose orientation
+// agrees, refined on the inliers (Umeyama on the centres when they are spread out).
+// Deterministic: every pair is tried when there are few shared images, else a seeded
+// sample.
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "geometry/similarity_transform.h"
+#include "tessera/reconstruction.h"
+
+namespace tessera {
+
+struct CenterAlignmentOptions {
+  size_t min_shared_images = 3;  // fewer shared registered images: no alignment
+  // A shared image agrees when its moved centre lies within this fraction of the
+  // target's scene size (median distance of its centres from their mean) ...
+  double max_center_error = 0.05;
+  // ... and its orientations differ by at most this many degrees.
+  double max_rotation_error_deg = 5;
+  size_t max_num_hypotheses = 5000;  // pairs of shared images tried at most
+  // Fewer of the shared images agreeing: no alignment (one of the models is likely
+  // wrong, folded or drifted, and a merge would bend the other).
+  double min_inlier_ratio = 0.7;
+};
+
+struct CenterAlignment {
+  bool success = false;
+  Similarity3d target_from_source;
+  std::vector<std::string> shared;   // registered in both, sorted
+  std::vector<std::string> inliers;  // sorted
+  double rms_center_error = 0;       // of the inliers, in the target's units
+  // The inliers' centres lie nearly on a line (smallest over largest singular value of
+  // the centred centres under 1%): the rotation comes from the orientations alone.
+  bool degenerate = false;
+  std::string reason;  // why not, when not
+};
+
+// target_from_source such that target ≈ T * source.
+CenterAlignment AlignByCameraCenters(const Reconstruction& source, const Reconstruction& target,
+                                     const CenterAlignmentOptions& options, uint64_t seed);
+
+// Moves `model` by `target_from_model`: every pose and point.
+void TransformModel(const Similarity3d& target_from_model, Reconstruction* model);
+
+}  // namespace tessera

@@ -1,0 +1,156 @@
+#include "partition/cluster_map.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <optional>
+#include <set>
+
+#include "partition/partition_stage.h"
+#include "pipeline/load_mapper_input.h"
+#include "pipeline/map_stage.h"
+#include "pipeline/mapping_summary.h"
+#include "pipeline/workspace.h"
+#include "tessera/errors.h"
+
+namespace tessera {
+namespace {
+
+// The database every cluster job reads at once: read only, without a lock. Immutable
+// reads do not see a write-ahead log, which only a killed writer leaves behind.
+std::filesystem::path CheckedDatabaseFile(const std::filesystem::path& workspace) {
+  const std::filesystem::path file = workspace / "database.db";
+  std::error_code error;
+  if (!std::filesystem::exists(file, error)) {
+    throw InputError(file.string() +
+                     ": no workspace database for map --cluster; run extract, "
+                     "match and partition first");
+  }
+  const std::filesystem::path wal = file.string() + "-wal";
+  if (std::filesystem::exists(wal, error) && std::filesystem::file_size(wal, error) > 0) {
+    throw InputError(wal.string() + ": " + file.string() +
+                     " has changes a killed writer did not fold in; open it with any stage "
+                     "(tessera partition) first");
+  }
+  return file;
+}
+
+// The summary of cluster K's finished models for clusters.json `fingerprint`, if any.
+std::optional<MappingSummary> FinishedCluster(const std::filesystem::path& folder, int cluster,
+                                              const std::string& fingerprint) {
+  const std::filesystem::path file = folder / "mapping_summary.json";
+  std::error_code error;
+  if (!std::filesystem::exists(file, error)) return std::nullopt;
+  try {
+    MappingSummary summary = MappingSummary::Read(file);
+    if (!summary.partition.is_object() || summary.partition.value("cluster", -1) != cluster ||
+        summary.partition.value("clusters_json", "") != fingerprint) {
+      return std::nullopt;
+    }
+    for (const MappingSummary::Model& model : summary.models) {
+      if (!std::filesystem::is_directory(folder / "sparse" / std::to_string(model.index), error)) {
+        return std::nullopt;
+      }
+    }
+    return summary;
+  } catch (const InputError&) {
+    return std::nullopt;  // half written or foreign: mapped again
+  }
+}
+
+}  // namespace
+
+std::filesystem::path ClusterFolder(const std::filesystem::path& workspace, int cluster) {
+  return workspace / "clusters" / std::to_string(cluster);
+}
+
+MapperInput RestrictMapperInput(const MapperInput& input, const std::vector<std::string>& images) {
+  const std::set<std::string> names(images.begin(), images.end());
+  MapperInput restricted;
+  for (const auto& [image_id, image] : input.images) {
+    if (names.count(image.name) == 0) continue;
+    restricted.images.emplace(image_id, image);
+    restricted.cameras.emplace(image.camera_id, input.cameras.at(image.camera_id));
+    const auto metadata = input.metadata.find(image_id);
+    if (metadata != input.metadata.end()) restricted.metadata.emplace(image_id, metadata->second);
+  }
+  for (const MapperInput::Pair& pair : input.pairs) {
+    if (restricted.images.count(pair.image_id1) != 0 &&
+        restricted.images.count(pair.image_id2) != 0) {
+      restricted.pairs.push_back(pair);
+    }
+  }
+  return restricted;
+}
+
+MapStageSummary MapCluster(const PipelineContext& context, const RunOptions& options, int cluster,
+                           const StageControl& control) {
+  context.Require("bundle_adjuster", "map");
+  const std::filesystem::path database_file = CheckedDatabaseFile(options.output_dir);
+  const std::string name = "cluster-" + std::to_string(cluster);
+  const auto workspace = Workspace::OpenShard(options.output_dir, name, [&] {
+    return std::make_unique<Database>(database_file, Database::Mode::kReadOnly);
+  });
+  const Database& database = workspace->database();
+  const ClustersFile clusters =
+      ReadWorkspaceClusters(options.output_dir, database, context.manifest);
+  if (cluster < 0 || cluster >= static_cast<int>(clusters.clusters.size())) {
+    throw InputError("--cluster " + std::to_string(cluster) + ": " +
+                     ClustersFilePath(options.output_dir).string() + " has " +
+                     std::to_string(clusters.clusters.size()) + " clusters (0 to " +
+                     std::to_string(clusters.clusters.size() - 1) + ")");
+  }
+  const std::filesystem::path folder = ClusterFolder(options.output_dir, cluster);
+  const std::string fingerprint = clusters.Fingerprint();
+  if (const auto finished = FinishedCluster(folder, cluster, fingerprint)) {
+    MapStageSummary summary;
+    summary.num_models = finished->models.size();
+    for (const MappingSummary::Model& model : finished->models) {
+      summary.num_registered += model.num_images;
+      summary.images_per_model.push_back(model.num_images);
+    }
+    summary.num_images = clusters.clusters[cluster].images.size();
+    spdlog::info("map: cluster {} is already mapped for this clusters.json ({}): skipped", cluster,
+                 folder.string());
+    return summary;
+  }
+  CheckImagesUnchanged(
+      *workspace, options.image_dir,
+      workspace->ScanOptions(context.manifest.camera.mask_path, context.manifest.max_image_pixels));
+  const MapperInput input =
+      RestrictMapperInput(LoadMapperInput(database), clusters.clusters[cluster].images);
+  spdlog::info("map: cluster {}: {} images, {} verified pairs, into {}", cluster,
+               input.images.size(), input.pairs.size(), folder.string());
+  MapSettings settings = context.MakeMapSettings(options.image_dir);
+  settings.exporters = nullptr;  // COLMAP binary: the exporters run on the merged models
+  MapTarget target;
+  target.input = &input;
+  target.output_dir = folder;
+  target.partition = {{"cluster", cluster}, {"clusters_json", fingerprint}};
+  return MapWorkspace(*workspace, settings, {}, control, target);
+}
+
+MapStageSummary MapClusterShard(const PipelineContext& context, const RunOptions& options,
+                                const Shard& shard, const StageControl& control) {
+  const ClustersFile clusters = ClustersFile::Read(ClustersFilePath(options.output_dir));
+  MapStageSummary total;
+  for (int cluster = shard.index; cluster < static_cast<int>(clusters.clusters.size());
+       cluster += shard.count) {
+    const MapStageSummary summary = MapCluster(context, options, cluster, control);
+    total.num_models += summary.num_models;
+    total.num_registered += summary.num_registered;
+    total.num_images += summary.num_images;
+    total.seconds += summary.seconds;
+    if (summary.status == StageStatus::kCancelled) {
+      total.status = StageStatus::kCancelled;
+      break;
+    }
+  }
+  spdlog::info("map: shard {}/{}: {} of {} clusters, {} models", shard.index, shard.count,
+               (clusters.clusters.size() + static_cast<size_t>(shard.count - shard.index) - 1) /
+                   static_cast<size_t>(shard.count),
+               clusters.clusters.size(), total.num_models);
+  return total;
+}
+
+}  // namespace tessera

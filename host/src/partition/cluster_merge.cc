@@ -1,0 +1,257 @@
+#include "partition/cluster_merge.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <set>
+
+namespace tessera {
+namespace {
+
+bool Larger(const ClusterModel& a, const ClusterModel& b) {
+  if (a.model.images.size() != b.model.images.size()) {
+    return a.model.images.size() > b.model.images.size();
+  }
+  if (a.model.points3D.size() != b.model.points3D.size()) {
+    return a.model.points3D.size() > b.model.points3D.size();
+  }
+  return a.clusters < b.clusters;
+}
+
+std::string ClusterList(const std::vector<int>& clusters) {
+  std::string text;
+  for (const int cluster : clusters) text += (text.empty() ? "" : "+") + std::to_string(cluster);
+  return text;
+}
+
+Point2D* ObservationOf(Reconstruction* model, const TrackElement& element) {
+  const auto it = model->images.find(element.image_id);
+  if (it == model->images.end() || element.point2D_idx >= it->second.points2D.size()) {
+    return nullptr;
+  }
+  return &it->second.points2D[element.point2D_idx];
+}
+
+bool TrackHasImage(const Track& track, image_t image_id) {
+  return std::any_of(track.begin(), track.end(),
+                     [&](const TrackElement& e) { return e.image_id == image_id; });
+}
+
+// `source` (moved into the target's frame) into `target`: its cameras and the images the
+// target lacks (shared images keep the target's pose); each source point joins the one
+// target point its observations in shared images belong to, else becomes a new point
+// on the observations that are free.
+void Unite(const Reconstruction& source, Reconstruction* target) {
+  for (const auto& [camera_id, camera] : source.cameras) target->cameras.emplace(camera_id, camera);
+  for (const auto& [image_id, image] : source.images) {
+    if (target->images.count(image_id) != 0) continue;
+    Image copy = image;
+    for (Point2D& point : copy.points2D) point.point3D_id = kInvalidPoint3DId;
+    target->images.emplace(image_id, std::move(copy));
+  }
+  point3D_t next_id = target->points3D.empty() ? 1 : target->points3D.rbegin()->first + 1;
+  for (const auto& [point3D_id, point] : source.points3D) {
+    std::set<point3D_t> joined;
+    for (const TrackElement& element : point.track) {
+      const Point2D* observation = ObservationOf(target, element);
+      if (observation != nullptr && observation->HasPoint3D())
+        joined.insert(observation->point3D_id);
+    }
+    const bool join = joined.size() == 1;
+    Point3D fresh;
+    fresh.xyz = point.xyz;
+    fresh.color = point.color;
+    const point3D_t id = join ? *joined.begin() : next_id;
+    Track& track = join ? target->points3D.at(id).track : fresh.track;
+    std::vector<Point2D*> linked;
+    for (const TrackElement& element : point.track) {
+      Point2D* observation = ObservationOf(target, element);
+      if (observation == nullptr || observation->HasPoint3D() ||
+          TrackHasImage(track, element.image_id)) {
+        continue;
+      }
+      track.push_back(element);
+      linked.push_back(observation);
+    }
+    if (!join && fresh.track.size() < 2) continue;
+    for (Point2D* observation : linked) observation->point3D_id = id;
+    if (!join) target->points3D.emplace(next_id++, std::move(fresh));
+  }
+}
+
+// Drops observations over `max_error` px (or behind the camera), points left with
+// fewer than 2, and images left with none. Returns the names of the images dropped.
+std::vector<std::string> FilterObservations(double max_error, Reconstruction* model) {
+  for (auto it = model->points3D.begin(); it != model->points3D.end();) {
+    Track kept;
+    for (const TrackElement& element : it->second.track) {
+      Point2D* observation = ObservationOf(model, element);
+      if (observation == nullptr) continue;  // names no keypoint of the model: dropped
+      const Image& image = model->images.at(element.image_id);
+      const Eigen::Vector3d in_cam = image.cam_from_world * it->second.xyz;
+      const bool good =
+          in_cam.z() > 0 &&
+          (model->cameras.at(image.camera_id).ImgFromCam(in_cam) - observation->xy).norm() <=
+              max_error;
+      if (good) {
+        kept.push_back(element);
+      } else {
+        observation->point3D_id = kInvalidPoint3DId;
+      }
+    }
+    if (kept.size() >= 2) {
+      it->second.track = std::move(kept);
+      ++it;
+      continue;
+    }
+    for (const TrackElement& element : kept)
+      ObservationOf(model, element)->point3D_id = kInvalidPoint3DId;
+    it = model->points3D.erase(it);
+  }
+  std::vector<std::string> dropped;
+  for (auto it = model->images.begin(); it != model->images.end();) {
+    const bool seen = std::any_of(it->second.points2D.begin(), it->second.points2D.end(),
+                                  [](const Point2D& p) { return p.HasPoint3D(); });
+    if (seen) {
+      ++it;
+      continue;
+    }
+    dropped.push_back(it->second.name);
+    it = model->images.erase(it);
+  }
+  return dropped;
+}
+
+class TreeMerger {
+ public:
+  TreeMerger(std::map<int, std::vector<Reconstruction>> models, const BundleAdjuster& adjuster,
+             const ClusterMergeOptions& options)
+      : models_(std::move(models)), adjuster_(adjuster), options_(options) {}
+
+  std::vector<ClusterModel> Merge(const ClusterTreeNode& node) {
+    std::vector<ClusterModel> pool;
+    if (node.cluster >= 0) {
+      for (Reconstruction& model : models_[node.cluster])
+        pool.push_back({std::move(model), {node.cluster}});
+      std::sort(pool.begin(), pool.end(), Larger);
+      return pool;
+    }
+    for (const ClusterTreeNode& child : node.children) {
+      std::vector<ClusterModel> models = Merge(child);
+      for (ClusterModel& model : models) pool.push_back(std::move(model));
+    }
+    std::sort(pool.begin(), pool.end(), Larger);
+    if (pool.size() < 2) return pool;
+    // The largest takes every other model it can, until none more joins.
+    std::vector<ClusterModel> rest(std::make_move_iterator(pool.begin() + 1),
+                                   std::make_move_iterator(pool.end()));
+    ClusterModel main = std::move(pool[0]);
+    std::map<std::vector<int>, ClusterMergeRecord> failures;
+    for (bool progress = true; progress;) {
+      progress = false;
+      for (auto it = rest.begin(); it != rest.end(); ++it) {
+        ClusterMergeRecord record = TryMerge(*it, &main);
+        if (record.merged) {
+          records.push_back(std::move(record));
+          failures.erase(it->clusters);
+          rest.erase(it);
+          progress = true;
+          break;
+        }
+        failures[it->clusters] = std::move(record);
+      }
+    }
+    for (auto& [clusters, record] : failures) {
+      spdlog::warn("merge: {}", record.Line());
+      records.push_back(std::move(record));
+    }
+    rest.push_back(std::move(main));
+    std::sort(rest.begin(), rest.end(), Larger);
+    return rest;
+  }
+
+  std::vector<ClusterMergeRecord> records;
+
+ private:
+  ClusterMergeRecord TryMerge(const ClusterModel& source, ClusterModel* target) {
+    ClusterMergeRecord record;
+    record.target_clusters = target->clusters;
+    record.source_clusters = source.clusters;
+    const CenterAlignment alignment =
+        AlignByCameraCenters(source.model, target->model, options_.alignment, options_.seed);
+    record.num_shared = alignment.shared.size();
+    record.num_inliers = alignment.inliers.size();
+    record.degenerate = alignment.degenerate;
+    if (!alignment.success) {
+      record.reason = alignment.reason;
+      return record;
+    }
+    record.scale = alignment.target_from_source.scale;
+    record.rms_center_error = alignment.rms_center_error;
+    Reconstruction moved = source.model;
+    TransformModel(alignment.target_from_source, &moved);
+    Reconstruction merged = target->model;
+    Unite(moved, &merged);
+    const size_t before = merged.images.size();
+    const BundleAdjustmentSummary adjustment = adjuster_.Adjust({}, &merged);
+    if (!adjustment.usable) {
+      record.reason = "the bundle adjustment of the merged model failed: " + adjustment.message;
+      return record;
+    }
+    record.images_lost = FilterObservations(options_.max_reprojection_error, &merged);
+    if (record.images_lost.size() > options_.max_merge_loss * static_cast<double>(before)) {
+      record.reason = "the merged model would lose " + std::to_string(record.images_lost.size()) +
+                      " of " + std::to_string(before) + " images (over " +
+                      std::to_string(static_cast<int>(100 * options_.max_merge_loss)) + "%)";
+      return record;
+    }
+    record.merged = true;
+    target->model = std::move(merged);
+    target->clusters.insert(target->clusters.end(), source.clusters.begin(), source.clusters.end());
+    std::sort(target->clusters.begin(), target->clusters.end());
+    spdlog::info("merge: {}", record.Line());
+    return record;
+  }
+
+  std::map<int, std::vector<Reconstruction>> models_;
+  const BundleAdjuster& adjuster_;
+  ClusterMergeOptions options_;
+};
+
+}  // namespace
+
+nlohmann::json ClusterMergeRecord::ToJson() const {
+  return {{"target_clusters", target_clusters},
+          {"source_clusters", source_clusters},
+          {"shared_images", num_shared},
+          {"inliers", num_inliers},
+          {"scale", scale},
+          {"rms_center_error", rms_center_error},
+          {"degenerate", degenerate},
+          {"images_lost", images_lost},
+          {"merged", merged},
+          {"reason", reason}};
+}
+
+std::string ClusterMergeRecord::Line() const {
+  const std::string clusters =
+      "clusters " + ClusterList(target_clusters) + " and " + ClusterList(source_clusters);
+  if (!merged) return clusters + " " + reason + ": left unmerged";
+  return clusters + " merged: " + std::to_string(num_inliers) + " of " +
+         std::to_string(num_shared) + " shared images agree, scale " + std::to_string(scale) +
+         ", " + std::to_string(images_lost.size()) + " images lost" +
+         (degenerate ? " (shared centres nearly on a line)" : "");
+}
+
+ClusterMergeResult MergeClusterModels(const ClusterTreeNode& tree,
+                                      std::map<int, std::vector<Reconstruction>> models,
+                                      const BundleAdjuster& adjuster,
+                                      const ClusterMergeOptions& options) {
+  TreeMerger merger(std::move(models), adjuster, options);
+  ClusterMergeResult result;
+  result.models = merger.Merge(tree);
+  result.merges = std::move(merger.records);
+  return result;
+}
+
+}  // namespace tessera

@@ -1,0 +1,64 @@
+#pragma once
+
+// Merging the models of the clusters bottom-up along the cluster tree: at each inner
+// node, the largest model of its children takes the others one by one, each moved by
+// the similarity its shared registered images give (center_alignment.h), its tracks
+// fused with the target's through the shared images, the result bundle adjusted and
+// observations over the reprojection limit dropped. A merge that would lose more than
+// max_merge_loss of the images is undone. Models that cannot be merged stay apart.
+// Every decision is recorded.
+
+#include <cstdint>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "partition/center_alignment.h"
+#include "partition/view_graph_partitioner.h"
+#include "tessera/bundle_adjuster.h"
+#include "tessera/reconstruction.h"
+
+namespace tessera {
+
+struct ClusterMergeOptions {
+  CenterAlignmentOptions alignment;
+  double max_reprojection_error = 8;  // px, after the merge's bundle adjustment
+  double max_merge_loss = 0.05;       // share of the images a merge may lose
+  uint64_t seed = 0;
+};
+
+// One merge decision.
+struct ClusterMergeRecord {
+  std::vector<int> target_clusters;  // the clusters each model holds
+  std::vector<int> source_clusters;
+  size_t num_shared = 0;  // registered images both hold
+  size_t num_inliers = 0;
+  double scale = 0;             // target_from_source
+  double rms_center_error = 0;  // in the target's units
+  bool degenerate = false;      // the inliers' centres lie nearly on a line
+  std::vector<std::string> images_lost;
+  bool merged = false;
+  std::string reason;  // why not, when not
+
+  nlohmann::json ToJson() const;
+  std::string Line() const;  // for the log
+};
+
+struct ClusterModel {
+  Reconstruction model;
+  std::vector<int> clusters;  // sorted
+};
+
+struct ClusterMergeResult {
+  std::vector<ClusterModel> models;  // largest first
+  std::vector<ClusterMergeRecord> merges;
+};
+
+// `models`: each cluster's models. `adjuster` adjusts every merged model.
+ClusterMergeResult MergeClusterModels(const ClusterTreeNode& tree,
+                                      std::map<int, std::vector<Reconstruction>> models,
+                                      const BundleAdjuster& adjuster,
+                                      const ClusterMergeOptions& options);
+
+}  // namespace tessera

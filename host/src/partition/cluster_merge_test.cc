@@ -1,0 +1,175 @@
+#include "partition/cluster_merge.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <random>
+#include <set>
+
+#include "eval/evaluation.h"
+#include "synthetic_scene.h"
+#include "test_support.h"
+
+namespace tessera {
+namespace {
+
+using testing::MakeSyntheticScene;
+using testing::SyntheticScene;
+using testing::SyntheticSceneOptions;
+
+// 60 cameras on an arc of 300 degrees, pairs only between neighbours up to 6 apart: an
+// ordered capture the partition cuts into a chain of clusters.
+SyntheticScene Scene() {
+  SyntheticSceneOptions options;
+  options.num_images = 60;
+  options.num_points = 3000;
+  options.arc_deg = 300;
+  options.max_pair_gap = 6;
+  options.seed = 5;
+  return MakeSyntheticScene(options);
+}
+
+// The true model of `images` (all when empty): true poses, and every true point seen by
+// at least two of them, with its observations there.
+Reconstruction TrueModel(const SyntheticScene& scene, const std::set<image_t>& images) {
+  Reconstruction model;
+  model.cameras = scene.input.cameras;
+  std::map<int, Track> tracks;
+  for (const auto& [image_id, image] : scene.input.images) {
+    if (!images.empty() && images.count(image_id) == 0) continue;
+    Image copy = image;
+    copy.cam_from_world = scene.true_cam_from_world.at(image_id);
+    copy.registered = true;
+    model.images.emplace(image_id, std::move(copy));
+    const std::vector<int>& truth = scene.true_point_of_keypoint.at(image_id);
+    for (size_t k = 0; k < truth.size(); ++k) {
+      if (truth[k] >= 0) tracks[truth[k]].push_back({image_id, static_cast<point2D_t>(k)});
+    }
+  }
+  point3D_t next_id = 1;
+  for (auto& [point, track] : tracks) {
+    if (track.size() < 2) continue;
+    for (const TrackElement& element : track) {
+      model.images.at(element.image_id).points2D[element.point2D_idx].point3D_id = next_id;
+    }
+    Point3D point3D;
+    point3D.xyz = scene.true_points3D[point];
+    point3D.track = track;
+    model.points3D.emplace(next_id++, std::move(point3D));
+  }
+  return model;
+}
+
+// Cluster `images` as its own mapping would give it: its own frame (a random
+// similarity) and a little noise on each pose.
+Reconstruction ClusterModelOf(const SyntheticScene& scene, const std::set<image_t>& images,
+                              uint32_t seed) {
+  Reconstruction model = TrueModel(scene, images);
+  std::mt19937 random(seed);
+  std::normal_distribution<double> normal(0, 1);
+  Similarity3d frame;
+  frame.scale = 0.5 + (random() % 100) / 50.0;
+  frame.rotation = Eigen::AngleAxisd(
+                       0.1 * (random() % 60),
+                       Eigen::Vector3d(normal(random), normal(random), normal(random)).normalized())
+                       .toRotationMatrix();
+  frame.translation = Eigen::Vector3d(normal(random), normal(random), normal(random)) * 5;
+  for (auto& [image_id, image] : model.images) {
+    image.cam_from_world.translation +=
+        0.01 * Eigen::Vector3d(normal(random), normal(random), normal(random));
+  }
+  TransformModel(frame, &model);
+  return model;
+}
+
+std::vector<WeightedEdge> ViewGraphOf(const SyntheticScene& scene) {
+  std::vector<WeightedEdge> edges;
+  for (const MapperInput::Pair& pair : scene.input.pairs) {
+    // Image ids are 1..N in name order: node = id - 1.
+    edges.push_back({pair.image_id1 - 1, pair.image_id2 - 1,
+                     static_cast<double>(pair.geometry.inlier_matches.size())});
+  }
+  return edges;
+}
+
+TEST(ClusterMerge, ASceneCutIntoClustersMergesBackWithEveryImage) {
+  const SyntheticScene scene = Scene();
+  const ViewGraphPartition partition = PartitionViewGraph(60, ViewGraphOf(scene), {24, 6});
+  ASSERT_GE(partition.clusters.size(), 4u);
+  std::map<int, std::vector<Reconstruction>> models;
+  for (size_t c = 0; c < partition.clusters.size(); ++c) {
+    std::set<image_t> images;
+    for (const size_t node : partition.clusters[c].nodes)
+      images.insert(static_cast<image_t>(node + 1));
+    models[static_cast<int>(c)].push_back(ClusterModelOf(scene, images, static_cast<uint32_t>(c)));
+  }
+  const ClusterMergeResult result =
+      MergeClusterModels(partition.tree, models, testing::CeresAdjusterOnOneThread(), {});
+  ASSERT_EQ(result.models.size(), 1u);
+  EXPECT_EQ(result.models[0].model.images.size(), 60u) << "no image lost";
+  EXPECT_EQ(result.models[0].clusters.size(), partition.clusters.size());
+  EXPECT_EQ(result.merges.size(), partition.clusters.size() - 1);
+  for (const ClusterMergeRecord& record : result.merges) {
+    EXPECT_TRUE(record.merged) << record.Line();
+    EXPECT_GE(record.num_inliers, 3u) << record.Line();
+  }
+  // Against the unpartitioned (true) model: every pose within tolerance.
+  const EvaluationResult evaluation =
+      EvaluateReconstruction(result.models[0].model, scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  EXPECT_EQ(evaluation.num_registered, 60u);
+  EXPECT_LT(evaluation.rotation_error_max_deg, 0.5);
+  EXPECT_LT(evaluation.position_error_max / evaluation.scene_extent, 0.01);
+}
+
+TEST(ClusterMerge, ClustersSharingFewerThanThreeImagesStayApartNamed) {
+  const SyntheticScene scene = Scene();
+  std::set<image_t> first, second;
+  for (image_t id = 1; id <= 31; ++id) first.insert(id);
+  for (image_t id = 30; id <= 60; ++id) second.insert(id);  // shares 30 and 31
+  ClusterTreeNode tree;
+  tree.children.resize(2);
+  tree.children[0].cluster = 0;
+  tree.children[1].cluster = 1;
+  std::map<int, std::vector<Reconstruction>> models;
+  models[0].push_back(ClusterModelOf(scene, first, 1));
+  models[1].push_back(ClusterModelOf(scene, second, 2));
+  const ClusterMergeResult result =
+      MergeClusterModels(tree, models, testing::CeresAdjusterOnOneThread(), {});
+  ASSERT_EQ(result.models.size(), 2u);
+  ASSERT_EQ(result.merges.size(), 1u);
+  const ClusterMergeRecord& record = result.merges[0];
+  EXPECT_FALSE(record.merged);
+  EXPECT_EQ(record.num_shared, 2u);
+  EXPECT_EQ(record.Line(), "clusters 0 and 1 share 2 registered images (need 3): left unmerged");
+}
+
+TEST(CenterAlignment, RecoversASimilarityDespiteAWrongImage) {
+  const SyntheticScene scene = Scene();
+  const Reconstruction truth = TrueModel(scene, {});
+  Reconstruction moved = truth;
+  Similarity3d frame;
+  frame.scale = 2.5;
+  frame.rotation = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  frame.translation = Eigen::Vector3d(4, -1, 2);
+  TransformModel(frame, &moved);
+  moved.images.at(7).cam_from_world.translation += Eigen::Vector3d(30, 0, 0);
+  const CenterAlignment alignment = AlignByCameraCenters(moved, truth, {}, 0);
+  ASSERT_TRUE(alignment.success) << alignment.reason;
+  EXPECT_EQ(alignment.shared.size(), 60u);
+  EXPECT_EQ(alignment.inliers.size(), 59u);
+  EXPECT_NEAR(alignment.target_from_source.scale, 1 / 2.5, 1e-9);
+  EXPECT_LT(alignment.rms_center_error, 1e-9);
+  EXPECT_FALSE(alignment.degenerate);
+  // Half the shared images elsewhere (a folded or drifted model): no alignment.
+  for (image_t id = 1; id <= 30; ++id) {
+    moved.images.at(id).cam_from_world.translation += Eigen::Vector3d(0, 5.0 + id, 0);
+  }
+  const CenterAlignment weak = AlignByCameraCenters(moved, truth, {}, 0);
+  EXPECT_FALSE(weak.success);
+  EXPECT_EQ(weak.reason,
+            "share 60 registered images, of which 30 agree on one similarity (need 70%)");
+}
+
+}  // namespace
+}  // namespace tessera

@@ -1,0 +1,81 @@
+#include "partition/hierarchical_map.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+#include "partition/merge_map_stage.h"
+#include "partition/partition_stage.h"
+#include "partition/process_pool.h"
+#include "pipeline/workspace.h"
+#include "tessera/errors.h"
+#include "util/timer.h"
+
+namespace tessera {
+namespace {
+
+// OUTPUT/clusters.json, made again unless it belongs to this database and manifest. The
+// workspace is held only meanwhile: the cluster processes read it without a lock.
+ClustersFile CurrentClusters(const PipelineContext& context, const RunOptions& options) {
+  Workspace::Options open;
+  open.require_database_for = "map --hierarchical";
+  const auto workspace = Workspace::Open(options.output_dir, open);
+  try {
+    ClustersFile clusters =
+        ReadWorkspaceClusters(options.output_dir, workspace->database(), context.manifest);
+    if (clusters.cluster_max_images == context.manifest.distributed.cluster_max_images &&
+        clusters.cluster_overlap == context.manifest.distributed.cluster_overlap) {
+      spdlog::info("map: {} is current: {} clusters", ClustersFilePath(options.output_dir).string(),
+                   clusters.clusters.size());
+      return clusters;
+    }
+  } catch (const InputError& error) {
+    spdlog::info("map: partitioning again ({})", error.what());
+  }
+  return PartitionWorkspace(*workspace, context.manifest);
+}
+
+}  // namespace
+
+MapStageSummary MapHierarchically(const PipelineContext& context, const RunOptions& options,
+                                  const HierarchicalMapOptions& hierarchical,
+                                  const StageControl& control) {
+  const Timer timer;
+  context.Require("bundle_adjuster", "map");
+  const ClustersFile clusters = CurrentClusters(context, options);
+  // Biggest first, so that the slowest cluster starts first.
+  std::vector<int> order;
+  for (const ClustersFile::Cluster& cluster : clusters.clusters) order.push_back(cluster.index);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+    return clusters.clusters[a].images.size() > clusters.clusters[b].images.size();
+  });
+  std::vector<std::vector<std::string>> commands;
+  for (const int cluster : order) {
+    std::vector<std::string> command = {hierarchical.tessera, "map"};
+    command.insert(command.end(), hierarchical.cluster_arguments.begin(),
+                   hierarchical.cluster_arguments.end());
+    command.push_back("--cluster");
+    command.push_back(std::to_string(cluster));
+    commands.push_back(std::move(command));
+  }
+  spdlog::info("map: {} clusters in {} processes at once", commands.size(), hierarchical.jobs);
+  const std::vector<int> codes = RunProcessPool(commands, hierarchical.jobs);
+  const double map_seconds = timer.ElapsedSeconds();
+  std::string failed;
+  for (size_t i = 0; i < codes.size(); ++i) {
+    if (codes[i] == 0 || codes[i] == 3) continue;
+    failed += (failed.empty() ? "" : ", ") + std::to_string(order[i]) + " (exit code " +
+              std::to_string(codes[i]) + ")";
+  }
+  if (!failed.empty()) {
+    throw InputError("map --hierarchical: the processes of cluster(s) " + failed +
+                     " failed (their log is above); the others are kept, and the same command "
+                     "maps only what is left");
+  }
+  spdlog::info("map: {} clusters mapped in {:.2f} s", commands.size(), map_seconds);
+  MapStageSummary summary = MergeClusterMaps(context, options, control);
+  summary.seconds = timer.ElapsedSeconds();
+  return summary;
+}
+
+}  // namespace tessera

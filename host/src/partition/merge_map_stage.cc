@@ -1,0 +1,153 @@
+#include "partition/merge_map_stage.h"
+
+#include <spdlog/spdlog.h>
+
+#include <set>
+
+#include "partition/cluster_map.h"
+#include "partition/cluster_merge.h"
+#include "partition/partition_stage.h"
+#include "pipeline/map_stage.h"
+#include "pipeline/mapping_summary.h"
+#include "pipeline/workspace.h"
+#include "plugin/bundle_adjuster_guard.h"
+#include "tessera/errors.h"
+#include "tessera/io/colmap_model_io.h"
+#include "util/timer.h"
+
+namespace tessera {
+namespace {
+
+// The models of cluster `cluster`, checked against its summary.
+std::vector<Reconstruction> ReadClusterModels(const std::filesystem::path& workspace, int cluster,
+                                              const std::string& clusters_fingerprint) {
+  const std::filesystem::path folder = ClusterFolder(workspace, cluster);
+  const std::filesystem::path summary_file = folder / "mapping_summary.json";
+  const std::string map_again = "; run `tessera map --cluster " + std::to_string(cluster) +
+                                " --output " + workspace.string() + "` again";
+  std::error_code error;
+  if (!std::filesystem::exists(summary_file, error)) {
+    throw InputError(folder.string() + ": cluster " + std::to_string(cluster) +
+                     " is not mapped (no mapping_summary.json)" + map_again);
+  }
+  const auto corrupt = [&](const std::string& what) {
+    return InputError(folder.string() + ": corrupt or truncated cluster folder (" + what + ")" +
+                      map_again);
+  };
+  MappingSummary summary;
+  try {
+    summary = MappingSummary::Read(summary_file);
+  } catch (const InputError& exception) {
+    throw corrupt(exception.what());
+  }
+  if (!summary.partition.is_object() || summary.partition.value("cluster", -1) != cluster ||
+      summary.partition.value("clusters_json", "") != clusters_fingerprint) {
+    throw InputError(summary_file.string() + ": mapped for another clusters.json" + map_again);
+  }
+  try {
+    std::vector<Reconstruction> models;
+    for (const MappingSummary::Model& entry : summary.models) {
+      const std::filesystem::path dir = folder / "sparse" / std::to_string(entry.index);
+      Reconstruction model = ReadColmapModel(dir);
+      if (model.images.size() != entry.num_images || model.points3D.size() != entry.num_points3D) {
+        throw InputError(dir.string() + ": holds " + std::to_string(model.images.size()) +
+                         " images and " + std::to_string(model.points3D.size()) +
+                         " points, its summary says " + std::to_string(entry.num_images) + " and " +
+                         std::to_string(entry.num_points3D));
+      }
+      models.push_back(std::move(model));
+    }
+    return models;
+  } catch (const InputError& exception) {
+    throw corrupt(exception.what());
+  }
+}
+
+// Why each image of the workspace that is in no merged model was left out.
+std::map<image_t, std::string> Unregistered(
+    const Database& database, const ClustersFile& clusters, const ClusterMergeResult& merged,
+    const std::map<int, std::vector<Reconstruction>>& by_cluster) {
+  std::set<std::string> in_model, in_cluster_model;
+  for (const ClusterModel& model : merged.models) {
+    for (const auto& [image_id, image] : model.model.images) in_model.insert(image.name);
+  }
+  for (const auto& [cluster, models] : by_cluster) {
+    for (const Reconstruction& model : models) {
+      for (const auto& [image_id, image] : model.images) in_cluster_model.insert(image.name);
+    }
+  }
+  const std::set<std::string> isolated(clusters.isolated.begin(), clusters.isolated.end());
+  std::map<image_t, std::string> reasons;
+  for (const Image& image : database.ReadAllImages()) {
+    if (in_model.count(image.name) != 0) continue;
+    reasons[image.image_id] =
+        isolated.count(image.name) != 0 ? "no verified pair: in no cluster"
+        : in_cluster_model.count(image.name) == 0
+            ? "registered in none of its clusters' models"
+            : "dropped by a merge: its observations did not fit the merged model";
+  }
+  return reasons;
+}
+
+}  // namespace
+
+MapStageSummary MergeClusterMaps(const PipelineContext& context, const RunOptions& options,
+                                 const StageControl& control) {
+  const Timer timer;
+  context.Require("bundle_adjuster", "map");
+  Workspace::Options open;
+  open.require_database_for = "merge --stage map";
+  const auto workspace = Workspace::Open(options.output_dir, open);
+  const Database& database = workspace->database();
+  const ClustersFile clusters =
+      ReadWorkspaceClusters(options.output_dir, database, context.manifest);
+  const std::string fingerprint = clusters.Fingerprint();
+  std::map<int, std::vector<Reconstruction>> by_cluster;
+  for (const ClustersFile::Cluster& cluster : clusters.clusters) {
+    by_cluster[cluster.index] = ReadClusterModels(options.output_dir, cluster.index, fingerprint);
+  }
+  const BundleAdjusterGuard adjuster(context.bundle_adjuster, &workspace->crash_log());
+  ClusterMergeOptions merge_options;
+  merge_options.seed = context.manifest.seed;
+  ClusterMergeResult merged =
+      MergeClusterModels(clusters.tree, by_cluster, adjuster, merge_options);
+
+  MapperResult result;
+  MapperInput input;
+  for (Image& image : database.ReadAllImages())
+    input.images.emplace(image.image_id, std::move(image));
+  result.unregistered_reasons = Unregistered(database, clusters, merged, by_cluster);
+  nlohmann::json records = nlohmann::json::array();
+  for (const ClusterMergeRecord& record : merged.merges) {
+    records.push_back(record.ToJson());
+    result.merges.push_back(record.Line());
+  }
+  nlohmann::json models = nlohmann::json::array();
+  for (ClusterModel& model : merged.models) {
+    models.push_back({{"clusters", model.clusters}, {"images", model.model.images.size()}});
+    result.models.push_back(std::move(model.model));
+    result.self_checks.emplace_back();
+  }
+  if (result.models.size() > 1) {
+    spdlog::warn(
+        "merge: {} models remain unmerged; mapping_summary.json says which clusters each "
+        "holds and why",
+        result.models.size());
+  }
+  MapTarget target;
+  target.partition = {{"clusters_json", fingerprint}, {"models", models}, {"merges", records}};
+  MapStageSummary summary = PlaceMapResult(*workspace, context.MakeMapSettings(options.image_dir),
+                                           result, input, target, control);
+  summary.seconds = timer.ElapsedSeconds();
+  // Leftover models may hold the same images: each counted once.
+  std::set<std::string> registered;
+  for (const Reconstruction& model : result.models) {
+    for (const auto& [image_id, image] : model.images) registered.insert(image.name);
+  }
+  spdlog::info("merge: {} clusters into {} model(s), {} of {} images registered, {:.2f} s",
+               clusters.clusters.size(), summary.num_models, registered.size(), summary.num_images,
+               summary.seconds);
+  return summary;
+}
+
+}  // namespace tessera

@@ -1,0 +1,140 @@
+#include "partition/partition_stage.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <map>
+#include <optional>
+
+#include "distributed/shard_database.h"
+#include "tessera/errors.h"
+#include "util/timer.h"
+
+namespace tessera {
+namespace {
+
+std::vector<std::string> Names(const std::vector<size_t>& nodes,
+                               const std::vector<std::string>& names) {
+  std::vector<std::string> out;
+  for (const size_t node : nodes) out.push_back(names[node]);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+ClustersFile ToClustersFile(const ViewGraphPartition& partition, const ViewGraph& graph) {
+  ClustersFile file;
+  file.pairs_fingerprint = graph.fingerprint;
+  file.tree = partition.tree;
+  file.isolated = Names(partition.isolated, graph.names);
+  file.cut_weight = partition.cut_weight;
+  file.total_weight = partition.total_weight;
+  for (size_t a = 0; a < partition.clusters.size(); ++a) {
+    ClustersFile::Cluster cluster;
+    cluster.index = static_cast<int>(a);
+    cluster.images = Names(partition.clusters[a].nodes, graph.names);
+    cluster.core = Names(partition.clusters[a].core, graph.names);
+    for (size_t b = 0; b < partition.clusters.size(); ++b) {
+      if (a == b) continue;
+      const std::vector<size_t> shared = SharedNodes(partition.clusters[a], partition.clusters[b]);
+      if (!shared.empty())
+        cluster.neighbours.push_back({static_cast<int>(b), Names(shared, graph.names)});
+    }
+    file.clusters.push_back(std::move(cluster));
+  }
+  return file;
+}
+
+}  // namespace
+
+ViewGraph LoadViewGraph(const Database& database) {
+  ViewGraph graph;
+  std::map<image_t, std::string> name_of;
+  for (const Image& image : database.ReadAllImages()) {
+    name_of[image.image_id] = image.name;
+    graph.names.push_back(image.name);
+  }
+  std::sort(graph.names.begin(), graph.names.end());
+  std::map<std::string, size_t> node_of;
+  for (size_t i = 0; i < graph.names.size(); ++i) node_of[graph.names[i]] = i;
+  const std::optional<std::vector<image_pair_t>> selected = database.ReadSelectedPairs();
+  for (const auto& [pair_id, geometry] : database.ReadAllTwoViewGeometries()) {
+    if (geometry.inlier_matches.empty()) continue;
+    if (selected && !std::binary_search(selected->begin(), selected->end(), pair_id)) continue;
+    const auto [image_id1, image_id2] = PairIdToImagePair(pair_id);
+    const auto it1 = name_of.find(image_id1), it2 = name_of.find(image_id2);
+    if (it1 == name_of.end() || it2 == name_of.end()) continue;
+    size_t node1 = node_of.at(it1->second), node2 = node_of.at(it2->second);
+    if (node1 > node2) std::swap(node1, node2);
+    graph.edges.push_back({node1, node2, static_cast<double>(geometry.inlier_matches.size())});
+  }
+  std::sort(graph.edges.begin(), graph.edges.end(), [](const auto& a, const auto& b) {
+    return std::make_pair(a.node1, a.node2) < std::make_pair(b.node1, b.node2);
+  });
+  std::string text;
+  for (const WeightedEdge& edge : graph.edges) {
+    text += graph.names[edge.node1] + '\t' + graph.names[edge.node2] + '\t' +
+            std::to_string(static_cast<size_t>(edge.weight)) + '\n';
+  }
+  graph.fingerprint = HashText(text);
+  return graph;
+}
+
+ClustersFile PartitionWorkspace(const Workspace& workspace, const Manifest& manifest) {
+  const Timer timer;
+  const Database& database = workspace.database();
+  const ViewGraph graph = LoadViewGraph(database);
+  if (graph.edges.empty()) {
+    throw InputError(database.path().string() +
+                     ": no verified image pairs in the workspace; run match first");
+  }
+  PartitionOptions options;
+  options.max_nodes = static_cast<size_t>(manifest.distributed.cluster_max_images);
+  options.overlap = static_cast<size_t>(manifest.distributed.cluster_overlap);
+  const ViewGraphPartition partition = PartitionViewGraph(graph.names.size(), graph.edges, options);
+  ClustersFile file = ToClustersFile(partition, graph);
+  file.manifest_fingerprint = ManifestFingerprint(manifest);
+  file.cluster_max_images = manifest.distributed.cluster_max_images;
+  file.cluster_overlap = manifest.distributed.cluster_overlap;
+  const std::filesystem::path path = ClustersFilePath(workspace.folder());
+  file.Write(path);
+
+  for (const ClustersFile::Cluster& cluster : file.clusters) {
+    std::string overlaps;
+    for (const ClustersFile::Neighbour& neighbour : cluster.neighbours) {
+      overlaps += (overlaps.empty() ? "" : ", ") + std::to_string(neighbour.shared.size()) +
+                  " with " + std::to_string(neighbour.cluster);
+    }
+    spdlog::info("partition: cluster {}: {} images ({} its own), shares {}", cluster.index,
+                 cluster.images.size(), cluster.core.size(), overlaps.empty() ? "none" : overlaps);
+  }
+  if (!file.isolated.empty()) {
+    spdlog::warn("partition: {} images have no verified pair and are in no cluster",
+                 file.isolated.size());
+  }
+  spdlog::info(
+      "partition: {} images in {} clusters of at most {} ({} shared with each neighbour); the "
+      "cuts hold {:.0f} of {:.0f} inliers ({:.1f}%); {:.2f} s; wrote {}",
+      graph.names.size() - file.isolated.size(), file.clusters.size(), file.cluster_max_images,
+      file.cluster_overlap, file.cut_weight, file.total_weight,
+      100.0 * file.cut_weight / std::max(1.0, file.total_weight), timer.ElapsedSeconds(),
+      path.string());
+  return file;
+}
+
+ClustersFile ReadWorkspaceClusters(const std::filesystem::path& workspace_folder,
+                                   const Database& database, const Manifest& manifest) {
+  const std::filesystem::path path = ClustersFilePath(workspace_folder);
+  ClustersFile file = ClustersFile::Read(path);
+  if (file.manifest_fingerprint != ManifestFingerprint(manifest)) {
+    throw InputError(path.string() +
+                     ": made with another manifest than this one; run `tessera partition` "
+                     "again with it");
+  }
+  if (file.pairs_fingerprint != LoadViewGraph(database).fingerprint) {
+    throw InputError(path.string() + ": made from other verified pairs than those of " +
+                     database.path().string() + "; run `tessera partition` again");
+  }
+  return file;
+}
+
+}  // namespace tessera

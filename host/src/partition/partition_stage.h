@@ -1,0 +1,41 @@
+#pragma once
+
+// `tessera partition`: the workspace's verified view graph cut into overlapping
+// clusters (view_graph_partitioner.h), written to OUTPUT/clusters.json; and the check
+// every later step makes that clusters.json still belongs to the workspace.
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "database/database.h"
+#include "manifest/manifest.h"
+#include "partition/clusters_file.h"
+#include "partition/view_graph_partitioner.h"
+#include "pipeline/workspace.h"
+
+namespace tessera {
+
+// The view graph the mapper would map: every image (node i is the i-th name in name
+// order) and each verified pair of the current selection (LoadMapperInput's rule),
+// weighted by its inliers.
+struct ViewGraph {
+  std::vector<std::string> names;  // sorted
+  std::vector<WeightedEdge> edges;
+  // A hash of the image names of each pair and its inlier count.
+  std::string fingerprint;
+};
+
+ViewGraph LoadViewGraph(const Database& database);
+
+// Cuts the workspace's view graph by the manifest's `distributed` settings, writes
+// OUTPUT/clusters.json atomically and logs the cut. Throws InputError naming the
+// database when it has no verified pair.
+ClustersFile PartitionWorkspace(const Workspace& workspace, const Manifest& manifest);
+
+// OUTPUT/clusters.json, refused (InputError naming it and what differs) when it was made
+// from other pairs than `database`'s or with another manifest.
+ClustersFile ReadWorkspaceClusters(const std::filesystem::path& workspace_folder,
+                                   const Database& database, const Manifest& manifest);
+
+}  // namespace tessera

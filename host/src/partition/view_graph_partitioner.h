@@ -1,0 +1,58 @@
+#pragma once
+
+// Cutting a weighted view graph (images as nodes, verified pairs as edges weighted by
+// their inliers) into overlapping clusters, after COLMAP's SceneClustering: recursive
+// spectral bisection (a sweep over the Fiedler vector of the normalized Laplacian, at
+// the smallest normalized cut with at least a quarter of the nodes on each side) until
+// a cluster's own images fit, then each pair of clusters joined by edges shares the
+// images with the strongest edges across their cut. Deterministic: ties go to the
+// lower node index (callers number the images in name order).
+
+#include <cstddef>
+#include <vector>
+
+namespace tessera {
+
+struct WeightedEdge {
+  size_t node1 = 0;
+  size_t node2 = 0;
+  double weight = 0;  // > 0: the pair's inlier count
+};
+
+struct PartitionOptions {
+  // A cluster holds at most this many nodes, overlap included.
+  size_t max_nodes = 300;
+  // Nodes a cluster takes from each neighbouring cluster (as long as it has room).
+  size_t overlap = 40;
+};
+
+// The bisection tree: a leaf names a cluster, an inner node its children (two after a
+// bisection; one per connected component at the root of a disconnected graph).
+struct ClusterTreeNode {
+  int cluster = -1;  // >= 0 for a leaf
+  std::vector<ClusterTreeNode> children;
+};
+
+struct ViewGraphPartition {
+  struct Cluster {
+    std::vector<size_t> core;   // its own nodes, ascending; the cores are disjoint
+    std::vector<size_t> nodes;  // core and the nodes taken from neighbours, ascending
+  };
+  std::vector<Cluster> clusters;  // in the tree's order, left to right
+  ClusterTreeNode tree;
+  std::vector<size_t> isolated;  // nodes with no edge, in no cluster
+  double cut_weight = 0;         // summed weight of the edges between different cores
+  double total_weight = 0;
+};
+
+// Partitions nodes 0..num_nodes-1 joined by `edges` (an edge given twice counts
+// twice). Throws std::invalid_argument when options.max_nodes < 3 * options.overlap or
+// an edge names a node out of range.
+ViewGraphPartition PartitionViewGraph(size_t num_nodes, const std::vector<WeightedEdge>& edges,
+                                      const PartitionOptions& options);
+
+// The nodes clusters a and b both hold, ascending.
+std::vector<size_t> SharedNodes(const ViewGraphPartition::Cluster& a,
+                                const ViewGraphPartition::Cluster& b);
+
+}  // namespace tessera

@@ -1,0 +1,123 @@
+#!/bin/bash
+# Partitioned mapping on the 11 images of the sample examples/fountain-P11-small at 512 px
+# (ORB for speed), clusters of at most 9 images sharing 3 with each neighbour:
+#  1. a cluster size below 3 overlaps is exit 2 naming distributed.cluster_max_images;
+#  2. `partition` writes clusters.json (2 clusters at least); `map --cluster K` maps
+#     each into OUTPUT/clusters/K, and a finished cluster is skipped when run again;
+#     `--cluster` outside the clusters is exit 2;
+#  3. `merge --stage map` merges them: one model with all 11 images, every merge
+#     decision in mapping_summary.json;
+#  3b. `map --hierarchical` does all three on one host, and reuses them when run again;
+#  3c. so do `map --cluster-shard K/2` for K = 0, 1 and the merge (the Slurm array's tasks);
+#  4. clusters.json of another manifest is exit 2 naming it; a truncated cluster model is
+#     exit 2 naming its folder, and the merged model is left untouched.
+# usage: partition_test.sh TESSERA DOWNSCALE SOURCE_DIR
+set -uo pipefail
+tessera=$1
+downscale=$2
+source_dir=$3
+source "$(dirname "$0")/common.sh"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+
+"$downscale" "$source_dir/examples/fountain-P11-small/images" "$work/images" 512 90 > /dev/null ||
+  fail "downscale"
+manifest() {  # manifest FILE MAX_IMAGES OVERLAP
+  cat > "$1" <<JSON
+{"pipeline": {"detector": {"plugin": "orb", "options": {"max_num_features": 2000}},
+              "pair_selector": {"plugin": "exhaustive"},
+              "matcher": {"plugin": "brute_force", "options": {"ratio": 0.8, "cross_check": true}},
+              "bundle_adjuster": {"plugin": "ceres"},
+              "exporters": [{"plugin": "colmap_binary"}]},
+ "camera": {"model": "SIMPLE_RADIAL", "single_camera": true},
+ "verification": {"max_error_px": 4.0, "min_num_inliers": 15},
+ "distributed": {"cluster_max_images": $2, "cluster_overlap": $3}}
+JSON
+}
+manifest "$work/m.json" 9 3
+manifest "$work/small.json" 8 3
+manifest "$work/other.json" 10 3
+out=$work/out
+expect_exit() {  # expect_exit CODE LOG TEXT COMMAND...: exit CODE and TEXT in the output
+  local code=$1 log=$2 text=$3
+  shift 3
+  "$@" > "$log" 2>&1
+  local got=$?
+  [ "$got" = "$code" ] || { tail -20 "$log"; fail "$*: exit $got, expected $code"; }
+  [ -z "$text" ] || grep -qF -- "$text" "$log" || { cat "$log"; fail "$*: no line with '$text'"; }
+}
+expect_exit 0 "$work/extract.log" "" "$tessera" extract --images "$work/images" --output "$out" \
+  --manifest "$work/m.json" --threads 2
+expect_exit 0 "$work/match.log" "" "$tessera" match --output "$out" --manifest "$work/m.json" \
+  --threads 2
+
+# 1. A cluster size below 3 overlaps.
+expect_exit 2 "$work/small.log" "$work/small.json: distributed.cluster_max_images" \
+  "$tessera" partition --output "$out" --manifest "$work/small.json"
+
+# 2. Partition, then each cluster.
+expect_exit 0 "$work/partition.log" "partition: cluster 0:" \
+  "$tessera" partition --output "$out" --manifest "$work/m.json"
+num_clusters=$(python3 -c '
+import json, sys
+c = json.load(open(sys.argv[1]))
+assert all(len(k["images"]) <= 9 for k in c["clusters"]), "a cluster over 9 images"
+print(len(c["clusters"]))' "$out/clusters.json") || fail "clusters.json"
+[ "$num_clusters" -ge 2 ] || fail "clusters.json: $num_clusters clusters, expected 2 or more"
+expect_exit 2 "$work/outside.log" "--cluster $num_clusters: " \
+  "$tessera" map --output "$out" --manifest "$work/m.json" --cluster "$num_clusters"
+for ((k = 0; k < num_clusters; ++k)); do
+  expect_exit 0 "$work/map$k.log" "map: cluster $k:" \
+    "$tessera" map --output "$out" --manifest "$work/m.json" --cluster "$k" --threads 2
+  [ -f "$out/clusters/$k/sparse/0/images.bin" ] || fail "cluster $k: no model"
+done
+expect_exit 0 "$work/again.log" "map: cluster 0 is already mapped for this clusters.json" \
+  "$tessera" map --output "$out" --manifest "$work/m.json" --cluster 0
+
+# 3. The merge.
+expect_exit 0 "$work/merge.log" "merge: $num_clusters clusters into 1 model(s), 11 of 11 images" \
+  "$tessera" merge --stage map --output "$out" --manifest "$work/m.json"
+python3 -c '
+import json, sys
+s = json.load(open(sys.argv[1]))
+assert len(s["models"]) == 1 and s["models"][0]["num_images"] == 11, s["models"]
+merges = s["partition"]["merges"]
+assert len(merges) == int(sys.argv[2]) - 1 and all(m["merged"] for m in merges), merges
+assert all(m["shared_images"] >= 3 for m in merges), merges' \
+  "$out/mapping_summary.json" "$num_clusters" || fail "mapping_summary.json"
+[ -f "$out/sparse/0/points3D.bin" ] || fail "no merged model in $out/sparse/0"
+
+# 3b. The same on one host: `map --hierarchical` partitions, maps the clusters in a pool
+# of 2 processes and merges them; run again, it reuses clusters.json and every cluster.
+mkdir -p "$work/hier"
+cp "$out/database.db" "$work/hier/"
+expect_exit 0 "$work/hier.log" "merge: $num_clusters clusters into 1 model(s), 11 of 11 images" \
+  "$tessera" map --hierarchical --jobs 2 --threads 1 --output "$work/hier" --manifest "$work/m.json"
+expect_exit 0 "$work/hier2.log" "map: cluster 0 is already mapped for this clusters.json" \
+  "$tessera" map --hierarchical --jobs 2 --threads 1 --output "$work/hier" --manifest "$work/m.json"
+grep -qF "clusters.json is current: $num_clusters clusters" "$work/hier2.log" ||
+  fail "map --hierarchical again: clusters.json not reused"
+
+# 3c. As `tessera slurm --partitioned` runs it: partition, a mapping array of 2 shards
+# (--cluster-shard K/2), the merge.
+mkdir -p "$work/sharded"
+cp "$out/database.db" "$work/sharded/"
+expect_exit 0 "$work/sharded-partition.log" "" \
+  "$tessera" partition --output "$work/sharded" --manifest "$work/m.json"
+for k in 0 1; do
+  expect_exit 0 "$work/sharded$k.log" "map: shard $k/2: " \
+    "$tessera" map --output "$work/sharded" --manifest "$work/m.json" --threads 2 --cluster-shard "$k/2"
+done
+expect_exit 0 "$work/sharded-merge.log" "merge: $num_clusters clusters into 1 model(s), 11 of 11 images" \
+  "$tessera" merge --stage map --output "$work/sharded" --manifest "$work/m.json"
+
+# 4. Bad input.
+expect_exit 2 "$work/foreign.log" "$out/clusters.json: made with another manifest" \
+  "$tessera" map --output "$out" --manifest "$work/other.json" --cluster 0
+before=$(cat "$out"/sparse/0/*.bin | md5sum)
+size=$(stat -c %s "$out/clusters/1/sparse/0/points3D.bin")
+truncate -s $((size / 2)) "$out/clusters/1/sparse/0/points3D.bin"
+expect_exit 2 "$work/corrupt.log" "$out/clusters/1: corrupt or truncated cluster folder" \
+  "$tessera" merge --stage map --output "$out" --manifest "$work/m.json"
+[ "$(cat "$out"/sparse/0/*.bin | md5sum)" = "$before" ] || fail "the merged model changed"
+echo "PASS: partition, $num_clusters clusters mapped and merged into one model of 11 images"
