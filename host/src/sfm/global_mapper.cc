@@ -350,11 +350,12 @@ void ExplainUnregistered(const MapperInput& input, const GlobalMapperOptions& op
 
 // The verified pairs with at least min_num_matches inliers between two input images, and
 // at least min_relative_pair_strength of the inliers of the strongest pair of each image
-// (the others are counted in `num_weak`); the images they join into `in_verified_pair`.
+// (the others are counted in result->num_weak_pairs_set_aside); the images they join
+// into `in_verified_pair`.
 std::vector<const MapperInput::Pair*> PairsThatMap(const MapperInput& input,
                                                    const GlobalMapperOptions& options,
                                                    std::set<image_t>* in_verified_pair,
-                                                   size_t* num_weak) {
+                                                   GlobalMapperResult* result) {
   std::vector<const MapperInput::Pair*> pairs;
   for (const MapperInput::Pair& pair : input.pairs) {
     if (!IsVerified(pair.geometry) ||
@@ -378,13 +379,14 @@ std::vector<const MapperInput::Pair*> PairsThatMap(const MapperInput& input,
         static_cast<double>(std::min(strongest.at(pair->image_id1), strongest.at(pair->image_id2)));
     if (static_cast<double>(pair->geometry.inlier_matches.size()) <
         options.min_relative_pair_strength * weaker_image_strongest) {
-      ++*num_weak;
+      ++result->num_weak_pairs_set_aside;
       continue;
     }
     strong.push_back(pair);
     in_verified_pair->insert(pair->image_id1);
     in_verified_pair->insert(pair->image_id2);
   }
+  result->num_verified_pairs = strong.size();
   return strong;
 }
 
@@ -459,6 +461,19 @@ std::vector<RelativeRotation> RelativeRotations(
   return relative_rotations;
 }
 
+// The view graph's line of the log: its pairs and what set them aside.
+void LogViewGraph(const MapperInput& input, size_t num_pairs, const GlobalMapperOptions& options,
+                  const GlobalMapperResult& result, const RotationAveragingResult& rotations) {
+  spdlog::info(
+      "global map: {} images, {} verified pairs: {} weaker than {:g} of their images' "
+      "strongest set aside, {} dropped by rotation cycles, {} by rotation averaging ({} "
+      "steps); {} tracks",
+      input.images.size(), num_pairs + result.num_weak_pairs_set_aside,
+      result.num_weak_pairs_set_aside, options.min_relative_pair_strength,
+      result.num_pairs_dropped_by_cycles, rotations.num_dropped, rotations.num_iterations,
+      result.num_tracks);
+}
+
 }  // namespace
 
 GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
@@ -490,11 +505,8 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
 
   // 1. The pairs that map.
   std::set<image_t> in_verified_pair;
-  size_t num_weak_pairs = 0;
   const std::vector<const MapperInput::Pair*> pairs =
-      PairsThatMap(input, options, &in_verified_pair, &num_weak_pairs);
-  result.num_verified_pairs = pairs.size();
-  result.num_weak_pairs_set_aside = num_weak_pairs;
+      PairsThatMap(input, options, &in_verified_pair, &result);
 
   // 2. Focal lengths of cameras without a prior, from the view graph.
   const std::map<camera_t, Camera> cameras =
@@ -540,13 +552,7 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   const FeatureTracks tracks = BuildFeatureTracks(pair_matches, num_points2D);
   result.num_tracks = tracks.tracks.size();
   lap(&steps.tracks);
-  spdlog::info(
-      "global map: {} images, {} verified pairs: {} weaker than {:g} of their images' "
-      "strongest set aside, {} dropped by rotation cycles, {} by rotation averaging ({} "
-      "steps); {} tracks",
-      input.images.size(), pairs.size() + num_weak_pairs, num_weak_pairs,
-      options.min_relative_pair_strength, result.num_pairs_dropped_by_cycles, rotations.num_dropped,
-      rotations.num_iterations, result.num_tracks);
+  LogViewGraph(input, pairs.size(), options, result, rotations);
 
   std::map<image_t, std::string> reasons;
   const PartRun run{input, cameras, options, should_stop, &result, &reasons, lap};
