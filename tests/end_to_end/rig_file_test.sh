@@ -82,3 +82,12 @@ expect_exit_2 "$work/no_images.json" "cameras[1].folder: 'center' has no images"
 echo '{"cameras": [{"folder": "left", "reference": true}, {"folder": "right"}], "frames": "same_name"}' \
   > "$work/stereo.json"
 expect_exit_2 "$work/stereo.json" "frames: moment '0002.jpg' has no image in 'right'" map
+
+# 4. Partitioned mapping does not hold rigs: refused before anything is mapped.
+"$tessera" map --output "$work/out" --manifest "$work/m.json" --rig "$work/stereo.json" \
+  --hierarchical > "$work/log" 2>&1
+code=$?
+[ "$code" = 2 ] || { tail -5 "$work/log"; fail "map --rig --hierarchical: exit code $code, not 2"; }
+grep -qF -- "--rig: partitioned mapping (--cluster, --cluster-shard, --hierarchical) does not hold rigs yet" \
+  "$work/log" || { tail -5 "$work/log"; fail "map --rig --hierarchical: not refused as expected"; }
+echo "map --rig --hierarchical: exit 2, refused"
