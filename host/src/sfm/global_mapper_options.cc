@@ -10,8 +10,8 @@ GlobalMapperOptions GlobalMapperOptions::FromJson(const nlohmann::json& json) {
   GlobalMapperOptions o;
   OptionReader reader(json);
   o.min_num_matches = reader.Get<int>("min_num_matches", o.min_num_matches, 5, 100000);
-  o.min_relative_pair_strength = reader.Get<double>(
-      "min_relative_pair_strength", o.min_relative_pair_strength, 0.0, 1.0);
+  o.min_relative_pair_strength =
+      reader.Get<double>("min_relative_pair_strength", o.min_relative_pair_strength, 0.0, 1.0);
   o.estimate_focal_length = reader.GetBool("estimate_focal_length", o.estimate_focal_length);
   o.filter_view_graph = reader.GetBool("filter_view_graph", o.filter_view_graph);
   o.view_graph_max_cycle_error =
