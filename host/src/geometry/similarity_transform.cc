@@ -36,4 +36,15 @@ Similarity3d EstimateSimilarity(const std::vector<Eigen::Vector3d>& src,
   return dst_from_src;
 }
 
+void TransformModel(const Similarity3d& new_from_old, Reconstruction* model) {
+  for (auto& [image_id, image] : model->images) {
+    const Eigen::Matrix3d cam_from_new =
+        image.cam_from_world.rotation.toRotationMatrix() * new_from_old.rotation.transpose();
+    image.cam_from_world.translation = new_from_old.scale * image.cam_from_world.translation -
+                                       cam_from_new * new_from_old.translation;
+    image.cam_from_world.rotation = Eigen::Quaterniond(cam_from_new).normalized();
+  }
+  for (auto& [point3D_id, point3D] : model->points3D) point3D.xyz = new_from_old * point3D.xyz;
+}
+
 }  // namespace tessera

@@ -7,6 +7,8 @@
 #include <Eigen/Core>
 #include <vector>
 
+#include "tessera/reconstruction.h"
+
 namespace tessera {
 
 // x_b = scale * rotation * x_a + translation.
@@ -24,5 +26,8 @@ struct Similarity3d {
 // Needs at least 3 pairs, not all collinear, for a unique answer.
 Similarity3d EstimateSimilarity(const std::vector<Eigen::Vector3d>& src,
                                 const std::vector<Eigen::Vector3d>& dst);
+
+// Moves `model` by `new_from_old` (x' = s R x + t): every camera pose and 3D point.
+void TransformModel(const Similarity3d& new_from_old, Reconstruction* model);
 
 }  // namespace tessera

@@ -84,18 +84,6 @@ bool Collinear(const std::vector<const SharedImage*>& images) {
 
 }  // namespace
 
-void TransformModel(const Similarity3d& t, Reconstruction* model) {
-  const Eigen::Quaterniond rotation(t.rotation);
-  for (auto& [image_id, image] : model->images) {
-    // x_cam = R_cw x_src + t_cw, x_src = R^T (x_tgt - t) / s; the camera frame scaled by s.
-    const Eigen::Quaterniond cam_rotation = image.cam_from_world.rotation * rotation.conjugate();
-    image.cam_from_world.translation =
-        t.scale * image.cam_from_world.translation - (cam_rotation * t.translation);
-    image.cam_from_world.rotation = cam_rotation.normalized();
-  }
-  for (auto& [point3D_id, point] : model->points3D) point.xyz = t * point.xyz;
-}
-
 CenterAlignment AlignByCameraCenters(const Reconstruction& source, const Reconstruction& target,
                                      const CenterAlignmentOptions& options, uint64_t seed) {
   CenterAlignment result;

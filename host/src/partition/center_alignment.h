@@ -46,7 +46,4 @@ struct CenterAlignment {
 CenterAlignment AlignByCameraCenters(const Reconstruction& source, const Reconstruction& target,
                                      const CenterAlignmentOptions& options, uint64_t seed);
 
-// Moves `model` by `target_from_model`: every pose and point.
-void TransformModel(const Similarity3d& target_from_model, Reconstruction* model);
-
 }  // namespace tessera

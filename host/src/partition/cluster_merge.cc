@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <set>
 
+#include "geometry/similarity_transform.h"
+
 namespace tessera {
 namespace {
 

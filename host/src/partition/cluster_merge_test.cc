@@ -7,6 +7,7 @@
 #include <set>
 
 #include "eval/evaluation.h"
+#include "geometry/similarity_transform.h"
 #include "synthetic_scene.h"
 #include "test_support.h"
 

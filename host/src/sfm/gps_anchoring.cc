@@ -37,18 +37,6 @@ Eigen::Matrix3d EnuFromEcefRotation(const Georeference& origin) {
   return rotation;
 }
 
-// `model` moved by x' = s R x + t.
-void TransformModel(const Similarity3d& sim, Reconstruction* model) {
-  for (auto& [image_id, image] : model->images) {
-    const Eigen::Matrix3d cam_from_new =
-        image.cam_from_world.rotation.toRotationMatrix() * sim.rotation.transpose();
-    image.cam_from_world.translation =
-        sim.scale * image.cam_from_world.translation - cam_from_new * sim.translation;
-    image.cam_from_world.rotation = Eigen::Quaterniond(cam_from_new).normalized();
-  }
-  for (auto& [point3D_id, point3D] : model->points3D) point3D.xyz = sim * point3D.xyz;
-}
-
 double Median(std::vector<double> values) {
   if (values.empty()) return 0;
   std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());

@@ -202,22 +202,31 @@ TEST(IncrementalPipeline, EstimatesTheFocalLengthWhenThereIsNoPrior) {
   ExpectNoCameraOff(scene, result.models[0], 0.1);
 }
 
+// Two unrelated scenes, each with its own camera (1 and 2, true focal lengths 1000 and
+// 1400 px) and no prior, their starting focal lengths off by `factor1` and `factor2`
+// (SyntheticSceneOptions::prior_focal_factor): a folder that mixes two captures.
+SyntheticScene TwoScenesWithoutFocalPrior(double factor1, double factor2,
+                                          SyntheticSceneOptions* first,
+                                          SyntheticSceneOptions* second) {
+  first->focal_prior = false;
+  first->prior_focal_factor = factor1;
+  first->seed = 11;
+  *second = *first;
+  second->focal_length = 1400;
+  second->prior_focal_factor = factor2;
+  second->seed = 13;
+  SyntheticScene scene = MakeSyntheticScene(*first);
+  testing::AppendScene(MakeSyntheticScene(*second), 100, "second_", 2, &scene);
+  return scene;
+}
+
 TEST(IncrementalPipeline, EstimatesTheFocalLengthOfEachSceneInAMixedSet) {
-  // Two unrelated scenes, each with its own camera and no prior (as in a folder that mixes
-  // photos of two captures). Where the pairs determine a camera's focal length (many
-  // pairs) mapping starts from it; with min_view_graph_focal_pairs 0 every camera is
-  // refined in a first model, and a first model holds one scene only, so the other
-  // camera needs a first model of its own. Both end at the true focal lengths.
-  SyntheticSceneOptions first;
-  first.focal_prior = false;
-  first.prior_focal_factor = 1.6;
-  first.seed = 11;
-  SyntheticSceneOptions second = first;
-  second.focal_length = 1400;
-  second.prior_focal_factor = 0.7;
-  second.seed = 13;
-  SyntheticScene scene = MakeSyntheticScene(first);
-  testing::AppendScene(MakeSyntheticScene(second), 100, "second_", 2, &scene);
+  // Where the pairs determine a camera's focal length (many pairs) mapping starts from
+  // it; with min_view_graph_focal_pairs 0 every camera is refined in a first model, and a
+  // first model holds one scene only, so the other camera needs a first model of its
+  // own. Both end at the true focal lengths.
+  SyntheticSceneOptions first, second;
+  const SyntheticScene scene = TwoScenesWithoutFocalPrior(1.6, 0.7, &first, &second);
   for (const int min_pairs : {10, 0}) {
     SCOPED_TRACE("min_view_graph_focal_pairs " + std::to_string(min_pairs));
     IncrementalMapperOptions options;
@@ -248,16 +257,8 @@ TEST(IncrementalPipeline, EstimatesTheFocalLengthOfEachSceneInAMixedSet) {
 // The building block both mappers calibrate with: a first model of at most 20 images
 // refines the focal length of the cameras asked for, here each scene's own.
 TEST(FirstModelCalibration, RefinesTheFocalLengthOfEachCameraAskedFor) {
-  SyntheticSceneOptions first;
-  first.focal_prior = false;
-  first.prior_focal_factor = 1.3;
-  first.seed = 11;
-  SyntheticSceneOptions second = first;
-  second.focal_length = 1400;
-  second.prior_focal_factor = 0.9;
-  second.seed = 13;
-  SyntheticScene scene = MakeSyntheticScene(first);
-  testing::AppendScene(MakeSyntheticScene(second), 100, "second_", 2, &scene);
+  SyntheticSceneOptions first, second;
+  const SyntheticScene scene = TwoScenesWithoutFocalPrior(1.3, 0.9, &first, &second);
   std::vector<const MapperInput::Pair*> pairs;
   for (const MapperInput::Pair& pair : scene.input.pairs) pairs.push_back(&pair);
   MapperRunState run(scene.input, testing::CeresAdjusterOnOneThread(), 7);
