@@ -5,13 +5,21 @@
 #include <algorithm>
 #include <map>
 #include <optional>
+#include <set>
+#include <utility>
 
 #include "distributed/shard_database.h"
+#include "partition/rotation_consistent_pairs.h"
+#include "pipeline/load_mapper_input.h"
 #include "tessera/errors.h"
+#include "util/random.h"
 #include "util/timer.h"
 
 namespace tessera {
 namespace {
+
+// Seed stream of the partition's random choices (the five-point RANSAC of pairs without E).
+constexpr uint64_t kRotationConsistencyStream = 1;
 
 std::vector<std::string> Names(const std::vector<size_t>& nodes,
                                const std::vector<std::string>& names) {
@@ -42,6 +50,31 @@ ClustersFile ToClustersFile(const ViewGraphPartition& partition, const ViewGraph
     file.clusters.push_back(std::move(cluster));
   }
   return file;
+}
+
+// The edges of `graph` whose pairs' rotations agree with the rest (rotation_consistent_pairs.h).
+std::vector<WeightedEdge> EdgesThatWeighInTheCut(const Database& database, const Manifest& manifest,
+                                                 const ViewGraph& graph) {
+  const MapperInput input = LoadMapperInput(database);
+  const RotationConsistentPairs consistent =
+      FindRotationConsistentPairs(input, DeriveSeed(manifest.seed, kRotationConsistencyStream));
+  std::set<std::pair<std::string, std::string>> kept;
+  for (const auto& [image_id1, image_id2] : consistent.pairs) {
+    const std::string& name1 = input.images.at(image_id1).name;
+    const std::string& name2 = input.images.at(image_id2).name;
+    kept.insert({std::min(name1, name2), std::max(name1, name2)});
+  }
+  std::vector<WeightedEdge> edges;
+  for (const WeightedEdge& edge : graph.edges) {
+    if (kept.count({graph.names[edge.node1], graph.names[edge.node2]}) != 0) edges.push_back(edge);
+  }
+  spdlog::info(
+      "partition: {} of {} verified pairs weigh in the cut: {} weaker than a fifth of their "
+      "images' strongest, {} whose rotations disagree with the rest (symmetric or repeated "
+      "structure), {} without a relative rotation; {} kept as an image's strongest",
+      edges.size(), graph.edges.size(), consistent.num_weak, consistent.num_inconsistent,
+      consistent.num_without_rotation, consistent.num_restored);
+  return edges;
 }
 
 }  // namespace
@@ -90,7 +123,8 @@ ClustersFile PartitionWorkspace(const Workspace& workspace, const Manifest& mani
   PartitionOptions options;
   options.max_nodes = static_cast<size_t>(manifest.distributed.cluster_max_images);
   options.overlap = static_cast<size_t>(manifest.distributed.cluster_overlap);
-  const ViewGraphPartition partition = PartitionViewGraph(graph.names.size(), graph.edges, options);
+  const ViewGraphPartition partition = PartitionViewGraph(
+      graph.names.size(), EdgesThatWeighInTheCut(database, manifest, graph), options);
   ClustersFile file = ToClustersFile(partition, graph);
   file.manifest_fingerprint = ManifestFingerprint(manifest);
   file.cluster_max_images = manifest.distributed.cluster_max_images;
