@@ -195,7 +195,10 @@ class TreeMerger {
     Reconstruction merged = target->model;
     Unite(moved, &merged);
     const size_t before = merged.images.size();
-    const BundleAdjustmentSummary adjustment = adjuster_.Adjust({}, &merged);
+    BundleAdjustmentConfig seam;
+    seam.max_num_iterations = options_.merge_max_num_iterations;
+    seam.function_tolerance = options_.merge_function_tolerance;
+    const BundleAdjustmentSummary adjustment = adjuster_.Adjust(seam, &merged);
     if (!adjustment.usable) {
       record.reason = "the bundle adjustment of the merged model failed: " + adjustment.message;
       return record;
@@ -253,6 +256,22 @@ ClusterMergeResult MergeClusterModels(const ClusterTreeNode& tree,
   ClusterMergeResult result;
   result.models = merger.Merge(tree);
   result.merges = std::move(merger.records);
+  for (ClusterModel& merged : result.models) {
+    if (merged.clusters.size() < 2) continue;
+    const BundleAdjustmentSummary adjustment = adjuster.Adjust({}, &merged.model);
+    if (!adjustment.usable) {
+      spdlog::warn("merge: the final adjustment of clusters {} failed ({}): kept as merged",
+                   ClusterList(merged.clusters), adjustment.message);
+      continue;
+    }
+    const std::vector<std::string> lost =
+        FilterObservations(options.max_reprojection_error, &merged.model);
+    result.images_lost_in_final_adjustment.insert(result.images_lost_in_final_adjustment.end(),
+                                                  lost.begin(), lost.end());
+  }
+  std::sort(result.models.begin(), result.models.end(), Larger);
+  std::sort(result.images_lost_in_final_adjustment.begin(),
+            result.images_lost_in_final_adjustment.end());
   return result;
 }
 

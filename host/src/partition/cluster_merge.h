@@ -25,6 +25,11 @@ struct ClusterMergeOptions {
   CenterAlignmentOptions alignment;
   double max_reprojection_error = 8;  // px, after the merge's bundle adjustment
   double max_merge_loss = 0.05;       // share of the images a merge may lose
+  // Each merge's adjustment only has to settle the seam well enough to judge the merge
+  // (which observations misfit): a few iterations. Every model made of several clusters
+  // gets one full adjustment at the end.
+  int merge_max_num_iterations = 10;
+  double merge_function_tolerance = 1e-3;
   uint64_t seed = 0;
 };
 
@@ -53,9 +58,13 @@ struct ClusterModel {
 struct ClusterMergeResult {
   std::vector<ClusterModel> models;  // largest first
   std::vector<ClusterMergeRecord> merges;
+  // Images the final adjustment of each merged model dropped (observations over the
+  // reprojection limit), in name order.
+  std::vector<std::string> images_lost_in_final_adjustment;
 };
 
-// `models`: each cluster's models. `adjuster` adjusts every merged model.
+// `models`: each cluster's models. `adjuster` adjusts every merge, and every model made
+// of several clusters once more at the end.
 ClusterMergeResult MergeClusterModels(const ClusterTreeNode& tree,
                                       std::map<int, std::vector<Reconstruction>> models,
                                       const BundleAdjuster& adjuster,

@@ -6,17 +6,23 @@
 
 #include "partition/cluster_map.h"
 #include "partition/cluster_merge.h"
+#include "partition/merged_model_check.h"
 #include "partition/partition_stage.h"
+#include "pipeline/load_mapper_input.h"
 #include "pipeline/map_stage.h"
 #include "pipeline/mapping_summary.h"
 #include "pipeline/workspace.h"
 #include "plugin/bundle_adjuster_guard.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
+#include "util/random.h"
 #include "util/timer.h"
 
 namespace tessera {
 namespace {
+
+// Seed stream of the check's five-point RANSAC on pairs without E.
+constexpr uint64_t kMergedModelCheckStream = 1;
 
 // The models of cluster `cluster`, checked against its summary.
 std::vector<Reconstruction> ReadClusterModels(const std::filesystem::path& workspace, int cluster,
@@ -113,9 +119,7 @@ MapStageSummary MergeClusterMaps(const PipelineContext& context, const RunOption
       MergeClusterModels(clusters.tree, by_cluster, adjuster, merge_options);
 
   MapperResult result;
-  MapperInput input;
-  for (Image& image : database.ReadAllImages())
-    input.images.emplace(image.image_id, std::move(image));
+  const MapperInput input = LoadMapperInput(database);
   result.unregistered_reasons = Unregistered(database, clusters, merged, by_cluster);
   nlohmann::json records = nlohmann::json::array();
   for (const ClusterMergeRecord& record : merged.merges) {
@@ -126,8 +130,10 @@ MapStageSummary MergeClusterMaps(const PipelineContext& context, const RunOption
   for (ClusterModel& model : merged.models) {
     models.push_back({{"clusters", model.clusters}, {"images", model.model.images.size()}});
     result.models.push_back(std::move(model.model));
-    result.self_checks.emplace_back();
   }
+  result.self_checks =
+      CheckMergedModels(input, result.models, MergedModelCheckOptions(),
+                        DeriveSeed(context.manifest.seed, kMergedModelCheckStream));
   if (result.models.size() > 1) {
     spdlog::warn(
         "merge: {} models remain unmerged; mapping_summary.json says which clusters each "
@@ -135,7 +141,10 @@ MapStageSummary MergeClusterMaps(const PipelineContext& context, const RunOption
         result.models.size());
   }
   MapTarget target;
-  target.partition = {{"clusters_json", fingerprint}, {"models", models}, {"merges", records}};
+  target.partition = {{"clusters_json", fingerprint},
+                      {"models", models},
+                      {"merges", records},
+                      {"images_lost_in_final_adjustment", merged.images_lost_in_final_adjustment}};
   MapStageSummary summary = PlaceMapResult(*workspace, context.MakeMapSettings(options.image_dir),
                                            result, input, target, control);
   summary.seconds = timer.ElapsedSeconds();
