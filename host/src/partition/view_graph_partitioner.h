@@ -56,7 +56,7 @@ ViewGraphPartition PartitionViewGraph(size_t num_nodes, const std::vector<Weight
                                       const PartitionOptions& options);
 
 // What the single-loop check sees in a graph: the nodes placed in the plane by the
-// 2nd and 3rd eigenvectors of the normalized Laplacian (each scaled by D^-1/2).
+// 2nd and 3rd eigenvectors of the normalized Laplacian.
 struct SingleLoopEvidence {
   double eigenvalue_ratio = 0;    // lambda3 / lambda2: 1 for a loop, about 4 for a path
   double smallest_radius = 0;     // least distance from the origin, over the median: 0 on a patch

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <random>
 #include <set>
@@ -223,6 +224,29 @@ TEST(ViewGraphPartitioner, ALoopWithAFewCrossEdgesIsStillASingleLoop) {
   const ViewGraphPartition partition = PartitionViewGraph(120, edges, {40, 10});
   ASSERT_EQ(partition.clusters.size(), 1u);
   EXPECT_TRUE(partition.clusters[0].single_loop);
+}
+
+TEST(ViewGraphPartitioner, ALoopOfUnevenWeightIsStillASingleLoop) {
+  // The inliers per pair 8 times as many on one side of the object as on the other.
+  std::vector<WeightedEdge> edges;
+  for (size_t i = 0; i < 200; ++i) {
+    const double scale =
+        std::pow(8.0, 0.5 + 0.5 * std::sin(static_cast<double>(i) * 2 * M_PI / 200));
+    for (size_t d = 1; d <= 3; ++d)
+      edges.push_back({i, (i + d) % 200, scale * 300.0 / static_cast<double>(d)});
+  }
+  EXPECT_TRUE(Measured("ring of 200, uneven weights", 200, edges).single_loop);
+  const ViewGraphPartition partition = PartitionViewGraph(200, edges, {40, 10});
+  ASSERT_EQ(partition.clusters.size(), 1u);
+  EXPECT_TRUE(partition.clusters[0].single_loop);
+}
+
+TEST(ViewGraphPartitioner, ALoopWithACrossEdgeAsStrongAsItsNeighboursIsCut) {
+  // Two loops sharing a side (a theta), not one walk round: cut as any graph.
+  std::vector<WeightedEdge> edges = Ring(120, 6);
+  edges.push_back({0, 60, 300});
+  EXPECT_FALSE(Measured("ring of 120 with a strong cross edge", 120, edges).single_loop);
+  ExpectCutAndNoneALoop(PartitionViewGraph(120, edges, {40, 10}), 120, 40);
 }
 
 TEST(ViewGraphPartitioner, ALargeLoopIsRecognisedOnTheCoarsenedGraph) {
