@@ -42,11 +42,14 @@ nlohmann::json ClustersFile::ToJson() const {
     for (const Neighbour& neighbour : cluster.neighbours) {
       neighbours.push_back({{"cluster", neighbour.cluster}, {"shared", neighbour.shared}});
     }
-    clusters_json.push_back({{"index", cluster.index},
-                             {"num_images", cluster.images.size()},
-                             {"images", cluster.images},
-                             {"core", cluster.core},
-                             {"neighbours", neighbours}});
+    nlohmann::json cluster_json = {{"index", cluster.index},
+                                   {"num_images", cluster.images.size()},
+                                   {"images", cluster.images},
+                                   {"core", cluster.core},
+                                   {"neighbours", neighbours}};
+    // Only when set: the files, and so the fingerprints, of other partitions stay as they were.
+    if (cluster.single_loop) cluster_json["single_loop"] = true;
+    clusters_json.push_back(std::move(cluster_json));
   }
   return {{"version", kVersion},
           {"pairs_fingerprint", pairs_fingerprint},
@@ -75,6 +78,7 @@ ClustersFile ClustersFile::FromJson(const nlohmann::json& json) {
     cluster.index = entry.at("index").get<int>();
     cluster.images = entry.at("images").get<std::vector<std::string>>();
     cluster.core = entry.at("core").get<std::vector<std::string>>();
+    cluster.single_loop = entry.value("single_loop", false);
     for (const nlohmann::json& neighbour : entry.at("neighbours")) {
       cluster.neighbours.push_back({neighbour.at("cluster").get<int>(),
                                     neighbour.at("shared").get<std::vector<std::string>>()});

@@ -25,6 +25,9 @@ struct ClustersFile {
     std::vector<std::string> images;  // its core and the images taken from neighbours, sorted
     std::vector<std::string> core;    // its own images (the cores are disjoint), sorted
     std::vector<Neighbour> neighbours;
+    // A single loop kept whole (ViewGraphPartition::Cluster::single_loop); written only
+    // when true, so a file without it (older ones too) reads as false.
+    bool single_loop = false;
   };
 
   std::string pairs_fingerprint;     // ViewGraph::fingerprint of the database

@@ -41,6 +41,7 @@ ClustersFile ToClustersFile(const ViewGraphPartition& partition, const ViewGraph
     cluster.index = static_cast<int>(a);
     cluster.images = Names(partition.clusters[a].nodes, graph.names);
     cluster.core = Names(partition.clusters[a].core, graph.names);
+    cluster.single_loop = partition.clusters[a].single_loop;
     for (size_t b = 0; b < partition.clusters.size(); ++b) {
       if (a == b) continue;
       const std::vector<size_t> shared = SharedNodes(partition.clusters[a], partition.clusters[b]);
@@ -140,6 +141,16 @@ ClustersFile PartitionWorkspace(const Workspace& workspace, const Manifest& mani
     }
     spdlog::info("partition: cluster {}: {} images ({} its own), shares {}", cluster.index,
                  cluster.images.size(), cluster.core.size(), overlaps.empty() ? "none" : overlaps);
+    if (cluster.single_loop) {
+      const int max_images = file.cluster_max_images;
+      spdlog::warn(
+          "partition: cluster {}: its {} images form a single loop (a capture once round); cut "
+          "into arcs its ends would not meet, so it is kept whole{}",
+          cluster.index, cluster.images.size(),
+          static_cast<int>(cluster.images.size()) > max_images
+              ? ", above distributed.cluster_max_images " + std::to_string(max_images)
+              : std::string());
+    }
   }
   if (!file.isolated.empty()) {
     spdlog::warn("partition: {} images have no verified pair and are in no cluster",

@@ -54,39 +54,73 @@ constexpr size_t kMaxDenseNodes = 800;
 // that each row sums to the node's volume.
 using LocalGraph = std::vector<std::map<size_t, double>>;
 
-// The Fiedler vector of the normalized Laplacian I - D^-1/2 W D^-1/2, scaled by D^-1/2
-// (the relaxed normalized cut), its sign fixed by the entry of largest magnitude (ties:
-// the first). A graph over kMaxDenseNodes is coarsened first by heavy-edge matching
-// (each node, in order, with its unmatched neighbour of heaviest edge, ties to the
-// lower), as multilevel partitioners do, and each node takes its coarse node's value.
-Eigen::VectorXd FiedlerVector(const LocalGraph& graph) {
+// The two lowest non-constant eigenpairs of the normalized Laplacian
+// I - D^-1/2 W D^-1/2, each vector scaled by D^-1/2 (the relaxed normalized cut) and its
+// sign fixed by the entry of largest magnitude (ties: the first). `second` is the Fiedler
+// vector. A graph of fewer than 3 nodes has no third pair: it repeats the second value
+// with a zero vector.
+struct LowSpectrum {
+  double second_value = 0;
+  double third_value = 0;
+  Eigen::VectorXd second;
+  Eigen::VectorXd third;
+};
+
+// Heavy-edge matching, as multilevel partitioners coarsen: each node, in order, with
+// its unmatched neighbour of heaviest edge (ties to the lower). The group of each node;
+// `num_groups` how many.
+std::vector<size_t> HeavyEdgeGroups(const LocalGraph& graph, size_t* num_groups) {
+  const size_t m = graph.size();
+  std::vector<size_t> group(m, m);
+  *num_groups = 0;
+  for (size_t u = 0; u < m; ++u) {
+    if (group[u] != m) continue;
+    group[u] = *num_groups;
+    size_t best = m;
+    double best_weight = 0;
+    for (const auto& [v, weight] : graph[u]) {
+      if (v != u && group[v] == m && weight > best_weight) {
+        best = v;
+        best_weight = weight;
+      }
+    }
+    if (best != m) group[best] = *num_groups;
+    ++*num_groups;
+  }
+  return group;
+}
+
+Eigen::VectorXd SignFixed(Eigen::VectorXd vector) {
+  Eigen::Index largest = 0;
+  for (Eigen::Index i = 1; i < vector.size(); ++i) {
+    if (std::abs(vector(i)) > std::abs(vector(largest)) + 1e-12) largest = i;
+  }
+  if (vector.size() > 0 && vector(largest) < 0) vector = -vector;
+  return vector;
+}
+
+// The LowSpectrum of `graph` (connected, at least 2 nodes). A graph over kMaxDenseNodes
+// is coarsened first and each node takes its coarse node's values (the eigenvalues are
+// the coarse graph's).
+LowSpectrum SpectrumOf(const LocalGraph& graph) {
   const size_t m = graph.size();
   if (m > kMaxDenseNodes) {
-    std::vector<size_t> group(m, m);
     size_t num_groups = 0;
-    for (size_t u = 0; u < m; ++u) {
-      if (group[u] != m) continue;
-      group[u] = num_groups;
-      size_t best = m;
-      double best_weight = 0;
-      for (const auto& [v, weight] : graph[u]) {
-        if (v != u && group[v] == m && weight > best_weight) {
-          best = v;
-          best_weight = weight;
-        }
-      }
-      if (best != m) group[best] = num_groups;
-      ++num_groups;
-    }
+    const std::vector<size_t> group = HeavyEdgeGroups(graph, &num_groups);
     if (num_groups < m - m / 10) {  // else the matching barely shrinks it: solved densely
       LocalGraph coarse(num_groups);
       for (size_t u = 0; u < m; ++u) {
         for (const auto& [v, weight] : graph[u]) coarse[group[u]][group[v]] += weight;
       }
-      const Eigen::VectorXd values = FiedlerVector(coarse);
-      Eigen::VectorXd fine(static_cast<Eigen::Index>(m));
-      for (size_t u = 0; u < m; ++u) fine(static_cast<Eigen::Index>(u)) = values(group[u]);
-      return fine;
+      LowSpectrum spectrum = SpectrumOf(coarse);
+      const auto prolong = [&](const Eigen::VectorXd& values) {
+        Eigen::VectorXd fine(static_cast<Eigen::Index>(m));
+        for (size_t u = 0; u < m; ++u) fine(static_cast<Eigen::Index>(u)) = values(group[u]);
+        return fine;
+      };
+      spectrum.second = prolong(spectrum.second);
+      spectrum.third = prolong(spectrum.third);
+      return spectrum;
     }
   }
   const Eigen::Index n = static_cast<Eigen::Index>(m);
@@ -101,18 +135,21 @@ Eigen::VectorXd FiedlerVector(const LocalGraph& graph) {
       Eigen::MatrixXd::Identity(n, n) -
       inverse_sqrt_degree.asDiagonal() * weights * inverse_sqrt_degree.asDiagonal();
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> solver(laplacian);
-  Eigen::VectorXd fiedler = inverse_sqrt_degree.cwiseProduct(solver.eigenvectors().col(1));
-  Eigen::Index largest = 0;
-  for (Eigen::Index i = 1; i < n; ++i) {
-    if (std::abs(fiedler(i)) > std::abs(fiedler(largest)) + 1e-12) largest = i;
+  LowSpectrum spectrum;
+  spectrum.second_value = solver.eigenvalues()(1);
+  spectrum.second = SignFixed(inverse_sqrt_degree.cwiseProduct(solver.eigenvectors().col(1)));
+  if (n >= 3) {
+    spectrum.third_value = solver.eigenvalues()(2);
+    spectrum.third = SignFixed(inverse_sqrt_degree.cwiseProduct(solver.eigenvectors().col(2)));
+  } else {
+    spectrum.third_value = spectrum.second_value;
+    spectrum.third = Eigen::VectorXd::Zero(n);
   }
-  if (fiedler(largest) < 0) fiedler = -fiedler;
-  return fiedler;
+  return spectrum;
 }
 
-// `nodes` (connected, at least 2) ordered along the Fiedler vector of the graph they
-// induce; ties by position.
-std::vector<size_t> FiedlerOrder(const std::vector<size_t>& nodes, const Adjacency& adjacency) {
+// The graph `nodes` induce, node i standing for nodes[i].
+LocalGraph InducedGraph(const std::vector<size_t>& nodes, const Adjacency& adjacency) {
   std::map<size_t, size_t> index;
   for (size_t i = 0; i < nodes.size(); ++i) index[nodes[i]] = i;
   LocalGraph graph(nodes.size());
@@ -122,7 +159,11 @@ std::vector<size_t> FiedlerOrder(const std::vector<size_t>& nodes, const Adjacen
       if (it != index.end()) graph[i][it->second] = weight;
     }
   }
-  const Eigen::VectorXd fiedler = FiedlerVector(graph);
+  return graph;
+}
+
+// `nodes` ordered along `fiedler` (their Fiedler vector, by position); ties by position.
+std::vector<size_t> FiedlerOrder(const std::vector<size_t>& nodes, const Eigen::VectorXd& fiedler) {
   std::vector<size_t> order(nodes.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
@@ -133,13 +174,14 @@ std::vector<size_t> FiedlerOrder(const std::vector<size_t>& nodes, const Adjacen
   return ordered;
 }
 
-// Splits connected `nodes` in two along the Fiedler order at the prefix of smallest
+// Splits connected `nodes` in two along their Fiedler vector at the prefix of smallest
 // normalized cut, cut/vol(A) + cut/vol(B), with at least a quarter of the nodes on
 // each side. Then each side keeps its largest connected component and the rest moves
 // across, so that both sides are connected.
 std::pair<std::vector<size_t>, std::vector<size_t>> Bisect(const std::vector<size_t>& nodes,
+                                                           const Eigen::VectorXd& fiedler,
                                                            const Adjacency& adjacency) {
-  const std::vector<size_t> order = FiedlerOrder(nodes, adjacency);
+  const std::vector<size_t> order = FiedlerOrder(nodes, fiedler);
   const size_t m = order.size();
   std::map<size_t, double> degree;  // within `nodes`
   std::map<size_t, bool> in_first;
@@ -189,7 +231,99 @@ std::pair<std::vector<size_t>, std::vector<size_t>> Bisect(const std::vector<siz
   return {first, second};
 }
 
+// The single-loop check. A loop (a capture once round an object or a block) is a cycle
+// of low degree; its 2nd and 3rd eigenvectors are a sine and a cosine round it
+// (lambda2 = lambda3), so it lies in their plane as a ring: every node about as far from
+// the origin, the angles covering the whole turn, each edge joining nodes of nearby
+// angle. A path or a strip has lambda3 about 4 lambda2 and lies on an arc of some 270
+// degrees; a patch (a grid, a hemisphere of views) has lambda2 = lambda3 too but fills a
+// disc, nodes near its centre; two loops joined meet at the origin. A few loop-closing
+// or cross edges split lambda2 and lambda3 a little and barely move the ring. The radii
+// and angles need no order along the loop, which is what the graph does not give. The
+// radii are taken before the D^-1/2 scaling (times the square root of the degree): so
+// they stay even where the inliers or the frames per turn vary round the loop (8 times
+// from one side to the other: 0.76 to 1.08 of the median, against 0.45 to 1.81 scaled).
+// One cross edge as strong as a neighbour's makes two loops sharing a side, not one
+// (ring of 120: lambda3/lambda2 2.7, least radius 0.41); it is cut as before.
+constexpr size_t kMinLoopNodes = 16;  // fewer: the gap between angles says little
+// A loop 1 (1.4 with a few weak cross edges), a path or strip 4.
+constexpr double kMaxLoopEigenvalueRatio = 2;
+// Of the median: a loop 0.75 to 1.15; a grid's or hemisphere's centre 0.2 or less.
+constexpr double kMinLoopRadius = 0.5;
+constexpr double kMaxLoopRadius = 2;
+// A loop of n nodes 360/n or so; a path 90.
+constexpr double kMaxLoopGapDegrees = 45;
+// An edge across more than this turn crosses the loop; a loop holds a few such.
+constexpr double kCrossingDegrees = 90;
+constexpr double kMaxLoopCrossingWeight = 0.05;
+
+SingleLoopEvidence LoopEvidence(const LocalGraph& graph, const LowSpectrum& spectrum) {
+  SingleLoopEvidence evidence;
+  const size_t m = graph.size();
+  evidence.eigenvalue_ratio = spectrum.second_value > 1e-12
+                                  ? spectrum.third_value / spectrum.second_value
+                                  : std::numeric_limits<double>::infinity();
+  std::vector<double> radii(m), angles(m);
+  for (size_t i = 0; i < m; ++i) {
+    const double x = spectrum.second(static_cast<Eigen::Index>(i));
+    const double y = spectrum.third(static_cast<Eigen::Index>(i));
+    double degree = 0;
+    for (const auto& [other, weight] : graph[i]) degree += weight;
+    radii[i] = std::hypot(x, y) * std::sqrt(degree);
+    angles[i] = std::atan2(y, x) * 180 / M_PI;
+  }
+  std::vector<double> sorted = radii;
+  std::sort(sorted.begin(), sorted.end());
+  const double median = m == 0 ? 0 : sorted[m / 2];
+  if (!(median > 0)) return evidence;
+  evidence.smallest_radius = sorted.front() / median;
+  evidence.largest_radius = sorted.back() / median;
+  sorted = angles;
+  std::sort(sorted.begin(), sorted.end());
+  evidence.widest_gap_degrees = 360 - (sorted.back() - sorted.front());
+  for (size_t i = 1; i < m; ++i) {
+    evidence.widest_gap_degrees = std::max(evidence.widest_gap_degrees, sorted[i] - sorted[i - 1]);
+  }
+  double total = 0, crossing = 0;
+  for (size_t u = 0; u < m; ++u) {
+    for (const auto& [v, weight] : graph[u]) {
+      if (v <= u) continue;
+      const double span = std::abs(angles[u] - angles[v]);
+      total += weight;
+      if (std::min(span, 360 - span) > kCrossingDegrees) crossing += weight;
+    }
+  }
+  evidence.crossing_weight = total > 0 ? crossing / total : 0;
+  evidence.single_loop =
+      m >= kMinLoopNodes && evidence.eigenvalue_ratio <= kMaxLoopEigenvalueRatio &&
+      evidence.smallest_radius >= kMinLoopRadius && evidence.largest_radius <= kMaxLoopRadius &&
+      evidence.widest_gap_degrees <= kMaxLoopGapDegrees &&
+      evidence.crossing_weight <= kMaxLoopCrossingWeight;
+  return evidence;
+}
+
 }  // namespace
+
+SingleLoopEvidence MeasureSingleLoop(size_t num_nodes, const std::vector<WeightedEdge>& edges) {
+  LocalGraph graph(num_nodes);
+  for (const WeightedEdge& edge : edges) {
+    if (edge.node1 >= num_nodes || edge.node2 >= num_nodes || edge.node1 == edge.node2) {
+      throw std::invalid_argument("MeasureSingleLoop: edge " + std::to_string(edge.node1) + "-" +
+                                  std::to_string(edge.node2) + " is not between nodes");
+    }
+    if (!(edge.weight > 0)) continue;
+    graph[edge.node1][edge.node2] += edge.weight;
+    graph[edge.node2][edge.node1] += edge.weight;
+  }
+  for (size_t node = 0; node < num_nodes; ++node) {
+    if (graph[node].empty()) {
+      throw std::invalid_argument("MeasureSingleLoop: node " + std::to_string(node) +
+                                  " has no edge");
+    }
+  }
+  if (num_nodes < 2) return {};
+  return LoopEvidence(graph, SpectrumOf(graph));
+}
 
 std::vector<size_t> SharedNodes(const ViewGraphPartition::Cluster& a,
                                 const ViewGraphPartition::Cluster& b) {
@@ -227,9 +361,10 @@ class Partitioner {
     }
     const std::vector<std::vector<size_t>> components = Components(connected, adjacency_);
     if (components.size() == 1) {
-      result_.tree = Split(components[0]);
+      result_.tree = Split(components[0], true);
     } else {
-      for (const auto& component : components) result_.tree.children.push_back(Split(component));
+      for (const auto& component : components)
+        result_.tree.children.push_back(Split(component, true));
     }
     owner_.assign(adjacency_.size(), -1);
     for (size_t c = 0; c < result_.clusters.size(); ++c) {
@@ -245,16 +380,25 @@ class Partitioner {
   }
 
  private:
-  ClusterTreeNode Split(const std::vector<size_t>& nodes) {
+  ClusterTreeNode Leaf(const std::vector<size_t>& nodes, bool single_loop) {
     ClusterTreeNode tree;
-    if (nodes.size() <= max_core_) {
-      tree.cluster = static_cast<int>(result_.clusters.size());
-      result_.clusters.push_back({nodes, nodes});
-      return tree;
-    }
-    const auto [first, second] = Bisect(nodes, adjacency_);
-    tree.children.push_back(Split(first));
-    tree.children.push_back(Split(second));
+    tree.cluster = static_cast<int>(result_.clusters.size());
+    result_.clusters.push_back({nodes, nodes, single_loop});
+    return tree;
+  }
+
+  // `nodes` connected; `whole_component` when they are a connected component of the
+  // graph, which is kept whole if it is a single loop (only a whole component: the
+  // arcs of a loop cut are no loops).
+  ClusterTreeNode Split(const std::vector<size_t>& nodes, bool whole_component) {
+    if (nodes.size() <= max_core_) return Leaf(nodes, false);
+    const LocalGraph graph = InducedGraph(nodes, adjacency_);
+    const LowSpectrum spectrum = SpectrumOf(graph);
+    if (whole_component && LoopEvidence(graph, spectrum).single_loop) return Leaf(nodes, true);
+    const auto [first, second] = Bisect(nodes, spectrum.second, adjacency_);
+    ClusterTreeNode tree;
+    tree.children.push_back(Split(first, false));
+    tree.children.push_back(Split(second, false));
     return tree;
   }
 

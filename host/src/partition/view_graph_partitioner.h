@@ -5,8 +5,9 @@
 // spectral bisection (a sweep over the Fiedler vector of the normalized Laplacian, at
 // the smallest normalized cut with at least a quarter of the nodes on each side) until
 // a cluster's own images fit, then each pair of clusters joined by edges shares the
-// images with the strongest edges across their cut. Deterministic: ties go to the
-// lower node index (callers number the images in name order).
+// images with the strongest edges across their cut. A connected component that is one
+// loop (a capture once round) is not cut but kept as one cluster, flagged. Deterministic:
+// ties go to the lower node index (callers number the images in name order).
 
 #include <cstddef>
 #include <vector>
@@ -37,6 +38,9 @@ struct ViewGraphPartition {
   struct Cluster {
     std::vector<size_t> core;   // its own nodes, ascending; the cores are disjoint
     std::vector<size_t> nodes;  // core and the nodes taken from neighbours, ascending
+    // A connected component that is one loop (a capture once round), kept whole even
+    // above max_nodes: cut into arcs, its ends would not meet again in the merge.
+    bool single_loop = false;
   };
   std::vector<Cluster> clusters;  // in the tree's order, left to right
   ClusterTreeNode tree;
@@ -50,6 +54,22 @@ struct ViewGraphPartition {
 // an edge names a node out of range.
 ViewGraphPartition PartitionViewGraph(size_t num_nodes, const std::vector<WeightedEdge>& edges,
                                       const PartitionOptions& options);
+
+// What the single-loop check sees in a graph: the nodes placed in the plane by the
+// 2nd and 3rd eigenvectors of the normalized Laplacian.
+struct SingleLoopEvidence {
+  double eigenvalue_ratio = 0;    // lambda3 / lambda2: 1 for a loop, about 4 for a path
+  double smallest_radius = 0;     // least distance from the origin, over the median: 0 on a patch
+  double largest_radius = 0;      // greatest distance from the origin, over the median
+  double widest_gap_degrees = 0;  // widest turn round the origin without a node: 90 on a path
+  double crossing_weight = 0;     // share of the weight on edges across more than a quarter turn
+  bool single_loop = false;       // every figure within a loop's bounds
+};
+
+// The single-loop check that PartitionViewGraph makes of each connected component it
+// would cut, made of nodes 0..num_nodes-1 joined by `edges` (a graph in pieces is not a
+// loop). Throws std::invalid_argument for a node without edges or an edge out of range.
+SingleLoopEvidence MeasureSingleLoop(size_t num_nodes, const std::vector<WeightedEdge>& edges);
 
 // The nodes clusters a and b both hold, ascending.
 std::vector<size_t> SharedNodes(const ViewGraphPartition::Cluster& a,

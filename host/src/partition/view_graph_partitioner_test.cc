@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <iostream>
 #include <random>
 #include <set>
+#include <string>
 
 namespace tessera {
 namespace {
@@ -149,6 +152,149 @@ TEST(ViewGraphPartitioner, ComponentsAreSeparateSubtrees) {
   EXPECT_EQ(partition.tree.children.size(), 2u);
   EXPECT_EQ(partition.isolated, std::vector<size_t>{5});
   EXPECT_EQ(partition.cut_weight, 0);
+}
+
+// A capture once round: `size` nodes in a ring, each joined to its 3 nearest on either
+// side, by weights that fall with the distance and vary by up to 25% either way.
+std::vector<WeightedEdge> Ring(size_t size, uint32_t seed) {
+  std::mt19937 random(seed);
+  std::vector<WeightedEdge> edges;
+  for (size_t i = 0; i < size; ++i) {
+    for (size_t d = 1; d <= 3; ++d) {
+      const double jitter = 0.75 + 0.5 * static_cast<double>(random() % 1001) / 1000;
+      edges.push_back({i, (i + d) % size, jitter * 300.0 / static_cast<double>(d)});
+    }
+  }
+  return edges;
+}
+
+SingleLoopEvidence Measured(const std::string& what, size_t num_nodes,
+                            const std::vector<WeightedEdge>& edges) {
+  const SingleLoopEvidence evidence = MeasureSingleLoop(num_nodes, edges);
+  std::cout << what << ": lambda3/lambda2 " << evidence.eigenvalue_ratio << ", radii "
+            << evidence.smallest_radius << " to " << evidence.largest_radius
+            << " of the median, widest gap " << evidence.widest_gap_degrees
+            << " degrees, crossing weight " << evidence.crossing_weight
+            << (evidence.single_loop ? ": a single loop" : ": no single loop") << "\n";
+  return evidence;
+}
+
+void ExpectCutAndNoneALoop(const ViewGraphPartition& partition, size_t num_nodes,
+                           size_t max_nodes) {
+  EXPECT_EQ(Covered(partition).size(), num_nodes);
+  EXPECT_GE(partition.clusters.size(), 2u);
+  for (const auto& cluster : partition.clusters) {
+    EXPECT_LE(cluster.nodes.size(), max_nodes);
+    EXPECT_FALSE(cluster.single_loop);
+  }
+}
+
+TEST(ViewGraphPartitioner, KeepsASingleLoopWholeAboveTheClusterSize) {
+  const std::vector<WeightedEdge> edges = Ring(120, 4);
+  EXPECT_TRUE(Measured("ring of 120", 120, edges).single_loop);
+  const ViewGraphPartition partition = PartitionViewGraph(120, edges, {40, 10});
+  ASSERT_EQ(partition.clusters.size(), 1u);
+  EXPECT_TRUE(partition.clusters[0].single_loop);
+  std::vector<size_t> all(120);
+  for (size_t i = 0; i < all.size(); ++i) all[i] = i;
+  EXPECT_EQ(partition.clusters[0].core, all);
+  EXPECT_EQ(partition.clusters[0].nodes, all);
+  EXPECT_EQ(partition.tree.cluster, 0);
+  EXPECT_EQ(partition.cut_weight, 0);
+  // Deterministic whatever the edge order.
+  std::vector<WeightedEdge> shuffled = edges;
+  std::shuffle(shuffled.begin(), shuffled.end(), std::mt19937(5));
+  const ViewGraphPartition again = PartitionViewGraph(120, shuffled, {40, 10});
+  ASSERT_EQ(again.clusters.size(), 1u);
+  EXPECT_TRUE(again.clusters[0].single_loop);
+}
+
+TEST(ViewGraphPartitioner, ALoopWithAFewCrossEdgesIsStillASingleLoop) {
+  // Three weak pairs across the object (wide baselines: a tenth of a neighbour's
+  // inliers) and two loop-closing pairs near the start: still one walk round.
+  std::vector<WeightedEdge> edges = Ring(120, 6);
+  std::mt19937 random(7);
+  for (size_t k = 0; k < 3; ++k) {
+    const size_t from = random() % 120;
+    edges.push_back({from, (from + 40 + random() % 40) % 120, 30});
+  }
+  edges.push_back({118, 2, 80});
+  edges.push_back({119, 3, 60});
+  EXPECT_TRUE(Measured("ring of 120 with cross edges", 120, edges).single_loop);
+  const ViewGraphPartition partition = PartitionViewGraph(120, edges, {40, 10});
+  ASSERT_EQ(partition.clusters.size(), 1u);
+  EXPECT_TRUE(partition.clusters[0].single_loop);
+}
+
+TEST(ViewGraphPartitioner, ALoopOfUnevenWeightIsStillASingleLoop) {
+  // The inliers per pair 8 times as many on one side of the object as on the other.
+  std::vector<WeightedEdge> edges;
+  for (size_t i = 0; i < 200; ++i) {
+    const double scale =
+        std::pow(8.0, 0.5 + 0.5 * std::sin(static_cast<double>(i) * 2 * M_PI / 200));
+    for (size_t d = 1; d <= 3; ++d)
+      edges.push_back({i, (i + d) % 200, scale * 300.0 / static_cast<double>(d)});
+  }
+  EXPECT_TRUE(Measured("ring of 200, uneven weights", 200, edges).single_loop);
+  const ViewGraphPartition partition = PartitionViewGraph(200, edges, {40, 10});
+  ASSERT_EQ(partition.clusters.size(), 1u);
+  EXPECT_TRUE(partition.clusters[0].single_loop);
+}
+
+TEST(ViewGraphPartitioner, ALoopWithACrossEdgeAsStrongAsItsNeighboursIsCut) {
+  // Two loops sharing a side (a theta), not one walk round: cut as any graph.
+  std::vector<WeightedEdge> edges = Ring(120, 6);
+  edges.push_back({0, 60, 300});
+  EXPECT_FALSE(Measured("ring of 120 with a strong cross edge", 120, edges).single_loop);
+  ExpectCutAndNoneALoop(PartitionViewGraph(120, edges, {40, 10}), 120, 40);
+}
+
+TEST(ViewGraphPartitioner, ALargeLoopIsRecognisedOnTheCoarsenedGraph) {
+  const std::vector<WeightedEdge> edges = Ring(2000, 8);
+  const ViewGraphPartition partition = PartitionViewGraph(2000, edges, {300, 40});
+  ASSERT_EQ(partition.clusters.size(), 1u);
+  EXPECT_TRUE(partition.clusters[0].single_loop);
+  EXPECT_EQ(partition.clusters[0].nodes.size(), 2000u);
+  Measured("ring of 2000 (coarsened)", 2000, edges);
+}
+
+TEST(ViewGraphPartitioner, AGridIsCutAndNoLoop) {
+  // A 12x12 patch of views, each joined to its 4 neighbours and more weakly to its
+  // diagonal ones.
+  std::vector<WeightedEdge> edges;
+  const auto node = [](size_t row, size_t column) { return row * 12 + column; };
+  for (size_t row = 0; row < 12; ++row) {
+    for (size_t column = 0; column < 12; ++column) {
+      if (column + 1 < 12) edges.push_back({node(row, column), node(row, column + 1), 200});
+      if (row + 1 < 12) edges.push_back({node(row, column), node(row + 1, column), 200});
+      if (row + 1 < 12 && column + 1 < 12)
+        edges.push_back({node(row, column), node(row + 1, column + 1), 80});
+      if (row + 1 < 12 && column > 0)
+        edges.push_back({node(row, column), node(row + 1, column - 1), 80});
+    }
+  }
+  EXPECT_FALSE(Measured("12x12 grid", 144, edges).single_loop);
+  ExpectCutAndNoneALoop(PartitionViewGraph(144, edges, {40, 10}), 144, 40);
+}
+
+TEST(ViewGraphPartitioner, AStripIsCutAndNoLoop) {
+  std::vector<WeightedEdge> edges;
+  for (size_t i = 0; i < 120; ++i) {
+    for (size_t d = 1; d <= 3 && i + d < 120; ++d) edges.push_back({i, i + d, 300.0 / d});
+  }
+  EXPECT_FALSE(Measured("strip of 120", 120, edges).single_loop);
+  ExpectCutAndNoneALoop(PartitionViewGraph(120, edges, {40, 10}), 120, 40);
+}
+
+TEST(ViewGraphPartitioner, TwoLoopsJoinedAreNoSingleLoop) {
+  // A figure eight: two rings of 60 sharing node 0's neighbourhood.
+  std::vector<WeightedEdge> edges = Ring(60, 9);
+  for (const WeightedEdge& edge : Ring(60, 10)) {
+    const auto shifted = [](size_t node) { return node == 0 ? node : node + 59; };
+    edges.push_back({shifted(edge.node1), shifted(edge.node2), edge.weight});
+  }
+  EXPECT_FALSE(Measured("figure eight of 2 x 60", 119, edges).single_loop);
+  ExpectCutAndNoneALoop(PartitionViewGraph(119, edges, {40, 10}), 119, 40);
 }
 
 TEST(ViewGraphPartitioner, RefusesAClusterSizeBelowThreeOverlaps) {
