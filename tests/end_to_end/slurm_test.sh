@@ -5,7 +5,8 @@
 # default manifest must give the same pairs, matches and geometries as a single-process
 # run and a byte-identical model. Then a failed shard: its database made unwritable,
 # the submission fails, and submitting again reruns only that shard. Then --partitioned:
-# the clusters mapped as a job array and merged into one model of all 11 images. Every daemon
+# the clusters mapped as a job array and merged into one model of all 11 images; and
+# lego-100 at 400 px in clusters of 40, merged into one right model of 100. Every daemon
 # started here is stopped by process id. Skips (exit 77) with the reason where Slurm
 # cannot start (not root, packages missing, daemons not coming up).
 # usage: slurm_test.sh TESSERA DOWNSCALE SOURCE_DIR
@@ -209,6 +210,42 @@ assert len(summary["partition"]["merges"]) == len(clusters) - 1, summary["partit
 print(len(clusters), "clusters")' "$part" > "$work/partitioned.txt" ||
   { cat "$part"/slurm/logs/*; fail "--partitioned: not one model of 11 images"; }
 echo "--partitioned: $(cat "$work/partitioned.txt") mapped as an array and merged into one model of 11 images"
+
+# lego-100 (an object seen from all round, with symmetric structure that gives wrong
+# pairs between opposite sides) at 400 px, retrieval pairs, clusters of at most 40
+# sharing 10: 100/100 in one model, no camera more than 5 degrees off.
+lego=$source_dir/../shared/datasets/lego-100
+require_dataset "$lego"
+"$downscale" "$lego/images" "$work/lego_images" 400 90 > /dev/null || fail "downscale lego-100"
+python3 -c '
+import json, sys
+manifest = json.load(open(sys.argv[1]))
+manifest["distributed"] = {"cluster_max_images": 40, "cluster_overlap": 10}
+json.dump(manifest, open(sys.argv[2], "w"))' "$source_dir/manifests/large_unordered.json" \
+  "$work/lego.json" || fail "the lego manifest"
+ids=$("$tessera" slurm --images "$work/lego_images" --output "$work/lego" --workers 3 \
+  --partitioned --manifest "$work/lego.json" 2> "$work/slurm5.log") ||
+  { cat "$work/slurm5.log"; fail "tessera slurm --partitioned on lego-100"; }
+read -r -a job_ids <<< "$ids"
+wait_jobs "${job_ids[@]}"
+[ -f "$work/lego/sparse/0/images.bin" ] ||
+  { cat "$work"/lego/slurm/logs/*; fail "lego-100: the merge wrote no model"; }
+"$tessera" eval "$work/lego/sparse/0" "$lego/transforms.json" --json > "$work/lego_eval.json" ||
+  fail "lego-100: tessera eval"
+python3 -c '
+import json, sys
+summary = json.load(open(sys.argv[1] + "/mapping_summary.json"))
+clusters = json.load(open(sys.argv[1] + "/clusters.json"))["clusters"]
+scores = json.load(open(sys.argv[2]))
+assert [m["num_images"] for m in summary["models"]] == [100], summary["models"]
+assert scores["registered"] == 100, scores["registered"]
+worst = max(image["rot_error_deg"] for image in scores["images"] if image["registered"])
+assert worst < 5, worst
+print("%d clusters of at most 40, one model of 100/100, worst rotation error %.2f deg" %
+      (len(clusters), worst))' "$work/lego" "$work/lego_eval.json" > "$work/lego.txt" ||
+  { cat "$work/lego.txt" "$work"/lego/slurm/logs/*.err 2> /dev/null | tail -40
+    fail "--partitioned on lego-100: not one right model of 100 images"; }
+echo "--partitioned on lego-100: $(cat "$work/lego.txt")"
 
 stop_daemons
 echo "PASS"
