@@ -156,11 +156,15 @@ ClustersFile PartitionWorkspace(const Workspace& workspace, const Manifest& mani
     spdlog::warn("partition: {} images have no verified pair and are in no cluster",
                  file.isolated.size());
   }
+  size_t largest = 0;
+  for (const ClustersFile::Cluster& cluster : file.clusters) {
+    largest = std::max(largest, cluster.images.size());
+  }
   spdlog::info(
-      "partition: {} images in {} clusters of at most {} ({} shared with each neighbour); the "
-      "cuts hold {:.0f} of {:.0f} inliers ({:.1f}%); {:.2f} s; wrote {}",
-      graph.names.size() - file.isolated.size(), file.clusters.size(), file.cluster_max_images,
-      file.cluster_overlap, file.cut_weight, file.total_weight,
+      "partition: {} images in {} clusters of at most {} (cluster_max_images {}, {} shared with "
+      "each neighbour); the cuts hold {:.0f} of {:.0f} inliers ({:.1f}%); {:.2f} s; wrote {}",
+      graph.names.size() - file.isolated.size(), file.clusters.size(), largest,
+      file.cluster_max_images, file.cluster_overlap, file.cut_weight, file.total_weight,
       100.0 * file.cut_weight / std::max(1.0, file.total_weight), timer.ElapsedSeconds(),
       path.string());
   return file;
