@@ -213,6 +213,47 @@ TEST(GlobalMapper, WeakPairsWithWrongRotationsAreSetAside) {
   EXPECT_EQ(all.num_verified_pairs, scene.input.pairs.size());
 }
 
+// The matches of pairs set aside as weak still join the model once the poses are known:
+// the last image's keypoints of its second half are matched only in weak pairs (a
+// twentieth of the matches, with the images 3 to 8 before it), its first half in strong
+// ones; retriangulation gives the second half points too.
+TEST(GlobalMapper, RetriangulationTakesTheMatchesOfWeakPairs) {
+  SyntheticSceneOptions options;
+  options.num_images = 16;
+  options.max_pair_gap = 8;
+  options.seed = 21;
+  SyntheticScene scene = MakeSyntheticScene(options);
+  const image_t last = 16;
+  const point2D_t half = static_cast<point2D_t>(scene.input.images.at(last).points2D.size() / 2);
+  size_t num_weak = 0;
+  for (MapperInput::Pair& pair : scene.input.pairs) {
+    if (pair.image_id2 != last) continue;
+    const bool strong = last - pair.image_id1 <= 2;
+    FeatureMatches kept;
+    for (const FeatureMatch& match : pair.geometry.inlier_matches) {
+      if ((match.point2D_idx2 < half) == strong) kept.push_back(match);
+    }
+    if (!strong) {
+      kept.resize(std::max<size_t>(pair.geometry.inlier_matches.size() / 20, 15));
+      ++num_weak;
+    }
+    pair.geometry.inlier_matches = kept;
+  }
+  ASSERT_EQ(num_weak, 6u);
+  const GlobalMapperResult result =
+      GlobalMapper::Reconstruct(scene.input, testing::CeresAdjusterOnOneThread(), {});
+  EXPECT_GE(result.num_weak_pairs_set_aside, num_weak);
+  ASSERT_EQ(result.models.size(), 1u);
+  ASSERT_EQ(result.models[0].images.count(last), 1u);
+  size_t num_second_half = 0;
+  const Image& image = result.models[0].images.at(last);
+  for (point2D_t k = half; k < image.points2D.size(); ++k) {
+    num_second_half += image.points2D[k].HasPoint3D();
+  }
+  EXPECT_GT(num_second_half, 50u);
+  ExpectConsistentAndTrue(scene, result.models[0]);
+}
+
 TEST(GlobalMapper, StopsWithinASecondOfBeingAsked) {
   SyntheticSceneOptions options;
   options.num_images = 20;
