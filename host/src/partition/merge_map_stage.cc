@@ -71,7 +71,8 @@ std::vector<Reconstruction> ReadClusterModels(const std::filesystem::path& works
 
 // Why each image of the workspace that is in no merged model was left out.
 std::map<image_t, std::string> Unregistered(
-    const Database& database, const ClustersFile& clusters, const ClusterMergeResult& merged,
+    const std::map<image_t, Image>& images, const ClustersFile& clusters,
+    const ClusterMergeResult& merged,
     const std::map<int, std::vector<Reconstruction>>& by_cluster) {
   std::set<std::string> in_model, in_cluster_model;
   for (const ClusterModel& model : merged.models) {
@@ -84,13 +85,12 @@ std::map<image_t, std::string> Unregistered(
   }
   const std::set<std::string> isolated(clusters.isolated.begin(), clusters.isolated.end());
   std::map<image_t, std::string> reasons;
-  for (const Image& image : database.ReadAllImages()) {
+  for (const auto& [image_id, image] : images) {
     if (in_model.count(image.name) != 0) continue;
-    reasons[image.image_id] =
-        isolated.count(image.name) != 0 ? "no verified pair: in no cluster"
-        : in_cluster_model.count(image.name) == 0
-            ? "registered in none of its clusters' models"
-            : "dropped by a merge: its observations did not fit the merged model";
+    reasons[image_id] = isolated.count(image.name) != 0 ? "no verified pair: in no cluster"
+                        : in_cluster_model.count(image.name) == 0
+                            ? "registered in none of its clusters' models"
+                            : "dropped by a merge: its observations did not fit the merged model";
   }
   return reasons;
 }
@@ -120,7 +120,7 @@ MapStageSummary MergeClusterMaps(const PipelineContext& context, const RunOption
 
   MapperResult result;
   const MapperInput input = LoadMapperInput(database);
-  result.unregistered_reasons = Unregistered(database, clusters, merged, by_cluster);
+  result.unregistered_reasons = Unregistered(input.images, clusters, merged, by_cluster);
   nlohmann::json records = nlohmann::json::array();
   for (const ClusterMergeRecord& record : merged.merges) {
     records.push_back(record.ToJson());

@@ -16,6 +16,24 @@ namespace {
 
 using Adjacency = std::vector<std::map<size_t, double>>;
 
+// Nodes 0..num_nodes-1 joined by the edges of positive weight (an edge given twice counts
+// twice). Throws std::invalid_argument, naming `caller`, when an edge is not between two
+// of the nodes.
+Adjacency AdjacencyOf(size_t num_nodes, const std::vector<WeightedEdge>& edges,
+                      const std::string& caller) {
+  Adjacency adjacency(num_nodes);
+  for (const WeightedEdge& edge : edges) {
+    if (edge.node1 >= num_nodes || edge.node2 >= num_nodes || edge.node1 == edge.node2) {
+      throw std::invalid_argument(caller + ": edge " + std::to_string(edge.node1) + "-" +
+                                  std::to_string(edge.node2) + " is not between nodes");
+    }
+    if (!(edge.weight > 0)) continue;
+    adjacency[edge.node1][edge.node2] += edge.weight;
+    adjacency[edge.node2][edge.node1] += edge.weight;
+  }
+  return adjacency;
+}
+
 // The connected components of `nodes` (ascending) in the graph they induce, largest
 // first, then by their lowest node; each ascending.
 std::vector<std::vector<size_t>> Components(const std::vector<size_t>& nodes,
@@ -305,16 +323,7 @@ SingleLoopEvidence LoopEvidence(const LocalGraph& graph, const LowSpectrum& spec
 }  // namespace
 
 SingleLoopEvidence MeasureSingleLoop(size_t num_nodes, const std::vector<WeightedEdge>& edges) {
-  LocalGraph graph(num_nodes);
-  for (const WeightedEdge& edge : edges) {
-    if (edge.node1 >= num_nodes || edge.node2 >= num_nodes || edge.node1 == edge.node2) {
-      throw std::invalid_argument("MeasureSingleLoop: edge " + std::to_string(edge.node1) + "-" +
-                                  std::to_string(edge.node2) + " is not between nodes");
-    }
-    if (!(edge.weight > 0)) continue;
-    graph[edge.node1][edge.node2] += edge.weight;
-    graph[edge.node2][edge.node1] += edge.weight;
-  }
+  const LocalGraph graph = AdjacencyOf(num_nodes, edges, "MeasureSingleLoop");
   for (size_t node = 0; node < num_nodes; ++node) {
     if (graph[node].empty()) {
       throw std::invalid_argument("MeasureSingleLoop: node " + std::to_string(node) +
@@ -339,17 +348,9 @@ class Partitioner {
  public:
   Partitioner(size_t num_nodes, const std::vector<WeightedEdge>& edges,
               const PartitionOptions& options)
-      : options_(options), adjacency_(num_nodes) {
-    for (const WeightedEdge& edge : edges) {
-      if (edge.node1 >= num_nodes || edge.node2 >= num_nodes || edge.node1 == edge.node2) {
-        throw std::invalid_argument("PartitionViewGraph: edge " + std::to_string(edge.node1) + "-" +
-                                    std::to_string(edge.node2) + " is not between nodes");
-      }
-      if (!(edge.weight > 0)) continue;
-      adjacency_[edge.node1][edge.node2] += edge.weight;
-      adjacency_[edge.node2][edge.node1] += edge.weight;
-      result_.total_weight += edge.weight;
-    }
+      : options_(options), adjacency_(AdjacencyOf(num_nodes, edges, "PartitionViewGraph")) {
+    for (const WeightedEdge& edge : edges)
+      result_.total_weight += edge.weight > 0 ? edge.weight : 0;
     // Room for the overlap with two neighbours.
     max_core_ = options.max_nodes - 2 * options.overlap;
   }

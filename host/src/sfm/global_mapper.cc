@@ -29,7 +29,7 @@ constexpr uint64_t kPositioningStream = 2;  // + the part's index
 // than kMaxSettledShift of the cameras' spread: moved that far, observations the last
 // retriangulation refused fit now. fox (video round an object, 2,304 px prior): the first
 // adjustment moves a camera 9% and the second 84%, and positions land within 1% of the
-// incremental mapper's against 2.5 times as far off after one round; fountain-P11 moves
+// incremental mapper's against 1.4 times as far off after one round; fountain-P11 moves
 // 0.15% and Herz-Jesus-P8 1.5%, and stop after one.
 constexpr int kMaxRetriangulationRounds = 2;
 constexpr double kMaxSettledShift = 0.02;
@@ -151,7 +151,6 @@ size_t NumObservationsOf(const Reconstruction& model) {
 
 namespace {
 
-// What mapping one connected part of the view graph shares with the whole run.
 // The inlier matches of every verified pair with at least min_num_matches inliers between
 // two input images.
 std::vector<ImagePairMatches> VerifiedPairMatches(const MapperInput& input,
@@ -177,6 +176,7 @@ std::vector<Track> TracksWithin(const FeatureTracks& tracks, const std::set<imag
   return within;
 }
 
+// What mapping one connected part of the view graph shares with the whole run.
 struct PartRun {
   const MapperInput& input;
   const std::map<camera_t, Camera>& cameras;
@@ -626,7 +626,8 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   // dropped by the rotations too: once the poses are known, each match is judged by its
   // reprojection, and the right ones join far-apart views that the strong pairs do not.
   const FeatureTracks retriangulation_tracks =
-      BuildFeatureTracks(VerifiedPairMatches(input, options), num_points2D);
+      options.retriangulate ? BuildFeatureTracks(VerifiedPairMatches(input, options), num_points2D)
+                            : FeatureTracks();
   lap(&steps.tracks);
   LogViewGraph(input, pairs.size(), options, result, rotations);
 
