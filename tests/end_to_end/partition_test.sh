@@ -2,7 +2,8 @@
 # Partitioned mapping on the 11 images of the sample examples/fountain-P11-small at 512 px
 # (ORB for speed), clusters of at most 9 images sharing 3 with each neighbour:
 #  1. a cluster size below 3 overlaps is exit 2 naming distributed.cluster_max_images;
-#  2. `partition` writes clusters.json (2 clusters at least); `map --cluster K` maps
+#  2. `partition` writes clusters.json (2 clusters at least) with the camera's focal
+#     length, found once for every cluster; `map --cluster K` maps
 #     each into OUTPUT/clusters/K, and a finished cluster is skipped when run again;
 #     `--cluster` outside the clusters is exit 2;
 #  3. `merge --stage map` merges them: one model with all 11 images, every merge
@@ -64,10 +65,19 @@ c = json.load(open(sys.argv[1]))
 assert all(len(k["images"]) <= 9 for k in c["clusters"]), "a cluster over 9 images"
 print(len(c["clusters"]))' "$out/clusters.json") || fail "clusters.json"
 [ "$num_clusters" -ge 2 ] || fail "clusters.json: $num_clusters clusters, expected 2 or more"
+# The images have no EXIF: the camera is calibrated once, on the whole view graph, and
+# every cluster maps with it (fountain-P11's focal length, 2759 px at 3072, is 460 px at 512).
+python3 -c '
+import json, sys
+c = json.load(open(sys.argv[1]))["cameras"]
+assert len(c) == 1 and abs(c[0]["focal_length"] - 460) < 0.1 * 460, c' "$out/clusters.json" ||
+  fail "clusters.json: no calibration near 460 px"
+grep -qE "partition: camera 1: focal length [0-9.]+ px .* for every cluster" "$work/partition.log" ||
+  fail "partition: the calibration is not logged"
 expect_exit 2 "$work/outside.log" "--cluster $num_clusters: " \
   "$tessera" map --output "$out" --manifest "$work/m.json" --cluster "$num_clusters"
 for ((k = 0; k < num_clusters; ++k)); do
-  expect_exit 0 "$work/map$k.log" "map: cluster $k:" \
+  expect_exit 0 "$work/map$k.log" "; focal lengths from clusters.json" \
     "$tessera" map --output "$out" --manifest "$work/m.json" --cluster "$k" --threads 2
   [ -f "$out/clusters/$k/sparse/0/images.bin" ] || fail "cluster $k: no model"
 done

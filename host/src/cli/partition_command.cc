@@ -29,7 +29,7 @@ CommandRegistration RegisterPartitionCommand(CLI::App& app, const GlobalOptions&
             Workspace::Options open;
             open.require_database_for = "partition";
             const auto workspace = Workspace::Open(options->output, open);
-            PartitionWorkspace(*workspace, context.manifest);
+            PartitionWorkspace(*workspace, context);
             return static_cast<int>(kExitSuccess);
           }};
 }

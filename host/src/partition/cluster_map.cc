@@ -6,6 +6,7 @@
 #include <optional>
 #include <set>
 
+#include "partition/cluster_calibration.h"
 #include "partition/partition_stage.h"
 #include "pipeline/load_mapper_input.h"
 #include "pipeline/map_stage.h"
@@ -117,10 +118,12 @@ MapStageSummary MapCluster(const PipelineContext& context, const RunOptions& opt
   CheckImagesUnchanged(
       *workspace, options.image_dir,
       workspace->ScanOptions(context.manifest.camera.mask_path, context.manifest.max_image_pixels));
-  const MapperInput input =
+  MapperInput input =
       RestrictMapperInput(LoadMapperInput(database), clusters.clusters[cluster].images);
-  spdlog::info("map: cluster {}: {} images, {} verified pairs, into {}", cluster,
-               input.images.size(), input.pairs.size(), folder.string());
+  ApplyCalibration(clusters.cameras, &input);
+  spdlog::info("map: cluster {}: {} images, {} verified pairs, into {}{}", cluster,
+               input.images.size(), input.pairs.size(), folder.string(),
+               clusters.cameras.empty() ? "" : "; focal lengths from clusters.json");
   MapSettings settings = context.MakeMapSettings(options.image_dir);
   settings.exporters = nullptr;  // COLMAP binary: the exporters run on the merged models
   MapTarget target;

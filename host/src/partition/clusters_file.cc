@@ -1,6 +1,7 @@
 #include "partition/clusters_file.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "distributed/shard_database.h"
 #include "tessera/errors.h"
@@ -51,16 +52,27 @@ nlohmann::json ClustersFile::ToJson() const {
     if (cluster.single_loop) cluster_json["single_loop"] = true;
     clusters_json.push_back(std::move(cluster_json));
   }
-  return {{"version", kVersion},
-          {"pairs_fingerprint", pairs_fingerprint},
-          {"manifest_fingerprint", manifest_fingerprint},
-          {"cluster_max_images", cluster_max_images},
-          {"cluster_overlap", cluster_overlap},
-          {"cut_weight", cut_weight},
-          {"total_weight", total_weight},
-          {"isolated", isolated},
-          {"tree", TreeToJson(tree)},
-          {"clusters", clusters_json}};
+  nlohmann::json json = {{"version", kVersion},
+                         {"pairs_fingerprint", pairs_fingerprint},
+                         {"manifest_fingerprint", manifest_fingerprint},
+                         {"cluster_max_images", cluster_max_images},
+                         {"cluster_overlap", cluster_overlap},
+                         {"cut_weight", cut_weight},
+                         {"total_weight", total_weight},
+                         {"isolated", isolated},
+                         {"tree", TreeToJson(tree)},
+                         {"clusters", clusters_json}};
+  // Only when there is one: the files, and so the fingerprints, of other partitions stay
+  // as they were.
+  for (const FocalLengthReport& camera : cameras) {
+    json["cameras"].push_back({{"camera_id", camera.camera_id},
+                               {"focal_length", camera.estimated},
+                               {"initial_focal_length", camera.initial},
+                               {"method", camera.method},
+                               {"num_pairs", camera.num_pairs},
+                               {"num_images", camera.num_images}});
+  }
+  return json;
 }
 
 ClustersFile ClustersFile::FromJson(const nlohmann::json& json) {
@@ -73,6 +85,21 @@ ClustersFile ClustersFile::FromJson(const nlohmann::json& json) {
   file.total_weight = json.at("total_weight").get<double>();
   file.isolated = json.at("isolated").get<std::vector<std::string>>();
   file.tree = TreeFromJson(json.at("tree"));
+  for (const nlohmann::json& entry : json.value("cameras", nlohmann::json::array())) {
+    FocalLengthReport camera;
+    camera.camera_id = entry.at("camera_id").get<camera_t>();
+    camera.estimated = entry.at("focal_length").get<double>();
+    camera.initial = entry.at("initial_focal_length").get<double>();
+    camera.method = entry.at("method").get<std::string>();
+    camera.num_pairs = entry.at("num_pairs").get<size_t>();
+    camera.num_images = entry.at("num_images").get<size_t>();
+    if (!(camera.estimated > 0) || !std::isfinite(camera.estimated)) {
+      throw nlohmann::json::other_error::create(
+          501, "camera " + std::to_string(camera.camera_id) + ": focal_length is not positive",
+          &entry);
+    }
+    file.cameras.push_back(std::move(camera));
+  }
   for (const nlohmann::json& entry : json.at("clusters")) {
     Cluster cluster;
     cluster.index = entry.at("index").get<int>();

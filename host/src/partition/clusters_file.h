@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "partition/view_graph_partitioner.h"
+#include "tessera/mapper.h"
 
 namespace tessera {
 
@@ -39,6 +40,10 @@ struct ClustersFile {
   std::vector<std::string> isolated;  // images with no verified pair
   double cut_weight = 0;              // inliers of the pairs between different cores
   double total_weight = 0;
+  // The focal length of each camera without a prior, found once on the whole view graph
+  // (cluster_calibration.h), that every cluster maps with; written only when there is
+  // one, so a file without it reads as none.
+  std::vector<FocalLengthReport> cameras;
 
   nlohmann::json ToJson() const;
   // Throws nlohmann::json::exception for a missing or mistyped field.

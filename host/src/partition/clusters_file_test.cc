@@ -67,5 +67,29 @@ TEST(ClustersFile, AMistypedFlagIsRefused) {
   EXPECT_THROW(ClustersFile::FromJson(json), nlohmann::json::exception);
 }
 
+TEST(ClustersFile, RoundTripsTheCalibrationOfEveryCluster) {
+  ClustersFile written = TwoClusters();
+  EXPECT_FALSE(written.ToJson().contains("cameras"));  // none: as before
+  FocalLengthReport camera;
+  camera.camera_id = 3;
+  camera.initial = 2304;
+  camera.estimated = 1379.5;
+  camera.method = "first model";
+  camera.num_images = 16;
+  written.cameras.push_back(camera);
+  const ClustersFile read = ClustersFile::FromJson(written.ToJson());
+  ASSERT_EQ(read.cameras.size(), 1u);
+  EXPECT_EQ(read.cameras[0].camera_id, 3u);
+  EXPECT_EQ(read.cameras[0].estimated, 1379.5);
+  EXPECT_EQ(read.cameras[0].initial, 2304);
+  EXPECT_EQ(read.cameras[0].method, "first model");
+  EXPECT_EQ(read.cameras[0].num_images, 16u);
+  EXPECT_NE(read.Fingerprint(), TwoClusters().Fingerprint());
+
+  nlohmann::json bad = written.ToJson();
+  bad["cameras"][0]["focal_length"] = -1.0;
+  EXPECT_THROW(ClustersFile::FromJson(bad), nlohmann::json::exception);
+}
+
 }  // namespace
 }  // namespace tessera

@@ -32,7 +32,7 @@ ClustersFile CurrentClusters(const PipelineContext& context, const RunOptions& o
   } catch (const InputError& error) {
     spdlog::info("map: partitioning again ({})", error.what());
   }
-  return PartitionWorkspace(*workspace, context.manifest);
+  return PartitionWorkspace(*workspace, context);
 }
 
 }  // namespace

@@ -119,6 +119,7 @@ MapStageSummary MergeClusterMaps(const PipelineContext& context, const RunOption
       MergeClusterModels(clusters.tree, by_cluster, adjuster, merge_options);
 
   MapperResult result;
+  result.focal_lengths = clusters.cameras;  // found by the partition, for every cluster
   const MapperInput input = LoadMapperInput(database);
   result.unregistered_reasons = Unregistered(input.images, clusters, merged, by_cluster);
   nlohmann::json records = nlohmann::json::array();

@@ -9,8 +9,10 @@
 #include <utility>
 
 #include "distributed/shard_database.h"
+#include "partition/cluster_calibration.h"
 #include "partition/rotation_consistent_pairs.h"
 #include "pipeline/load_mapper_input.h"
+#include "plugin/bundle_adjuster_guard.h"
 #include "tessera/errors.h"
 #include "util/random.h"
 #include "util/timer.h"
@@ -18,8 +20,10 @@
 namespace tessera {
 namespace {
 
-// Seed stream of the partition's random choices (the five-point RANSAC of pairs without E).
+// Seed streams of the partition's random choices: the five-point RANSAC of pairs without
+// E, and the first model that calibrates a camera the view graph leaves open.
 constexpr uint64_t kRotationConsistencyStream = 1;
+constexpr uint64_t kCalibrationStream = 2;
 
 std::vector<std::string> Names(const std::vector<size_t>& nodes,
                                const std::vector<std::string>& names) {
@@ -53,10 +57,10 @@ ClustersFile ToClustersFile(const ViewGraphPartition& partition, const ViewGraph
   return file;
 }
 
-// The edges of `graph` whose pairs' rotations agree with the rest (rotation_consistent_pairs.h).
-std::vector<WeightedEdge> EdgesThatWeighInTheCut(const Database& database, const Manifest& manifest,
+// The edges of `graph` whose pairs' rotations agree with the rest
+// (rotation_consistent_pairs.h), the relative rotations taken with `input`'s cameras.
+std::vector<WeightedEdge> EdgesThatWeighInTheCut(const MapperInput& input, const Manifest& manifest,
                                                  const ViewGraph& graph) {
-  const MapperInput input = LoadMapperInput(database);
   const RotationConsistentPairs consistent =
       FindRotationConsistentPairs(input, DeriveSeed(manifest.seed, kRotationConsistencyStream));
   std::set<std::pair<std::string, std::string>> kept;
@@ -76,6 +80,28 @@ std::vector<WeightedEdge> EdgesThatWeighInTheCut(const Database& database, const
       edges.size(), graph.edges.size(), consistent.num_weak, consistent.num_inconsistent,
       consistent.num_without_rotation, consistent.num_restored);
   return edges;
+}
+
+// The focal lengths of the cameras without a prior, found once for every cluster
+// (cluster_calibration.h), logged; `input` takes them.
+std::vector<FocalLengthReport> CalibrateForClusters(const PipelineContext& context,
+                                                    const Workspace& workspace,
+                                                    MapperInput* input) {
+  const BundleAdjusterGuard adjuster(context.bundle_adjuster, &workspace.crash_log());
+  std::vector<FocalLengthReport> calibration = CalibrateCamerasWithoutPrior(
+      *input, adjuster, DeriveSeed(context.manifest.seed, kCalibrationStream));
+  for (const FocalLengthReport& camera : calibration) {
+    spdlog::info(
+        "partition: camera {}: focal length {:.1f} px (it had no prior; default {:.1f} px) from "
+        "{}, for every cluster",
+        camera.camera_id, camera.estimated, camera.initial,
+        camera.method == "view graph"
+            ? "the view graph's " + std::to_string(camera.num_pairs) + " pairs"
+            : "a first model of " + std::to_string(camera.num_images) +
+                  " images (the pairs do not determine it)");
+  }
+  ApplyCalibration(calibration, input);
+  return calibration;
 }
 
 }  // namespace
@@ -113,8 +139,10 @@ ViewGraph LoadViewGraph(const Database& database) {
   return graph;
 }
 
-ClustersFile PartitionWorkspace(const Workspace& workspace, const Manifest& manifest) {
+ClustersFile PartitionWorkspace(const Workspace& workspace, const PipelineContext& context) {
   const Timer timer;
+  context.Require("bundle_adjuster", "partition");
+  const Manifest& manifest = context.manifest;
   const Database& database = workspace.database();
   const ViewGraph graph = LoadViewGraph(database);
   if (graph.edges.empty()) {
@@ -124,9 +152,12 @@ ClustersFile PartitionWorkspace(const Workspace& workspace, const Manifest& mani
   PartitionOptions options;
   options.max_nodes = static_cast<size_t>(manifest.distributed.cluster_max_images);
   options.overlap = static_cast<size_t>(manifest.distributed.cluster_overlap);
+  MapperInput input = LoadMapperInput(database);
+  std::vector<FocalLengthReport> calibration = CalibrateForClusters(context, workspace, &input);
   const ViewGraphPartition partition = PartitionViewGraph(
-      graph.names.size(), EdgesThatWeighInTheCut(database, manifest, graph), options);
+      graph.names.size(), EdgesThatWeighInTheCut(input, manifest, graph), options);
   ClustersFile file = ToClustersFile(partition, graph);
+  file.cameras = std::move(calibration);
   file.manifest_fingerprint = ManifestFingerprint(manifest);
   file.cluster_max_images = manifest.distributed.cluster_max_images;
   file.cluster_overlap = manifest.distributed.cluster_overlap;

@@ -12,6 +12,7 @@
 #include "manifest/manifest.h"
 #include "partition/clusters_file.h"
 #include "partition/view_graph_partitioner.h"
+#include "pipeline/pipeline_context.h"
 #include "pipeline/workspace.h"
 
 namespace tessera {
@@ -28,10 +29,11 @@ struct ViewGraph {
 
 ViewGraph LoadViewGraph(const Database& database);
 
-// Cuts the workspace's view graph by the manifest's `distributed` settings, writes
-// OUTPUT/clusters.json atomically and logs the cut. Throws InputError naming the
-// database when it has no verified pair.
-ClustersFile PartitionWorkspace(const Workspace& workspace, const Manifest& manifest);
+// Calibrates the cameras without a focal prior once for every cluster
+// (cluster_calibration.h, with the context's bundle adjuster), cuts the workspace's view
+// graph by the manifest's `distributed` settings, writes OUTPUT/clusters.json atomically
+// and logs the cut. Throws InputError naming the database when it has no verified pair.
+ClustersFile PartitionWorkspace(const Workspace& workspace, const PipelineContext& context);
 
 // OUTPUT/clusters.json, refused (InputError naming it and what differs) when it was made
 // from other pairs than `database`'s or with another manifest.

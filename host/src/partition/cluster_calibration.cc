@@ -1,0 +1,93 @@
+#include "partition/cluster_calibration.h"
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+#include "tessera/sfm/first_model_calibration.h"
+#include "tessera/sfm/global_mapper_options.h"
+#include "tessera/sfm/incremental_mapper_options.h"
+#include "tessera/two_view_geometry.h"
+
+namespace tessera {
+namespace {
+
+// A view-graph focal length whose mean robust cost per pair is above this has no clear
+// minimum (FocalLengthEstimate::cost), as the mappers judge.
+constexpr double kClearFocalMinimumCost = 0.05;
+
+// The pairs the global mapper maps: verified, with enough inliers.
+std::vector<const MapperInput::Pair*> CalibrationPairs(const MapperInput& input) {
+  const GlobalMapperOptions options;
+  std::vector<const MapperInput::Pair*> pairs;
+  for (const MapperInput::Pair& pair : input.pairs) {
+    const int config = pair.geometry.config;
+    const bool verified =
+        config == TwoViewGeometry::CALIBRATED || config == TwoViewGeometry::UNCALIBRATED ||
+        config == TwoViewGeometry::PLANAR || config == TwoViewGeometry::PANORAMIC ||
+        config == TwoViewGeometry::PLANAR_OR_PANORAMIC;
+    if (verified &&
+        static_cast<int>(pair.geometry.inlier_matches.size()) >= options.min_num_matches &&
+        input.images.count(pair.image_id1) > 0 && input.images.count(pair.image_id2) > 0) {
+      pairs.push_back(&pair);
+    }
+  }
+  return pairs;
+}
+
+}  // namespace
+
+std::vector<FocalLengthReport> CalibrateCamerasWithoutPrior(
+    const MapperInput& input, const BundleAdjuster& adjuster, uint64_t seed,
+    const FocalLengthEstimationOptions& view_graph) {
+  std::set<camera_t> without_prior;
+  for (const auto& [camera_id, camera] : input.cameras) {
+    if (!camera.has_prior_focal_length) without_prior.insert(camera_id);
+  }
+  const std::vector<const MapperInput::Pair*> pairs = CalibrationPairs(input);
+  if (without_prior.empty() || pairs.empty()) return {};
+  std::vector<FocalLengthReport> reports;
+  std::set<camera_t> undetermined = without_prior;
+  for (const auto& [camera_id, estimate] : EstimateFocalLengths(input, pairs, view_graph)) {
+    if (without_prior.count(camera_id) == 0 || estimate.at_search_bound ||
+        estimate.cost > kClearFocalMinimumCost || estimate.num_pairs == 0) {
+      continue;
+    }
+    FocalLengthReport report;
+    report.camera_id = camera_id;
+    report.initial = input.cameras.at(camera_id).MeanFocalLength();
+    report.estimated = estimate.focal_length;
+    report.method = "view graph";
+    report.num_pairs = estimate.num_pairs;
+    reports.push_back(report);
+    undetermined.erase(camera_id);
+  }
+  if (!undetermined.empty()) {
+    MapperRunState run(input, adjuster, seed);
+    for (const auto& [camera_id, first_model] :
+         FocalLengthsFromFirstModels(IncrementalMapperOptions(), run, undetermined, pairs)) {
+      if (first_model.focal_length == 0) continue;  // implausible
+      FocalLengthReport report;
+      report.camera_id = camera_id;
+      report.initial = input.cameras.at(camera_id).MeanFocalLength();
+      report.estimated = first_model.focal_length;
+      report.method = "first model";
+      report.num_images = first_model.num_images;
+      reports.push_back(report);
+    }
+  }
+  std::sort(reports.begin(), reports.end(),
+            [](const auto& a, const auto& b) { return a.camera_id < b.camera_id; });
+  return reports;
+}
+
+void ApplyCalibration(const std::vector<FocalLengthReport>& calibration, MapperInput* input) {
+  for (const FocalLengthReport& report : calibration) {
+    const auto camera = input->cameras.find(report.camera_id);
+    if (camera == input->cameras.end()) continue;
+    camera->second.SetFocalLength(report.estimated);
+    camera->second.has_prior_focal_length = true;
+  }
+}
+
+}  // namespace tessera
