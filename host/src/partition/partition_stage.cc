@@ -183,6 +183,13 @@ ClustersFile PartitionWorkspace(const Workspace& workspace, const PipelineContex
               : std::string());
     }
   }
+  for (const ViewGraphPartition::NarrowCut& cut : partition.narrow_cuts) {
+    spdlog::warn(
+        "partition: clusters {} and {} meet along a narrow cut: only {} images of one see "
+        "the other, so the images they share would all lie in one place; they share {} "
+        "(up to twice distributed.cluster_overlap)",
+        cut.cluster1, cut.cluster2, cut.front, cut.shared);
+  }
   if (!file.isolated.empty()) {
     spdlog::warn("partition: {} images have no verified pair and are in no cluster",
                  file.isolated.size());

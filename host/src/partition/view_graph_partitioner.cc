@@ -446,16 +446,16 @@ class Partitioner {
     for (const ClusterTreeNode& child : tree.children) Bridges(child, weights, bridges);
   }
 
-  // Cluster `to` takes up to the overlap of `from`'s core, one node at a time: the one
+  // Cluster `to` takes up to `overlap` of `from`'s core, one node at a time: the one
   // with the strongest edges into what it holds so far, so that the overlap grows from
   // the cut into the neighbour as long as it has room.
-  void TakeOverlap(int to, int from) {
+  void TakeOverlap(int to, int from, size_t overlap) {
     ViewGraphPartition::Cluster& cluster = result_.clusters[to];
     const auto holds = [&](size_t node) {
       return std::binary_search(cluster.nodes.begin(), cluster.nodes.end(), node);
     };
     const size_t room = options_.max_nodes - std::min(options_.max_nodes, cluster.nodes.size());
-    for (size_t taken = 0; taken < std::min(room, options_.overlap); ++taken) {
+    for (size_t taken = 0; taken < std::min(room, overlap); ++taken) {
       double best_weight = 0;
       size_t best = 0;
       for (const size_t node : result_.clusters[from].core) {
@@ -485,9 +485,26 @@ class Partitioner {
     std::sort(rest.begin(), rest.end());
     for (const auto& [weight, pair] : rest) order.push_back(pair);
     for (const auto& [a, b] : order) {
-      TakeOverlap(a, b);
-      TakeOverlap(b, a);
+      const size_t front = std::min(Front(a, b), Front(b, a));
+      const bool narrow = front < std::max<size_t>(3, options_.overlap / 4);
+      const size_t overlap = narrow ? 2 * options_.overlap : options_.overlap;
+      TakeOverlap(a, b, overlap);
+      TakeOverlap(b, a, overlap);
+      if (narrow) {
+        result_.narrow_cuts.push_back(
+            {a, b, front, SharedNodes(result_.clusters[a], result_.clusters[b]).size()});
+      }
     }
+  }
+
+  // The nodes of cluster `of`'s core with an edge to cluster `to`'s core.
+  size_t Front(int of, int to) const {
+    size_t front = 0;
+    for (const size_t node : result_.clusters[of].core) {
+      front += std::any_of(adjacency_[node].begin(), adjacency_[node].end(),
+                           [&](const auto& edge) { return owner_[edge.first] == to; });
+    }
+    return front;
   }
 
   PartitionOptions options_;

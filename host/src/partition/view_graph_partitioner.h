@@ -44,6 +44,15 @@ struct ViewGraphPartition {
   };
   std::vector<Cluster> clusters;  // in the tree's order, left to right
   ClusterTreeNode tree;
+  // A pair of neighbouring clusters whose cut few nodes see across: fewer than 3, or than
+  // a quarter of the overlap, on one side (a narrow passage, whose shared images would
+  // all lie in one place). They share up to twice the overlap, as their room allows.
+  struct NarrowCut {
+    int cluster1 = 0, cluster2 = 0;
+    size_t front = 0;   // nodes of the narrower side's core with an edge across
+    size_t shared = 0;  // nodes the two clusters share
+  };
+  std::vector<NarrowCut> narrow_cuts;
   std::vector<size_t> isolated;  // nodes with no edge, in no cluster
   double cut_weight = 0;         // summed weight of the edges between different cores
   double total_weight = 0;

@@ -75,6 +75,33 @@ TEST(ViewGraphPartitioner, CutsFourBlobsAlongTheWeakEdges) {
   }
 }
 
+// Two blobs of 50 joined by edges from `front` nodes of each: a narrow passage when
+// only 2 nodes see across (fewer than 3), a wide one with 10.
+ViewGraphPartition TwoBlobsJoinedBy(size_t front) {
+  std::vector<WeightedEdge> edges = Blobs(2, 50, 4);
+  edges.erase(
+      std::remove_if(edges.begin(), edges.end(),
+                     [](const WeightedEdge& e) { return (e.node1 < 50) != (e.node2 < 50); }),
+      edges.end());
+  for (size_t k = 0; k < front; ++k) edges.push_back({k, 50 + k, 150});
+  return PartitionViewGraph(100, edges, {80, 10});
+}
+
+TEST(ViewGraphPartitioner, ANarrowCutSharesTwiceTheOverlapAndSaysSo) {
+  const ViewGraphPartition narrow = TwoBlobsJoinedBy(2);
+  ASSERT_EQ(narrow.clusters.size(), 2u);
+  ASSERT_EQ(narrow.narrow_cuts.size(), 1u);
+  EXPECT_EQ(narrow.narrow_cuts[0].front, 2u);
+  EXPECT_EQ(narrow.narrow_cuts[0].shared, 40u);  // 20 each way: twice the overlap
+  EXPECT_EQ(SharedNodes(narrow.clusters[0], narrow.clusters[1]).size(), 40u);
+  for (const auto& cluster : narrow.clusters) EXPECT_LE(cluster.nodes.size(), 80u);
+
+  const ViewGraphPartition wide = TwoBlobsJoinedBy(10);
+  ASSERT_EQ(wide.clusters.size(), 2u);
+  EXPECT_TRUE(wide.narrow_cuts.empty());
+  EXPECT_EQ(SharedNodes(wide.clusters[0], wide.clusters[1]).size(), 20u);
+}
+
 TEST(ViewGraphPartitioner, IsDeterministicWhateverTheEdgeOrder) {
   std::vector<WeightedEdge> edges = Blobs(6, 40, 2);
   const ViewGraphPartition first = PartitionViewGraph(240, edges, {90, 20});
