@@ -183,8 +183,18 @@ ClustersFile PartitionWorkspace(const Workspace& workspace, const PipelineContex
               : std::string());
     }
   }
+  for (const ViewGraphPartition::LoopCheck& check : partition.loop_checks) {
+    const SingleLoopEvidence& loop = check.evidence;
+    spdlog::info(
+        "partition: a component of {} images is {}: lambda3/lambda2 {:.2f} (a loop: at most "
+        "2), radii {:.2f} to {:.2f} of the median (0.5 to 2), widest empty turn {:.0f} deg (45), "
+        "{:.1f}% of the weight across a quarter turn (5%)",
+        check.num_nodes, loop.single_loop ? "a single loop" : "no single loop",
+        loop.eigenvalue_ratio, loop.smallest_radius, loop.largest_radius, loop.widest_gap_degrees,
+        100 * loop.crossing_weight);
+  }
   for (const ViewGraphPartition::NarrowCut& cut : partition.narrow_cuts) {
-    spdlog::warn(
+    spdlog::info(
         "partition: clusters {} and {} meet along a narrow cut: only {} images of one see "
         "the other, so the images they share would all lie in one place; they share {} "
         "(up to twice distributed.cluster_overlap)",

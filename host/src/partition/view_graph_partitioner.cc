@@ -395,7 +395,11 @@ class Partitioner {
     if (nodes.size() <= max_core_) return Leaf(nodes, false);
     const LocalGraph graph = InducedGraph(nodes, adjacency_);
     const LowSpectrum spectrum = SpectrumOf(graph);
-    if (whole_component && LoopEvidence(graph, spectrum).single_loop) return Leaf(nodes, true);
+    if (whole_component) {
+      const SingleLoopEvidence evidence = LoopEvidence(graph, spectrum);
+      result_.loop_checks.push_back({nodes.size(), evidence});
+      if (evidence.single_loop) return Leaf(nodes, true);
+    }
     const auto [first, second] = Bisect(nodes, spectrum.second, adjacency_);
     ClusterTreeNode tree;
     tree.children.push_back(Split(first, false));

@@ -34,6 +34,17 @@ struct ClusterTreeNode {
   std::vector<ClusterTreeNode> children;
 };
 
+// What the single-loop check sees in a graph: the nodes placed in the plane by the
+// 2nd and 3rd eigenvectors of the normalized Laplacian.
+struct SingleLoopEvidence {
+  double eigenvalue_ratio = 0;    // lambda3 / lambda2: 1 for a loop, about 4 for a path
+  double smallest_radius = 0;     // least distance from the origin, over the median: 0 on a patch
+  double largest_radius = 0;      // greatest distance from the origin, over the median
+  double widest_gap_degrees = 0;  // widest turn round the origin without a node: 90 on a path
+  double crossing_weight = 0;     // share of the weight on edges across more than a quarter turn
+  bool single_loop = false;       // every figure within a loop's bounds
+};
+
 struct ViewGraphPartition {
   struct Cluster {
     std::vector<size_t> core;   // its own nodes, ascending; the cores are disjoint
@@ -53,6 +64,13 @@ struct ViewGraphPartition {
     size_t shared = 0;  // nodes the two clusters share
   };
   std::vector<NarrowCut> narrow_cuts;
+  // The single-loop check of each connected component the cut would split, in the
+  // tree's order: what it measured, and so why it was cut or kept whole.
+  struct LoopCheck {
+    size_t num_nodes = 0;
+    SingleLoopEvidence evidence;
+  };
+  std::vector<LoopCheck> loop_checks;
   std::vector<size_t> isolated;  // nodes with no edge, in no cluster
   double cut_weight = 0;         // summed weight of the edges between different cores
   double total_weight = 0;
@@ -63,17 +81,6 @@ struct ViewGraphPartition {
 // an edge names a node out of range.
 ViewGraphPartition PartitionViewGraph(size_t num_nodes, const std::vector<WeightedEdge>& edges,
                                       const PartitionOptions& options);
-
-// What the single-loop check sees in a graph: the nodes placed in the plane by the
-// 2nd and 3rd eigenvectors of the normalized Laplacian.
-struct SingleLoopEvidence {
-  double eigenvalue_ratio = 0;    // lambda3 / lambda2: 1 for a loop, about 4 for a path
-  double smallest_radius = 0;     // least distance from the origin, over the median: 0 on a patch
-  double largest_radius = 0;      // greatest distance from the origin, over the median
-  double widest_gap_degrees = 0;  // widest turn round the origin without a node: 90 on a path
-  double crossing_weight = 0;     // share of the weight on edges across more than a quarter turn
-  bool single_loop = false;       // every figure within a loop's bounds
-};
 
 // The single-loop check that PartitionViewGraph makes of each connected component it
 // would cut, made of nodes 0..num_nodes-1 joined by `edges` (a graph in pieces is not a

@@ -222,6 +222,11 @@ TEST(ViewGraphPartitioner, KeepsASingleLoopWholeAboveTheClusterSize) {
   const ViewGraphPartition partition = PartitionViewGraph(120, edges, {40, 10});
   ASSERT_EQ(partition.clusters.size(), 1u);
   EXPECT_TRUE(partition.clusters[0].single_loop);
+  // What the check measured, for the log.
+  ASSERT_EQ(partition.loop_checks.size(), 1u);
+  EXPECT_EQ(partition.loop_checks[0].num_nodes, 120u);
+  EXPECT_TRUE(partition.loop_checks[0].evidence.single_loop);
+  EXPECT_LE(partition.loop_checks[0].evidence.eigenvalue_ratio, 2.0);
   std::vector<size_t> all(120);
   for (size_t i = 0; i < all.size(); ++i) all[i] = i;
   EXPECT_EQ(partition.clusters[0].core, all);
@@ -301,7 +306,10 @@ TEST(ViewGraphPartitioner, AGridIsCutAndNoLoop) {
     }
   }
   EXPECT_FALSE(Measured("12x12 grid", 144, edges).single_loop);
-  ExpectCutAndNoneALoop(PartitionViewGraph(144, edges, {40, 10}), 144, 40);
+  const ViewGraphPartition partition = PartitionViewGraph(144, edges, {40, 10});
+  ExpectCutAndNoneALoop(partition, 144, 40);
+  ASSERT_EQ(partition.loop_checks.size(), 1u);  // the whole component, not its parts
+  EXPECT_FALSE(partition.loop_checks[0].evidence.single_loop);
 }
 
 TEST(ViewGraphPartitioner, AStripIsCutAndNoLoop) {
