@@ -9,7 +9,8 @@
 #     PLY and transforms.json say which frame they are in;
 #  2. GPS that contradicts the images (each image tagged with another's position): the
 #     model keeps its own frame, no georeference.json, a warning that says why;
-#  3. a GPS sigma of 0: exit 2 naming the option;
+#  1b. the global mapper, on the same matches, anchors its model the same way;
+#  3. a GPS sigma of 0: exit 2 naming the option (both mappers);
 #  and `eval --no-align` scores the anchored model in its own frame (the ground truth's
 #  given by --gt-origin), and refuses a model without georeference.json or ground truth
 #  without a frame.
@@ -41,13 +42,17 @@ m["pipeline"]["exporters"] = [{"plugin": "colmap_text"}, {"plugin": "ply"},
 json.dump(m, open(sys.argv[2] + "/gps.json", "w"))
 m["pipeline"]["mapper"]["options"]["gps_horizontal_sigma"] = 0
 json.dump(m, open(sys.argv[2] + "/zero.json", "w"))
+m["pipeline"]["mapper"]["plugin"] = "global"
+json.dump(m, open(sys.argv[2] + "/zero_global.json", "w"))
+m["pipeline"]["mapper"]["options"]["gps_horizontal_sigma"] = 0.25
+json.dump(m, open(sys.argv[2] + "/gps_global.json", "w"))
 PY
 
 # 1. Anchored.
 "$tessera" run --images "$work/images" --output "$work/out" --manifest "$work/gps.json" \
   --threads 2 2> "$work/run.log" || { tail -20 "$work/run.log"; fail "tessera run"; }
 grep "anchored to the GPS" "$work/run.log" || { tail -20 "$work/run.log"; fail "not anchored"; }
-python3 - "$work/out" "$work/geotag.txt" "$dataset/gt" <<'PY' || fail "the model is not where its GPS says"
+cat > "$work/check_anchored.py" <<'PY'
 import json, math, os, sys
 out, tags = sys.argv[1], sys.argv[2]
 geo = json.load(open(os.path.join(out, "sparse/0/georeference.json")))
@@ -114,7 +119,17 @@ frames = json.load(open(os.path.join(out, "transforms.json")))
 assert frames["georeference"]["frame"] == "ENU", frames.get("georeference")
 assert b"comment frame: ENU metres" in open(os.path.join(out, "sparse/0/points3D.ply"), "rb").read(600)
 PY
+python3 "$work/check_anchored.py" "$work/out" "$work/geotag.txt" "$dataset/gt" ||
+  fail "the model is not where its GPS says"
 echo "anchored: georeference.json, centres within the GPS noise, PLY and transforms.json in ENU"
+# 1b. The global mapper anchors its models the same way, on the same matches.
+mkdir -p "$work/global" && cp "$work/out/database.db" "$work/global/" || fail "copy the database"
+"$tessera" map --output "$work/global" --images "$work/images" --manifest "$work/gps_global.json" \
+  --threads 2 2> "$work/global.log" || { tail -20 "$work/global.log"; fail "global map with GPS"; }
+grep "anchored to the GPS" "$work/global.log" || { tail -20 "$work/global.log"; fail "global: not anchored"; }
+python3 "$work/check_anchored.py" "$work/global" "$work/geotag.txt" "$dataset/gt" ||
+  fail "global: the model is not where its GPS says"
+echo "global mapper: anchored as well"
 # eval --no-align: the ground truth's frame is ENU about the geotag origin.
 "$tessera" eval "$work/out/sparse/0" "$dataset/gt" --no-align --gt-origin 46.52,6.57,400 --json \
   > "$work/noalign.json" || fail "eval --no-align"
@@ -159,4 +174,9 @@ code=0
 "$tessera" map --output "$work/out" --manifest "$work/zero.json" 2> "$work/zero.log" || code=$?
 [ "$code" = 2 ] && grep -q "pipeline.mapper.options.gps_horizontal_sigma" "$work/zero.log" ||
   { cat "$work/zero.log"; fail "sigma 0: exit $code"; }
+code=0
+"$tessera" map --output "$work/global" --manifest "$work/zero_global.json" 2> "$work/zero_global.log" ||
+  code=$?
+[ "$code" = 2 ] && grep -q "pipeline.mapper.options.gps_horizontal_sigma" "$work/zero_global.log" ||
+  { cat "$work/zero_global.log"; fail "global, sigma 0: exit $code"; }
 echo "PASS"

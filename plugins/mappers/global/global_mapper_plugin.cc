@@ -5,10 +5,12 @@
 // Where the view graph does not determine a camera's focal length (images around an
 // object), a first model of a few images does, before rotation averaging: relative
 // rotations from a focal length far off are wrong.
-// Its options are GlobalMapperOptions (tessera/sfm/global_mapper_options.h) and the
-// self-check's two.
+// Its options are GlobalMapperOptions (tessera/sfm/global_mapper_options.h), the
+// self-check's two and GPS anchoring's four (use_gps_prior and its sigmas and least
+// number of images, as the incremental mapper names them).
 
 #include <algorithm>
+#include <cstdio>
 #include <optional>
 #include <set>
 #include <string>
@@ -18,6 +20,7 @@
 #include "tessera/sfm/first_model_calibration.h"
 #include "tessera/sfm/focal_length_estimation.h"
 #include "tessera/sfm/global_mapper.h"
+#include "tessera/sfm/gps_anchoring.h"
 #include "tessera/sfm/view_graph.h"
 
 namespace tessera {
@@ -45,12 +48,25 @@ class GlobalMapperPlugin : public Mapper {
         reader.Get<double>("reg_max_rotation_error", reg_max_rotation_error_, 0.1, 180.0);
     min_model_agreement_ =
         reader.Get<double>("min_model_agreement", min_model_agreement_, 0.0, 1.0);
-    mapper.erase("reg_max_rotation_error");
-    mapper.erase("min_model_agreement");
+    use_gps_prior_ = reader.GetBool("use_gps_prior", use_gps_prior_);
+    gps_.horizontal_sigma_m =
+        reader.Get<double>("gps_horizontal_sigma", gps_.horizontal_sigma_m, 1e-3, 1e6);
+    gps_.vertical_sigma_m =
+        reader.Get<double>("gps_vertical_sigma", gps_.vertical_sigma_m, 1e-3, 1e6);
+    gps_.min_num_images = reader.Get<int>("gps_min_images", gps_.min_num_images, 3, 1000000);
+    for (const char* own : {"reg_max_rotation_error", "min_model_agreement", "use_gps_prior",
+                            "gps_horizontal_sigma", "gps_vertical_sigma", "gps_min_images"}) {
+      mapper.erase(own);
+    }
     options_ = GlobalMapperOptions::FromJson(mapper);
+    gps_.ba_max_num_iterations = options_.final_ba_max_num_iterations;
     effective_options_ = options_.ToJson();
     effective_options_["reg_max_rotation_error"] = reg_max_rotation_error_;
     effective_options_["min_model_agreement"] = min_model_agreement_;
+    effective_options_["use_gps_prior"] = use_gps_prior_;
+    effective_options_["gps_horizontal_sigma"] = gps_.horizontal_sigma_m;
+    effective_options_["gps_vertical_sigma"] = gps_.vertical_sigma_m;
+    effective_options_["gps_min_images"] = gps_.min_num_images;
   }
 
   MapperResult Map(const MapperInput& input, const MapperContext& context) const override {
@@ -106,6 +122,7 @@ class GlobalMapperPlugin : public Mapper {
     result.num_global_ba = mapped.num_bundle_adjustments;
     result.seconds = mapped.seconds;
     result.self_checks = SelfChecks(input, context.seed, result.models);
+    if (use_gps_prior_) AnchorToGps(input, context, &result);
     result.details = {
         {"num_verified_pairs", mapped.num_verified_pairs},
         {"num_weak_pairs_set_aside", mapped.num_weak_pairs_set_aside},
@@ -228,9 +245,40 @@ class GlobalMapperPlugin : public Mapper {
     return checks;
   }
 
+  // Each model anchored to its images' GPS in a local east-north-up frame, as the
+  // incremental mapper does with use_gps_prior (tessera/sfm/gps_anchoring.h); a model
+  // that cannot be keeps its own frame, with a warning that says why.
+  void AnchorToGps(const MapperInput& input, const MapperContext& context,
+                   MapperResult* result) const {
+    result->georeferences.clear();
+    for (size_t index = 0; index < result->models.size(); ++index) {
+      const GpsAnchoringReport report =
+          AnchorModelToGps(input.metadata, *context.bundle_adjuster, gps_,
+                           context.seed + 0x69700 + index, &result->models[index]);
+      if (report.anchored) {
+        char line[400];
+        std::snprintf(line, sizeof(line),
+                      "model %zu: anchored to the GPS of %zu of its %zu geotagged images, in an "
+                      "east-north-up frame in metres from %.7f, %.7f, %.1f m; camera centres are "
+                      "a mean %.2f m (median %.2f m) from their GPS positions",
+                      index, report.num_agreeing, report.num_geotagged, report.origin.latitude_deg,
+                      report.origin.longitude_deg, report.origin.altitude_m, report.mean_error_m,
+                      report.median_error_m);
+        log().Info(line);
+        result->georeferences.push_back(report.origin);
+      } else {
+        log().Warn("model " + std::to_string(index) + " is not georeferenced (use_gps_prior): " +
+                   report.reason + "; it keeps its own frame and scale");
+        result->georeferences.push_back(std::nullopt);
+      }
+    }
+  }
+
   GlobalMapperOptions options_;
   double reg_max_rotation_error_ = 10.0;
   double min_model_agreement_ = 0.75;
+  bool use_gps_prior_ = false;
+  GpsAnchoringOptions gps_;
 };
 
 }  // namespace tessera
