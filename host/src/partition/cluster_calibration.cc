@@ -47,19 +47,21 @@ std::vector<FocalLengthReport> CalibrateCamerasWithoutPrior(
   const std::vector<const MapperInput::Pair*> pairs = CalibrationPairs(input);
   if (without_prior.empty() || pairs.empty()) return {};
   std::vector<FocalLengthReport> reports;
+  const auto report = [&](camera_t camera_id, double focal_length, const char* method) {
+    FocalLengthReport& added = reports.emplace_back();
+    added.camera_id = camera_id;
+    added.initial = input.cameras.at(camera_id).MeanFocalLength();
+    added.estimated = focal_length;
+    added.method = method;
+    return &added;
+  };
   std::set<camera_t> undetermined = without_prior;
   for (const auto& [camera_id, estimate] : EstimateFocalLengths(input, pairs, view_graph)) {
     if (without_prior.count(camera_id) == 0 || estimate.at_search_bound ||
         estimate.cost > kClearFocalMinimumCost || estimate.num_pairs == 0) {
       continue;
     }
-    FocalLengthReport report;
-    report.camera_id = camera_id;
-    report.initial = input.cameras.at(camera_id).MeanFocalLength();
-    report.estimated = estimate.focal_length;
-    report.method = "view graph";
-    report.num_pairs = estimate.num_pairs;
-    reports.push_back(report);
+    report(camera_id, estimate.focal_length, "view graph")->num_pairs = estimate.num_pairs;
     undetermined.erase(camera_id);
   }
   if (!undetermined.empty()) {
@@ -67,13 +69,8 @@ std::vector<FocalLengthReport> CalibrateCamerasWithoutPrior(
     for (const auto& [camera_id, first_model] :
          FocalLengthsFromFirstModels(IncrementalMapperOptions(), run, undetermined, pairs)) {
       if (first_model.focal_length == 0) continue;  // implausible
-      FocalLengthReport report;
-      report.camera_id = camera_id;
-      report.initial = input.cameras.at(camera_id).MeanFocalLength();
-      report.estimated = first_model.focal_length;
-      report.method = "first model";
-      report.num_images = first_model.num_images;
-      reports.push_back(report);
+      report(camera_id, first_model.focal_length, "first model")->num_images =
+          first_model.num_images;
     }
   }
   std::sort(reports.begin(), reports.end(),
