@@ -124,6 +124,88 @@ std::vector<std::string> FilterObservations(double max_error, Reconstruction* mo
   return dropped;
 }
 
+// The seam of a merge in the united model: the images both models registered and,
+// `rings` times over, every image that sees a point one of those sees. Every observation
+// the union leaves unsettled lies in these: a source point joins a target point through
+// a shared image, so its other observers see a point a shared image sees, and a shared
+// image (at the target's pose) is the only one that sees both models' points. Farther
+// images see only their own model's points at their own model's poses.
+std::set<image_t> SeamImages(const Reconstruction& source, const Reconstruction& target,
+                             const Reconstruction& united, int rings) {
+  std::set<image_t> seam;
+  for (const auto& [image_id, image] : source.images) {
+    const auto it = target.images.find(image_id);
+    if (image.registered && it != target.images.end() && it->second.registered) {
+      seam.insert(image_id);
+    }
+  }
+  std::set<image_t> frontier = seam;
+  for (int ring = 0; ring < rings && !frontier.empty(); ++ring) {
+    std::set<image_t> next;
+    for (const image_t image_id : frontier) {
+      for (const Point2D& point2D : united.images.at(image_id).points2D) {
+        if (!point2D.HasPoint3D()) continue;
+        for (const TrackElement& element : united.points3D.at(point2D.point3D_id).track) {
+          const auto it = united.images.find(element.image_id);
+          if (it != united.images.end() && it->second.registered &&
+              seam.insert(element.image_id).second) {
+            next.insert(element.image_id);
+          }
+        }
+      }
+    }
+    frontier = std::move(next);
+  }
+  return seam;
+}
+
+// Adjusts the poses of `seam` and the points they see, as the mapper's local adjustment
+// does: on a sub-model of just those images, those points and the other registered images
+// that see them, held constant, so that the cost follows the seam and not the model. The
+// intrinsics stay: a camera is shared with images outside the problem, which its move
+// would leave misfit (the final adjustment refines them). Writes back only what moved.
+BundleAdjustmentSummary AdjustSeam(const BundleAdjuster& adjuster, const std::set<image_t>& seam,
+                                   BundleAdjustmentConfig config, Reconstruction* model) {
+  Reconstruction local;
+  for (const image_t image_id : seam) {
+    for (const Point2D& point2D : model->images.at(image_id).points2D) {
+      if (point2D.HasPoint3D() && local.points3D.count(point2D.point3D_id) == 0) {
+        local.points3D.emplace(point2D.point3D_id, model->points3D.at(point2D.point3D_id));
+      }
+    }
+  }
+  std::set<image_t> images = seam;
+  for (const auto& [point3D_id, point3D] : local.points3D) {
+    for (const TrackElement& element : point3D.track) {
+      const auto it = model->images.find(element.image_id);
+      if (it == model->images.end() || !it->second.registered) continue;
+      if (images.insert(element.image_id).second) config.constant_poses.insert(element.image_id);
+    }
+  }
+  for (const image_t image_id : images) {
+    const Image& image = model->images.at(image_id);
+    local.images.emplace(image_id, image);
+    local.cameras.emplace(image.camera_id, model->cameras.at(image.camera_id));
+  }
+  config.images = images;
+  config.refine_focal_length = false;
+  config.refine_principal_point = false;
+  config.refine_extra_params = false;
+  const BundleAdjustmentSummary summary = adjuster.Adjust(config, &local);
+  spdlog::debug("merge: seam adjustment of {} images ({} held): {}", seam.size(),
+                config.constant_poses.size(), summary.BriefReport());
+  if (!summary.usable) return summary;
+  for (const image_t image_id : seam) {
+    model->images.at(image_id).cam_from_world = local.images.at(image_id).cam_from_world;
+  }
+  for (const auto& [point3D_id, point3D] : local.points3D) {
+    Point3D& kept = model->points3D.at(point3D_id);
+    kept.xyz = point3D.xyz;
+    kept.error = point3D.error;
+  }
+  return summary;
+}
+
 class TreeMerger {
  public:
   TreeMerger(std::map<int, std::vector<Reconstruction>> models, const BundleAdjuster& adjuster,
@@ -198,7 +280,9 @@ class TreeMerger {
     BundleAdjustmentConfig seam;
     seam.max_num_iterations = options_.merge_max_num_iterations;
     seam.function_tolerance = options_.merge_function_tolerance;
-    const BundleAdjustmentSummary adjustment = adjuster_.Adjust(seam, &merged);
+    const BundleAdjustmentSummary adjustment = AdjustSeam(
+        adjuster_, SeamImages(source.model, target->model, merged, options_.merge_seam_rings), seam,
+        &merged);
     if (!adjustment.usable) {
       record.reason = "the bundle adjustment of the merged model failed: " + adjustment.message;
       return record;
@@ -259,6 +343,8 @@ ClusterMergeResult MergeClusterModels(const ClusterTreeNode& tree,
   for (ClusterModel& merged : result.models) {
     if (merged.clusters.size() < 2) continue;
     const BundleAdjustmentSummary adjustment = adjuster.Adjust({}, &merged.model);
+    spdlog::info("merge: final adjustment of clusters {}: {}", ClusterList(merged.clusters),
+                 adjustment.BriefReport());
     if (!adjustment.usable) {
       spdlog::warn("merge: the final adjustment of clusters {} failed ({}): kept as merged",
                    ClusterList(merged.clusters), adjustment.message);

@@ -3,10 +3,10 @@
 // Merging the models of the clusters bottom-up along the cluster tree: at each inner
 // node, the largest model of its children takes the others one by one, each moved by
 // the similarity its shared registered images give (center_alignment.h), its tracks
-// fused with the target's through the shared images, the result bundle adjusted and
-// observations over the reprojection limit dropped. A merge that would lose more than
-// max_merge_loss of the images is undone. Models that cannot be merged stay apart.
-// Every decision is recorded.
+// fused with the target's through the shared images, the seam between them bundle
+// adjusted and observations over the reprojection limit dropped. A merge that would
+// lose more than max_merge_loss of the images is undone. Models that cannot be merged
+// stay apart. Every decision is recorded.
 
 #include <cstdint>
 #include <map>
@@ -26,8 +26,11 @@ struct ClusterMergeOptions {
   double max_reprojection_error = 8;  // px, after the merge's bundle adjustment
   double max_merge_loss = 0.05;       // share of the images a merge may lose
   // Each merge's adjustment only has to settle the seam well enough to judge the merge
-  // (which observations misfit): a few iterations. Every model made of several clusters
-  // gets one full adjustment at the end.
+  // (which observations misfit): a few iterations, on the seam alone (the shared images
+  // and merge_seam_rings rings of the images that see their points, with the images
+  // around held), so that a merge costs the same however large the models. Every model
+  // made of several clusters gets one full adjustment at the end.
+  int merge_seam_rings = 1;
   int merge_max_num_iterations = 10;
   double merge_function_tolerance = 1e-3;
   uint64_t seed = 0;

@@ -123,6 +123,106 @@ TEST(ClusterMerge, ASceneCutIntoClustersMergesBackWithEveryImage) {
   EXPECT_LT(evaluation.position_error_max / evaluation.scene_extent, 0.01);
 }
 
+// The Ceres adjuster for the first `num_calls` calls, each recorded; later calls are
+// refused, so that a model comes back as its merges left it, before the final adjustment.
+class FirstCallsAdjuster : public BundleAdjuster {
+ public:
+  explicit FirstCallsAdjuster(size_t num_calls) : num_calls_(num_calls) {}
+  BundleAdjustmentSummary Adjust(const BundleAdjustmentConfig& config,
+                                 Reconstruction* reconstruction) const override {
+    configs.push_back(config);
+    num_images.push_back(reconstruction->images.size());
+    if (configs.size() <= num_calls_) {
+      return testing::CeresAdjusterOnOneThread().Adjust(config, reconstruction);
+    }
+    BundleAdjustmentSummary refused;
+    refused.message = "refused by the test";
+    return refused;
+  }
+  mutable std::vector<BundleAdjustmentConfig> configs;
+  mutable std::vector<size_t> num_images;
+
+ private:
+  const size_t num_calls_;
+};
+
+// 120 cameras one unit apart along a line, each seeing the stretch of points ahead of it
+// (about 16 positions), as partition_benchmark's paths.
+SyntheticScene PathScene() {
+  SyntheticSceneOptions options;
+  options.layout = SyntheticSceneOptions::Layout::kPath;
+  options.num_images = 120;
+  options.num_points = 40 * 120;
+  options.max_pair_gap = 10;
+  options.seed = 5;
+  return MakeSyntheticScene(options);
+}
+
+TEST(ClusterMerge, AMergeAdjustsOnlyTheSeamAndTheFinalAdjustmentTheWhole) {
+  const SyntheticScene scene = PathScene();
+  std::set<image_t> first, second;
+  for (image_t id = 1; id <= 80; ++id) first.insert(id);
+  for (image_t id = 71; id <= 120; ++id) second.insert(id);  // shares 71 to 80
+  ClusterTreeNode tree;
+  tree.children.resize(2);
+  tree.children[0].cluster = 0;
+  tree.children[1].cluster = 1;
+  std::map<int, std::vector<Reconstruction>> models;
+  models[0].push_back(ClusterModelOf(scene, first, 1));
+  models[1].push_back(ClusterModelOf(scene, second, 2));
+  const Reconstruction target = models[0][0];
+
+  // The merge's adjustment alone: the final one refused.
+  FirstCallsAdjuster merge_only(1);
+  const ClusterMergeResult merged = MergeClusterModels(tree, models, merge_only, {});
+  ASSERT_EQ(merged.models.size(), 1u);
+  ASSERT_TRUE(merged.merges[0].merged) << merged.merges[0].Line();
+  ASSERT_EQ(merge_only.configs.size(), 2u);
+  // Its problem: the seam, some of the 120 images, those away from the shared ones held.
+  const BundleAdjustmentConfig& seam = merge_only.configs[0];
+  EXPECT_FALSE(seam.images.empty());
+  EXPECT_LT(seam.images.size(), 80u);
+  EXPECT_LT(merge_only.num_images[0], 80u) << "the adjuster sees a sub-model";
+  EXPECT_FALSE(seam.constant_poses.empty());
+  for (image_t id = 71; id <= 80; ++id) {
+    EXPECT_EQ(seam.images.count(id), 1u) << id;
+    EXPECT_EQ(seam.constant_poses.count(id), 0u) << id;
+  }
+  // The target's images far from the seam keep their poses bit for bit; the shared ones
+  // moved.
+  const Reconstruction& after_merge = merged.models[0].model;
+  ASSERT_EQ(after_merge.images.size(), 120u);
+  for (image_t id = 1; id <= 30; ++id) {
+    EXPECT_EQ(seam.images.count(id), 0u) << id;
+    const Rigid3d& pose = after_merge.images.at(id).cam_from_world;
+    const Rigid3d& before = target.images.at(id).cam_from_world;
+    EXPECT_EQ(pose.rotation.coeffs(), before.rotation.coeffs()) << id;
+    EXPECT_EQ(pose.translation, before.translation) << id;
+  }
+  size_t num_moved = 0;
+  for (image_t id = 71; id <= 80; ++id) {
+    num_moved += after_merge.images.at(id).cam_from_world.translation !=
+                 target.images.at(id).cam_from_world.translation;
+  }
+  EXPECT_GT(num_moved, 0u);
+  EvaluationResult evaluation = EvaluateReconstruction(after_merge, scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  EXPECT_LT(evaluation.position_error_max / evaluation.scene_extent, 0.01);
+
+  // With the final adjustment, of the whole model: the truth within tolerance.
+  FirstCallsAdjuster both(2);
+  const ClusterMergeResult adjusted = MergeClusterModels(tree, models, both, {});
+  ASSERT_EQ(adjusted.models.size(), 1u);
+  ASSERT_EQ(both.configs.size(), 2u);
+  EXPECT_TRUE(both.configs[1].images.empty());
+  EXPECT_EQ(both.num_images[1], 120u);
+  evaluation = EvaluateReconstruction(adjusted.models[0].model, scene.GroundTruth());
+  ASSERT_TRUE(evaluation.aligned) << evaluation.error;
+  EXPECT_EQ(evaluation.num_registered, 120u);
+  EXPECT_LT(evaluation.rotation_error_max_deg, 0.5);
+  EXPECT_LT(evaluation.position_error_max / evaluation.scene_extent, 0.01);
+}
+
 TEST(ClusterMerge, ClustersSharingFewerThanThreeImagesStayApartNamed) {
   const SyntheticScene scene = Scene();
   std::set<image_t> first, second;
