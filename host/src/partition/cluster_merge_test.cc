@@ -83,6 +83,24 @@ Reconstruction ClusterModelOf(const SyntheticScene& scene, const std::set<image_
   return model;
 }
 
+// Two clusters side by side, images first..last_of_first and first_of_second..last, each
+// in its own frame (ClusterModelOf), under one inner node of `tree`.
+std::map<int, std::vector<Reconstruction>> TwoClusterModels(const SyntheticScene& scene,
+                                                            image_t last_of_first,
+                                                            image_t first_of_second,
+                                                            ClusterTreeNode* tree) {
+  std::set<image_t> first, second;
+  for (image_t id = 1; id <= last_of_first; ++id) first.insert(id);
+  for (image_t id = first_of_second; id <= scene.input.images.size(); ++id) second.insert(id);
+  tree->children.resize(2);
+  tree->children[0].cluster = 0;
+  tree->children[1].cluster = 1;
+  std::map<int, std::vector<Reconstruction>> models;
+  models[0].push_back(ClusterModelOf(scene, first, 1));
+  models[1].push_back(ClusterModelOf(scene, second, 2));
+  return models;
+}
+
 std::vector<WeightedEdge> ViewGraphOf(const SyntheticScene& scene) {
   std::vector<WeightedEdge> edges;
   for (const MapperInput::Pair& pair : scene.input.pairs) {
@@ -160,17 +178,10 @@ SyntheticScene PathScene() {
 
 TEST(ClusterMerge, AMergeAdjustsOnlyTheSeamAndTheFinalAdjustmentTheWhole) {
   const SyntheticScene scene = PathScene();
-  std::set<image_t> first, second;
-  for (image_t id = 1; id <= 80; ++id) first.insert(id);
-  for (image_t id = 71; id <= 120; ++id) second.insert(id);  // shares 71 to 80
   ClusterTreeNode tree;
-  tree.children.resize(2);
-  tree.children[0].cluster = 0;
-  tree.children[1].cluster = 1;
-  std::map<int, std::vector<Reconstruction>> models;
-  models[0].push_back(ClusterModelOf(scene, first, 1));
-  models[1].push_back(ClusterModelOf(scene, second, 2));
-  const Reconstruction target = models[0][0];
+  // 1 to 80 and 71 to 120: they share 71 to 80.
+  const std::map<int, std::vector<Reconstruction>> models = TwoClusterModels(scene, 80, 71, &tree);
+  const Reconstruction target = models.at(0).front();
 
   // The merge's adjustment alone: the final one refused.
   FirstCallsAdjuster merge_only(1);
@@ -225,16 +236,9 @@ TEST(ClusterMerge, AMergeAdjustsOnlyTheSeamAndTheFinalAdjustmentTheWhole) {
 
 TEST(ClusterMerge, ClustersSharingFewerThanThreeImagesStayApartNamed) {
   const SyntheticScene scene = Scene();
-  std::set<image_t> first, second;
-  for (image_t id = 1; id <= 31; ++id) first.insert(id);
-  for (image_t id = 30; id <= 60; ++id) second.insert(id);  // shares 30 and 31
   ClusterTreeNode tree;
-  tree.children.resize(2);
-  tree.children[0].cluster = 0;
-  tree.children[1].cluster = 1;
-  std::map<int, std::vector<Reconstruction>> models;
-  models[0].push_back(ClusterModelOf(scene, first, 1));
-  models[1].push_back(ClusterModelOf(scene, second, 2));
+  // 1 to 31 and 30 to 60: they share 30 and 31.
+  const std::map<int, std::vector<Reconstruction>> models = TwoClusterModels(scene, 31, 30, &tree);
   const ClusterMergeResult result =
       MergeClusterModels(tree, models, testing::CeresAdjusterOnOneThread(), {});
   ASSERT_EQ(result.models.size(), 2u);
