@@ -39,6 +39,65 @@ class StopCallback : public ceres::IterationCallback {
   bool stopped_ = false;
 };
 
+// Ceres built without a sparse library (SuiteSparse, Eigen's sparse Cholesky) rejects the
+// sparse solvers; the iterative Schur solver needs none.
+void UseIterativeSchurWithoutSparseLibrary(ceres::Solver::Options* solver_options) {
+  std::string why;
+  if (!solver_options->IsValid(&why)) {
+    solver_options->linear_solver_type = ceres::ITERATIVE_SCHUR;
+    solver_options->preconditioner_type = ceres::SCHUR_JACOBI;
+  }
+}
+
+// Stage 1 of the positioning: every point at unit depth along each of its rays. The
+// scales held at 1 and the loss squared make the problem linear in the centres and points,
+// so one Gauss-Newton step solves it, whatever the random start (which only fills the
+// directions the rays leave free). Each camera then sees its points in front of it, in
+// their directions, and a long chain of cameras is laid out at once. From the random start
+// alone the robust solver unfolds such a chain a few cameras per iteration: on
+// mapper_benchmark's path of 3,000 images it took 35 iterations, and 12 from this start.
+// Leaves the scales variable again, under no loss.
+ceres::Solver::Summary SolveAtUnitDepth(ceres::Solver::Options solver_options,
+                                        std::map<image_t, Eigen::Vector3d>* centers,
+                                        std::vector<Eigen::Vector3d>* points,
+                                        std::vector<double>* scales,
+                                        ceres::LossFunctionWrapper* loss, ceres::Problem* problem) {
+  for (double& scale : *scales) problem->SetParameterBlockConstant(&scale);
+  loss->Reset(nullptr, ceres::TAKE_OWNERSHIP);
+  solver_options.max_num_iterations = 2;
+  solver_options.initial_trust_region_radius = 1e16;  // Gauss-Newton: the problem is linear
+  solver_options.max_trust_region_radius = 1e16;
+  solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
+  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+  for (Eigen::Vector3d& point : *points) {
+    if (problem->HasParameterBlock(point.data())) ordering->AddElementToGroup(point.data(), 0);
+  }
+  for (auto& [image_id, center] : *centers) ordering->AddElementToGroup(center.data(), 1);
+  solver_options.linear_solver_ordering = ordering;
+  UseIterativeSchurWithoutSparseLibrary(&solver_options);
+  ceres::Solver::Summary summary;
+  ceres::Solve(solver_options, problem, &summary);
+  for (double& scale : *scales) problem->SetParameterBlockVariable(&scale);
+  return summary;
+}
+
+// Stage 2: the scales free, under the Huber loss, from where stage 1 left the problem.
+void SolveRobustly(ceres::Solver::Options solver_options, const GlobalPositioningOptions& options,
+                   ceres::LossFunctionWrapper* loss, ceres::Problem* problem,
+                   ceres::Solver::Summary* summary) {
+  loss->Reset(new ceres::HuberLoss(options.huber_threshold), ceres::TAKE_OWNERSHIP);
+  solver_options.max_num_iterations = options.max_num_iterations;
+  solver_options.function_tolerance = options.function_tolerance;
+  solver_options.use_nonmonotonic_steps = options.use_nonmonotonic_steps;
+  // Sparse Cholesky of the whole normal equations: on mapper_benchmark's paths a third
+  // faster per iteration than the Schur complement over the scales (Ceres 2.1 has no
+  // specialised eliminator for their 1-dimensional blocks).
+  solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  UseIterativeSchurWithoutSparseLibrary(&solver_options);
+  *summary = ceres::Solver::Summary();
+  ceres::Solve(solver_options, problem, summary);
+}
+
 }  // namespace
 
 GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& cameras,
@@ -73,12 +132,11 @@ GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& camer
   ceres::Problem::Options problem_options;
   problem_options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(problem_options);
-  ceres::HuberLoss loss(options.huber_threshold);
+  ceres::LossFunctionWrapper loss(nullptr, ceres::TAKE_OWNERSHIP);  // set by each stage
   size_t num_observations = 0;
   for (const Track& track : tracks) num_observations += track.size();
   std::vector<double> scales;
   scales.reserve(num_observations);  // the blocks' addresses must not move
-  auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
   for (size_t t = 0; t < tracks.size(); ++t) {
     for (const TrackElement& element : tracks[t]) {
       const auto rotation = R_cam_from_world.find(element.image_id);
@@ -94,32 +152,29 @@ GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& camer
           new ceres::AutoDiffCostFunction<RayResidual, 3, 3, 3, 1>(new RayResidual(ray)), &loss,
           center, result.points[t].data(), &scales.back());
       problem.SetParameterLowerBound(&scales.back(), 0, 1e-5);
-      ordering->AddElementToGroup(&scales.back(), 0);
-      ordering->AddElementToGroup(result.points[t].data(), 1);
-      ordering->AddElementToGroup(center, 2);
     }
   }
   if (problem.NumResidualBlocks() == 0) return result;
   problem.SetParameterBlockConstant(result.centers.begin()->second.data());
 
-  ceres::Solver::Options solver_options;
-  solver_options.max_num_iterations = options.max_num_iterations;
-  solver_options.function_tolerance = options.function_tolerance;
-  solver_options.use_nonmonotonic_steps = options.use_nonmonotonic_steps;
-  solver_options.num_threads = options.num_threads;
-  solver_options.linear_solver_type = ceres::SPARSE_SCHUR;
-  solver_options.linear_solver_ordering = ordering;
-  std::string why;
-  if (!solver_options.IsValid(&why)) {
-    solver_options.linear_solver_type = ceres::ITERATIVE_SCHUR;
-    solver_options.preconditioner_type = ceres::SCHUR_JACOBI;
-  }
   StopCallback callback(should_stop);
-  solver_options.callbacks.push_back(&callback);
-  solver_options.logging_type = ceres::SILENT;
-  ceres::Solver::Summary summary;
-  ceres::Solve(solver_options, &problem, &summary);
+  const auto base_options = [&] {
+    ceres::Solver::Options solver_options;
+    solver_options.num_threads = options.num_threads;
+    solver_options.callbacks.push_back(&callback);
+    solver_options.logging_type = ceres::SILENT;
+    return solver_options;
+  };
+
+  // 1. Every point at unit depth along its rays; 2. the scales free under the robust loss,
+  // from there.
+  ceres::Solver::Summary summary =
+      SolveAtUnitDepth(base_options(), &result.centers, &result.points, &scales, &loss, &problem);
   result.num_iterations = static_cast<int>(summary.iterations.size());
+  if (!callback.stopped()) {
+    SolveRobustly(base_options(), options, &loss, &problem, &summary);
+    result.num_iterations += static_cast<int>(summary.iterations.size());
+  }
   result.initial_cost = summary.initial_cost;
   result.final_cost = summary.final_cost;
   result.cancelled = callback.stopped();

@@ -6,7 +6,10 @@
 // point X; its residual is d - s (X - c) with a free scale s >= 1e-5 of its own (BATA's
 // formulation, Zhuang et al. CVPR 2018), under a Huber loss. The problem is convex in
 // nothing but converges from a random start in practice, which saves the relative
-// translations that the older pipelines average and the outliers they bring.
+// translations that the older pipelines average and the outliers they bring. Before the
+// robust solve, one linear step from that start puts every point at unit depth along
+// its rays (the scales held at 1, a squared loss): a long chain of cameras is then laid
+// out at once, where the robust solver alone unfolded it a few cameras per iteration.
 // Gauge: the first camera's centre (lowest id) is held at the origin; the scale of the
 // solution is free, so it is normalised afterwards (median camera-to-point distance 1).
 
