@@ -11,6 +11,7 @@
 #include <thread>
 #include <utility>
 
+#include "keypoint_color_sampler.h"
 #include "tessera/errors.h"
 #include "tessera/io/image_io.h"
 
@@ -43,9 +44,35 @@ struct ImageSamples {
   std::string warning;
 };
 
+// The bgr image's size against its camera's: empty when they agree, else the warning.
+std::string SizeProblem(const std::filesystem::path& path, const cv::Mat& bgr, const Image& image,
+                        const std::map<camera_t, Camera>& cameras) {
+  const auto camera_it = cameras.find(image.camera_id);
+  if (camera_it == cameras.end() || (static_cast<size_t>(bgr.cols) == camera_it->second.width &&
+                                     static_cast<size_t>(bgr.rows) == camera_it->second.height)) {
+    return "";
+  }
+  return path.string() + ": the image is " + std::to_string(bgr.cols) + "x" +
+         std::to_string(bgr.rows) + " but its camera " + std::to_string(image.camera_id) + " is " +
+         std::to_string(camera_it->second.width) + "x" + std::to_string(camera_it->second.height) +
+         "; colours cannot be sampled";
+}
+
 ImageSamples SampleImage(const std::filesystem::path& image_dir, const Image& image,
-                         const Reconstruction& reconstruction) {
+                         const Reconstruction& reconstruction,
+                         const KeypointColorSampler* sampler) {
   ImageSamples result;
+  const std::vector<Eigen::Vector3d>* presampled =
+      sampler != nullptr ? sampler->Samples(image) : nullptr;
+  if (presampled != nullptr) {
+    for (size_t idx = 0; idx < image.points2D.size(); ++idx) {
+      const Point2D& point2D = image.points2D[idx];
+      if (point2D.HasPoint3D() && reconstruction.points3D.count(point2D.point3D_id) > 0) {
+        result.samples.emplace_back(point2D.point3D_id, (*presampled)[idx]);
+      }
+    }
+    return result;
+  }
   const std::filesystem::path path = image_dir / image.name;
   cv::Mat bgr;
   try {
@@ -54,17 +81,8 @@ ImageSamples SampleImage(const std::filesystem::path& image_dir, const Image& im
     result.warning = error.what();
     return result;
   }
-  const auto camera_it = reconstruction.cameras.find(image.camera_id);
-  if (camera_it != reconstruction.cameras.end() &&
-      (static_cast<size_t>(bgr.cols) != camera_it->second.width ||
-       static_cast<size_t>(bgr.rows) != camera_it->second.height)) {
-    result.warning = path.string() + ": the image is " + std::to_string(bgr.cols) + "x" +
-                     std::to_string(bgr.rows) + " but its camera " +
-                     std::to_string(image.camera_id) + " is " +
-                     std::to_string(camera_it->second.width) + "x" +
-                     std::to_string(camera_it->second.height) + "; colours cannot be sampled";
-    return result;
-  }
+  result.warning = SizeProblem(path, bgr, image, reconstruction.cameras);
+  if (!result.warning.empty()) return result;
   for (const Point2D& point2D : image.points2D) {
     if (!point2D.HasPoint3D() || reconstruction.points3D.count(point2D.point3D_id) == 0) {
       continue;
@@ -78,7 +96,8 @@ ImageSamples SampleImage(const std::filesystem::path& image_dir, const Image& im
 // is most of the time); results in the order of `images`.
 std::vector<ImageSamples> SampleImages(const std::filesystem::path& image_dir,
                                        const std::vector<const Image*>& images,
-                                       const Reconstruction& reconstruction, int num_threads) {
+                                       const Reconstruction& reconstruction, int num_threads,
+                                       const KeypointColorSampler* sampler) {
   std::vector<ImageSamples> results(images.size());
   std::atomic<size_t> next{0};
   std::exception_ptr failure;
@@ -86,7 +105,7 @@ std::vector<ImageSamples> SampleImages(const std::filesystem::path& image_dir,
   const auto work = [&] {
     for (size_t k = next++; k < images.size(); k = next++) {
       try {
-        results[k] = SampleImage(image_dir, *images[k], reconstruction);
+        results[k] = SampleImage(image_dir, *images[k], reconstruction, sampler);
       } catch (...) {
         const std::lock_guard<std::mutex> lock(failure_mutex);
         if (!failure) failure = std::current_exception();
@@ -107,6 +126,12 @@ std::vector<ImageSamples> SampleImages(const std::filesystem::path& image_dir,
 
 std::vector<std::string> ColorPointsFromImages(const std::filesystem::path& image_dir,
                                                Reconstruction* reconstruction, int num_threads) {
+  return ColorPointsFromImages(image_dir, reconstruction, num_threads, nullptr);
+}
+
+std::vector<std::string> ColorPointsFromImages(const std::filesystem::path& image_dir,
+                                               Reconstruction* reconstruction, int num_threads,
+                                               const KeypointColorSampler* sampler) {
   std::vector<const Image*> images;
   for (const auto& [image_id, image] : reconstruction->images) {
     if (image.registered &&
@@ -119,7 +144,7 @@ std::vector<std::string> ColorPointsFromImages(const std::filesystem::path& imag
   std::vector<std::string> warnings;
   std::map<point3D_t, std::pair<Eigen::Vector3d, int>> sums;
   for (const ImageSamples& image_samples :
-       SampleImages(image_dir, images, *reconstruction, num_threads)) {
+       SampleImages(image_dir, images, *reconstruction, num_threads, sampler)) {
     if (!image_samples.warning.empty()) warnings.push_back(image_samples.warning);
     for (const auto& [point3D_id, rgb] : image_samples.samples) {
       // Eigen leaves a default-constructed vector uninitialised: start from zero.
@@ -137,6 +162,59 @@ std::vector<std::string> ColorPointsFromImages(const std::filesystem::path& imag
     }
   }
   return warnings;
+}
+
+KeypointColorSampler::KeypointColorSampler(std::filesystem::path image_dir,
+                                           const std::map<image_t, Image>& images,
+                                           const std::map<camera_t, Camera>& cameras,
+                                           size_t max_bytes)
+    : image_dir_(std::move(image_dir)),
+      images_(images),
+      cameras_(cameras),
+      max_bytes_(max_bytes),
+      thread_([this] { Run(); }) {}
+
+KeypointColorSampler::~KeypointColorSampler() { Stop(); }
+
+void KeypointColorSampler::Stop() {
+  stop_ = true;
+  Wait();
+}
+
+void KeypointColorSampler::Wait() {
+  if (thread_.joinable()) thread_.join();
+}
+
+const std::vector<Eigen::Vector3d>* KeypointColorSampler::Samples(const Image& image) const {
+  const auto it = samples_.find(image.image_id);
+  if (it == samples_.end()) return nullptr;
+  const std::vector<Point2D>& sampled = images_.at(image.image_id).points2D;
+  if (sampled.size() != image.points2D.size()) return nullptr;
+  for (size_t idx = 0; idx < sampled.size(); ++idx) {
+    if (sampled[idx].xy != image.points2D[idx].xy) return nullptr;
+  }
+  return &it->second;
+}
+
+void KeypointColorSampler::Run() {
+  size_t num_bytes = 0;
+  for (const auto& [image_id, image] : images_) {
+    const size_t image_bytes = image.points2D.size() * sizeof(Eigen::Vector3d);
+    if (stop_ || num_bytes + image_bytes > max_bytes_) return;
+    if (image.points2D.empty()) continue;
+    const std::filesystem::path path = image_dir_ / image.name;
+    try {
+      const cv::Mat bgr = ReadColorImage(path);
+      if (!SizeProblem(path, bgr, image, cameras_).empty()) continue;
+      std::vector<Eigen::Vector3d> rgb;
+      rgb.reserve(image.points2D.size());
+      for (const Point2D& point2D : image.points2D) rgb.push_back(InterpolateRgb(bgr, point2D.xy));
+      samples_.emplace(image_id, std::move(rgb));
+      num_bytes += image_bytes;
+    } catch (...) {
+      // Unreadable now: ColorPointsFromImages reads it again and names it if it still is.
+    }
+  }
 }
 
 }  // namespace tessera

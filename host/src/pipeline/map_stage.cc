@@ -8,6 +8,7 @@
 
 #include "feature/database_feature_reader.h"
 #include "image/camera_assignment.h"
+#include "io/keypoint_color_sampler.h"
 #include "outputs/output_transaction.h"
 #include "pipeline/load_mapper_input.h"
 #include "pipeline/mapper_result_check.h"
@@ -147,6 +148,10 @@ void ExportModel(const Reconstruction& model, size_t index,
 
 // Places the models of `result`, their exports and OUTPUT/mapping_summary.json as one
 // set (OutputTransaction): with no model, what the earlier runs wrote is removed.
+// At most this much of keypoint colours sampled while mapping (24 bytes a keypoint: about
+// 1,000 images of 10,000 keypoints); the images past it are decoded after mapping.
+constexpr size_t kMaxKeypointColorBytes = size_t{256} << 20;
+
 // Returns false when cancelled before the set was placed (nothing of it is).
 bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
                      const MapperResult& result, const MapperInput& input,
@@ -290,6 +295,12 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
                      " in this workspace (plugin_crashes.tsv) and is not run on them "
                      "again; choose another mapper, or fix the plugin");
   }
+  // The keypoints' colours, sampled on the core the mapper leaves idle; stopped (and
+  // joined) before colouring, or when the stage ends otherwise.
+  std::optional<KeypointColorSampler> colors;
+  if (!image_dir.empty()) {
+    colors.emplace(image_dir, input.images, input.cameras, kMaxKeypointColorBytes);
+  }
   MapperResult result;
   try {
     result = mapper.Call(PluginStage::kMap, subject,
@@ -311,9 +322,12 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
   if (image_dir.empty()) {
     spdlog::warn("map: the image folder is unknown (pass --images); points are not coloured");
   } else {
+    colors->Stop();
+    spdlog::debug("map: keypoint colours of {} images sampled while mapping",
+                  colors->num_sampled());
     for (Reconstruction& model : result.models) {
       for (const std::string& warning :
-           ColorPointsFromImages(image_dir, &model, settings.num_threads)) {
+           ColorPointsFromImages(image_dir, &model, settings.num_threads, &*colors)) {
         spdlog::warn("map: {}", warning);
       }
     }
