@@ -65,14 +65,19 @@ TEST(GlobalPositioning, ExactRotationsGiveTheCentresFromARandomStart) {
   EXPECT_LT(MaxCenterError(scene, result.centers), 0.05);
 }
 
-TEST(GlobalPositioning, APathOfCamerasSeeingLocalStretches) {
+// 30 cameras one unit apart along a line, each seeing a local stretch of a wall.
+SyntheticScene PathOf30() {
   SyntheticSceneOptions options;
   options.layout = SyntheticSceneOptions::Layout::kPath;
   options.num_images = 30;
   options.num_points = 40 * 30;
   options.max_pair_gap = 10;
   options.seed = 3;
-  const SyntheticScene scene = MakeSyntheticScene(options);
+  return MakeSyntheticScene(options);
+}
+
+TEST(GlobalPositioning, APathOfCamerasSeeingLocalStretches) {
+  const SyntheticScene scene = PathOf30();
   const GlobalPositioningResult result = PositionGlobally(
       scene.input.cameras, scene.input.images, TrueRotations(scene), TracksOf(scene), {});
   ASSERT_TRUE(result.usable);
@@ -86,13 +91,7 @@ TEST(GlobalPositioning, APathOfCamerasSeeingLocalStretches) {
 // alone they agreed only to the solver's tolerance (a long chain of cameras was unfolded
 // a few cameras per iteration: 35 iterations for mapper_benchmark's 3,000 images, 12 now).
 TEST(GlobalPositioning, TheRandomStartDoesNotChangeTheResult) {
-  SyntheticSceneOptions options;
-  options.layout = SyntheticSceneOptions::Layout::kPath;
-  options.num_images = 30;
-  options.num_points = 40 * 30;
-  options.max_pair_gap = 10;
-  options.seed = 3;
-  const SyntheticScene scene = MakeSyntheticScene(options);
+  const SyntheticScene scene = PathOf30();
   const std::vector<Track> tracks = TracksOf(scene);
   std::vector<GlobalPositioningResult> results;
   for (const uint64_t seed : {1, 2}) {
