@@ -146,12 +146,12 @@ void ExportModel(const Reconstruction& model, size_t index,
   }
 }
 
-// Places the models of `result`, their exports and OUTPUT/mapping_summary.json as one
-// set (OutputTransaction): with no model, what the earlier runs wrote is removed.
 // At most this much of keypoint colours sampled while mapping (24 bytes a keypoint: about
 // 1,000 images of 10,000 keypoints); the images past it are decoded after mapping.
 constexpr size_t kMaxKeypointColorBytes = size_t{256} << 20;
 
+// Places the models of `result`, their exports and OUTPUT/mapping_summary.json as one
+// set (OutputTransaction): with no model, what the earlier runs wrote is removed.
 // Returns false when cancelled before the set was placed (nothing of it is).
 bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
                      const MapperResult& result, const MapperInput& input,
