@@ -150,6 +150,24 @@ void ExportModel(const Reconstruction& model, size_t index,
 // 1,000 images of 10,000 keypoints); the images past it are decoded after mapping.
 constexpr size_t kMaxKeypointColorBytes = size_t{256} << 20;
 
+// Colours the points of `models` from the images of `image_dir`, with the keypoint
+// colours `colors` sampled while mapping (stopped here) where it has them.
+void ColorModels(const std::filesystem::path& image_dir, int num_threads,
+                 KeypointColorSampler* colors, std::vector<Reconstruction>* models) {
+  if (image_dir.empty() || colors == nullptr) {
+    spdlog::warn("map: the image folder is unknown (pass --images); points are not coloured");
+    return;
+  }
+  colors->Stop();
+  spdlog::debug("map: keypoint colours of {} images sampled while mapping", colors->num_sampled());
+  for (Reconstruction& model : *models) {
+    for (const std::string& warning :
+         ColorPointsFromImages(image_dir, &model, num_threads, colors)) {
+      spdlog::warn("map: {}", warning);
+    }
+  }
+}
+
 // Places the models of `result`, their exports and OUTPUT/mapping_summary.json as one
 // set (OutputTransaction): with no model, what the earlier runs wrote is removed.
 // Returns false when cancelled before the set was placed (nothing of it is).
@@ -319,19 +337,7 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
     control.Report("map", input.images.size(), input.images.size());
   }
 
-  if (image_dir.empty()) {
-    spdlog::warn("map: the image folder is unknown (pass --images); points are not coloured");
-  } else {
-    colors->Stop();
-    spdlog::debug("map: keypoint colours of {} images sampled while mapping",
-                  colors->num_sampled());
-    for (Reconstruction& model : result.models) {
-      for (const std::string& warning :
-           ColorPointsFromImages(image_dir, &model, settings.num_threads, &*colors)) {
-        spdlog::warn("map: {}", warning);
-      }
-    }
-  }
+  ColorModels(image_dir, settings.num_threads, colors ? &*colors : nullptr, &result.models);
   summary.seconds = timer.ElapsedSeconds();
   if (!PlaceMapOutputs(workspace, settings, result, input, image_dir, control, target, &summary)) {
     cancelled();
