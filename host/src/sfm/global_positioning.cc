@@ -64,7 +64,7 @@ void UseIterativeSchurWithoutSparseLibrary(ceres::Solver::Options* solver_option
 // mapper_benchmark's path of 3,000 images it took 35 iterations, and 12 from this start.
 // Leaves the scales variable again, under no loss.
 ceres::Solver::Summary SolveAtUnitDepth(ceres::Solver::Options solver_options,
-                                        std::map<image_t, Eigen::Vector3d>* centers,
+                                        std::vector<Eigen::Vector3d>* centers,
                                         std::vector<Eigen::Vector3d>* points,
                                         std::vector<double>* scales,
                                         ceres::LossFunctionWrapper* loss, ceres::Problem* problem) {
@@ -79,7 +79,7 @@ ceres::Solver::Summary SolveAtUnitDepth(ceres::Solver::Options solver_options,
   for (Eigen::Vector3d& point : *points) {
     if (problem->HasParameterBlock(point.data())) ordering->AddElementToGroup(point.data(), 0);
   }
-  for (auto& [image_id, center] : *centers) ordering->AddElementToGroup(center.data(), 1);
+  for (Eigen::Vector3d& center : *centers) ordering->AddElementToGroup(center.data(), 1);
   solver_options.linear_solver_ordering = ordering;
   UseIterativeSchurWithoutSparseLibrary(&solver_options);
   ceres::Solver::Summary summary;
@@ -123,17 +123,23 @@ GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& camer
     return Eigen::Vector3d(x, y, z);
   };
 
-  // Centres of the images with an observation; the first stays at the origin.
+  // Centres of the images with an observation, in image id order; the first stays at the
+  // origin. Ceres orders the blocks of each elimination group by their addresses, so the
+  // centres, like the points and the scales, lie in one array while they are solved for:
+  // in the nodes of a map their order, and so the last bits of every position, followed
+  // the heap's history (one run in about 15 of the same map differed).
+  std::map<image_t, size_t> center_index;
   for (const Track& track : tracks) {
     for (const TrackElement& element : track) {
-      if (R_cam_from_world.count(element.image_id) > 0) {
-        result.centers.emplace(element.image_id, Eigen::Vector3d::Zero());
-      }
+      if (R_cam_from_world.count(element.image_id) > 0) center_index.emplace(element.image_id, 0);
     }
   }
-  if (result.centers.empty()) return result;
-  for (auto& [image_id, center] : result.centers) {
-    if (image_id != result.centers.begin()->first) center = random_vector();
+  if (center_index.empty()) return result;
+  std::vector<Eigen::Vector3d> centers(center_index.size(), Eigen::Vector3d::Zero());
+  size_t next_index = 0;
+  for (auto& [image_id, index] : center_index) {
+    index = next_index++;
+    if (index > 0) centers[index] = random_vector();
   }
   result.points.resize(tracks.size());
   for (Eigen::Vector3d& point : result.points) point = random_vector();
@@ -156,7 +162,7 @@ GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& camer
           camera.CamFromImg(image.points2D.at(element.point2D_idx).xy).homogeneous().normalized();
       const Eigen::Vector3d ray = rotation->second.transpose() * ray_in_cam;
       scales.push_back(1.0);
-      double* center = result.centers.at(element.image_id).data();
+      double* center = centers[center_index.at(element.image_id)].data();
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<RayResidual, 3, 3, 3, 1>(new RayResidual(ray)), &loss,
           center, result.points[t].data(), &scales.back());
@@ -164,7 +170,7 @@ GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& camer
     }
   }
   if (problem.NumResidualBlocks() == 0) return result;
-  problem.SetParameterBlockConstant(result.centers.begin()->second.data());
+  problem.SetParameterBlockConstant(centers.front().data());
 
   StopCallback callback(should_stop);
   const auto base_options = [&] {
@@ -178,7 +184,7 @@ GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& camer
   // 1. Every point at unit depth along its rays; 2. the scales free under the robust loss,
   // from there.
   ceres::Solver::Summary summary =
-      SolveAtUnitDepth(base_options(), &result.centers, &result.points, &scales, &loss, &problem);
+      SolveAtUnitDepth(base_options(), &centers, &result.points, &scales, &loss, &problem);
   result.num_iterations = static_cast<int>(summary.iterations.size());
   if (!callback.stopped()) {
     SolveRobustly(base_options(), options, &loss, &problem, &summary);
@@ -188,6 +194,7 @@ GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& camer
   result.final_cost = summary.final_cost;
   result.cancelled = callback.stopped();
   result.usable = summary.IsSolutionUsable() && !result.cancelled;
+  for (const auto& [image_id, index] : center_index) result.centers[image_id] = centers[index];
 
   // Scale: the median camera-to-point distance over the observations becomes 1.
   std::vector<double> distances;
