@@ -273,6 +273,26 @@ TEST(FirstModelCalibration, RefinesTheFocalLengthOfEachCameraAskedFor) {
   EXPECT_EQ(FocalLengthsFromFirstModels(IncrementalMapperOptions(), run, {2}, pairs).count(1), 0u);
 }
 
+// A first model stops growing once its focal length has settled: on 30 images it needs
+// far fewer than kMaxFirstModelImages to land within 2% of the truth.
+TEST(FirstModelCalibration, StopsGrowingOnceTheFocalLengthSettles) {
+  SyntheticSceneOptions options;
+  options.num_images = 30;
+  options.focal_prior = false;
+  options.prior_focal_factor = 1.3;
+  options.seed = 11;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  std::vector<const MapperInput::Pair*> pairs;
+  for (const MapperInput::Pair& pair : scene.input.pairs) pairs.push_back(&pair);
+  MapperRunState run(scene.input, testing::CeresAdjusterOnOneThread(), 7);
+  const std::map<camera_t, FirstModelFocalLength> refined =
+      FocalLengthsFromFirstModels(IncrementalMapperOptions(), run, {1}, pairs);
+  ASSERT_EQ(refined.count(1), 1u);
+  EXPECT_NEAR(refined.at(1).focal_length, options.focal_length, 0.02 * options.focal_length);
+  EXPECT_GE(refined.at(1).num_images, kMinFirstModelImages);
+  EXPECT_LT(refined.at(1).num_images, kMaxFirstModelImages - 5);
+}
+
 // GPS for each image of `scene`: its true centre, scaled to metres, in an east-north-up
 // frame at `origin`, plus noise; `shuffle` hands each image another's position.
 void Geotag(SyntheticScene* scene, const Georeference& origin, double metres_per_unit,

@@ -26,7 +26,7 @@ struct FirstModelFocalLength {
 
 // A first model needs this many images at least, and grows to this many at most (its
 // bundle adjustment determines the focal length well long before, at a fraction of a
-// whole model's cost).
+// whole model's cost); it stops sooner once its focal lengths have settled.
 constexpr size_t kMinFirstModelImages = 5;
 constexpr size_t kMaxFirstModelImages = 20;
 
