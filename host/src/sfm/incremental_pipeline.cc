@@ -254,6 +254,28 @@ void MergeAlignedModels(const IncrementalMapperOptions& options,
 constexpr double kSettledFocalLengthChange = 0.005;
 constexpr int kSettledFocalLengthSteps = 2;
 
+// The largest relative change of the focal length of a camera of the model's registered
+// images since `focal_lengths` (1 where a camera joined), which then holds the current
+// ones.
+double LargestFocalLengthChange(const IncrementalMapper& mapper,
+                                std::map<camera_t, double>* focal_lengths) {
+  std::map<camera_t, double> now;
+  for (const auto& [image_id, image] : mapper.model().images) {
+    if (mapper.observations().IsRegistered(image_id)) {
+      now[image.camera_id] = mapper.model().cameras.at(image.camera_id).MeanFocalLength();
+    }
+  }
+  double largest_change = 0;
+  for (const auto& [camera_id, focal_length] : now) {
+    const auto before = focal_lengths->find(camera_id);
+    largest_change = std::max(largest_change, before == focal_lengths->end()
+                                                  ? 1.0
+                                                  : std::abs(focal_length / before->second - 1));
+  }
+  *focal_lengths = std::move(now);
+  return largest_change;
+}
+
 // A first model of at most kMaxFirstModelImages images from `pairs`, with `run.cameras`,
 // for the focal lengths its bundle adjustments refine; empty when no pair initialises one.
 Reconstruction MapFirstModel(const IncrementalMapperOptions& options, const MapperRunState& run,
@@ -278,15 +300,7 @@ Reconstruction MapFirstModel(const IncrementalMapperOptions& options, const Mapp
       const size_t registered = mapper.NumRegisteredImages();
       Grow(&mapper, &no_observer, registered + 1);
       if (mapper.NumRegisteredImages() == registered) break;  // no image registers
-      double largest_change = 0;
-      for (const auto& [camera_id, camera] : mapper.model().cameras) {
-        const double focal_length = camera.MeanFocalLength();
-        const auto before = focal_lengths.find(camera_id);
-        largest_change = std::max(
-            largest_change,
-            before == focal_lengths.end() ? 1.0 : std::abs(focal_length / before->second - 1));
-        focal_lengths[camera_id] = focal_length;
-      }
+      const double largest_change = LargestFocalLengthChange(mapper, &focal_lengths);
       settled_steps = largest_change < kSettledFocalLengthChange ? settled_steps + 1 : 0;
       if (mapper.NumRegisteredImages() >= kMinFirstModelImages &&
           settled_steps >= kSettledFocalLengthSteps) {
