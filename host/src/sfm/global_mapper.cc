@@ -7,6 +7,7 @@
 #include <chrono>
 #include <set>
 
+#include "sfm/pair_strength.h"
 #include "tessera/io/model_statistics.h"
 #include "tessera/sfm/feature_tracks.h"
 #include "tessera/sfm/focal_length_estimation.h"
@@ -438,22 +439,10 @@ std::vector<const MapperInput::Pair*> PairsThatMap(const MapperInput& input,
     pairs.push_back(&pair);
   }
   // Weak pairs set aside (GlobalMapperOptions::min_relative_pair_strength).
-  std::map<image_t, size_t> strongest;
-  for (const MapperInput::Pair* pair : pairs) {
-    const size_t n = pair->geometry.inlier_matches.size();
-    strongest[pair->image_id1] = std::max(strongest[pair->image_id1], n);
-    strongest[pair->image_id2] = std::max(strongest[pair->image_id2], n);
-  }
-  std::vector<const MapperInput::Pair*> strong;
-  for (const MapperInput::Pair* pair : pairs) {
-    const double weaker_image_strongest =
-        static_cast<double>(std::min(strongest.at(pair->image_id1), strongest.at(pair->image_id2)));
-    if (static_cast<double>(pair->geometry.inlier_matches.size()) <
-        options.min_relative_pair_strength * weaker_image_strongest) {
-      ++result->num_weak_pairs_set_aside;
-      continue;
-    }
-    strong.push_back(pair);
+  std::vector<const MapperInput::Pair*> strong =
+      StrongPairs(pairs, options.min_relative_pair_strength);
+  result->num_weak_pairs_set_aside += pairs.size() - strong.size();
+  for (const MapperInput::Pair* pair : strong) {
     in_verified_pair->insert(pair->image_id1);
     in_verified_pair->insert(pair->image_id2);
   }

@@ -1,6 +1,10 @@
 #include "tessera/sfm/incremental_pipeline.h"
 
 #include <gtest/gtest.h>
+#include <spdlog/sinks/ostream_sink.h>
+#include <spdlog/spdlog.h>
+
+#include <sstream>
 
 #include "eval/evaluation.h"
 #include "geometry/essential_matrix.h"
@@ -291,6 +295,64 @@ TEST(FirstModelCalibration, StopsGrowingOnceTheFocalLengthSettles) {
   EXPECT_NEAR(refined.at(1).focal_length, options.focal_length, 0.02 * options.focal_length);
   EXPECT_GE(refined.at(1).num_images, kMinFirstModelImages);
   EXPECT_LT(refined.at(1).num_images, kMaxFirstModelImages - 5);
+}
+
+// Weak pairs (a few of the inliers their images have with their best neighbours) are
+// left out of a first model: it maps the same with them as without them, even when their
+// matches are wrong.
+TEST(FirstModelCalibration, WeakPairsDoNotChangeTheFirstModel) {
+  SyntheticSceneOptions options;
+  options.num_images = 20;
+  options.focal_prior = false;
+  options.prior_focal_factor = 1.3;
+  options.seed = 5;
+  SyntheticScene with_weak = MakeSyntheticScene(options);
+  SyntheticScene without_weak = with_weak;
+  std::vector<MapperInput::Pair> kept;
+  size_t num_weakened = 0;
+  for (size_t k = 0; k < with_weak.input.pairs.size(); ++k) {
+    if (k % 3 != 1) {
+      kept.push_back(with_weak.input.pairs[k]);
+      continue;
+    }
+    // 16 wrong matches, as repeated texture gives: each feature with another's partner.
+    std::vector<FeatureMatch>& inliers = with_weak.input.pairs[k].geometry.inlier_matches;
+    ASSERT_GT(inliers.size(), 100u);
+    std::vector<FeatureMatch> wrong(16);
+    for (size_t i = 0; i < wrong.size(); ++i) {
+      wrong[i].point2D_idx1 = inliers[i].point2D_idx1;
+      wrong[i].point2D_idx2 = inliers[(i + 1) % wrong.size()].point2D_idx2;
+    }
+    inliers = wrong;
+    ++num_weakened;
+  }
+  without_weak.input.pairs = kept;
+  ASSERT_GT(num_weakened, 20u);
+  const auto first_model = [](const SyntheticScene& scene) {
+    std::vector<const MapperInput::Pair*> pairs;
+    for (const MapperInput::Pair& pair : scene.input.pairs) pairs.push_back(&pair);
+    MapperRunState run(scene.input, testing::CeresAdjusterOnOneThread(), 7);
+    return FocalLengthsFromFirstModels(IncrementalMapperOptions(), run, {1}, pairs);
+  };
+  // Its view graph (logged at debug level) holds the strong pairs alone.
+  std::ostringstream log;
+  const auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>(
+      "test", std::make_shared<spdlog::sinks::ostream_sink_mt>(log)));
+  const spdlog::level::level_enum level = spdlog::get_level();
+  spdlog::set_level(spdlog::level::debug);
+  const std::map<camera_t, FirstModelFocalLength> refined = first_model(with_weak);
+  spdlog::set_default_logger(previous);
+  spdlog::set_level(level);
+  EXPECT_NE(log.str().find(" of " + std::to_string(kept.size()) + " verified pairs dropped"),
+            std::string::npos)
+      << log.str().substr(0, 2000);
+  const std::map<camera_t, FirstModelFocalLength> expected = first_model(without_weak);
+  ASSERT_EQ(refined.count(1), 1u);
+  ASSERT_EQ(expected.count(1), 1u);
+  EXPECT_EQ(refined.at(1).focal_length, expected.at(1).focal_length);
+  EXPECT_EQ(refined.at(1).num_images, expected.at(1).num_images);
+  EXPECT_NEAR(refined.at(1).focal_length, options.focal_length, 0.02 * options.focal_length);
 }
 
 // GPS for each image of `scene`: its true centre, scaled to metres, in an east-north-up
