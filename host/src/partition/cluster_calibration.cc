@@ -8,6 +8,7 @@
 #include "tessera/sfm/global_mapper_options.h"
 #include "tessera/sfm/incremental_mapper_options.h"
 #include "tessera/two_view_geometry.h"
+#include "verified_pairs/verified_pairs.h"
 
 namespace tessera {
 namespace {
@@ -18,21 +19,7 @@ constexpr double kClearFocalMinimumCost = 0.05;
 
 // The pairs the global mapper maps: verified, with enough inliers.
 std::vector<const MapperInput::Pair*> CalibrationPairs(const MapperInput& input) {
-  const GlobalMapperOptions options;
-  std::vector<const MapperInput::Pair*> pairs;
-  for (const MapperInput::Pair& pair : input.pairs) {
-    const int config = pair.geometry.config;
-    const bool verified =
-        config == TwoViewGeometry::CALIBRATED || config == TwoViewGeometry::UNCALIBRATED ||
-        config == TwoViewGeometry::PLANAR || config == TwoViewGeometry::PANORAMIC ||
-        config == TwoViewGeometry::PLANAR_OR_PANORAMIC;
-    if (verified &&
-        static_cast<int>(pair.geometry.inlier_matches.size()) >= options.min_num_matches &&
-        input.images.count(pair.image_id1) > 0 && input.images.count(pair.image_id2) > 0) {
-      pairs.push_back(&pair);
-    }
-  }
-  return pairs;
+  return VerifiedPairs(input, static_cast<size_t>(GlobalMapperOptions().min_num_matches));
 }
 
 }  // namespace

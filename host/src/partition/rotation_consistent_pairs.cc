@@ -8,55 +8,12 @@
 #include "tessera/sfm/global_mapper_options.h"
 #include "tessera/sfm/rotation_averaging.h"
 #include "tessera/sfm/view_graph.h"
+#include "verified_pairs/verified_pairs.h"
 
 namespace tessera {
 namespace {
 
-bool IsVerified(const TwoViewGeometry& geometry) {
-  return geometry.config == TwoViewGeometry::CALIBRATED ||
-         geometry.config == TwoViewGeometry::UNCALIBRATED ||
-         geometry.config == TwoViewGeometry::PLANAR ||
-         geometry.config == TwoViewGeometry::PANORAMIC ||
-         geometry.config == TwoViewGeometry::PLANAR_OR_PANORAMIC;
-}
-
 std::pair<image_t, image_t> Key(image_t a, image_t b) { return {std::min(a, b), std::max(a, b)}; }
-
-// The verified pairs with enough inliers between two input images.
-std::vector<const MapperInput::Pair*> VerifiedPairs(const MapperInput& input,
-                                                    const GlobalMapperOptions& options) {
-  std::vector<const MapperInput::Pair*> pairs;
-  for (const MapperInput::Pair& pair : input.pairs) {
-    if (IsVerified(pair.geometry) && pair.image_id1 != pair.image_id2 &&
-        pair.geometry.inlier_matches.size() >= static_cast<size_t>(options.min_num_matches) &&
-        input.images.count(pair.image_id1) != 0 && input.images.count(pair.image_id2) != 0) {
-      pairs.push_back(&pair);
-    }
-  }
-  return pairs;
-}
-
-// The pairs with at least min_relative_pair_strength of the inliers of the strongest pair
-// of each of their images.
-std::vector<const MapperInput::Pair*> StrongPairs(
-    const std::vector<const MapperInput::Pair*>& pairs, const GlobalMapperOptions& options) {
-  std::map<image_t, size_t> strongest;
-  for (const MapperInput::Pair* pair : pairs) {
-    const size_t n = pair->geometry.inlier_matches.size();
-    strongest[pair->image_id1] = std::max(strongest[pair->image_id1], n);
-    strongest[pair->image_id2] = std::max(strongest[pair->image_id2], n);
-  }
-  std::vector<const MapperInput::Pair*> strong;
-  for (const MapperInput::Pair* pair : pairs) {
-    const double weaker =
-        static_cast<double>(std::min(strongest.at(pair->image_id1), strongest.at(pair->image_id2)));
-    if (static_cast<double>(pair->geometry.inlier_matches.size()) >=
-        options.min_relative_pair_strength * weaker) {
-      strong.push_back(pair);
-    }
-  }
-  return strong;
-}
 
 // The input's cameras, those without a prior at the focal length the pairs give where
 // they determine it (as the global mapper starts).
@@ -79,9 +36,11 @@ std::map<camera_t, Camera> CamerasForRotations(const MapperInput& input,
 RotationConsistentPairs FindRotationConsistentPairs(const MapperInput& input, uint64_t seed) {
   const GlobalMapperOptions options;
   RotationConsistentPairs result;
-  const std::vector<const MapperInput::Pair*> verified = VerifiedPairs(input, options);
+  const std::vector<const MapperInput::Pair*> verified =
+      VerifiedPairs(input, static_cast<size_t>(options.min_num_matches));
   result.num_verified = verified.size();
-  const std::vector<const MapperInput::Pair*> strong = StrongPairs(verified, options);
+  const std::vector<const MapperInput::Pair*> strong =
+      StrongPairs(verified, options.min_relative_pair_strength);
   result.num_weak = verified.size() - strong.size();
 
   ViewGraph view_graph = ViewGraph::Build(input, CamerasForRotations(input, strong), strong, seed);

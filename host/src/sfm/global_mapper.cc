@@ -7,7 +7,6 @@
 #include <chrono>
 #include <set>
 
-#include "sfm/pair_strength.h"
 #include "tessera/io/model_statistics.h"
 #include "tessera/sfm/feature_tracks.h"
 #include "tessera/sfm/focal_length_estimation.h"
@@ -18,6 +17,7 @@
 #include "tessera/sfm/track_triangulation.h"
 #include "tessera/sfm/view_graph.h"
 #include "util/random.h"
+#include "verified_pairs/verified_pairs.h"
 
 namespace tessera {
 namespace {
@@ -61,14 +61,6 @@ double LargestCenterShift(const std::map<image_t, Eigen::Vector3d>& before,
       largest = std::max(largest, (image.ProjectionCenter() - it->second).norm());
   }
   return largest / std::max(1e-12, median(spread));
-}
-
-bool IsVerified(const TwoViewGeometry& geometry) {
-  return geometry.config == TwoViewGeometry::CALIBRATED ||
-         geometry.config == TwoViewGeometry::UNCALIBRATED ||
-         geometry.config == TwoViewGeometry::PLANAR ||
-         geometry.config == TwoViewGeometry::PANORAMIC ||
-         geometry.config == TwoViewGeometry::PLANAR_OR_PANORAMIC;
 }
 
 std::string Format(double value) { return fmt::format("{:g}", value); }
@@ -157,12 +149,9 @@ namespace {
 std::vector<ImagePairMatches> VerifiedPairMatches(const MapperInput& input,
                                                   const GlobalMapperOptions& options) {
   std::vector<ImagePairMatches> matches;
-  for (const MapperInput::Pair& pair : input.pairs) {
-    if (IsVerified(pair.geometry) && pair.image_id1 != pair.image_id2 &&
-        pair.geometry.inlier_matches.size() >= static_cast<size_t>(options.min_num_matches) &&
-        input.images.count(pair.image_id1) != 0 && input.images.count(pair.image_id2) != 0) {
-      matches.push_back({pair.image_id1, pair.image_id2, pair.geometry.inlier_matches});
-    }
+  for (const MapperInput::Pair* pair :
+       VerifiedPairs(input, static_cast<size_t>(options.min_num_matches))) {
+    matches.push_back({pair->image_id1, pair->image_id2, pair->geometry.inlier_matches});
   }
   return matches;
 }
@@ -428,16 +417,8 @@ std::vector<const MapperInput::Pair*> PairsThatMap(const MapperInput& input,
                                                    const GlobalMapperOptions& options,
                                                    std::set<image_t>* in_verified_pair,
                                                    GlobalMapperResult* result) {
-  std::vector<const MapperInput::Pair*> pairs;
-  for (const MapperInput::Pair& pair : input.pairs) {
-    if (!IsVerified(pair.geometry) ||
-        pair.geometry.inlier_matches.size() < static_cast<size_t>(options.min_num_matches) ||
-        input.images.count(pair.image_id1) == 0 || input.images.count(pair.image_id2) == 0 ||
-        pair.image_id1 == pair.image_id2) {
-      continue;
-    }
-    pairs.push_back(&pair);
-  }
+  const std::vector<const MapperInput::Pair*> pairs =
+      VerifiedPairs(input, static_cast<size_t>(options.min_num_matches));
   // Weak pairs set aside (GlobalMapperOptions::min_relative_pair_strength).
   std::vector<const MapperInput::Pair*> strong =
       StrongPairs(pairs, options.min_relative_pair_strength);

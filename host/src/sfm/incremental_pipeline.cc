@@ -10,7 +10,6 @@
 #include <set>
 #include <utility>
 
-#include "sfm/pair_strength.h"
 #include "sfm/rig_poses.h"
 #include "tessera/sfm/first_model_calibration.h"
 #include "tessera/sfm/focal_length_estimation.h"
@@ -18,6 +17,7 @@
 #include "tessera/sfm/model_merger.h"
 #include "tessera/sfm/view_graph.h"
 #include "util/random.h"
+#include "verified_pairs/verified_pairs.h"
 
 namespace tessera {
 namespace {
@@ -31,15 +31,6 @@ constexpr uint64_t kMergeStream = 3;
 constexpr double kClearFocalMinimumCost = 0.05;
 // Rounds of growing again after the final refinement, while images still register.
 constexpr int kMaxFinalGrowRounds = 2;
-
-// Configurations whose matches are correspondences of one 3D point.
-bool IsVerified(const TwoViewGeometry& geometry) {
-  return geometry.config == TwoViewGeometry::CALIBRATED ||
-         geometry.config == TwoViewGeometry::UNCALIBRATED ||
-         geometry.config == TwoViewGeometry::PLANAR ||
-         geometry.config == TwoViewGeometry::PANORAMIC ||
-         geometry.config == TwoViewGeometry::PLANAR_OR_PANORAMIC;
-}
 
 // The caller's observer (null: none, as in the calibration pass), the index of the
 // model being grown, and whether the observer asked to stop.
@@ -405,21 +396,6 @@ void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
   }
 }
 
-// The pairs that map: verified, with min_num_matches inliers, between input images.
-std::vector<const MapperInput::Pair*> SelectVerifiedPairs(const IncrementalMapperOptions& options,
-                                                          const MapperInput& input) {
-  std::vector<const MapperInput::Pair*> verified_pairs;
-  for (const MapperInput::Pair& pair : input.pairs) {
-    if (!IsVerified(pair.geometry) ||
-        pair.geometry.inlier_matches.size() < static_cast<size_t>(options.min_num_matches) ||
-        input.images.count(pair.image_id1) == 0 || input.images.count(pair.image_id2) == 0) {
-      continue;
-    }
-    verified_pairs.push_back(&pair);
-  }
-  return verified_pairs;
-}
-
 // Checks each model against the view graph and logs the result, with a warning that
 // names the disagreeing images of a model that may be folded.
 std::vector<ModelSelfCheck> SelfCheckModels(const IncrementalMapperOptions& options,
@@ -580,7 +556,8 @@ MapperResult IncrementalPipeline::Reconstruct(const MapperInput& input,
   const auto should_stop = [&control] { return control.ShouldStop(); };
   MapperResult result;
 
-  const std::vector<const MapperInput::Pair*> verified_pairs = SelectVerifiedPairs(options_, input);
+  const std::vector<const MapperInput::Pair*> verified_pairs =
+      VerifiedPairs(input, static_cast<size_t>(options_.min_num_matches));
   if (options_.estimate_focal_length) {
     EstimateFocalLengthsWithoutPrior(options_, run, verified_pairs, &run.cameras,
                                      &result.focal_lengths);

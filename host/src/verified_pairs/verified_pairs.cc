@@ -1,10 +1,30 @@
-#include "sfm/pair_strength.h"
+#include "verified_pairs/verified_pairs.h"
 
 #include <algorithm>
-#include <cstddef>
 #include <map>
 
 namespace tessera {
+
+bool IsVerified(const TwoViewGeometry& geometry) {
+  return geometry.config == TwoViewGeometry::CALIBRATED ||
+         geometry.config == TwoViewGeometry::UNCALIBRATED ||
+         geometry.config == TwoViewGeometry::PLANAR ||
+         geometry.config == TwoViewGeometry::PANORAMIC ||
+         geometry.config == TwoViewGeometry::PLANAR_OR_PANORAMIC;
+}
+
+std::vector<const MapperInput::Pair*> VerifiedPairs(const MapperInput& input,
+                                                    size_t min_num_inliers) {
+  std::vector<const MapperInput::Pair*> pairs;
+  for (const MapperInput::Pair& pair : input.pairs) {
+    if (IsVerified(pair.geometry) && pair.geometry.inlier_matches.size() >= min_num_inliers &&
+        pair.image_id1 != pair.image_id2 && input.images.count(pair.image_id1) > 0 &&
+        input.images.count(pair.image_id2) > 0) {
+      pairs.push_back(&pair);
+    }
+  }
+  return pairs;
+}
 
 std::vector<const MapperInput::Pair*> StrongPairs(
     const std::vector<const MapperInput::Pair*>& pairs, double min_relative_strength) {
