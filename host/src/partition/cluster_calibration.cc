@@ -7,7 +7,6 @@
 #include "tessera/sfm/first_model_calibration.h"
 #include "tessera/sfm/global_mapper_options.h"
 #include "tessera/sfm/incremental_mapper_options.h"
-#include "tessera/two_view_geometry.h"
 #include "verified_pairs/verified_pairs.h"
 
 namespace tessera {

@@ -30,11 +30,13 @@ struct FirstModelFocalLength {
 constexpr size_t kMinFirstModelImages = 5;
 constexpr size_t kMaxFirstModelImages = 20;
 
-// Maps first models of at most kMaxFirstModelImages images from `pairs` with `run.cameras`, until
-// each camera of `to_refine` is in one of kMinFirstModelImages images or more, or no pair is left
-// among the images of cameras still to refine (several scenes in one folder get a first model
-// each). Returns the refined focal length of each camera a first model reached, 0 where it is
-// implausible (below a quarter or above five times the image's larger side).
+// Maps first models of at most kMaxFirstModelImages images with `run.cameras` from the strong
+// pairs among `pairs` (at least 0.2 of the inliers of the strongest pair of the weaker of their
+// images, as the global mapper keeps), until each camera of `to_refine` is in one of
+// kMinFirstModelImages images or more, or no pair is left among the images of cameras still to
+// refine (several scenes in one folder get a first model each). Returns the refined focal length of
+// each camera a first model reached, 0 where it is implausible (below a quarter or above five times
+// the image's larger side).
 TESSERA_SFM_EXPORT std::map<camera_t, FirstModelFocalLength> FocalLengthsFromFirstModels(
     const IncrementalMapperOptions& options, const MapperRunState& run,
     std::set<camera_t> to_refine, std::vector<const MapperInput::Pair*> pairs);
