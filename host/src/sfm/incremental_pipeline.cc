@@ -13,6 +13,7 @@
 #include "sfm/rig_poses.h"
 #include "tessera/sfm/first_model_calibration.h"
 #include "tessera/sfm/focal_length_estimation.h"
+#include "tessera/sfm/global_mapper_options.h"
 #include "tessera/sfm/gps_anchoring.h"
 #include "tessera/sfm/model_merger.h"
 #include "tessera/sfm/view_graph.h"
@@ -245,11 +246,6 @@ void MergeAlignedModels(const IncrementalMapperOptions& options,
 // has stayed below this for this many images in a row.
 constexpr double kSettledFocalLengthChange = 0.005;
 constexpr int kSettledFocalLengthSteps = 2;
-// A first model maps from the pairs with at least this share of the inliers of their
-// images' strongest pairs (the global mapper's min_relative_pair_strength): its images
-// are neighbours, held together by strong pairs, and its view graph costs one five-point
-// estimate per pair. Around fox's object 468 of 1,170 pairs are that strong.
-constexpr double kFirstModelMinRelativePairStrength = 0.2;
 
 // The largest relative change of the focal length of a camera of the model's registered
 // images since `focal_lengths` (1 where a camera joined), which then holds the current
@@ -476,7 +472,11 @@ std::map<camera_t, FirstModelFocalLength> FocalLengthsFromFirstModels(
     const IncrementalMapperOptions& options, const MapperRunState& run,
     std::set<camera_t> to_refine, std::vector<const MapperInput::Pair*> pairs) {
   std::map<camera_t, FirstModelFocalLength> refined;
-  pairs = StrongPairs(pairs, kFirstModelMinRelativePairStrength);
+  // From the pairs the global mapper keeps by default (min_relative_pair_strength): a
+  // first model's images are neighbours, held together by strong pairs, and its view
+  // graph costs one five-point estimate per pair. Around fox's object 468 of 1,170 pairs
+  // are that strong.
+  pairs = StrongPairs(pairs, GlobalMapperOptions().min_relative_pair_strength);
   while (!to_refine.empty() && !pairs.empty()) {
     const Reconstruction model = MapFirstModel(options, run, pairs);
     if (model.images.size() >= kMinFirstModelImages) {

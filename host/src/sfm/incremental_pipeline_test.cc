@@ -277,20 +277,31 @@ TEST(FirstModelCalibration, RefinesTheFocalLengthOfEachCameraAskedFor) {
   EXPECT_EQ(FocalLengthsFromFirstModels(IncrementalMapperOptions(), run, {2}, pairs).count(1), 0u);
 }
 
-// A first model stops growing once its focal length has settled: on 30 images it needs
-// far fewer than kMaxFirstModelImages to land within 2% of the truth.
-TEST(FirstModelCalibration, StopsGrowingOnceTheFocalLengthSettles) {
+// The options of a scene of `num_images` whose one camera has no focal-length prior and
+// starts 1.3 times off.
+SyntheticSceneOptions WithoutFocalPrior(int num_images, uint64_t seed) {
   SyntheticSceneOptions options;
-  options.num_images = 30;
+  options.num_images = num_images;
   options.focal_prior = false;
   options.prior_focal_factor = 1.3;
-  options.seed = 11;
-  const SyntheticScene scene = MakeSyntheticScene(options);
+  options.seed = seed;
+  return options;
+}
+
+// What first models from every pair of `scene` give camera 1.
+std::map<camera_t, FirstModelFocalLength> FirstModelOfCamera1(const SyntheticScene& scene) {
   std::vector<const MapperInput::Pair*> pairs;
   for (const MapperInput::Pair& pair : scene.input.pairs) pairs.push_back(&pair);
   MapperRunState run(scene.input, testing::CeresAdjusterOnOneThread(), 7);
+  return FocalLengthsFromFirstModels(IncrementalMapperOptions(), run, {1}, pairs);
+}
+
+// A first model stops growing once its focal length has settled: on 30 images it needs
+// far fewer than kMaxFirstModelImages to land within 2% of the truth.
+TEST(FirstModelCalibration, StopsGrowingOnceTheFocalLengthSettles) {
+  const SyntheticSceneOptions options = WithoutFocalPrior(30, 11);
   const std::map<camera_t, FirstModelFocalLength> refined =
-      FocalLengthsFromFirstModels(IncrementalMapperOptions(), run, {1}, pairs);
+      FirstModelOfCamera1(MakeSyntheticScene(options));
   ASSERT_EQ(refined.count(1), 1u);
   EXPECT_NEAR(refined.at(1).focal_length, options.focal_length, 0.02 * options.focal_length);
   EXPECT_GE(refined.at(1).num_images, kMinFirstModelImages);
@@ -301,11 +312,7 @@ TEST(FirstModelCalibration, StopsGrowingOnceTheFocalLengthSettles) {
 // left out of a first model: it maps the same with them as without them, even when their
 // matches are wrong.
 TEST(FirstModelCalibration, WeakPairsDoNotChangeTheFirstModel) {
-  SyntheticSceneOptions options;
-  options.num_images = 20;
-  options.focal_prior = false;
-  options.prior_focal_factor = 1.3;
-  options.seed = 5;
+  const SyntheticSceneOptions options = WithoutFocalPrior(20, 5);
   SyntheticScene with_weak = MakeSyntheticScene(options);
   SyntheticScene without_weak = with_weak;
   std::vector<MapperInput::Pair> kept;
@@ -328,12 +335,6 @@ TEST(FirstModelCalibration, WeakPairsDoNotChangeTheFirstModel) {
   }
   without_weak.input.pairs = kept;
   ASSERT_GT(num_weakened, 20u);
-  const auto first_model = [](const SyntheticScene& scene) {
-    std::vector<const MapperInput::Pair*> pairs;
-    for (const MapperInput::Pair& pair : scene.input.pairs) pairs.push_back(&pair);
-    MapperRunState run(scene.input, testing::CeresAdjusterOnOneThread(), 7);
-    return FocalLengthsFromFirstModels(IncrementalMapperOptions(), run, {1}, pairs);
-  };
   // Its view graph (logged at debug level) holds the strong pairs alone.
   std::ostringstream log;
   const auto previous = spdlog::default_logger();
@@ -341,13 +342,13 @@ TEST(FirstModelCalibration, WeakPairsDoNotChangeTheFirstModel) {
       "test", std::make_shared<spdlog::sinks::ostream_sink_mt>(log)));
   const spdlog::level::level_enum level = spdlog::get_level();
   spdlog::set_level(spdlog::level::debug);
-  const std::map<camera_t, FirstModelFocalLength> refined = first_model(with_weak);
+  const std::map<camera_t, FirstModelFocalLength> refined = FirstModelOfCamera1(with_weak);
   spdlog::set_default_logger(previous);
   spdlog::set_level(level);
   EXPECT_NE(log.str().find(" of " + std::to_string(kept.size()) + " verified pairs dropped"),
             std::string::npos)
       << log.str().substr(0, 2000);
-  const std::map<camera_t, FirstModelFocalLength> expected = first_model(without_weak);
+  const std::map<camera_t, FirstModelFocalLength> expected = FirstModelOfCamera1(without_weak);
   ASSERT_EQ(refined.count(1), 1u);
   ASSERT_EQ(expected.count(1), 1u);
   EXPECT_EQ(refined.at(1).focal_length, expected.at(1).focal_length);
