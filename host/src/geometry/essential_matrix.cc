@@ -9,6 +9,10 @@
 namespace tessera {
 namespace {
 
+// Points beyond 1000 baselines carry no depth information (t has unit norm).
+constexpr double kMinDepth = std::numeric_limits<double>::epsilon();
+constexpr double kMaxDepth = 1000.0;
+
 // Counts and collects points in front of both cameras for the candidate (R, t),
 // triangulating once for both signs of t: with P1 = [I | 0], the DLT solution for
 // (R, -t) is exactly the negated solution for (R, t).
@@ -21,9 +25,6 @@ void CheckCheiralityBothSigns(const Eigen::Matrix3d& R, const Eigen::Vector3d& t
   Eigen::Matrix<double, 3, 4> cam2_from_world;
   cam2_from_world.leftCols<3>() = R;
   cam2_from_world.col(3) = t;
-  // Points beyond 1000 baselines carry no depth information (t has unit norm).
-  constexpr double kMinDepth = std::numeric_limits<double>::epsilon();
-  constexpr double kMaxDepth = 1000.0;
   points3D_pos->clear();
   points3D_neg->clear();
   const Eigen::Vector3d R_row2 = R.row(2).transpose();
@@ -41,6 +42,34 @@ void CheckCheiralityBothSigns(const Eigen::Matrix3d& R, const Eigen::Vector3d& t
     if (-depth1 > kMinDepth && -depth1 < kMaxDepth && depth2_neg > kMinDepth &&
         depth2_neg < kMaxDepth) {
       points3D_neg->push_back(-point3D);
+    }
+  }
+}
+
+// Counts the correspondences in front of both cameras for the candidate (R, t) and for
+// (R, -t). With f1 = (x1, 1) and f2 = (x2, 1), the depths d1, d2 minimise
+// |d2 f2 - d1 R f1 - t|^2 (both z depths, as the rays have z = 1); negating t negates
+// both. Parallel rays (no unique minimum) count for neither.
+void CountInFrontBothSigns(const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
+                           const std::vector<Eigen::Vector2d>& points1,
+                           const std::vector<Eigen::Vector2d>& points2, size_t* num_pos,
+                           size_t* num_neg) {
+  *num_pos = 0;
+  *num_neg = 0;
+  for (size_t i = 0; i < points1.size(); ++i) {
+    const Eigen::Vector3d a = R * points1[i].homogeneous();
+    const Eigen::Vector3d b = points2[i].homogeneous();
+    const double aa = a.squaredNorm(), bb = b.squaredNorm(), ab = a.dot(b);
+    const double at = a.dot(t), bt = b.dot(t);
+    const double det = aa * bb - ab * ab;
+    if (!(det > 0)) continue;
+    const double depth1 = (ab * bt - bb * at) / det;
+    const double depth2 = (aa * bt - ab * at) / det;
+    if (depth1 > kMinDepth && depth1 < kMaxDepth && depth2 > kMinDepth && depth2 < kMaxDepth) {
+      ++*num_pos;
+    }
+    if (-depth1 > kMinDepth && -depth1 < kMaxDepth && -depth2 > kMinDepth && -depth2 < kMaxDepth) {
+      ++*num_neg;
     }
   }
 }
@@ -83,6 +112,29 @@ bool PoseFromEssentialMatrix(const Eigen::Matrix3d& E, const std::vector<Eigen::
     }
   }
   return !points3D->empty();
+}
+
+size_t RelativePoseFromEssentialMatrix(const Eigen::Matrix3d& E,
+                                       const std::vector<Eigen::Vector2d>& points1,
+                                       const std::vector<Eigen::Vector2d>& points2,
+                                       Rigid3d* cam2_from_cam1) {
+  Eigen::Matrix3d R1, R2;
+  Eigen::Vector3d t;
+  DecomposeEssentialMatrix(E, &R1, &R2, &t);
+  size_t best = 0;
+  for (const Eigen::Matrix3d* R : {&R1, &R2}) {
+    size_t num_pos = 0, num_neg = 0;
+    CountInFrontBothSigns(*R, t, points1, points2, &num_pos, &num_neg);
+    for (const bool positive : {true, false}) {
+      const size_t count = positive ? num_pos : num_neg;
+      if (count > best) {
+        cam2_from_cam1->rotation = Eigen::Quaterniond(*R).normalized();
+        cam2_from_cam1->translation = positive ? t : Eigen::Vector3d(-t);
+        best = count;
+      }
+    }
+  }
+  return best;
 }
 
 Eigen::Matrix3d EssentialMatrixFromPose(const Rigid3d& cam2_from_cam1) {

@@ -47,6 +47,50 @@ TEST(PoseFromEssentialMatrix, CheiralityPicksTheTruth) {
   }
 }
 
+// The pose alone, from the rays' depths instead of triangulated points: the candidate of
+// PoseFromEssentialMatrix, and about as many points in front, with noise and with wrong
+// correspondences (some behind a camera), over several scenes and baselines.
+TEST(RelativePoseFromEssentialMatrix, PicksThePoseThatTriangulationPicks) {
+  for (const uint64_t seed : {1, 2, 3, 4, 5, 6}) {
+    SyntheticTwoViewOptions options;
+    options.num_points = 300;
+    options.noise_px = 1.0;
+    options.outlier_ratio = 0.2;
+    options.baseline = seed % 2 == 0 ? 0.3 : 2.0;
+    options.rotation_deg = 5.0 * static_cast<double>(seed);
+    options.seed = seed;
+    const auto scene = MakeSyntheticTwoViewScene(options);
+    for (const double sign : {1.0, -1.0}) {
+      const Eigen::Matrix3d E = sign * EssentialMatrixFromPose(scene.cam2_from_cam1);
+      Rigid3d triangulated;
+      std::vector<Eigen::Vector3d> points3D;
+      ASSERT_TRUE(PoseFromEssentialMatrix(E, scene.normalized1, scene.normalized2, &triangulated,
+                                          &points3D));
+      Rigid3d pose;
+      const size_t num_in_front =
+          RelativePoseFromEssentialMatrix(E, scene.normalized1, scene.normalized2, &pose);
+      EXPECT_LT(RotationErrorDeg(pose.rotation, scene.cam2_from_cam1.rotation), 1e-8) << seed;
+      EXPECT_LT(DirectionErrorDeg(pose.translation, scene.cam2_from_cam1.translation), 1e-6)
+          << seed;
+      EXPECT_EQ(pose.rotation.coeffs(), triangulated.rotation.coeffs()) << seed;
+      EXPECT_EQ(pose.translation, triangulated.translation) << seed;
+      // Every true point is in front; wrong correspondences fall on either side.
+      EXPECT_GE(num_in_front, 240u) << seed;
+      EXPECT_LE(num_in_front > points3D.size() ? num_in_front - points3D.size()
+                                               : points3D.size() - num_in_front,
+                3u)
+          << seed << ": " << num_in_front << " against " << points3D.size() << " triangulated";
+    }
+  }
+}
+
+TEST(RelativePoseFromEssentialMatrix, NoPointInFrontLeavesThePose) {
+  const Rigid3d truth(Eigen::Quaterniond::Identity(), Eigen::Vector3d(1, 0, 0));
+  Rigid3d pose(Eigen::Quaterniond(0, 1, 0, 0), Eigen::Vector3d(7, 8, 9));
+  EXPECT_EQ(RelativePoseFromEssentialMatrix(EssentialMatrixFromPose(truth), {}, {}, &pose), 0u);
+  EXPECT_EQ(pose.translation, Eigen::Vector3d(7, 8, 9));
+}
+
 TEST(FundamentalFromEssentialMatrix, MapsPixelsToTheEpipolarConstraint) {
   SyntheticTwoViewOptions options;
   options.num_points = 20;

@@ -84,10 +84,9 @@ bool RelativeRotation(const MapperInput& input, const std::map<camera_t, Camera>
   if (!E.allFinite() || E.isZero()) return false;
   E = ProjectToEssential(E);
   Rigid3d cam2_from_cam1;
-  std::vector<Eigen::Vector3d> points3D;
-  if (!PoseFromEssentialMatrix(E, points1, points2, &cam2_from_cam1, &points3D)) return false;
+  const size_t num_in_front = RelativePoseFromEssentialMatrix(E, points1, points2, &cam2_from_cam1);
   // Half the inliers behind a camera: the decomposition is a guess.
-  if (points3D.size() * 2 < points1.size()) return false;
+  if (num_in_front == 0 || num_in_front * 2 < points1.size()) return false;
   *R = cam2_from_cam1.rotation.toRotationMatrix();
   return true;
 }
