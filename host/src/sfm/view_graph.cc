@@ -69,6 +69,9 @@ bool RelativeRotation(const MapperInput& input, const std::map<camera_t, Camera>
     ransac_options.confidence = 0.999;
     ransac_options.min_inlier_ratio = kMinInlierRatio;
     ransac_options.max_num_trials = kMaxNumTrials;
+    // A model with fewer inliers is refused below: give up once one would have been found.
+    ransac_options.min_num_inliers =
+        static_cast<int>(std::ceil(kMinInlierRatio * static_cast<double>(points1.size())));
     const auto report =
         LORANSAC<EssentialMatrixFivePointEstimator, EssentialMatrixFivePointEstimator>(
             ransac_options, DeriveSeed(seed, ImagePairToPairId(pair.image_id1, pair.image_id2)))
