@@ -7,7 +7,8 @@
 #   spatial           the spatial selector alone (6 nearest within 50 m);
 #   aerial.json       the shipped recipe: spatial (20 within 150 m) + retrieval (10);
 #   aerial_small_k    the same two selectors with 6 and 3 neighbours, so that on sets
-#                     this small the united pairs are fewer than exhaustive's.
+#                     this small the united pairs are fewer than exhaustive's;
+#   aerial_global.json  aerial.json with the global mapper, anchored to the GPS too.
 # usage: benchmarks/geotagged.sh [NOISE [THREADS]]   (defaults: 3 m, all cores)
 set -euo pipefail
 noise=${1:-3}
@@ -38,5 +39,5 @@ for scene in fountain-P11 Herz-Jesus-P8; do
   "$tessera" -q bench --images "$work/$scene/images" --gt "$datasets/$scene/gt" \
     --output "$work/$scene/bench" --threads "$threads" \
     "$manifests/default.json" "$work/spatial.json" "$manifests/aerial.json" \
-    "$work/aerial_small_k.json"
+    "$work/aerial_small_k.json" "$manifests/aerial_global.json"
 done
