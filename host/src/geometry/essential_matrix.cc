@@ -13,6 +13,10 @@ namespace {
 constexpr double kMinDepth = std::numeric_limits<double>::epsilon();
 constexpr double kMaxDepth = 1000.0;
 
+bool InFrontOfBoth(double depth1, double depth2) {
+  return depth1 > kMinDepth && depth1 < kMaxDepth && depth2 > kMinDepth && depth2 < kMaxDepth;
+}
+
 // Counts and collects points in front of both cameras for the candidate (R, t),
 // triangulating once for both signs of t: with P1 = [I | 0], the DLT solution for
 // (R, -t) is exactly the negated solution for (R, t).
@@ -35,14 +39,8 @@ void CheckCheiralityBothSigns(const Eigen::Matrix3d& R, const Eigen::Vector3d& t
     const double depth1 = point3D.z();
     const double depth2_pos = R_row2.dot(point3D) + t.z();
     const double depth2_neg = -R_row2.dot(point3D) - t.z();
-    if (depth1 > kMinDepth && depth1 < kMaxDepth && depth2_pos > kMinDepth &&
-        depth2_pos < kMaxDepth) {
-      points3D_pos->push_back(point3D);
-    }
-    if (-depth1 > kMinDepth && -depth1 < kMaxDepth && depth2_neg > kMinDepth &&
-        depth2_neg < kMaxDepth) {
-      points3D_neg->push_back(-point3D);
-    }
+    if (InFrontOfBoth(depth1, depth2_pos)) points3D_pos->push_back(point3D);
+    if (InFrontOfBoth(-depth1, depth2_neg)) points3D_neg->push_back(-point3D);
   }
 }
 
@@ -65,12 +63,8 @@ void CountInFrontBothSigns(const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
     if (!(det > 0)) continue;
     const double depth1 = (ab * bt - bb * at) / det;
     const double depth2 = (aa * bt - ab * at) / det;
-    if (depth1 > kMinDepth && depth1 < kMaxDepth && depth2 > kMinDepth && depth2 < kMaxDepth) {
-      ++*num_pos;
-    }
-    if (-depth1 > kMinDepth && -depth1 < kMaxDepth && -depth2 > kMinDepth && -depth2 < kMaxDepth) {
-      ++*num_neg;
-    }
+    if (InFrontOfBoth(depth1, depth2)) ++*num_pos;
+    if (InFrontOfBoth(-depth1, -depth2)) ++*num_neg;
   }
 }
 
