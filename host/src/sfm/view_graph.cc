@@ -4,10 +4,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <utility>
 
 #include "estimators/essential_matrix.h"
 #include "estimators/ransac.h"
 #include "geometry/essential_matrix.h"
+#include "sfm/mapper_threads.h"
+#include "util/parallel.h"
 #include "util/random.h"
 
 namespace tessera {
@@ -98,17 +101,21 @@ bool RelativeRotation(const MapperInput& input, const std::map<camera_t, Camera>
 
 ViewGraph ViewGraph::Build(const MapperInput& input, const std::map<camera_t, Camera>& cameras,
                            const std::vector<const MapperInput::Pair*>& pairs, uint64_t seed) {
+  // Each pair alone, with its own seed: any number of threads gives the same edges.
+  std::vector<ViewGraphEdge> edges(pairs.size());
+  ParallelFor(pairs.size(), MapperThreads(), [&](size_t k) {
+    const MapperInput::Pair& pair = *pairs[k];
+    ViewGraphEdge& edge = edges[k];
+    edge.image_id1 = pair.image_id1;
+    edge.image_id2 = pair.image_id2;
+    edge.num_inliers = pair.geometry.inlier_matches.size();
+    edge.has_rotation = RelativeRotation(input, cameras, pair, seed, &edge.R_cam2_from_cam1);
+  });
   ViewGraph graph;
-  graph.edges_.reserve(pairs.size());
-  for (const MapperInput::Pair* pair : pairs) {
-    ViewGraphEdge edge;
-    edge.image_id1 = pair->image_id1;
-    edge.image_id2 = pair->image_id2;
-    edge.num_inliers = pair->geometry.inlier_matches.size();
-    edge.has_rotation = RelativeRotation(input, cameras, *pair, seed, &edge.R_cam2_from_cam1);
-    graph.edges_of_image_[edge.image_id1].push_back(graph.edges_.size());
-    graph.edges_of_image_[edge.image_id2].push_back(graph.edges_.size());
-    graph.edges_.push_back(edge);
+  graph.edges_ = std::move(edges);
+  for (size_t k = 0; k < graph.edges_.size(); ++k) {
+    graph.edges_of_image_[graph.edges_[k].image_id1].push_back(k);
+    graph.edges_of_image_[graph.edges_[k].image_id2].push_back(k);
   }
   return graph;
 }

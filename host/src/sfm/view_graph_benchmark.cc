@@ -6,15 +6,17 @@
 // cube of points, all pairs matched, 0.5 px noise. The arguments: the number of points (a
 // pair's inliers are most of them) and the percentage of wrong matches among the inliers
 // (5; 60 leaves no essential matrix with the half of them the view graph asks for, so
-// every pair's RANSAC runs until it gives up). Scene generation is not timed.
+// every pair's RANSAC runs until it gives up), and the threads (a map stage gives Build
+// its own count). Scene generation is not timed; per_pair is wall time.
 //
-//   view_graph_benchmark                    # 200 and 1,000 points, 5%; 200, 60%
+//   view_graph_benchmark                    # 200 and 1,000 points, 5%; 200, 60%; 1 and 2 threads
 //   view_graph_benchmark --benchmark_filter=/1000/
 
 #include <benchmark/benchmark.h>
 
 #include <vector>
 
+#include "sfm/mapper_threads.h"
 #include "synthetic_scene.h"
 #include "tessera/sfm/view_graph.h"
 
@@ -35,6 +37,7 @@ void BM_ViewGraphBuildUncalibrated(benchmark::State& state) {
     num_inliers += pair.geometry.inlier_matches.size();
   }
   size_t num_with_rotation = 0;
+  const ScopedMapperThreads threads(static_cast<int>(state.range(2)));
   for (auto _ : state) {
     const ViewGraph graph = ViewGraph::Build(scene.input, scene.input.cameras, pairs, 0);
     num_with_rotation = 0;
@@ -50,9 +53,9 @@ void BM_ViewGraphBuildUncalibrated(benchmark::State& state) {
 }
 
 BENCHMARK(BM_ViewGraphBuildUncalibrated)
-    ->Args({200, 5})
-    ->Args({1000, 5})
-    ->Args({200, 60})
+    ->ArgsProduct({{200}, {5, 60}, {1, 2}})
+    ->ArgsProduct({{1000}, {5}, {1, 2}})
+    ->UseRealTime()
     ->Unit(benchmark::kMillisecond);
 
 }  // namespace

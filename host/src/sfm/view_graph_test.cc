@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <thread>
+
+#include "sfm/mapper_threads.h"
 #include "synthetic_scene.h"
 #include "tessera/sfm/focal_length_estimation.h"
 
@@ -38,6 +41,45 @@ TEST(ViewGraph, RelativeRotationsOfCalibratedAndUncalibratedPairsMatchTheTruth) 
                 focal_prior ? 0.01 : 0.2)
           << edge.image_id1 << "-" << edge.image_id2 << (focal_prior ? " (E)" : " (F)");
     }
+  }
+}
+
+TEST(ViewGraph, GivesTheSameEdgesOnAnyNumberOfThreads) {
+  SyntheticSceneOptions options;
+  options.focal_prior = false;  // every rotation from seeded five-point RANSAC
+  options.num_images = 8;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  EXPECT_EQ(MapperThreads(), 1);
+  const ViewGraph one = ViewGraph::Build(scene.input, scene.input.cameras, AllPairs(scene), 7);
+  ViewGraph three;
+  {
+    const ScopedMapperThreads threads(3);
+    EXPECT_EQ(MapperThreads(), 3);
+    {
+      const ScopedMapperThreads inner(0);
+      EXPECT_EQ(MapperThreads(), 1);
+    }
+    EXPECT_EQ(MapperThreads(), 3);
+    // Another thread is not in this thread's scope.
+    int elsewhere = 0;
+    std::thread([&elsewhere] { elsewhere = MapperThreads(); }).join();
+    EXPECT_EQ(elsewhere, 1);
+    three = ViewGraph::Build(scene.input, scene.input.cameras, AllPairs(scene), 7);
+  }
+  EXPECT_EQ(MapperThreads(), 1);
+  ASSERT_EQ(three.edges().size(), one.edges().size());
+  for (size_t k = 0; k < one.edges().size(); ++k) {
+    const ViewGraphEdge& a = one.edges()[k];
+    const ViewGraphEdge& b = three.edges()[k];
+    EXPECT_EQ(a.image_id1, b.image_id1);
+    EXPECT_EQ(a.image_id2, b.image_id2);
+    EXPECT_EQ(a.num_inliers, b.num_inliers);
+    ASSERT_TRUE(a.has_rotation);
+    EXPECT_EQ(a.has_rotation, b.has_rotation);
+    EXPECT_EQ(a.R_cam2_from_cam1, b.R_cam2_from_cam1) << a.image_id1 << "-" << a.image_id2;
+  }
+  for (const auto& [image_id, image] : scene.input.images) {
+    EXPECT_EQ(one.EdgesOf(image_id), three.EdgesOf(image_id)) << image_id;
   }
 }
 
