@@ -22,6 +22,7 @@
 #include <string>
 
 #include "index_files.h"
+#include "kmeans_tree.h"
 #include "tessera/match_filter.h"
 #include "tessera/sdk.h"
 #include "vectorized_l2.h"
@@ -106,6 +107,34 @@ NearestNeighbors Search(const Index& index, const FeatureDescriptors& query, siz
   return neighbors;
 }
 
+// The same neighbours as Search over the FLANN index the tree was copied from.
+NearestNeighbors Search(const flann_kmeans::KMeansTree& tree, const FeatureDescriptors& query,
+                        size_t k, int checks) {
+  const size_t num_queries = static_cast<size_t>(query.size());
+  const size_t dimension = static_cast<size_t>(query.dimension());
+  NearestNeighbors neighbors(num_queries);
+  flann_kmeans::SearchScratch scratch;
+  int indices[2];
+  float distances[2];
+  for (size_t i = 0; i < num_queries; ++i) {
+    const size_t found =
+        tree.Search(query.data.data() + i * dimension, k, checks, &scratch, indices, distances);
+    if (found > 0) {
+      neighbors.best[i] = indices[0];
+      neighbors.best_distance[i] = std::sqrt(distances[0]);
+    }
+    if (found > 1 && k > 1) {
+      neighbors.second[i] = indices[1];
+      neighbors.second_distance[i] = std::sqrt(distances[1]);
+    }
+  }
+  return neighbors;
+}
+
+using VectorizedL2Uint8 = flann_l2::VectorizedL2Uint8;
+using KMeansL2Index = flann::KMeansIndex<VectorizedL2Uint8>;
+using HierarchicalHammingIndex = flann::HierarchicalClusteringIndex<flann::Hamming<unsigned char>>;
+
 // Indexes of one type built over their own copy of the descriptors (FLANN keeps a
 // pointer to the data), shared by every pair that searches the same image, least
 // recently used evicted first once there are more than `capacity` of them or they hold
@@ -115,12 +144,16 @@ NearestNeighbors Search(const Index& index, const FeatureDescriptors& query, siz
 template <typename Index>
 class IndexCache {
  public:
+  // A k-means index is copied into a flat tree (the same neighbours, found faster) and
+  // then dropped; an index whose tree cannot be read is kept and searched.
   struct Entry {
     FeatureDescriptors descriptors;
     std::unique_ptr<Index> index;
+    std::unique_ptr<const flann_kmeans::KMeansTree> tree;
     size_t Bytes() const {
       return static_cast<size_t>(descriptors.data.size()) +
-             static_cast<size_t>(std::max(0, index->usedMemory()));
+             (index ? static_cast<size_t>(std::max(0, index->usedMemory())) : 0) +
+             (tree ? tree->Bytes() : 0);
     }
   };
   // Builds (or loads) the index of descriptors with this key; `shared` false: for this
@@ -156,6 +189,7 @@ class IndexCache {
         auto entry = std::make_shared<Entry>();
         entry->descriptors = descriptors;
         entry->index = build(entry->descriptors, key, /*shared=*/true);
+        Flatten(entry.get());
         const size_t bytes = entry->Bytes();
         promise.set_value(std::move(entry));
         std::lock_guard<std::mutex> lock(mutex_);
@@ -183,6 +217,7 @@ class IndexCache {
       auto own = std::make_shared<Entry>();
       own->descriptors = descriptors;
       own->index = build(own->descriptors, key, /*shared=*/false);
+      Flatten(own.get());
       return own;
     }
     return entry;
@@ -203,6 +238,16 @@ class IndexCache {
     }
   }
 
+  static void Flatten(Entry* entry) {
+    if constexpr (std::is_same_v<Index, KMeansL2Index>) {
+      entry->tree =
+          flann_kmeans::KMeansTree::FromIndex(*entry->index, entry->descriptors.data.data(),
+                                              static_cast<size_t>(entry->descriptors.size()),
+                                              static_cast<size_t>(entry->descriptors.dimension()));
+      if (entry->tree) entry->index.reset();
+    }
+  }
+
   void Forget(const flann_index_files::DescriptorsKey& key) {
     std::lock_guard<std::mutex> lock(mutex_);
     entries_.remove_if([this, key](const Slot& slot) {
@@ -218,10 +263,6 @@ class IndexCache {
   std::list<Slot> entries_;
   size_t bytes_ = 0;  // of the built entries in entries_
 };
-
-using VectorizedL2Uint8 = flann_l2::VectorizedL2Uint8;
-using KMeansL2Index = flann::KMeansIndex<VectorizedL2Uint8>;
-using HierarchicalHammingIndex = flann::HierarchicalClusteringIndex<flann::Hamming<unsigned char>>;
 
 }  // namespace
 
@@ -381,6 +422,7 @@ class FlannMatcher : public Matcher {
         };
         if (options_.index_cache_size > 0) {
           const auto entry = kmeans_cache_->Get(data, build);
+          if (entry->tree) return Search(*entry->tree, query, k, options_.checks);
           return Search(*entry->index, query, k, search_params, /*squared_distances=*/true);
         }
         return Search(*build(data, flann_index_files::KeyOf(data), /*shared=*/true), query, k,

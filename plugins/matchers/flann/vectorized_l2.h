@@ -128,6 +128,89 @@ __attribute__((target("avx2"))) float AvxL2ToCentre(const uint8_t* a, const Cent
   }
 }
 
+// AvxL2ToCentre's end for a query given as floats: the tail into lane 0, then the lanes.
+__attribute__((target("avx2"))) inline float FinishCentreLanes(__m256 sum, const float* a_float,
+                                                               const float* centre, size_t i,
+                                                               size_t size) {
+  alignas(32) float lanes[kLanes];
+  _mm256_store_ps(lanes, sum);
+  for (; i < size; ++i) {
+    const float diff = a_float[i] - centre[i];
+    lanes[0] += diff * diff;
+  }
+  return ((lanes[0] + lanes[1]) + (lanes[2] + lanes[3])) +
+         ((lanes[4] + lanes[5]) + (lanes[6] + lanes[7]));
+}
+
+// The distances of one query to `count` float centres stored one after another, four
+// centres at a time so that their sums do not wait on each other. `a_float` holds the
+// query's bytes as floats (exact), which saves converting them again for every centre.
+// Each centre's eight lanes and tail take the reference's operations in its order, so
+// every value is L2ToCentre's.
+__attribute__((target("avx2"))) inline void AvxL2ToCentres(const float* a_float,
+                                                           const float* centres, size_t count,
+                                                           size_t size, float* out) {
+  const size_t vector_end = size - size % kLanes;
+  size_t c = 0;
+  for (; c + 4 <= count; c += 4) {
+    const float* c0 = centres + c * size;
+    const float* c1 = c0 + size;
+    const float* c2 = c1 + size;
+    const float* c3 = c2 + size;
+    __m256 s0 = _mm256_setzero_ps(), s1 = _mm256_setzero_ps(), s2 = _mm256_setzero_ps(),
+           s3 = _mm256_setzero_ps();
+    for (size_t i = 0; i < vector_end; i += kLanes) {
+      const __m256 a8 = _mm256_loadu_ps(a_float + i);
+      const __m256 d0 = _mm256_sub_ps(a8, _mm256_loadu_ps(c0 + i));
+      const __m256 d1 = _mm256_sub_ps(a8, _mm256_loadu_ps(c1 + i));
+      const __m256 d2 = _mm256_sub_ps(a8, _mm256_loadu_ps(c2 + i));
+      const __m256 d3 = _mm256_sub_ps(a8, _mm256_loadu_ps(c3 + i));
+      s0 = _mm256_add_ps(s0, _mm256_mul_ps(d0, d0));
+      s1 = _mm256_add_ps(s1, _mm256_mul_ps(d1, d1));
+      s2 = _mm256_add_ps(s2, _mm256_mul_ps(d2, d2));
+      s3 = _mm256_add_ps(s3, _mm256_mul_ps(d3, d3));
+    }
+    out[c] = FinishCentreLanes(s0, a_float, c0, vector_end, size);
+    out[c + 1] = FinishCentreLanes(s1, a_float, c1, vector_end, size);
+    out[c + 2] = FinishCentreLanes(s2, a_float, c2, vector_end, size);
+    out[c + 3] = FinishCentreLanes(s3, a_float, c3, vector_end, size);
+  }
+  for (; c < count; ++c) {
+    const float* centre = centres + c * size;
+    __m256 sum = _mm256_setzero_ps();
+    for (size_t i = 0; i < vector_end; i += kLanes) {
+      const __m256 diff = _mm256_sub_ps(_mm256_loadu_ps(a_float + i), _mm256_loadu_ps(centre + i));
+      sum = _mm256_add_ps(sum, _mm256_mul_ps(diff, diff));
+    }
+    out[c] = FinishCentreLanes(sum, a_float, centre, vector_end, size);
+  }
+}
+
+// Bytes against bytes, sixteen dimensions a step: squared differences summed in pairs
+// and in eight integer lanes, exact.
+__attribute__((target("avx2"))) inline int32_t AvxL2Bytes(const uint8_t* a, const uint8_t* b,
+                                                          size_t size) {
+  __m256i sum = _mm256_setzero_si256();
+  size_t i = 0;
+  for (; i + 16 <= size; i += 16) {
+    const __m256i a16 =
+        _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(a + i)));
+    const __m256i b16 =
+        _mm256_cvtepu8_epi16(_mm_loadu_si128(reinterpret_cast<const __m128i*>(b + i)));
+    const __m256i diff = _mm256_sub_epi16(a16, b16);
+    sum = _mm256_add_epi32(sum, _mm256_madd_epi16(diff, diff));
+  }
+  alignas(32) int32_t lanes[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(lanes), sum);
+  int32_t total = 0;
+  for (const int32_t lane : lanes) total += lane;
+  for (; i < size; ++i) {
+    const int32_t diff = static_cast<int32_t>(a[i]) - static_cast<int32_t>(b[i]);
+    total += diff * diff;
+  }
+  return total;
+}
+
 inline bool HasAvx2() {
   static const bool has_avx2 = __builtin_cpu_supports("avx2");
   return has_avx2;
@@ -147,6 +230,38 @@ float L2ToCentre(const uint8_t* a, const Centre* b, size_t size) {
 #endif
 }
 
+// The distances of bytes `a` to `count` float centres stored one after another, each
+// L2ToCentre's value. `a_float`: the same query as floats, `size` of them.
+inline void L2ToCentres(const uint8_t* a, const float* a_float, const float* centres, size_t count,
+                        size_t size, float* out) {
+#if defined(__x86_64__)
+  if (internal::HasAvx2()) {
+    internal::AvxL2ToCentres(a_float, centres, count, size, out);
+    return;
+  }
+#endif
+  (void)a_float;
+  for (size_t c = 0; c < count; ++c) out[c] = L2ToCentre(a, centres + c * size, size);
+}
+
+// Bytes against bytes: exact in integers (at most 255^2 per dimension, so up to 33,000
+// dimensions), hence the same value from every kernel.
+inline int32_t ScalarL2Bytes(const uint8_t* a, const uint8_t* b, size_t size) {
+  int32_t sum = 0;
+  for (size_t i = 0; i < size; ++i) {
+    const int32_t diff = static_cast<int32_t>(a[i]) - static_cast<int32_t>(b[i]);
+    sum += diff * diff;
+  }
+  return sum;
+}
+
+inline int32_t L2Bytes(const uint8_t* a, const uint8_t* b, size_t size) {
+#if defined(__x86_64__)
+  if (internal::HasAvx2()) return internal::AvxL2Bytes(a, b, size);
+#endif
+  return ScalarL2Bytes(a, b, size);
+}
+
 // The distance functor FLANN's trees are built and searched with.
 struct VectorizedL2Uint8 {
   typedef bool is_kdtree_distance;
@@ -159,12 +274,7 @@ struct VectorizedL2Uint8 {
     using A = std::remove_cv_t<std::remove_reference_t<decltype(*a)>>;
     using B = std::remove_cv_t<std::remove_reference_t<decltype(*b)>>;
     if constexpr (std::is_integral_v<A> && std::is_integral_v<B>) {
-      int32_t sum = 0;  // at most 255^2 per dimension: exact up to 33,000 dimensions
-      for (size_t i = 0; i < size; ++i) {
-        const int32_t diff = static_cast<int32_t>(a[i]) - static_cast<int32_t>(b[i]);
-        sum += diff * diff;
-      }
-      return static_cast<ResultType>(sum);
+      return static_cast<ResultType>(L2Bytes(&a[0], &b[0], size));
     } else if constexpr (std::is_integral_v<A>) {
       return L2ToCentre<B>(&a[0], &b[0], size);
     } else {

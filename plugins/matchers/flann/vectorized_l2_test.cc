@@ -55,6 +55,51 @@ TEST(VectorizedL2, KernelsGiveTheReferenceBitsForDoubleCentres) {
   ExpectKernelsMatchTheReference<double>(2);
 }
 
+// Several centres at once (four at a time, then one by one) give each centre's bits.
+TEST(VectorizedL2, CentresInBatchesGiveEachCentresBits) {
+  std::mt19937 rng(3);
+  std::uniform_int_distribution<int> byte(0, 255);
+  std::uniform_real_distribution<float> centre(-10.0f, 265.0f);
+  for (const size_t size : {size_t{3}, size_t{8}, size_t{61}, size_t{128}}) {
+    for (size_t count = 0; count <= 9; ++count) {
+      std::vector<uint8_t> a(size);
+      std::vector<float> a_float(size), centres(count * size), out(count);
+      for (size_t i = 0; i < size; ++i) {
+        a[i] = static_cast<uint8_t>(byte(rng));
+        a_float[i] = a[i];
+      }
+      for (float& value : centres) value = centre(rng);
+      L2ToCentres(a.data(), a_float.data(), centres.data(), count, size, out.data());
+      for (size_t c = 0; c < count; ++c) {
+        ASSERT_TRUE(SameBits(out[c], ScalarL2ToCentre(a.data(), centres.data() + c * size, size)))
+            << size << " dimensions, centre " << c << " of " << count;
+      }
+    }
+  }
+}
+
+TEST(VectorizedL2, BytesKernelsAreExact) {
+  std::mt19937 rng(4);
+  std::uniform_int_distribution<int> byte(0, 255);
+  for (const size_t size :
+       {size_t{0}, size_t{5}, size_t{16}, size_t{31}, size_t{128}, size_t{131}}) {
+    std::vector<uint8_t> a(size), b(size);
+    for (size_t i = 0; i < size; ++i) {
+      a[i] = static_cast<uint8_t>(byte(rng));
+      b[i] = static_cast<uint8_t>(byte(rng));
+    }
+    int32_t expected = 0;
+    for (size_t i = 0; i < size; ++i) expected += (a[i] - b[i]) * (a[i] - b[i]);
+    EXPECT_EQ(ScalarL2Bytes(a.data(), b.data(), size), expected) << size;
+    EXPECT_EQ(L2Bytes(a.data(), b.data(), size), expected) << size;
+#if defined(__x86_64__)
+    if (internal::HasAvx2()) {
+      EXPECT_EQ(internal::AvxL2Bytes(a.data(), b.data(), size), expected) << size;
+    }
+#endif
+  }
+}
+
 TEST(VectorizedL2, BytesAgainstBytesAreExact) {
   std::vector<uint8_t> a(128, 255), b(128, 0);
   EXPECT_EQ(VectorizedL2Uint8()(a.data(), b.data(), a.size()), 128.0f * 255 * 255);
