@@ -23,7 +23,61 @@
 #include <limits>
 #include <vector>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 namespace tessera::flann_kmeans {
+
+namespace internal {
+
+#if defined(__x86_64__)
+// The lowest of `width` (a multiple of 8) floats, eight lanes at a time. Exact: min
+// rounds nothing, and the ranks hold no NaN.
+__attribute__((target("avx2"))) inline float AvxLowest(const float* values, size_t width) {
+  __m256 lowest = _mm256_loadu_ps(values);
+  for (size_t i = 8; i < width; i += 8) lowest = _mm256_min_ps(lowest, _mm256_loadu_ps(values + i));
+  __m128 half = _mm_min_ps(_mm256_castps256_ps128(lowest), _mm256_extractf128_ps(lowest, 1));
+  half = _mm_min_ps(half, _mm_movehl_ps(half, half));
+  half = _mm_min_ss(half, _mm_shuffle_ps(half, half, 1));
+  return _mm_cvtss_f32(half);
+}
+
+// The first of `width` (a multiple of 8) floats equal to `value`; `width` if none is.
+__attribute__((target("avx2"))) inline size_t AvxFind(const float* values, size_t width,
+                                                      float value) {
+  const __m256 wanted = _mm256_set1_ps(value);
+  for (size_t i = 0; i < width; i += 8) {
+    const int mask =
+        _mm256_movemask_ps(_mm256_cmp_ps(_mm256_loadu_ps(values + i), wanted, _CMP_EQ_OQ));
+    if (mask != 0) return i + static_cast<size_t>(__builtin_ctz(static_cast<unsigned>(mask)));
+  }
+  return width;
+}
+
+inline bool QueueHasAvx2() {
+  static const bool has_avx2 = __builtin_cpu_supports("avx2");
+  return has_avx2;
+}
+#endif
+
+inline float Lowest(const float* values, size_t width) {
+#if defined(__x86_64__)
+  if (QueueHasAvx2()) return AvxLowest(values, width);
+#endif
+  float lowest = values[0];
+  for (size_t i = 1; i < width; ++i) lowest = std::min(lowest, values[i]);
+  return lowest;
+}
+
+inline size_t Find(const float* values, size_t width, float value) {
+#if defined(__x86_64__)
+  if (QueueHasAvx2()) return AvxFind(values, width, value);
+#endif
+  return static_cast<size_t>(std::find(values, values + width, value) - values);
+}
+
+}  // namespace internal
 
 // A rank and a number (a node, or a block), packed into one 64-bit word: a heap then moves
 // an entry with one load and one store, which the CPU forwards from store to load.
@@ -126,7 +180,7 @@ class BlockBranchQueue {
     std::copy(centre_distances, centre_distances + count,
               centre_distances_.data() + block * width_);
     first_[block] = first;
-    const float lowest = Lowest(block_ranks);
+    const float lowest = internal::Lowest(block_ranks, width_);
     if (lowest != kGone) {
       heap_.push_back(RankedEntry(lowest, static_cast<uint32_t>(block)));
       std::push_heap(heap_.begin(), heap_.end(), RanksAfter());
@@ -140,12 +194,13 @@ class BlockBranchQueue {
     const float rank = heap_[0].rank();
     const uint32_t block = heap_[0].id();
     float* const block_ranks = ranks_.data() + static_cast<size_t>(block) * width_;
-    const size_t child = std::find(block_ranks, block_ranks + width_, rank) - block_ranks;
+    const size_t child = internal::Find(block_ranks, width_, rank);
+    if (child == width_) return PopResult::kTie;  // cannot be: start again in FLANN's order
     *node = first_[block] + static_cast<uint32_t>(child);
     *centre_distance = centre_distances_[static_cast<size_t>(block) * width_ + child];
     block_ranks[child] = kGone;
     --waiting_;
-    const float lowest = Lowest(block_ranks);
+    const float lowest = internal::Lowest(block_ranks, width_);
     if (lowest == kGone) {
       std::pop_heap(heap_.begin(), heap_.end(), RanksAfter());
       heap_.pop_back();
@@ -158,12 +213,6 @@ class BlockBranchQueue {
 
  private:
   static constexpr float kGone = std::numeric_limits<float>::infinity();
-
-  float Lowest(const float* block_ranks) const {
-    float lowest = kGone;
-    for (size_t i = 0; i < width_; ++i) lowest = std::min(lowest, block_ranks[i]);
-    return lowest;
-  }
 
   // Restores the heap after its top entry's rank grew.
   void SiftDownTop() {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -93,6 +95,31 @@ TEST(BranchQueues, AFullQueueDropsOrRefuses) {
   EXPECT_FALSE(Add(&blocks, 10, {4.0f, 3.0f, 2.0f, 1.0f, 0.0f}, 0));
   blocks.Reset(5, 4);
   EXPECT_TRUE(Add(&blocks, 10, {4.0f, 3.0f, 2.0f, 1.0f, 0.0f}, 0));
+}
+
+// The block helpers against the standard library, including infinity (a branch gone).
+TEST(BranchQueues, LowestAndFindAgreeWithTheStandardLibrary) {
+  std::vector<float> values = {3.0f, -1.5f, 7.0f, -1.5f, 0.0f, 2.0f, 9.0f, 4.0f,
+                               8.0f, 5.0f,  6.0f, -2.0f, 1.0f, 1.0f, 3.5f, 2.5f};
+  for (const size_t width : {size_t{8}, size_t{16}}) {
+    const float lowest = *std::min_element(values.begin(), values.begin() + width);
+    EXPECT_EQ(internal::Lowest(values.data(), width), lowest) << width;
+    for (const float value : {lowest, 1.0f, 4.0f, 42.0f}) {
+      const size_t expected = static_cast<size_t>(
+          std::find(values.begin(), values.begin() + width, value) - values.begin());
+      EXPECT_EQ(internal::Find(values.data(), width, value), expected) << value;
+#if defined(__x86_64__)
+      if (internal::QueueHasAvx2()) {
+        EXPECT_EQ(internal::AvxFind(values.data(), width, value), expected) << value;
+      }
+#endif
+    }
+  }
+  std::vector<float> gone(8, std::numeric_limits<float>::infinity());
+  EXPECT_EQ(internal::Lowest(gone.data(), 8), std::numeric_limits<float>::infinity());
+  gone[5] = 2.0f;
+  EXPECT_EQ(internal::Lowest(gone.data(), 8), 2.0f);
+  EXPECT_EQ(internal::Find(gone.data(), 8, 2.0f), 5u);
 }
 
 }  // namespace

@@ -137,6 +137,7 @@ bool KMeansTree::Read(const internal::TreeRecorder& recorder, size_t rows, size_
     if (node.leaf) {
       node.first = static_cast<uint32_t>(leaf_ids_.size());
       node.count = static_cast<uint32_t>(source.rows.size());
+      largest_leaf_ = std::max(largest_leaf_, source.rows.size());
       for (const size_t row : source.rows) {
         leaf_ids_.push_back(static_cast<uint32_t>(row));
         leaf_rows_.insert(leaf_rows_.end(), data + row * dimension, data + (row + 1) * dimension);
@@ -174,12 +175,14 @@ bool KMeansTree::Descend(uint32_t node, float centre_distance, const uint8_t* qu
     }
     if (current.leaf) {
       if (*checks >= max_checks && result->Full()) return true;
-      const uint8_t* row = leaf_rows_.data() + static_cast<size_t>(current.first) * dimension_;
-      for (uint32_t i = 0; i < current.count; ++i, row += dimension_) {
-        result->Add(static_cast<float>(flann_l2::L2Bytes(query, row, dimension_)),
-                    leaf_ids_[current.first + i]);
-        ++*checks;
+      int32_t* const row_distances = scratch->row_distances.data();
+      flann_l2::L2BytesToRows(query,
+                              leaf_rows_.data() + static_cast<size_t>(current.first) * dimension_,
+                              current.count, dimension_, row_distances);
+      for (uint32_t i = 0; i < current.count; ++i) {
+        result->Add(static_cast<float>(row_distances[i]), leaf_ids_[current.first + i]);
       }
+      *checks += static_cast<int>(current.count);
       return true;
     }
     float* const distances = scratch->distances.data();
@@ -228,6 +231,7 @@ size_t KMeansTree::Search(const uint8_t* query, size_t k, int max_checks, Search
   scratch->query.assign(query, query + dimension_);
   scratch->distances.resize(branching_);
   scratch->ranks.resize(branching_);
+  scratch->row_distances.resize(largest_leaf_);
   ++scratch->searches;
   internal::NearestTwo result(k);
   scratch->blocks.Reset(branching_, rows_);

@@ -93,9 +93,10 @@ class TreeRecorder : public flann::serialization::OutputArchive<TreeRecorder> {
 
 // What one thread reuses from query to query.
 struct SearchScratch {
-  std::vector<float> query;      // the query's bytes as floats
-  std::vector<float> distances;  // to the centres of the children of the node explored
-  std::vector<float> ranks;      // of those children
+  std::vector<float> query;            // the query's bytes as floats
+  std::vector<float> distances;        // to the centres of the children of the node explored
+  std::vector<float> ranks;            // of those children
+  std::vector<int32_t> row_distances;  // to the rows of the leaf visited
   BlockBranchQueue blocks;
   FlannBranchQueue flann;
   // Queries searched, and how many of them again with FLANN's queue after a tie.
@@ -156,6 +157,7 @@ class KMeansTree {
   size_t dimension_ = 0;
   size_t rows_ = 0;
   size_t branching_ = 0;
+  size_t largest_leaf_ = 0;  // rows
   float cb_index_ = 0.0f;
   std::vector<Node> nodes_;         // breadth first: a node's children are consecutive
   std::vector<float> variances_;    // node i's at i

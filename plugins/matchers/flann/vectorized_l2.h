@@ -211,6 +211,13 @@ __attribute__((target("avx2"))) inline int32_t AvxL2Bytes(const uint8_t* a, cons
   return total;
 }
 
+// Bytes `a` against `count` byte rows stored one after another, AvxL2Bytes on each.
+__attribute__((target("avx2"))) inline void AvxL2BytesToRows(const uint8_t* a, const uint8_t* rows,
+                                                             size_t count, size_t size,
+                                                             int32_t* out) {
+  for (size_t r = 0; r < count; ++r) out[r] = AvxL2Bytes(a, rows + r * size, size);
+}
+
 inline bool HasAvx2() {
   static const bool has_avx2 = __builtin_cpu_supports("avx2");
   return has_avx2;
@@ -260,6 +267,18 @@ inline int32_t L2Bytes(const uint8_t* a, const uint8_t* b, size_t size) {
   if (internal::HasAvx2()) return internal::AvxL2Bytes(a, b, size);
 #endif
   return ScalarL2Bytes(a, b, size);
+}
+
+// Bytes `a` against `count` byte rows stored one after another, each L2Bytes's value.
+inline void L2BytesToRows(const uint8_t* a, const uint8_t* rows, size_t count, size_t size,
+                          int32_t* out) {
+#if defined(__x86_64__)
+  if (internal::HasAvx2()) {
+    internal::AvxL2BytesToRows(a, rows, count, size, out);
+    return;
+  }
+#endif
+  for (size_t r = 0; r < count; ++r) out[r] = ScalarL2Bytes(a, rows + r * size, size);
 }
 
 // The distance functor FLANN's trees are built and searched with.
