@@ -5,14 +5,15 @@
 // the same pruning, the same count of checks and FLANN's own result set and priority
 // queue order, hence the same neighbours and distances, bit for bit.
 //
-// What differs is the bookkeeping around the search. For every query FLANN allocates a
-// priority queue with room for the whole data set, for every node it explores a vector
-// of distances, and it computes the distance to a branch's centre twice: once to rank the
-// branch, once more when it enters it. Its leaves point to descriptors scattered over the
-// data set, and its queue holds 16-byte entries. Here the queue is reused from query to
-// query, a branch carries its centre's distance, the children of a node and the
-// descriptors of a leaf lie side by side, and the integer distances run in vector
-// registers.
+// What differs is the bookkeeping around the search. FLANN pushes every child but the
+// nearest of each node it explores into one binary heap, most of them never taken; for
+// every query it allocates that heap with room for the whole data set, for every node a
+// vector of distances, and it computes the distance to a branch's centre twice. Its
+// leaves point to descriptors scattered over the data set. Here the queue holds one
+// entry per explored node (BlockBranchQueue, branch_queues.h: a query that meets tied
+// branches is searched again with FLANN's heap order), is reused from query to query and
+// keeps each branch's centre distance; the children of a node and the descriptors of a
+// leaf lie side by side, and the distances run in vector registers.
 //
 // The tree is read through KMeansIndex::serialize, FLANN's public saving interface, with
 // an archive that records the values instead of writing bytes. When what it records is
@@ -119,8 +120,8 @@ class KMeansTree {
                 int* indices, float* distances) const;
 
   size_t Bytes() const {
-    return nodes_.size() * sizeof(Node) + centres_.size() * sizeof(float) + leaf_rows_.size() +
-           leaf_ids_.size() * sizeof(uint32_t);
+    return nodes_.size() * sizeof(Node) + (centres_.size() + variances_.size()) * sizeof(float) +
+           leaf_rows_.size() + leaf_ids_.size() * sizeof(uint32_t);
   }
 
  private:
@@ -170,8 +171,8 @@ template <typename Distance>
 std::unique_ptr<KMeansTree> KMeansTree::FromIndex(const flann::KMeansIndex<Distance>& index,
                                                   const uint8_t* data, size_t rows,
                                                   size_t dimension) {
-  static_assert(std::is_same_v<typename Distance::ResultType, float>,
-                "the tree stores float centres");
+  static_assert(std::is_same_v<Distance, flann_l2::VectorizedL2Uint8>,
+                "the search computes VectorizedL2Uint8's distances, float centres");
   if (rows == 0 || rows > UINT32_MAX || index.size() != rows || index.veclen() != dimension) {
     return nullptr;
   }
