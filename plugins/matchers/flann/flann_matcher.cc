@@ -144,16 +144,29 @@ using HierarchicalHammingIndex = flann::HierarchicalClusteringIndex<flann::Hammi
 template <typename Index>
 class IndexCache {
  public:
-  // A k-means index is copied into a flat tree (the same neighbours, found faster) and
-  // then dropped; an index whose tree cannot be read is kept and searched.
+  // A k-means index is copied into a flat tree (the same neighbours, found faster, and a
+  // copy of the rows of its own), and then dropped with the descriptors it was built
+  // over; an index whose tree cannot be read is kept and searched.
   struct Entry {
-    FeatureDescriptors descriptors;
+    FeatureDescriptors descriptors;  // empty once `tree` holds the rows
     std::unique_ptr<Index> index;
     std::unique_ptr<const flann_kmeans::KMeansTree> tree;
     size_t Bytes() const {
       return static_cast<size_t>(descriptors.data.size()) +
              (index ? static_cast<size_t>(std::max(0, index->usedMemory())) : 0) +
              (tree ? tree->Bytes() : 0);
+    }
+    // Whether the index is over exactly these descriptors (hashes can collide).
+    bool Holds(const FeatureDescriptors& other) const {
+      if (descriptors.metric != other.metric) return false;
+      if (tree) {
+        return tree->HoldsRows(other.data.data(), static_cast<size_t>(other.size()),
+                               static_cast<size_t>(other.dimension()));
+      }
+      return descriptors.data.rows() == other.data.rows() &&
+             descriptors.data.cols() == other.data.cols() &&
+             std::memcmp(descriptors.data.data(), other.data.data(),
+                         static_cast<size_t>(other.data.size())) == 0;
     }
   };
   // Builds (or loads) the index of descriptors with this key; `shared` false: for this
@@ -209,11 +222,7 @@ class IndexCache {
     }
     std::shared_ptr<const Entry> entry = future.get();
     // A hash collision between different descriptors: build privately.
-    if (entry->descriptors.metric != descriptors.metric ||
-        entry->descriptors.data.rows() != descriptors.data.rows() ||
-        entry->descriptors.data.cols() != descriptors.data.cols() ||
-        std::memcmp(entry->descriptors.data.data(), descriptors.data.data(),
-                    static_cast<size_t>(descriptors.data.size())) != 0) {
+    if (!entry->Holds(descriptors)) {
       auto own = std::make_shared<Entry>();
       own->descriptors = descriptors;
       own->index = build(own->descriptors, key, /*shared=*/false);
@@ -244,7 +253,10 @@ class IndexCache {
           flann_kmeans::KMeansTree::FromIndex(*entry->index, entry->descriptors.data.data(),
                                               static_cast<size_t>(entry->descriptors.size()),
                                               static_cast<size_t>(entry->descriptors.dimension()));
-      if (entry->tree) entry->index.reset();
+      if (entry->tree) {
+        entry->index.reset();
+        entry->descriptors.data.resize(0, entry->descriptors.data.cols());
+      }
     }
   }
 

@@ -158,6 +158,17 @@ bool KMeansTree::Read(const internal::TreeRecorder& recorder, size_t rows, size_
   return true;
 }
 
+bool KMeansTree::HoldsRows(const uint8_t* data, size_t rows, size_t dimension) const {
+  if (rows != rows_ || dimension != dimension_) return false;
+  for (size_t at = 0; at < leaf_ids_.size(); ++at) {
+    if (std::memcmp(leaf_rows_.data() + at * dimension,
+                    data + static_cast<size_t>(leaf_ids_[at]) * dimension, dimension) != 0) {
+      return false;
+    }
+  }
+  return true;
+}
+
 template <typename Queue>
 bool KMeansTree::Descend(uint32_t node, float centre_distance, const uint8_t* query, int max_checks,
                          int* checks, internal::NearestTwo* result, Queue* queue,

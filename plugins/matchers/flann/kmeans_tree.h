@@ -119,6 +119,10 @@ class KMeansTree {
   size_t Search(const uint8_t* query, size_t k, int max_checks, SearchScratch* scratch,
                 int* indices, float* distances) const;
 
+  // Whether `rows` rows of `dimension` bytes at `data` are the rows the tree was copied
+  // with, byte for byte.
+  bool HoldsRows(const uint8_t* data, size_t rows, size_t dimension) const;
+
   size_t Bytes() const {
     return nodes_.size() * sizeof(Node) + (centres_.size() + variances_.size()) * sizeof(float) +
            leaf_rows_.size() + leaf_ids_.size() * sizeof(uint32_t);

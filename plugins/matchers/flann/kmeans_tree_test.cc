@@ -121,6 +121,19 @@ TEST(KMeansTree, RefusesAnIndexOfOtherRows) {
   EXPECT_NE(KMeansTree::FromIndex(*index, data.data(), 500, dimension), nullptr);
 }
 
+TEST(KMeansTree, KnowsTheRowsItWasCopiedWith) {
+  const size_t dimension = 32;
+  std::vector<uint8_t> data = ClusteredRows(500, dimension, 10, 8);
+  const auto index = BuildIndex(data, dimension, 8);
+  const auto tree = KMeansTree::FromIndex(*index, data.data(), 500, dimension);
+  ASSERT_NE(tree, nullptr);
+  std::vector<uint8_t> same = data;
+  EXPECT_TRUE(tree->HoldsRows(same.data(), 500, dimension));
+  EXPECT_FALSE(tree->HoldsRows(same.data(), 499, dimension));
+  same[321 * dimension + 7] ^= 1;
+  EXPECT_FALSE(tree->HoldsRows(same.data(), 500, dimension));
+}
+
 // Fewer rows than the branching: the root is a leaf.
 TEST(KMeansTree, SearchesATreeThatIsOneLeaf) {
   const size_t dimension = 128;
