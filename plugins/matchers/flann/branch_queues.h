@@ -23,9 +23,7 @@
 #include <limits>
 #include <vector>
 
-#if defined(__x86_64__)
-#include <immintrin.h>
-#endif
+#include "vectorized_l2.h"  // flann_l2::internal::HasAvx2, <immintrin.h>
 
 namespace tessera::flann_kmeans {
 
@@ -55,15 +53,11 @@ __attribute__((target("avx2"))) inline size_t AvxFind(const float* values, size_
   return width;
 }
 
-inline bool QueueHasAvx2() {
-  static const bool has_avx2 = __builtin_cpu_supports("avx2");
-  return has_avx2;
-}
 #endif
 
 inline float Lowest(const float* values, size_t width) {
 #if defined(__x86_64__)
-  if (QueueHasAvx2()) return AvxLowest(values, width);
+  if (flann_l2::internal::HasAvx2()) return AvxLowest(values, width);
 #endif
   float lowest = values[0];
   for (size_t i = 1; i < width; ++i) lowest = std::min(lowest, values[i]);
@@ -72,7 +66,7 @@ inline float Lowest(const float* values, size_t width) {
 
 inline size_t Find(const float* values, size_t width, float value) {
 #if defined(__x86_64__)
-  if (QueueHasAvx2()) return AvxFind(values, width, value);
+  if (flann_l2::internal::HasAvx2()) return AvxFind(values, width, value);
 #endif
   return static_cast<size_t>(std::find(values, values + width, value) - values);
 }

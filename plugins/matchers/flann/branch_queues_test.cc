@@ -109,7 +109,7 @@ TEST(BranchQueues, LowestAndFindAgreeWithTheStandardLibrary) {
           std::find(values.begin(), values.begin() + width, value) - values.begin());
       EXPECT_EQ(internal::Find(values.data(), width, value), expected) << value;
 #if defined(__x86_64__)
-      if (internal::QueueHasAvx2()) {
+      if (flann_l2::internal::HasAvx2()) {
         EXPECT_EQ(internal::AvxFind(values.data(), width, value), expected) << value;
       }
 #endif

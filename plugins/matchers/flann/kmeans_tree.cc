@@ -133,7 +133,7 @@ bool KMeansTree::Read(const internal::TreeRecorder& recorder, size_t rows, size_
   nodes_.reserve(read.size());
   for (size_t at = 0; at < order.size(); ++at) {
     const ReadNode& source = read[order[at]];
-    Node node{source.radius, source.variance, 0, 0, source.children.empty()};
+    Node node{source.radius, 0, 0, source.children.empty()};
     if (node.leaf) {
       node.first = static_cast<uint32_t>(leaf_ids_.size());
       node.count = static_cast<uint32_t>(source.rows.size());
@@ -148,7 +148,7 @@ bool KMeansTree::Read(const internal::TreeRecorder& recorder, size_t rows, size_
       order.insert(order.end(), source.children.begin(), source.children.end());
     }
     nodes_.push_back(node);
-    variances_.push_back(node.variance);
+    variances_.push_back(source.variance);
   }
   centres_.resize(order.size() * dimension);
   for (size_t i = 0; i < order.size(); ++i) {

@@ -131,7 +131,6 @@ class KMeansTree {
  private:
   struct Node {
     float radius;
-    float variance;
     uint32_t first;  // first child (inner node) or first leaf row (leaf)
     uint32_t count;  // children or leaf rows
     bool leaf;
