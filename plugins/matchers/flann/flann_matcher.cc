@@ -21,6 +21,7 @@
 #include <mutex>
 #include <string>
 
+#include "index_cache.h"
 #include "index_files.h"
 #include "kmeans_tree.h"
 #include "tessera/match_filter.h"
@@ -107,6 +108,10 @@ NearestNeighbors Search(const Index& index, const FeatureDescriptors& query, siz
   return neighbors;
 }
 
+using flann_cache::HierarchicalHammingIndex;
+using flann_cache::IndexCache;
+using flann_cache::KMeansL2Index;
+
 // The same neighbours as Search over the FLANN index the tree was copied from.
 NearestNeighbors Search(const flann_kmeans::KMeansTree& tree, const FeatureDescriptors& query,
                         size_t k, int checks) {
@@ -130,151 +135,6 @@ NearestNeighbors Search(const flann_kmeans::KMeansTree& tree, const FeatureDescr
   }
   return neighbors;
 }
-
-using VectorizedL2Uint8 = flann_l2::VectorizedL2Uint8;
-using KMeansL2Index = flann::KMeansIndex<VectorizedL2Uint8>;
-using HierarchicalHammingIndex = flann::HierarchicalClusteringIndex<flann::Hamming<unsigned char>>;
-
-// Indexes of one type built over their own copy of the descriptors (FLANN keeps a
-// pointer to the data), shared by every pair that searches the same image, least
-// recently used evicted first once there are more than `capacity` of them or they hold
-// more than `max_bytes` (descriptors plus the index's own memory; the newest always
-// stays). Thread-safe; a second caller of an index being built waits for it instead of
-// building it again, and an evicted index lives on while a pair still searches it.
-template <typename Index>
-class IndexCache {
- public:
-  // A k-means index is copied into a flat tree (the same neighbours, found faster, and a
-  // copy of the rows of its own), and then dropped with the descriptors it was built
-  // over; an index whose tree cannot be read is kept and searched.
-  struct Entry {
-    FeatureDescriptors descriptors;  // empty once `tree` holds the rows
-    std::unique_ptr<Index> index;
-    std::unique_ptr<const flann_kmeans::KMeansTree> tree;
-    size_t Bytes() const {
-      return static_cast<size_t>(descriptors.data.size()) +
-             (index ? static_cast<size_t>(std::max(0, index->usedMemory())) : 0) +
-             (tree ? tree->Bytes() : 0);
-    }
-    // Whether the index is over exactly these descriptors (hashes can collide).
-    bool Holds(const FeatureDescriptors& other) const {
-      if (descriptors.metric != other.metric) return false;
-      if (tree) {
-        return tree->HoldsRows(other.data.data(), static_cast<size_t>(other.size()),
-                               static_cast<size_t>(other.dimension()));
-      }
-      return descriptors.data.rows() == other.data.rows() &&
-             descriptors.data.cols() == other.data.cols() &&
-             std::memcmp(descriptors.data.data(), other.data.data(),
-                         static_cast<size_t>(other.data.size())) == 0;
-    }
-  };
-  // Builds (or loads) the index of descriptors with this key; `shared` false: for this
-  // caller alone, without the index files.
-  using Builder = std::function<std::unique_ptr<Index>(
-      const FeatureDescriptors&, const flann_index_files::DescriptorsKey&, bool shared)>;
-
-  IndexCache(size_t capacity, size_t max_bytes) : capacity_(capacity), max_bytes_(max_bytes) {}
-
-  std::shared_ptr<const Entry> Get(const FeatureDescriptors& descriptors, const Builder& build) {
-    const flann_index_files::DescriptorsKey key = flann_index_files::KeyOf(descriptors);
-    std::shared_future<std::shared_ptr<const Entry>> future;
-    std::promise<std::shared_ptr<const Entry>> promise;
-    bool must_build = false;
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      for (auto it = entries_.begin(); it != entries_.end(); ++it) {
-        if (it->key == key) {
-          entries_.splice(entries_.begin(), entries_, it);  // most recently used first
-          future = it->future;
-          break;
-        }
-      }
-      if (!future.valid()) {
-        future = promise.get_future().share();
-        entries_.push_front({key, future, 0});
-        Evict();
-        must_build = true;
-      }
-    }
-    if (must_build) {
-      try {
-        auto entry = std::make_shared<Entry>();
-        entry->descriptors = descriptors;
-        entry->index = build(entry->descriptors, key, /*shared=*/true);
-        Flatten(entry.get());
-        const size_t bytes = entry->Bytes();
-        promise.set_value(std::move(entry));
-        std::lock_guard<std::mutex> lock(mutex_);
-        for (Slot& slot : entries_) {
-          if (slot.key == key && slot.bytes == 0) {
-            slot.bytes = bytes;
-            bytes_ += bytes;
-            break;
-          }
-        }
-        Evict();
-      } catch (...) {
-        promise.set_exception(std::current_exception());
-        Forget(key);
-        throw;
-      }
-    }
-    std::shared_ptr<const Entry> entry = future.get();
-    // A hash collision between different descriptors: build privately.
-    if (!entry->Holds(descriptors)) {
-      auto own = std::make_shared<Entry>();
-      own->descriptors = descriptors;
-      own->index = build(own->descriptors, key, /*shared=*/false);
-      Flatten(own.get());
-      return own;
-    }
-    return entry;
-  }
-
- private:
-  struct Slot {
-    flann_index_files::DescriptorsKey key;
-    std::shared_future<std::shared_ptr<const Entry>> future;
-    size_t bytes;  // 0 while it is being built
-  };
-
-  // Under mutex_: drops least recently used entries beyond either limit, never the newest.
-  void Evict() {
-    while (entries_.size() > 1 && (entries_.size() > capacity_ || bytes_ > max_bytes_)) {
-      bytes_ -= entries_.back().bytes;
-      entries_.pop_back();
-    }
-  }
-
-  static void Flatten(Entry* entry) {
-    if constexpr (std::is_same_v<Index, KMeansL2Index>) {
-      entry->tree =
-          flann_kmeans::KMeansTree::FromIndex(*entry->index, entry->descriptors.data.data(),
-                                              static_cast<size_t>(entry->descriptors.size()),
-                                              static_cast<size_t>(entry->descriptors.dimension()));
-      if (entry->tree) {
-        entry->index.reset();
-        entry->descriptors.data.resize(0, entry->descriptors.data.cols());
-      }
-    }
-  }
-
-  void Forget(const flann_index_files::DescriptorsKey& key) {
-    std::lock_guard<std::mutex> lock(mutex_);
-    entries_.remove_if([this, key](const Slot& slot) {
-      if (slot.key != key) return false;
-      bytes_ -= slot.bytes;
-      return true;
-    });
-  }
-
-  size_t capacity_;
-  size_t max_bytes_;
-  std::mutex mutex_;
-  std::list<Slot> entries_;
-  size_t bytes_ = 0;  // of the built entries in entries_
-};
 
 }  // namespace
 
@@ -304,10 +164,11 @@ class FlannMatcher : public Matcher {
         reader.Get<int>("index_cache_mb", options_.index_cache_mb, 1, 1000000);
     reader.Finish();
     const size_t cache_bytes = static_cast<size_t>(options_.index_cache_mb) << 20;
+    const auto warn = [this](const std::string& text) { log().Warn(text); };
     kmeans_cache_ =
-        std::make_unique<IndexCache<KMeansL2Index>>(options_.index_cache_size, cache_bytes);
+        std::make_unique<IndexCache<KMeansL2Index>>(options_.index_cache_size, cache_bytes, warn);
     hierarchical_cache_ = std::make_unique<IndexCache<HierarchicalHammingIndex>>(
-        options_.index_cache_size, cache_bytes);
+        options_.index_cache_size, cache_bytes, warn);
     effective_options_ = reader.Effective();
   }
 
