@@ -20,15 +20,14 @@ grep -q "no display\|built without the GUI" "$work/err.txt" || fail "message: $(
 env -u DISPLAY -u WAYLAND_DISPLAY "$tessera" plugins > /dev/null ||
   fail "tessera plugins without a display"
 if grep -q "built without the GUI" "$work/err.txt"; then
-  echo "SKIP: this tessera was built without the GUI"
-  exit 77
+  skip_or_fail "this tessera was built without the GUI"
 fi
 
-command -v Xvfb > /dev/null || { echo "SKIP: Xvfb is not installed"; exit 77; }
+command -v Xvfb > /dev/null || skip_or_fail "Xvfb is not installed"
 exec {fd}<> <(:)
 Xvfb -displayfd "$fd" -screen 0 1600x1000x24 -nolisten tcp > /dev/null 2>&1 &
 xvfb_pid=$!
-read -r -t 10 -u "$fd" display || { echo "SKIP: Xvfb did not start"; exit 77; }
+read -r -t 10 -u "$fd" display || skip_or_fail "Xvfb did not start"
 export DISPLAY=":$display" LIBGL_ALWAYS_SOFTWARE=1
 
 mkdir -p "$work/empty"

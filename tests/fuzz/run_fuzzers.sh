@@ -13,7 +13,8 @@
 # Environment: TESSERA_FUZZ_CORPUS_DIR keeps the corpus there between runs (default: a
 # temporary copy); TESSERA_FUZZ_JOBS targets run at once (default 2).
 # Exit codes: 0 no finding, 1 a finding or a build failure, 77 clang's fuzzer runtime
-# is missing (skipped).
+# is missing (skipped; under CI=true a failure, as scripts/install_dependencies.sh
+# installs it: common.sh's skip_or_fail).
 set -euo pipefail
 
 source_dir=$(cd "$1" && pwd)
@@ -21,6 +22,7 @@ build_dir=$2
 seconds=${3:-30}
 shared_dir=${TESSERA_SHARED_DIR:-${4:-}}
 shift $(($# < 4 ? $# : 4))
+source "$source_dir/tests/end_to_end/common.sh"
 all_targets=(manifest exif image_header colmap_binary colmap_text ground_truth database)
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=("${all_targets[@]}")
@@ -32,17 +34,15 @@ trap 'rm -rf "$work"' EXIT
 # --- clang and its libFuzzer runtime -------------------------------------------------
 clangxx=${TESSERA_FUZZ_CXX:-$(command -v clang++ || true)}
 if [ -z "$clangxx" ]; then
-  echo "run_fuzzers: SKIPPED: clang++ not found (Debian package clang)"
-  exit 77
+  skip_or_fail "run_fuzzers: clang++ not found (Debian package clang)"
 fi
 printf '#include <cstddef>\n#include <cstdint>\nextern "C" int LLVMFuzzerTestOneInput(const uint8_t*, size_t) { return 0; }\n' \
   > "$work/probe.cc"
 if ! "$clangxx" -fsanitize=fuzzer,address,undefined "$work/probe.cc" -o "$work/probe" \
      > "$work/probe.log" 2>&1; then
-  echo "run_fuzzers: SKIPPED: $clangxx cannot link -fsanitize=fuzzer (libFuzzer's runtime," \
-       "Debian package libclang-rt-dev, is missing):"
   head -3 "$work/probe.log"
-  exit 77
+  skip_or_fail "run_fuzzers: $clangxx cannot link -fsanitize=fuzzer (libFuzzer's runtime," \
+               "Debian package libclang-rt-dev, is missing)"
 fi
 
 # --- build ------------------------------------------------------------------------------
@@ -121,7 +121,6 @@ if [ -n "$datasets" ] && [ -d "$datasets" ]; then
     if [ -n "$first_image" ]; then head -c 16384 "$first_image" > "$seeds/exif/dataset_$name"; fi
   done
 else
-  source "$source_dir/tests/end_to_end/common.sh"
   skip_part_or_fail "run_fuzzers: no shared datasets at '${datasets:-}': ground-truth seeds" \
     "from the committed ones only"
 fi

@@ -19,11 +19,9 @@ for candidate in python3 /usr/bin/python3; do
     break
   fi
 done
-if [ -z "$python" ]; then
-  echo "SKIP: no python3 with open3d (apt-get install python3-open3d); the PLY check with" \
-       "Open3D did not run"
-  exit 77
-fi
+[ -n "$python" ] ||
+  skip_or_fail "no python3 with open3d (apt-get install python3-open3d); the PLY check with" \
+               "Open3D did not run"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
