@@ -239,7 +239,7 @@ kids=""
 if [ -n "$failing_plugins" ]; then
   sed 's/"bundle_adjuster"/"mapper": {"plugin": "failing_mapper"}, "bundle_adjuster"/' \
     "$work/m.json" > "$work/failing.json"
-  expect_exit 3 "$work/failing.log" "merge: no cluster holds a model" \
+  expect_exit 3 "$work/failing.log" "map --hierarchical: no cluster of $out holds a model" \
     env TESSERA_PLUGIN_PATH="$failing_plugins" "$tessera" map --hierarchical --jobs 2 \
     --threads 1 --output "$out" --manifest "$work/failing.json"
   [ "$(cat "$out"/sparse/0/*.bin "$out/mapping_summary.json" | md5sum)" = "$model" ] ||
