@@ -6,6 +6,9 @@
 #                                 or removed (a sentinel tree is checked after each case)
 #   foreign files deleted         a file in the output folder that Tessera did not write
 #                                 changed or removed
+# and, in the read-back section on clusters.json and the cluster processes (issue 46),
+#   models removed by a failed run, orphans after kill -9 of a parent, and cluster
+#   processes left 20 s after a signal to their parent.
 # Every count but the first ("cases tried") must be 0. On a 512 px copy of
 # examples/fountain-P11-small with ORB (a few seconds per case).
 # usage: benchmarks/bad_outputs.sh [TESSERA]
@@ -176,10 +179,127 @@ check "3DGS re-export of a smaller model: no old image left" 0 '[ "$(ls "$work/g
 check "--threads 65537" 2 "" "" -- \
   "$tessera" run --images "$work/d" --output "$work/thr" --manifest "$work/bin.json" --threads 65537
 
+# === Read-back: clusters.json and the cluster processes (issue 46) =====================
+# A partitioned workspace of the 11 images (clusters of at most 9, 3 shared), mapped by
+# map --hierarchical once. Each case works on a copy; counted besides the above:
+#   models removed by a failed run   a failing or stopped run changed the merged model
+#                                    (sparse/, mapping_summary.json) that was there
+#   orphans after kill -9 of a parent  cluster processes running 20 s after a kill -9 of
+#                                    the main process of map --hierarchical
+#   children left after a signal     the same 20 s after SIGTERM or SIGINT to it alone
+removed=0 orphans=0 left_running=0
+manifest "$work/part.json" '[{"plugin": "colmap_binary"}]' \
+  '"distributed": {"cluster_max_images": 9, "cluster_overlap": 3}'
+t run --images "$work/all" --output "$work/cbase" --manifest "$work/part.json" > "$work/cbase.log" 2>&1 &&
+  t map --hierarchical --jobs 2 --output "$work/cbase" --manifest "$work/part.json" >> "$work/cbase.log" 2>&1 ||
+  { tail -5 "$work/cbase.log"; echo "the partitioned base run failed"; exit 1; }
+model_sums() { (cd "$1" && find sparse mapping_summary.json -type f 2> /dev/null | sort | xargs -r sha1sum); }
+forge() {  # forge DIR PYTHON: edits DIR/clusters.json, loaded as c
+  python3 -c "
+import json, sys
+c = json.load(open(sys.argv[1]))
+$2
+json.dump(c, open(sys.argv[1], 'w'))" "$1/clusters.json"
+}
+# cluster_case NAME EXPECTED MESSAGE FORGE -- COMMAND... (OUT in COMMAND: the case's copy)
+cluster_case() {
+  local name=$1 expected=$2 message=$3 edit=$4
+  shift 5
+  local out=$work/c$tried
+  rm -rf "$out"; cp -a "$work/cbase" "$out"
+  [ -z "$edit" ] || forge "$out" "$edit"
+  local before; before=$(model_sums "$out")
+  check "$name" "$expected" "grep -qF -- \"${message//OUT/$out}\" \"\$work/case.log\"" "" -- "${@//OUT/$out}"
+  # A run that fails (exit other than 0) must leave the model that was there.
+  [ "$expected" = 0 ] || [ "$(model_sums "$out")" = "$before" ] ||
+    { removed=$((removed + 1)); echo "    the model that was there changed"; }
+}
+hier=(t map --hierarchical --jobs 2 --output OUT --manifest "$work/part.json")
+one=(t map --cluster 0 --output OUT --manifest "$work/part.json")
+merge=("$tessera" merge --stage map --output OUT --manifest "$work/part.json")  # no --threads
+focal='c["cameras"][0]["focal_length"] = 1e300'
+cluster_case "clusters.json focal 1e300 (hierarchical)" 2 "OUT/clusters.json: cameras: camera 1: focal_length 1e+300 px" "$focal" -- "${hier[@]}"
+cluster_case "clusters.json focal 1e300 (cluster)" 2 "OUT/clusters.json: cameras: camera 1: focal_length 1e+300 px" "$focal" -- "${one[@]}"
+cluster_case "clusters.json focal 1e300 (merge)" 2 "OUT/clusters.json: cameras: camera 1: focal_length 1e+300 px" "$focal" -- "${merge[@]}"
+cluster_case "clusters.json focal -1" 2 "OUT/clusters.json: cameras[0].focal_length = -1" 'c["cameras"][0]["focal_length"] = -1' -- "${hier[@]}"
+cluster_case "clusters.json focal 0.01 px" 2 "OUT/clusters.json: cameras: camera 1: focal_length 0.01 px" 'c["cameras"][0]["focal_length"] = 0.01' -- "${hier[@]}"
+cluster_case "clusters.json focal a string" 2 "OUT/clusters.json: not a clusters file" 'c["cameras"][0]["focal_length"] = "460"' -- "${hier[@]}"
+cluster_case "clusters.json camera id 99" 2 "OUT/clusters.json: cameras: camera 99: not a camera of the workspace" 'c["cameras"][0]["camera_id"] = 99' -- "${hier[@]}"
+cluster_case "clusters.json camera id 1e300" 2 "OUT/clusters.json: cameras[0].camera_id = 1e+300" 'c["cameras"][0]["camera_id"] = 1e300' -- "${one[@]}"
+cluster_case "clusters.json camera listed twice" 2 "OUT/clusters.json: cameras: camera 1 is listed twice" 'c["cameras"].append(c["cameras"][0])' -- "${hier[@]}"
+cluster_case "clusters.json image ../../etc/passwd (hierarchical)" 2 "OUT/clusters.json: cluster 0: image '../../etc/passwd' is not an image of the workspace" 'c["clusters"][0]["images"].append("../../etc/passwd")' -- "${hier[@]}"
+cluster_case "clusters.json image ../../etc/passwd (cluster)" 2 "OUT/clusters.json: cluster 0: image '../../etc/passwd' is not an image of the workspace" 'c["clusters"][0]["images"].append("../../etc/passwd")' -- "${one[@]}"
+cluster_case "clusters.json image /etc/passwd in a core" 2 "OUT/clusters.json: cluster 1: image '/etc/passwd' is not an image of the workspace" 'c["clusters"][1]["images"].append("/etc/passwd"); c["clusters"][1]["core"].append("/etc/passwd")' -- "${merge[@]}"
+cluster_case "clusters.json isolated image not in workspace" 2 "OUT/clusters.json: isolated: image 'ghost.jpg' is not an image of the workspace" 'c["isolated"].append("ghost.jpg")' -- "${hier[@]}"
+cluster_case "clusters.json image listed twice" 2 "OUT/clusters.json: cluster 0: images: image '" 'c["clusters"][0]["images"].append(c["clusters"][0]["images"][0])' -- "${hier[@]}"
+cluster_case "clusters.json image in two cores" 2 "is in the core of cluster 0 too" 'x = c["clusters"][0]["core"][0]; c["clusters"][1]["core"].append(x); c["clusters"][1]["images"] = sorted(set(c["clusters"][1]["images"] + [x]))' -- "${one[@]}"
+cluster_case "clusters.json image dropped from every core" 2 "has verified pairs but is in no cluster's core" 'x = c["clusters"][0]["core"].pop(); [k["images"].remove(x) for k in c["clusters"] if x in k["images"]]; [n["shared"].remove(x) for k in c["clusters"] for n in k["neighbours"] if x in n["shared"]]' -- "${hier[@]}"
+cluster_case "clusters.json neighbour 99" 2 "OUT/clusters.json: cluster 0: neighbour 99: not another cluster" 'c["clusters"][0]["neighbours"].append({"cluster": 99, "shared": []})' -- "${hier[@]}"
+cluster_case "clusters.json cluster missing from the tree" 2 "is missing from its list or its tree" 'c["tree"] = {"cluster": 0}' -- "${hier[@]}"
+cluster_case "clusters.json tree 100000 levels deep" 2 "tree: deeper than 1000 levels" 'text = json.dumps(c).replace(json.dumps(c["tree"]), "{\"children\": [" * 100000 + "{\"cluster\": 0}" + "]}" * 100000)
+open(sys.argv[1], "w").write(text); sys.exit(0)' -- "${hier[@]}"
+cluster_case "clusters.json not JSON (not partitioned over)" 2 "OUT/clusters.json: not a clusters file" 'open(sys.argv[1], "w").write("{not json"); sys.exit(0)' -- "${hier[@]}"
+cluster_case "clusters.json missing (stale: partitioned again)" 0 "map: partitioning again" "" -- bash -c 'rm "$0/clusters.json"; exec "$@"' OUT "${hier[@]/#t/$tessera}"
+# The advice works: the merge's command maps a truncated cluster again, then the merge.
+out=$work/advice; rm -rf "$out"; cp -a "$work/cbase" "$out"
+truncate -s 100 "$out/clusters/1/sparse/0/points3D.bin"
+check "truncated cluster: merge names a command" 2 'grep -q "run \`tessera map --cluster 1 " "$work/case.log"' "" -- "${merge[@]//OUT/$out}"
+advice=$(grep -o 'run `tessera map --cluster 1 [^`]*`' "$work/case.log" | head -1 | sed 's/^run `tessera //; s/`$//')
+# shellcheck disable=SC2086
+check "truncated cluster: the command it names" 0 'grep -q "moved aside to" "$work/case.log"' "" -- "$tessera" $advice --threads 2
+check "truncated cluster: the merge after it" 0 'grep -q "merge: .* into 1 model(s), 11 of 11 images" "$work/case.log"' "" -- "${merge[@]//OUT/$out}"
+manifest "$work/partfail.json" '[{"plugin": "colmap_binary"}]' \
+  '"distributed": {"cluster_max_images": 9, "cluster_overlap": 3}'
+sed -i 's/"bundle_adjuster"/"mapper": {"plugin": "failing_mapper"}, "bundle_adjuster"/' "$work/partfail.json"
+cluster_case "every cluster fails (failing_mapper)" 3 "map --hierarchical: no cluster of OUT holds a model" "" -- \
+  env TESSERA_PLUGIN_PATH="$bin/../test_plugins/failing" "$tessera" map --hierarchical --jobs 2 --threads 1 --output OUT --manifest "$work/partfail.json"
+
+# Signals to the main process of map --hierarchical alone, and kill -9 of it, once a
+# cluster process runs (one at a time, the clusters not mapped yet).
+alive() { [ -r "/proc/$1/status" ] && ! grep -q '^State:[[:space:]]*Z' "/proc/$1/status"; }
+# parent_case NAME SIGNAL EXPECTED [stop]: "stop" stops the cluster processes first, as a
+# cluster busy in a long step is: only a death signal ends them then.
+parent_case() {
+  local name=$1 signal=$2 expected=$3 stop=${4:-} out=$work/sig$tried
+  tried=$((tried + 1))
+  rm -rf "$out"; cp -a "$work/cbase" "$out"; rm -rf "$out/clusters"
+  local before; before=$(model_sums "$out")
+  "$tessera" map --hierarchical --jobs 1 --threads 1 --output "$out" --manifest "$work/part.json" > "$work/case.log" 2>&1 &
+  local pid=$! kids="" deadline=$((SECONDS + 60))
+  while [ -z "$kids" ] && [ "$SECONDS" -lt "$deadline" ] && kill -0 "$pid" 2> /dev/null; do
+    kids=$(pgrep -P "$pid"); sleep 0.05
+  done
+  # shellcheck disable=SC2086
+  [ -z "$stop" ] || kill -STOP $kids 2> /dev/null
+  kill -"$signal" "$pid"; wait "$pid" 2> /dev/null; local code=$?
+  deadline=$((SECONDS + 20))
+  local left=0 kid
+  for kid in $kids; do while alive "$kid" && [ "$SECONDS" -lt "$deadline" ]; do sleep 0.1; done; done
+  for kid in $kids; do alive "$kid" && { left=$((left + 1)); kill -9 "$kid"; }; done
+  local verdict=ok
+  if [ -z "$kids" ]; then verdict="no cluster process seen"; silent=$((silent + 1))
+  elif [ "$left" != 0 ]; then
+    verdict="$left cluster process(es) left after 20 s"
+    if [ "$signal" = KILL ]; then orphans=$((orphans + left)); else left_running=$((left_running + left)); fi
+  elif [ "$code" != "$expected" ]; then verdict="exit $code, expected $expected"; silent=$((silent + 1))
+  elif grep -q "merge: " "$work/case.log"; then verdict="merged after the signal"; silent=$((silent + 1))
+  fi
+  [ "$(model_sums "$out")" = "$before" ] || { removed=$((removed + 1)); verdict="model removed"; }
+  printf "%-52s exit %s  %s\n" "$name" "$code" "$verdict"
+}
+parent_case "SIGTERM to the main process alone" TERM 130
+parent_case "SIGINT to the main process alone" INT 130
+parent_case "kill -9 of the main process" KILL 137
+parent_case "kill -9 of the main process, children stopped" KILL 137 stop
+# === End of the read-back section on clusters.json and cluster processes ===============
+
 echo
 echo "cases tried: $tried"
 echo "crashes: $crashes"
 echo "silent wrong outputs: $silent"
 echo "files outside the output folder touched: $outside"
 echo "files not written by Tessera deleted: $foreign"
-[ $((crashes + silent + outside + foreign)) = 0 ]
+echo "models removed by a failed run: $removed"
+echo "orphans after kill -9 of a parent: $orphans"
+echo "cluster processes left 20 s after a signal to their parent: $left_running"
+[ $((crashes + silent + outside + foreign + removed + orphans + left_running)) = 0 ]

@@ -6,9 +6,6 @@
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
-#ifdef __linux__
-#include <sys/prctl.h>
-#endif
 
 #include <cerrno>
 #include <cstdio>
@@ -24,6 +21,7 @@
 #include "plugin/plugin_call.h"
 #include "plugin/plugin_crash_log.h"
 #include "tessera/errors.h"
+#include "util/child_process.h"
 #include "util/exit_codes.h"
 
 namespace py = pybind11;
@@ -83,7 +81,8 @@ extern "C" void CancelChildStage(int) { g_child_cancel.Cancel(); }
 // Signals as the CLI has them, not as the interpreter left them: SIGINT and SIGTERM
 // cancel (every time: the parent forwards the Ctrl-C the terminal also sent), fatal
 // signals in a plugin call end the child with exit code 4 and a record on `crash_fd`.
-void PrepareChild(int crash_fd) {
+// `parent`: the interpreter's process, whose end cancels the stage.
+void PrepareChild(int crash_fd, pid_t parent) {
   struct sigaction action {};
   action.sa_handler = CancelChildStage;
   sigemptyset(&action.sa_mask);
@@ -92,10 +91,9 @@ void PrepareChild(int crash_fd) {
   sigset_t none;
   sigemptyset(&none);
   sigprocmask(SIG_SETMASK, &none, nullptr);
-#ifdef __linux__
-  // An interpreter that dies cancels its stage, which then releases the workspace.
-  prctl(PR_SET_PDEATHSIG, SIGTERM);
-#endif
+  // An interpreter that dies (kill -9 included) cancels its stage, which then releases
+  // the workspace; one that died before this line too.
+  DieWithParent(parent, SIGTERM);
   InstallPluginCrashHandler(kExitPluginCrash);
   SetPluginCrashReportFd(crash_fd);
 }
@@ -130,8 +128,8 @@ nlohmann::json RunStage(const std::function<nlohmann::json(const StageControl&)>
 // done, total]} lines, each answered by one byte ('c': go on, else cancel), then one
 // line of the result, the error or the interruption. Never returns.
 [[noreturn]] void ChildMain(const std::function<nlohmann::json(const StageControl&)>& stage,
-                            bool report_progress, int channel, int crash_fd) {
-  PrepareChild(crash_fd);
+                            bool report_progress, int channel, int crash_fd, pid_t parent) {
+  PrepareChild(crash_fd, parent);
   std::mutex progress_mutex;  // the stages report one at a time; this makes sure
   StageControl control;
   control.cancel = &g_child_cancel;
@@ -298,12 +296,13 @@ nlohmann::json RunInChildProcess(const std::string& verb, const py::object& prog
   std::fflush(nullptr);  // the child must not write our buffered output again
   // Forked with the GIL held: no other thread is inside the interpreter; the child
   // never enters it, and starts its own threads only once it runs the stage.
+  const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid < 0) ThrowSystemError(verb, "start the stage's process");
   if (pid == 0) {
     channel.Close();  // the child sees the parent end the channel when the parent ends
     crash_read.Close();
-    ChildMain(stage, !progress.is_none(), child_channel.get(), crash_write.get());
+    ChildMain(stage, !progress.is_none(), child_channel.get(), crash_write.get(), parent);
   }
   child_channel.Close();
   crash_write.Close();

@@ -5,6 +5,7 @@ bad manifests raised as the named exceptions."""
 import json
 import os
 import pathlib
+import signal
 import subprocess
 import sys
 import threading
@@ -148,6 +149,63 @@ except KeyboardInterrupt:
     summary = tessera.extract(images=images, output=tmp_path / "out", manifest=manifest,
                               threads=2)
     assert summary["num_reused"] >= 3
+
+
+def _children(pid):
+    """The processes whose parent is `pid` (from /proc/*/stat)."""
+    found = []
+    for stat in pathlib.Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue  # ended meanwhile
+        if int(fields[1]) == pid:
+            found.append(int(stat.parent.name))
+    return found
+
+
+def _running(pid):
+    """Whether `pid` is a process that has not ended (a zombie has)."""
+    try:
+        return pathlib.Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.parametrize("signal_number", [signal.SIGTERM, signal.SIGKILL])
+def test_the_stage_process_stops_with_an_interpreter_that_is_killed(sample, tmp_path,
+                                                                     signal_number):
+    # SIGTERM (as a scheduler or `timeout` sends it) or SIGKILL to the interpreter alone,
+    # as soon as the stage's process runs: the stage process is cancelled by its death
+    # signal and ends (within a generous 20 s: the test waits on the event, never times
+    # it) without finishing the run; on its own it would map on and write
+    # run_summary.json.
+    images, manifest, _ = sample
+    script = f"""
+import tessera
+tessera.run(images={str(images)!r}, output={str(tmp_path / "out")!r},
+            manifest={str(manifest)!r}, threads=1)
+"""
+    interpreter = subprocess.Popen([sys.executable, "-c", script], start_new_session=True,
+                                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 60
+        children = []
+        while not children and interpreter.poll() is None and time.monotonic() < deadline:
+            children = _children(interpreter.pid)
+            time.sleep(0.01)
+        assert children, "no stage process started"
+        os.kill(interpreter.pid, signal_number)
+        interpreter.wait()
+        deadline = time.monotonic() + 20
+        while any(_running(child) for child in children) and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert not any(_running(child) for child in children), "the stage process outlived it"
+        assert not (tmp_path / "out" / "run_summary.json").exists()
+    finally:
+        if interpreter.poll() is None:
+            interpreter.kill()
+            interpreter.wait()
 
 
 def test_the_example_writes_a_png_of_the_sample(sample, tmp_path):

@@ -163,6 +163,14 @@ CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
             } else if (hierarchical->count() > 0) {
               summary = MapHierarchically(context, run, HierarchicalOptions(*options, *jobs),
                                           InterruptibleControl());
+              if (summary.status == StageStatus::kCompleted && summary.num_models == 0) {
+                // Not the unpartitioned map's message: the earlier models stay (merge_map_stage.h).
+                spdlog::error(
+                    "map --hierarchical: no cluster of {} holds a model (see the warnings "
+                    "above); the models it held before are left as they were",
+                    options->output);
+                return static_cast<int>(kExitNoModel);
+              }
             } else {
               summary = RunMap(context, run, InterruptibleControl());
             }

@@ -23,11 +23,6 @@ std::string FormatNumber(double value) {
   return stream.str();
 }
 
-// Horizontal field of view across the longer side, in degrees.
-double FieldOfViewDeg(double focal_px, double longer_side_px) {
-  return 2 * std::atan(longer_side_px / 2 / focal_px) * 180 / kPi;
-}
-
 class PriorBuilder {
  public:
   PriorBuilder(const ImageEntry& image, std::vector<std::string>* warnings)
@@ -45,11 +40,8 @@ class PriorBuilder {
   // Whether the focal length gives a plausible field of view; warns about the others.
   bool IsPlausible(double focal_px, const std::string& what) {
     const double longer = std::max(image_.width, image_.height);
+    if (IsPlausibleFocalLength(focal_px, longer)) return true;
     const double fov = FieldOfViewDeg(focal_px, longer);
-    if (std::isfinite(fov) && fov >= kMinPlausibleFieldOfViewDeg &&
-        fov <= kMaxPlausibleFieldOfViewDeg) {
-      return true;
-    }
     Warn("the focal length from " + what + " (" + FormatNumber(focal_px) +
          " px) gives a field of view of " + FormatNumber(fov) + " degrees, outside [" +
          FormatNumber(kMinPlausibleFieldOfViewDeg) + ", " +
@@ -130,6 +122,16 @@ std::vector<bool> ImagesKnownIntrinsicsFit(const std::vector<ImageEntry>& images
 }
 
 }  // namespace
+
+double FieldOfViewDeg(double focal_px, double longer_side_px) {
+  return 2 * std::atan(longer_side_px / 2 / focal_px) * 180 / kPi;
+}
+
+bool IsPlausibleFocalLength(double focal_px, double longer_side_px) {
+  const double fov = FieldOfViewDeg(focal_px, longer_side_px);
+  return std::isfinite(fov) && fov >= kMinPlausibleFieldOfViewDeg &&
+         fov <= kMaxPlausibleFieldOfViewDeg;
+}
 
 std::optional<FocalLengthPrior> EstimateFocalLengthPrior(const ImageEntry& image,
                                                          std::vector<std::string>* warnings) {

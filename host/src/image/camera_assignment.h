@@ -23,6 +23,15 @@ namespace tessera {
 constexpr double kMinPlausibleFieldOfViewDeg = 1;
 constexpr double kMaxPlausibleFieldOfViewDeg = 150;
 
+// The field of view, in degrees, that `focal_px` gives across `longer_side_px`.
+double FieldOfViewDeg(double focal_px, double longer_side_px);
+
+// Whether `focal_px` gives a field of view across `longer_side_px` in
+// [kMinPlausibleFieldOfViewDeg, kMaxPlausibleFieldOfViewDeg] (about 0.13 to 57 times the
+// longer side): EXIF priors, and the focal lengths Tessera reads back from its own files
+// (clusters.json), are believed only then.
+bool IsPlausibleFocalLength(double focal_px, double longer_side_px);
+
 // The folder of an image, relative to the image folder ("a/b" for "a/b/c.jpg"); empty
 // for an image at the top level.
 std::string ImageFolder(const std::string& image_name);

@@ -3,7 +3,6 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
-#include <optional>
 #include <set>
 
 #include "partition/cluster_calibration.h"
@@ -13,6 +12,7 @@
 #include "pipeline/mapping_summary.h"
 #include "pipeline/workspace.h"
 #include "tessera/errors.h"
+#include "tessera/io/colmap_model_io.h"
 
 namespace tessera {
 namespace {
@@ -36,26 +36,25 @@ std::filesystem::path CheckedDatabaseFile(const std::filesystem::path& workspace
   return file;
 }
 
-// The summary of cluster K's finished models for clusters.json `fingerprint`, if any.
-std::optional<MappingSummary> FinishedCluster(const std::filesystem::path& folder, int cluster,
-                                              const std::string& fingerprint) {
-  const std::filesystem::path file = folder / "mapping_summary.json";
-  std::error_code error;
-  if (!std::filesystem::exists(file, error)) return std::nullopt;
-  try {
-    MappingSummary summary = MappingSummary::Read(file);
-    if (!summary.partition.is_object() || summary.partition.value("cluster", -1) != cluster ||
-        summary.partition.value("clusters_json", "") != fingerprint) {
-      return std::nullopt;
+// Renames a corrupt cluster folder OUTPUT/clusters/K to K.corrupt-N, the first N free:
+// kept for a look, out of the way of the cluster's new models. Throws InputError naming
+// the folder when it cannot be moved.
+void SetCorruptClusterAside(const std::filesystem::path& folder, const std::string& problem) {
+  for (int n = 1;; ++n) {
+    const std::filesystem::path aside = folder.string() + ".corrupt-" + std::to_string(n);
+    std::error_code error;
+    if (std::filesystem::symlink_status(aside, error).type() !=
+        std::filesystem::file_type::not_found) {
+      continue;
     }
-    for (const MappingSummary::Model& model : summary.models) {
-      if (!std::filesystem::is_directory(folder / "sparse" / std::to_string(model.index), error)) {
-        return std::nullopt;
-      }
+    std::filesystem::rename(folder, aside, error);
+    if (error) {
+      throw InputError(folder.string() + ": cannot move the corrupt cluster folder aside to " +
+                       aside.string() + ": " + error.message() + " (" + problem + ")");
     }
-    return summary;
-  } catch (const InputError&) {
-    return std::nullopt;  // half written or foreign: mapped again
+    spdlog::warn("map: {}; moved aside to {}, the cluster is mapped again", problem,
+                 aside.string());
+    return;
   }
 }
 
@@ -63,6 +62,55 @@ std::optional<MappingSummary> FinishedCluster(const std::filesystem::path& folde
 
 std::filesystem::path ClusterFolder(const std::filesystem::path& workspace, int cluster) {
   return workspace / "clusters" / std::to_string(cluster);
+}
+
+ClusterOutput ReadClusterOutput(const std::filesystem::path& workspace, int cluster,
+                                const std::string& clusters_fingerprint) {
+  using State = ClusterOutput::State;
+  const std::filesystem::path folder = ClusterFolder(workspace, cluster);
+  const std::filesystem::path summary_file = folder / "mapping_summary.json";
+  ClusterOutput output;
+  std::error_code error;
+  if (!std::filesystem::exists(summary_file, error)) {
+    output.problem = folder.string() + ": cluster " + std::to_string(cluster) +
+                     " is not mapped (no mapping_summary.json)";
+    return output;
+  }
+  const auto corrupt = [&](const std::string& what) {
+    output.state = State::kCorrupt;
+    output.problem = folder.string() + ": corrupt or truncated cluster folder (" + what + ")";
+    return output;
+  };
+  MappingSummary summary;
+  try {
+    summary = MappingSummary::Read(summary_file);
+  } catch (const InputError& exception) {
+    return corrupt(exception.what());
+  }
+  if (!summary.partition.is_object() || summary.partition.value("cluster", -1) != cluster ||
+      summary.partition.value("clusters_json", "") != clusters_fingerprint) {
+    output.state = State::kOtherClustersFile;
+    output.problem = summary_file.string() + ": mapped for another clusters.json";
+    return output;
+  }
+  try {
+    for (const MappingSummary::Model& entry : summary.models) {
+      const std::filesystem::path dir = folder / "sparse" / std::to_string(entry.index);
+      Reconstruction model = ReadColmapModel(dir);
+      if (model.images.size() != entry.num_images || model.points3D.size() != entry.num_points3D) {
+        return corrupt(dir.string() + ": holds " + std::to_string(model.images.size()) +
+                       " images and " + std::to_string(model.points3D.size()) +
+                       " points, its summary says " + std::to_string(entry.num_images) + " and " +
+                       std::to_string(entry.num_points3D));
+      }
+      output.models.push_back(std::move(model));
+    }
+  } catch (const InputError& exception) {
+    output.models.clear();
+    return corrupt(exception.what());
+  }
+  output.state = State::kFinished;
+  return output;
 }
 
 MapperInput RestrictMapperInput(const MapperInput& input, const std::vector<std::string>& images) {
@@ -103,17 +151,21 @@ MapStageSummary MapCluster(const PipelineContext& context, const RunOptions& opt
   }
   const std::filesystem::path folder = ClusterFolder(options.output_dir, cluster);
   const std::string fingerprint = clusters.Fingerprint();
-  if (const auto finished = FinishedCluster(folder, cluster, fingerprint)) {
+  const ClusterOutput output = ReadClusterOutput(options.output_dir, cluster, fingerprint);
+  if (output.state == ClusterOutput::State::kFinished) {
     MapStageSummary summary;
-    summary.num_models = finished->models.size();
-    for (const MappingSummary::Model& model : finished->models) {
-      summary.num_registered += model.num_images;
-      summary.images_per_model.push_back(model.num_images);
+    summary.num_models = output.models.size();
+    for (const Reconstruction& model : output.models) {
+      summary.num_registered += model.images.size();
+      summary.images_per_model.push_back(model.images.size());
     }
     summary.num_images = clusters.clusters[cluster].images.size();
     spdlog::info("map: cluster {} is already mapped for this clusters.json ({}): skipped", cluster,
                  folder.string());
     return summary;
+  }
+  if (output.state == ClusterOutput::State::kCorrupt) {
+    SetCorruptClusterAside(folder, output.problem);
   }
   CheckImagesUnchanged(
       *workspace, options.image_dir,

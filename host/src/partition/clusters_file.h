@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "partition/view_graph_partitioner.h"
+#include "tessera/errors.h"
 #include "tessera/mapper.h"
 
 namespace tessera {
@@ -46,16 +47,38 @@ struct ClustersFile {
   std::vector<FocalLengthReport> cameras;
 
   nlohmann::json ToJson() const;
-  // Throws nlohmann::json::exception for a missing or mistyped field.
+  // Throws nlohmann::json::exception for a missing or mistyped field, InputError naming
+  // the field (not the file) for a number out of range: an integer that is not one or
+  // does not fit, a weight or focal length that is not finite and positive, a method
+  // that is neither "view graph" nor "first model".
   static ClustersFile FromJson(const nlohmann::json& json);
 
-  // Reads FILE; throws InputError naming it when it is missing (and what to run), cannot
-  // be parsed, or names a cluster twice or out of order.
+  // Reads FILE: StaleClustersError when it is missing or of another version (what to
+  // run), InputError naming it and the cluster and entry at fault when it cannot be
+  // parsed (FromJson) or fails CheckClusters.
   static ClustersFile Read(const std::filesystem::path& file);
+  // Throws InputError naming `file`, the cluster and the entry when the clusters do not
+  // hold together: a cluster missing from the list or the tree, or there twice; an image
+  // listed twice in one list, a core image not among the cluster's images or in two
+  // cores (or isolated too); a neighbour that is not another cluster, or a shared image
+  // not held by both; a camera listed twice. What needs the workspace (the image names,
+  // the camera ids, the focal lengths) is checked by ReadWorkspaceClusters.
+  void CheckClusters(const std::string& file) const;
   // Writes FILE atomically.
   void Write(const std::filesystem::path& file) const;
   // A hash of the file's content, which cluster models record to be recognised.
   std::string Fingerprint() const;
+
+ private:
+  void CheckNeighbours(const Cluster& cluster, const std::string& what) const;
+};
+
+// A clusters.json that no longer describes the workspace: missing, of another version,
+// made with another manifest or from other pairs. `map --hierarchical` partitions again;
+// other faults of the file (InputError) are refused.
+class StaleClustersError : public InputError {
+ public:
+  using InputError::InputError;
 };
 
 // The clusters file of a workspace.

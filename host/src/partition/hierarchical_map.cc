@@ -14,8 +14,10 @@
 namespace tessera {
 namespace {
 
-// OUTPUT/clusters.json, made again unless it belongs to this database and manifest. The
-// workspace is held only meanwhile: the cluster processes read it without a lock.
+// OUTPUT/clusters.json, made again when it is missing or stale (made from other pairs,
+// with another manifest or other cluster settings); a file that is not stale but wrong
+// (ReadWorkspaceClusters) is refused, not written over. The workspace is held only
+// meanwhile: the cluster processes read it without a lock.
 ClustersFile CurrentClusters(const PipelineContext& context, const RunOptions& options) {
   Workspace::Options open;
   open.require_database_for = "map --hierarchical";
@@ -29,7 +31,7 @@ ClustersFile CurrentClusters(const PipelineContext& context, const RunOptions& o
                    clusters.clusters.size());
       return clusters;
     }
-  } catch (const InputError& error) {
+  } catch (const StaleClustersError& error) {
     spdlog::info("map: partitioning again ({})", error.what());
   }
   return PartitionWorkspace(*workspace, context);
@@ -59,8 +61,19 @@ MapStageSummary MapHierarchically(const PipelineContext& context, const RunOptio
     commands.push_back(std::move(command));
   }
   spdlog::info("map: {} clusters in {} processes at once", commands.size(), hierarchical.jobs);
-  const std::vector<int> codes = RunProcessPool(commands, hierarchical.jobs);
+  // SIGINT or SIGTERM to this process reaches the clusters' as SIGTERM: each cancels.
+  const std::vector<int> codes =
+      RunProcessPool(commands, hierarchical.jobs, [&] { return control.Cancelled(); });
   const double map_seconds = timer.ElapsedSeconds();
+  if (control.Cancelled()) {
+    MapStageSummary summary;
+    summary.status = StageStatus::kCancelled;
+    spdlog::warn(
+        "map: stopped: {} of {} clusters finished (each is kept and skipped when run again); "
+        "the models in {} are left as they were",
+        std::count(codes.begin(), codes.end(), 0), codes.size(), options.output_dir.string());
+    return summary;
+  }
   std::string failed;
   for (size_t i = 0; i < codes.size(); ++i) {
     if (codes[i] == 0 || codes[i] == 3) continue;

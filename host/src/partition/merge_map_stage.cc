@@ -24,49 +24,20 @@ namespace {
 // Seed stream of the check's five-point RANSAC on pairs without E.
 constexpr uint64_t kMergedModelCheckStream = 1;
 
-// The models of cluster `cluster`, checked against its summary.
+// The models of cluster `cluster`, checked against its summary; InputError naming its
+// folder and the command that maps it again otherwise.
 std::vector<Reconstruction> ReadClusterModels(const std::filesystem::path& workspace, int cluster,
-                                              const std::string& clusters_fingerprint) {
-  const std::filesystem::path folder = ClusterFolder(workspace, cluster);
-  const std::filesystem::path summary_file = folder / "mapping_summary.json";
-  const std::string map_again = "; run `tessera map --cluster " + std::to_string(cluster) +
-                                " --output " + workspace.string() + "` again";
-  std::error_code error;
-  if (!std::filesystem::exists(summary_file, error)) {
-    throw InputError(folder.string() + ": cluster " + std::to_string(cluster) +
-                     " is not mapped (no mapping_summary.json)" + map_again);
-  }
-  const auto corrupt = [&](const std::string& what) {
-    return InputError(folder.string() + ": corrupt or truncated cluster folder (" + what + ")" +
-                      map_again);
-  };
-  MappingSummary summary;
-  try {
-    summary = MappingSummary::Read(summary_file);
-  } catch (const InputError& exception) {
-    throw corrupt(exception.what());
-  }
-  if (!summary.partition.is_object() || summary.partition.value("cluster", -1) != cluster ||
-      summary.partition.value("clusters_json", "") != clusters_fingerprint) {
-    throw InputError(summary_file.string() + ": mapped for another clusters.json" + map_again);
-  }
-  try {
-    std::vector<Reconstruction> models;
-    for (const MappingSummary::Model& entry : summary.models) {
-      const std::filesystem::path dir = folder / "sparse" / std::to_string(entry.index);
-      Reconstruction model = ReadColmapModel(dir);
-      if (model.images.size() != entry.num_images || model.points3D.size() != entry.num_points3D) {
-        throw InputError(dir.string() + ": holds " + std::to_string(model.images.size()) +
-                         " images and " + std::to_string(model.points3D.size()) +
-                         " points, its summary says " + std::to_string(entry.num_images) + " and " +
-                         std::to_string(entry.num_points3D));
-      }
-      models.push_back(std::move(model));
-    }
-    return models;
-  } catch (const InputError& exception) {
-    throw corrupt(exception.what());
-  }
+                                              const std::string& clusters_fingerprint,
+                                              const Manifest& manifest) {
+  ClusterOutput output = ReadClusterOutput(workspace, cluster, clusters_fingerprint);
+  if (output.state == ClusterOutput::State::kFinished) return std::move(output.models);
+  throw InputError(output.problem + "; run `tessera map --cluster " + std::to_string(cluster) +
+                   " --output " + workspace.string() +
+                   (manifest.file.empty() ? "" : " --manifest " + manifest.file.string()) +
+                   "` again" +
+                   (output.state == ClusterOutput::State::kCorrupt
+                        ? ", which sets the corrupt folder aside and maps the cluster again"
+                        : ""));
 }
 
 // Why each image of the workspace that is in no merged model was left out.
@@ -110,13 +81,25 @@ MapStageSummary MergeClusterMaps(const PipelineContext& context, const RunOption
   const std::string fingerprint = clusters.Fingerprint();
   std::map<int, std::vector<Reconstruction>> by_cluster;
   for (const ClustersFile::Cluster& cluster : clusters.clusters) {
-    by_cluster[cluster.index] = ReadClusterModels(options.output_dir, cluster.index, fingerprint);
+    by_cluster[cluster.index] =
+        ReadClusterModels(options.output_dir, cluster.index, fingerprint, context.manifest);
   }
   const BundleAdjusterGuard adjuster(context.bundle_adjuster, &workspace->crash_log());
   ClusterMergeOptions merge_options;
   merge_options.seed = context.manifest.seed;
   ClusterMergeResult merged =
       MergeClusterModels(clusters.tree, by_cluster, adjuster, merge_options);
+  if (merged.models.empty()) {
+    // A failed partitioned run leaves the models that were there: nothing is placed.
+    spdlog::warn(
+        "merge: no cluster holds a model; what {} held before (its models and "
+        "mapping_summary.json, an earlier run's) is left as it was",
+        options.output_dir.string());
+    MapStageSummary summary;
+    summary.num_images = database.ReadAllImages().size();
+    summary.seconds = timer.ElapsedSeconds();
+    return summary;
+  }
 
   MapperResult result;
   result.focal_lengths = clusters.cameras;  // found by the partition, for every cluster

@@ -9,6 +9,7 @@
 #include <utility>
 
 #include "distributed/shard_database.h"
+#include "image/camera_assignment.h"
 #include "partition/cluster_calibration.h"
 #include "partition/rotation_consistent_pairs.h"
 #include "pipeline/load_mapper_input.h"
@@ -102,6 +103,59 @@ std::vector<FocalLengthReport> CalibrateForClusters(const PipelineContext& conte
   }
   ApplyCalibration(calibration, input);
   return calibration;
+}
+
+// 1e+300, not its 301 digits.
+std::string Shortest(double value) { return fmt::format("{:.6g}", value); }
+
+// Refuses (InputError naming `path`, the cluster and the entry) a clusters.json that
+// names an image the workspace does not have, leaves out an image with verified pairs,
+// or calibrates a camera the workspace does not have, or with a focal length no lens
+// gives (IsPlausibleFocalLength, as EXIF priors are judged).
+void CheckClustersAgainstWorkspace(const std::filesystem::path& path, const ClustersFile& file,
+                                   const ViewGraph& graph, const Database& database) {
+  const std::set<std::string> names(graph.names.begin(), graph.names.end());
+  const auto check = [&](const std::vector<std::string>& images, const std::string& where) {
+    for (const std::string& name : images) {
+      if (names.count(name) == 0) {
+        throw InputError(path.string() + ": " + where + ": image '" + name +
+                         "' is not an image of the workspace (" + database.path().string() + ")");
+      }
+    }
+  };
+  std::set<std::string> placed(file.isolated.begin(), file.isolated.end());
+  check(file.isolated, "isolated");
+  for (const ClustersFile::Cluster& cluster : file.clusters) {
+    check(cluster.images, "cluster " + std::to_string(cluster.index));
+    placed.insert(cluster.core.begin(), cluster.core.end());
+  }
+  for (const WeightedEdge& edge : graph.edges) {
+    for (const size_t node : {edge.node1, edge.node2}) {
+      if (placed.count(graph.names[node]) == 0) {
+        throw InputError(path.string() + ": image '" + graph.names[node] +
+                         "' has verified pairs but is in no cluster's core and not isolated");
+      }
+    }
+  }
+  std::map<camera_t, Camera> cameras;
+  for (Camera& camera : database.ReadAllCameras()) cameras.emplace(camera.camera_id, camera);
+  for (const FocalLengthReport& report : file.cameras) {
+    const std::string where =
+        path.string() + ": cameras: camera " + std::to_string(report.camera_id) + ": ";
+    const auto camera = cameras.find(report.camera_id);
+    if (camera == cameras.end()) {
+      throw InputError(where + "not a camera of the workspace (" + database.path().string() + ")");
+    }
+    const double longer = std::max(camera->second.width, camera->second.height);
+    if (!IsPlausibleFocalLength(report.estimated, longer)) {
+      throw InputError(where + "focal_length " + Shortest(report.estimated) +
+                       " px gives a field of view of " +
+                       Shortest(FieldOfViewDeg(report.estimated, longer)) + " degrees across its " +
+                       std::to_string(static_cast<int>(longer)) + " px images, outside [" +
+                       Shortest(kMinPlausibleFieldOfViewDeg) + ", " +
+                       Shortest(kMaxPlausibleFieldOfViewDeg) + "]");
+    }
+  }
 }
 
 }  // namespace
@@ -223,14 +277,16 @@ ClustersFile ReadWorkspaceClusters(const std::filesystem::path& workspace_folder
   const std::filesystem::path path = ClustersFilePath(workspace_folder);
   ClustersFile file = ClustersFile::Read(path);
   if (file.manifest_fingerprint != ManifestFingerprint(manifest)) {
-    throw InputError(path.string() +
-                     ": made with another manifest than this one; run `tessera partition` "
-                     "again with it");
+    throw StaleClustersError(path.string() +
+                             ": made with another manifest than this one; run `tessera "
+                             "partition` again with it");
   }
-  if (file.pairs_fingerprint != LoadViewGraph(database).fingerprint) {
-    throw InputError(path.string() + ": made from other verified pairs than those of " +
-                     database.path().string() + "; run `tessera partition` again");
+  const ViewGraph graph = LoadViewGraph(database);
+  if (file.pairs_fingerprint != graph.fingerprint) {
+    throw StaleClustersError(path.string() + ": made from other verified pairs than those of " +
+                             database.path().string() + "; run `tessera partition` again");
   }
+  CheckClustersAgainstWorkspace(path, file, graph, database);
   return file;
 }
 

@@ -35,8 +35,13 @@ ViewGraph LoadViewGraph(const Database& database);
 // and logs the cut. Throws InputError naming the database when it has no verified pair.
 ClustersFile PartitionWorkspace(const Workspace& workspace, const PipelineContext& context);
 
-// OUTPUT/clusters.json, refused (InputError naming it and what differs) when it was made
-// from other pairs than `database`'s or with another manifest.
+// OUTPUT/clusters.json, checked as input: StaleClustersError naming it and what differs
+// when it is missing or was made from other pairs than `database`'s or with another
+// manifest; InputError naming it, the cluster and the entry when a value is out of range
+// or does not hold together (ClustersFile::Read), names an image the workspace does not
+// have, leaves out one with verified pairs, or calibrates a camera the workspace does not
+// have or with a focal length that gives no plausible field of view across its images
+// (IsPlausibleFocalLength, image/camera_assignment.h).
 ClustersFile ReadWorkspaceClusters(const std::filesystem::path& workspace_folder,
                                    const Database& database, const Manifest& manifest);
 

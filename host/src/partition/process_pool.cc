@@ -1,45 +1,45 @@
 #include "partition/process_pool.h"
 
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
+#include <signal.h>
 
 #include <algorithm>
-#include <cerrno>
+#include <chrono>
 #include <map>
 
-extern char** environ;
+#include "util/child_process.h"
 
 namespace tessera {
+namespace {
 
-std::vector<int> RunProcessPool(const std::vector<std::vector<std::string>>& commands, int jobs) {
-  std::vector<int> codes(commands.size(), 127);
-  std::map<pid_t, size_t> running;
+// How long the pool waits for a child before it looks at `stop_requested` again.
+constexpr std::chrono::milliseconds kStopCheckInterval(100);
+
+}  // namespace
+
+std::vector<int> RunProcessPool(const std::vector<std::vector<std::string>>& commands, int jobs,
+                                const std::function<bool()>& stop_requested) {
+  std::vector<int> codes(commands.size(), kNotStarted);
+  // A cluster whose pool is gone is merged by no one: its process is killed at once.
+  ChildProcesses children(SIGKILL);
+  std::map<pid_t, size_t> command_of;
   size_t next = 0;
-  while (next < commands.size() || !running.empty()) {
-    while (next < commands.size() && static_cast<int>(running.size()) < std::max(1, jobs)) {
-      std::vector<char*> argv;
-      for (const std::string& arg : commands[next]) argv.push_back(const_cast<char*>(arg.c_str()));
-      argv.push_back(nullptr);
-      pid_t pid = 0;
-      if (posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ) == 0) {
-        running[pid] = next;
-      }
+  bool stopping = false;
+  for (;;) {
+    if (!stopping && stop_requested && stop_requested()) {
+      stopping = true;
+      children.SignalAll(SIGTERM);  // each cancels its cluster, as Ctrl-C does
+    }
+    while (!stopping && next < commands.size() &&
+           static_cast<int>(children.running().size()) < std::max(1, jobs)) {
+      const std::optional<pid_t> pid = children.Start(commands[next]);
+      codes[next] = 127;
+      if (pid) command_of[*pid] = next;
       ++next;
     }
-    if (running.empty()) continue;
-    int status = 0;
-    const pid_t pid = waitpid(-1, &status, 0);
-    if (pid < 0) {
-      if (errno == EINTR) continue;
-      break;  // no child left to wait for
+    if (children.running().empty()) break;
+    if (const auto ended = children.WaitForOne(kStopCheckInterval)) {
+      codes[command_of.at(ended->pid)] = ended->exit_code;
     }
-    const auto it = running.find(pid);
-    if (it == running.end()) continue;
-    codes[it->second] = WIFEXITED(status)     ? WEXITSTATUS(status)
-                        : WIFSIGNALED(status) ? 128 + WTERMSIG(status)
-                                              : 1;
-    running.erase(it);
   }
   return codes;
 }

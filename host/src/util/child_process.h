@@ -1,0 +1,69 @@
+#pragma once
+
+// Child processes that stop with the process that started them: the cluster processes
+// of `map --hierarchical` (partition/process_pool.h) and the Python module's stage
+// process (python/src/stage_process.cc).
+//  - A child dies with its parent, however the parent ends (kill -9 included): it asks
+//    the kernel for a signal when its parent goes (PR_SET_PDEATHSIG), then checks that
+//    the parent is still there, for a parent that ended before it asked.
+//  - A parent that is asked to stop passes the request on to its children
+//    (ChildProcesses::SignalAll), and reaps them; what it did not reap when it lets go of
+//    them is killed.
+
+#include <sys/types.h>
+
+#include <chrono>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace tessera {
+
+// In a child just forked from the process `parent` (getpid() before the fork): the kernel
+// sends `death_signal` when the thread that forked it ends; if `parent` has already gone,
+// the child raises `death_signal` itself at once. Async-signal-safe: callable between fork and exec
+// in a parent with threads. Does nothing but the check where the kernel has no such
+// request (not Linux).
+void DieWithParent(pid_t parent, int death_signal);
+
+// The exit code a shell gives a waitpid status: the process's own, 128 + N for a process
+// ended by signal N.
+int ExitCodeOfWaitStatus(int wait_status);
+
+// Children started from argv (argv[0] an executable path, not searched in PATH), which
+// inherit stdout and stderr and die with the thread that started them.
+class ChildProcesses {
+ public:
+  // `death_signal`: what each child gets when this process ends first.
+  explicit ChildProcesses(int death_signal) : death_signal_(death_signal) {}
+  // Sends SIGKILL to the children not reaped yet and reaps them: an exception in the
+  // parent leaves none behind.
+  ~ChildProcesses();
+  ChildProcesses(const ChildProcesses&) = delete;
+  ChildProcesses& operator=(const ChildProcesses&) = delete;
+
+  // Starts argv with SIGINT and SIGTERM at their defaults and no signal blocked. Returns
+  // its pid, or nullopt (errno set) when no process could be made; a program that cannot
+  // be run ends its child with exit code 127.
+  std::optional<pid_t> Start(const std::vector<std::string>& argv);
+
+  struct Ended {
+    pid_t pid = 0;
+    int exit_code = 0;  // ExitCodeOfWaitStatus
+  };
+  // Reaps one child that has ended, waiting up to `timeout` for one; nullopt when none
+  // ended meanwhile or none is left.
+  std::optional<Ended> WaitForOne(std::chrono::milliseconds timeout);
+
+  // Sends `signal_number` to every child not reaped yet.
+  void SignalAll(int signal_number) const;
+
+  const std::set<pid_t>& running() const { return running_; }
+
+ private:
+  int death_signal_;
+  std::set<pid_t> running_;
+};
+
+}  // namespace tessera

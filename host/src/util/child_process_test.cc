@@ -1,0 +1,135 @@
+#include "util/child_process.h"
+
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
+namespace tessera {
+namespace {
+
+// A bound no healthy run comes near: the tests wait for an event, never time one.
+constexpr auto kGenerous = std::chrono::seconds(20);
+
+// Reaps `pid` (a child of this process), waiting up to kGenerous; nullopt if it is still
+// running then (it is killed and reaped, so that no test leaves it behind).
+std::optional<int> ReapWithin(pid_t pid) {
+  const auto deadline = std::chrono::steady_clock::now() + kGenerous;
+  int status = 0;
+  while (std::chrono::steady_clock::now() < deadline) {
+    if (waitpid(pid, &status, WNOHANG) == pid) return status;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  kill(pid, SIGKILL);
+  waitpid(pid, &status, 0);
+  return std::nullopt;
+}
+
+// This test process adopts the orphans of its children (PR_SET_CHILD_SUBREAPER), so that
+// a test can reap a grandchild whose parent it killed.
+class ChildProcessTest : public ::testing::Test {
+ protected:
+  void SetUp() override { ASSERT_EQ(prctl(PR_SET_CHILD_SUBREAPER, 1), 0); }
+  void TearDown() override { prctl(PR_SET_CHILD_SUBREAPER, 0); }
+};
+
+TEST_F(ChildProcessTest, AChildDiesWithAParentKilledOutright) {
+  int fds[2];
+  ASSERT_EQ(pipe(fds), 0);
+  const pid_t parent = fork();
+  ASSERT_GE(parent, 0);
+  if (parent == 0) {
+    // The parent: starts a long child, says its pid, waits to be killed.
+    ChildProcesses children(SIGKILL);
+    const std::optional<pid_t> child = children.Start({"/bin/sleep", "600"});
+    const pid_t pid = child.value_or(-1);
+    if (write(fds[1], &pid, sizeof(pid)) != sizeof(pid)) _exit(1);
+    for (;;) pause();
+  }
+  close(fds[1]);
+  pid_t child = -1;
+  ASSERT_EQ(read(fds[0], &child, sizeof(child)), static_cast<ssize_t>(sizeof(child)));
+  close(fds[0]);
+  ASSERT_GT(child, 0);
+  kill(parent, SIGKILL);
+  ASSERT_TRUE(ReapWithin(parent).has_value());
+  // The orphan is this process's now; without its death signal it would sleep on.
+  const std::optional<int> status = ReapWithin(child);
+  ASSERT_TRUE(status.has_value()) << "the child outlived its parent by 20 s";
+  ASSERT_TRUE(WIFSIGNALED(*status));
+  EXPECT_EQ(WTERMSIG(*status), SIGKILL);
+}
+
+TEST_F(ChildProcessTest, AChildWhoseParentDiedBeforeItsRequestDiesAtOnce) {
+  // The race DieWithParent closes: the parent ends between fork and the request.
+  const pid_t parent = fork();
+  ASSERT_GE(parent, 0);
+  if (parent == 0) {
+    const pid_t parent_pid = getpid();
+    const pid_t child = fork();
+    if (child < 0) _exit(1);
+    if (child == 0) {
+      while (getppid() == parent_pid) usleep(1000);  // the parent has gone
+      DieWithParent(parent_pid, SIGKILL);
+      _exit(0);  // reached only without the check
+    }
+    _exit(0);
+  }
+  ASSERT_TRUE(ReapWithin(parent).has_value());
+  int status = 0;
+  // The grandchild is this process's (the subreaper) once its parent has gone.
+  pid_t grandchild = -1;
+  const auto deadline = std::chrono::steady_clock::now() + kGenerous;
+  while (grandchild <= 0 && std::chrono::steady_clock::now() < deadline) {
+    grandchild = waitpid(-1, &status, WNOHANG);
+    if (grandchild == 0) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ASSERT_GT(grandchild, 0);
+  ASSERT_TRUE(WIFSIGNALED(status)) << "exit code " << WEXITSTATUS(status);
+  EXPECT_EQ(WTERMSIG(status), SIGKILL);
+}
+
+TEST_F(ChildProcessTest, SignalsReachEveryChildAndTheirCodesComeBack) {
+  ChildProcesses children(SIGKILL);
+  ASSERT_TRUE(children.Start({"/bin/sleep", "600"}).has_value());
+  ASSERT_TRUE(children.Start({"/bin/sleep", "600"}).has_value());
+  const std::optional<pid_t> missing = children.Start({"/nonexistent/program"});
+  ASSERT_TRUE(missing.has_value());  // the fork worked; the exec cannot
+  const std::optional<ChildProcesses::Ended> first =
+      children.WaitForOne(std::chrono::duration_cast<std::chrono::milliseconds>(kGenerous));
+  ASSERT_TRUE(first.has_value());
+  EXPECT_EQ(first->pid, *missing);
+  EXPECT_EQ(first->exit_code, 127);
+  children.SignalAll(SIGTERM);
+  for (int k = 0; k < 2; ++k) {
+    const auto ended =
+        children.WaitForOne(std::chrono::duration_cast<std::chrono::milliseconds>(kGenerous));
+    ASSERT_TRUE(ended.has_value());
+    EXPECT_EQ(ended->exit_code, 128 + SIGTERM);
+  }
+  EXPECT_TRUE(children.running().empty());
+}
+
+TEST_F(ChildProcessTest, ChildrenLeftWhenTheOwnerGoesAreKilled) {
+  pid_t pid = -1;
+  {
+    ChildProcesses children(SIGKILL);
+    pid = children.Start({"/bin/sleep", "600"}).value_or(-1);
+    ASSERT_GT(pid, 0);
+  }
+  // Reaped by the destructor: no longer a child of this process.
+  EXPECT_EQ(waitpid(pid, nullptr, WNOHANG), -1);
+  EXPECT_EQ(kill(pid, 0), -1);
+}
+
+TEST(ExitCodeOfWaitStatus, IsTheShellsCode) {
+  EXPECT_EQ(ExitCodeOfWaitStatus(3 << 8), 3);  // exited with 3
+  EXPECT_EQ(ExitCodeOfWaitStatus(SIGKILL), 128 + SIGKILL);
+}
+
+}  // namespace
+}  // namespace tessera
