@@ -2,8 +2,8 @@
 # Rig files that cannot be used (`--rig rig.json`) end the run with exit code 2 and one
 # line naming the file and the JSON field. On a 512 px copy of images of the sample
 # examples/fountain-P11-small (in the repository), with ORB for speed:
-#  1. malformed JSON, two reference cameras, a bad rotation: exit 2 before an image is
-#     read (no workspace is made);
+#  1. malformed JSON, two reference cameras, a bad rotation, a translation no rig can
+#     have (1e300 m, issue 47): exit 2 before an image is read (no workspace is made);
 #  2. `run --rig` naming a camera folder that is not there: exit 2 before an image is
 #     read; one that has no images: exit 2 from the map stage; both naming
 #     cameras[1].folder;
@@ -66,6 +66,14 @@ cat > "$work/bad_rotation.json" <<'JSON'
 JSON
 expect_exit_2 "$work/bad_rotation.json" \
   "cameras[1].cam_from_rig.rotation_wxyz: must be an array of 4 numbers" run --images "$work/images"
+cat > "$work/far.json" <<'JSON'
+{"cameras": [{"folder": "left", "reference": true},
+             {"folder": "right", "cam_from_rig": {"rotation_wxyz": [1, 0, 0, 0],
+                                                  "translation": [1e300, 0, 0]}}]}
+JSON
+expect_exit_2 "$work/far.json" \
+  "cameras[1].cam_from_rig.translation: 1e+300 m from the reference camera is beyond what a rig can be (at most 100 m) (camera 'right')" \
+  run --images "$work/images"
 [ ! -e "$work/out/database.db" ] || fail "a bad rig file: the workspace was made all the same"
 
 # 2. A camera folder that is not there (before an image is read), then one with no images.
