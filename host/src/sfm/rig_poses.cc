@@ -198,9 +198,11 @@ void DescribeGivenCamera(const CameraRig& rig, size_t r, camera_t camera_id,
     (*camera)["cam_from_rig"] = PoseJson(given);
     (*camera)["source"] = "given";
     if (log_lines != nullptr) {
-      log_lines->push_back(
-          fmt::format("rig {}, camera {}: cam_from_rig given, held in {} frames: {}", r, camera_id,
-                      num_whole, PoseText(given)));
+      log_lines->push_back(fmt::format(
+          "rig {}, camera {}: cam_from_rig given, {}: {}", r, camera_id,
+          num_whole == 0 ? "held in no frame (none has both images in this model)"
+                         : fmt::format("held in all {} frames registered whole", num_whole),
+          PoseText(given)));
     }
     return;
   }
