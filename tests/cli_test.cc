@@ -147,6 +147,70 @@ TEST(Cli, InvalidPluginOptionIsExitCode2) {
       << result.output;
 }
 
+// The global mapper reads its own options and hands the rest to GlobalMapperOptions:
+// an unknown key is named with the closest of all of them, or with the whole list.
+TEST(Cli, GlobalMapperUnknownKeysNameEveryKnownKey) {
+  testing::TemporaryDir dir;
+  const auto map_with = [&](const std::string& options) {
+    const auto manifest = dir.path() / "global.json";
+    std::ofstream(manifest) << R"({"pipeline": {"mapper": {"plugin": "global", "options": )"
+                            << options << "}}}";
+    return RunTessera("map --output " + (dir.path() / "out").string() + " --manifest " +
+                      manifest.string());
+  };
+  const auto own_key = map_with(R"({"use_gps_priors": true})");
+  EXPECT_EQ(own_key.exit_code, 2) << own_key.output;
+  EXPECT_NE(
+      own_key.output.find(
+          "pipeline.mapper.options.use_gps_priors: unknown key; did you mean 'use_gps_prior'?"),
+      std::string::npos)
+      << own_key.output;
+  const auto shared_key = map_with(R"({"ba_num_round": 2})");
+  EXPECT_NE(shared_key.output.find(
+                "pipeline.mapper.options.ba_num_round: unknown key; did you mean 'ba_num_rounds'?"),
+            std::string::npos)
+      << shared_key.output;
+  const auto far_key = map_with(R"({"completely_unrelated": 1})");
+  EXPECT_EQ(far_key.exit_code, 2) << far_key.output;
+  for (const char* key : {"ba_function_tolerance", "gps_min_images", "min_model_agreement",
+                          "reg_max_rotation_error", "seed", "use_gps_prior"}) {
+    EXPECT_NE(far_key.output.find(key), std::string::npos)
+        << key << " not listed: " << far_key.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "database.db"));
+}
+
+// Range messages say the range in a few characters: CLI11's NonNegativeNumber wrote its
+// upper bound, DBL_MAX, in 309 digits.
+TEST(Cli, ANegativeModelIndexIsRefusedReadably) {
+  const auto result =
+      RunTessera("export --model /nonexistent --format ply --output /tmp/x --model-index -1");
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("--model-index: Value -1 is not a whole number of at least 0"),
+            std::string::npos)
+      << result.output;
+  EXPECT_LT(result.output.size(), 300u) << result.output;
+}
+
+TEST(Cli, GtOriginAltitudeIsRangeChecked) {
+  for (const char* origin : {"46.5,6.5,1e9", "46.5,6.5,-200000", "46.5,6.5,nan"}) {
+    const auto result = RunTessera(std::string("eval /nonexistent /nonexistent --no-align "
+                                               "--gt-origin ") +
+                                   origin);
+    EXPECT_EQ(result.exit_code, 2) << origin << ": " << result.output;
+    EXPECT_NE(result.output.find("--gt-origin: expected LAT,LON,ALT (latitude in [-90, 90], "
+                                 "longitude in [-180, 180] degrees, altitude in [-100000, "
+                                 "100000] metres), got '" +
+                                 std::string(origin) + "'"),
+              std::string::npos)
+        << result.output;
+  }
+  // In range: past the argument check, to the model folder.
+  const auto in_range =
+      RunTessera("eval /nonexistent /nonexistent --no-align --gt-origin 46.5,6.5,8848");
+  EXPECT_EQ(in_range.output.find("--gt-origin"), std::string::npos) << in_range.output;
+}
+
 TEST(Cli, TooFewImagesIsExitCode2) {
   testing::TemporaryDir dir;
   std::filesystem::create_directories(dir.path() / "images");

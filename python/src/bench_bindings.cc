@@ -13,6 +13,7 @@
 #include "bench/bench.h"
 #include "bindings.h"
 #include "json_objects.h"
+#include "tessera/errors.h"
 
 namespace py = pybind11;
 using OptionalPath = std::optional<std::filesystem::path>;
@@ -25,6 +26,10 @@ void BindBench(py::module_& module) {
       [](const std::filesystem::path& images, const std::vector<std::filesystem::path>& manifests,
          const std::filesystem::path& output, const OptionalPath& ground_truth,
          const OptionalPath& camera_K, bool with_colmap, int threads) {
+        // Refused as the command line refuses --threads out of 0..1024.
+        if (threads < 0 || threads > 1024) {
+          throw InputError("threads: " + std::to_string(threads) + " is not in 0..1024");
+        }
         BenchOptions options;
         options.images = images.string();
         for (const auto& manifest : manifests) options.manifests.push_back(manifest.string());

@@ -8,11 +8,14 @@
 #include <pybind11/stl/filesystem.h>
 #include <pybind11/stl_bind.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <limits>
 #include <map>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "bindings.h"
 #include "numpy_views.h"
@@ -70,13 +73,69 @@ py::array_t<double> ImgFromCam(const Camera& camera, const Rigid3d& cam_from_wor
   return pixels;
 }
 
+// `values` as `count` finite doubles; ValueError naming `what` otherwise.
+std::vector<double> FiniteValues(const py::array_t<double, py::array::forcecast>& values,
+                                 size_t count, const std::string& what) {
+  if (values.ndim() != 1 || static_cast<size_t>(values.shape(0)) != count) {
+    throw py::value_error(what + ": expected " + std::to_string(count) + " numbers (a (" +
+                          std::to_string(count) + ",) array)");
+  }
+  std::vector<double> result(values.data(), values.data() + count);
+  for (size_t k = 0; k < count; ++k) {
+    if (!std::isfinite(result[k])) {
+      throw py::value_error(what + ": value " + std::to_string(k) + " is " +
+                            std::to_string(result[k]) + ", not a finite number");
+    }
+  }
+  return result;
+}
+
+// The first value of `model` that is not finite, named as the model's reader would name
+// the record ("point3D 17: xyz[0] is nan"); empty when every value is finite. Tessera's
+// reader refuses such a file, so write() refuses to make one.
+std::string FirstNonFinite(const Reconstruction& model) {
+  const auto check = [](const double* values, size_t count, const std::string& what) {
+    for (size_t k = 0; k < count; ++k) {
+      if (!std::isfinite(values[k])) {
+        return what + "[" + std::to_string(k) + "] is " + std::to_string(values[k]);
+      }
+    }
+    return std::string();
+  };
+  for (const auto& [camera_id, camera] : model.cameras) {
+    const std::string bad = check(camera.params.data(), camera.params.size(),
+                                  "camera " + std::to_string(camera_id) + ": params");
+    if (!bad.empty()) return bad;
+  }
+  for (const auto& [image_id, image] : model.images) {
+    const std::string name = "image " + std::to_string(image_id) + " ('" + image.name + "')";
+    std::string bad = check(image.cam_from_world.rotation.coeffs().data(), 4,
+                            name + ": cam_from_world rotation (x, y, z, w)");
+    if (bad.empty()) {
+      bad =
+          check(image.cam_from_world.translation.data(), 3, name + ": cam_from_world translation");
+    }
+    for (size_t idx = 0; bad.empty() && idx < image.points2D.size(); ++idx) {
+      bad = check(image.points2D[idx].xy.data(), 2, name + ": keypoint " + std::to_string(idx));
+    }
+    if (!bad.empty()) return bad;
+  }
+  for (const auto& [point3D_id, point] : model.points3D) {
+    const std::string name = "point3D " + std::to_string(point3D_id);
+    std::string bad = check(point.xyz.data(), 3, name + ": xyz");
+    if (bad.empty()) bad = check(&point.error, 1, name + ": error");
+    if (!bad.empty()) return bad;
+  }
+  return "";
+}
+
 void BindCamera(py::module_& module) {
   py::class_<Camera>(module, "Camera", "A camera: model, image size and parameters.")
       .def_readonly("camera_id", &Camera::camera_id)
       .def_property_readonly("model", &Camera::ModelName, "COLMAP's model name, e.g. 'PINHOLE'")
       .def_readonly("width", &Camera::width)
       .def_readonly("height", &Camera::height)
-      .def_property_readonly(
+      .def_property(
           "params",
           [](py::object self) {
             const Camera& camera = self.cast<const Camera&>();
@@ -84,7 +143,14 @@ void BindCamera(py::module_& module) {
                                      {static_cast<py::ssize_t>(camera.params.size())},
                                      {sizeof(double)}, self);
           },
-          "Parameters in COLMAP's order for the model, (P,) float64: a view (no copy)")
+          [](Camera& camera, const py::array_t<double, py::array::forcecast>& values) {
+            const std::vector<double> params =
+                FiniteValues(values, camera.params.size(),
+                             "Camera " + std::to_string(camera.camera_id) + ".params");
+            std::copy(params.begin(), params.end(), camera.params.begin());
+          },
+          "Parameters in COLMAP's order for the model, (P,) float64: a read-only view (no "
+          "copy); assign P finite numbers to change them")
       .def("calibration_matrix", &Camera::CalibrationMatrix, "K, 3x3, of the pinhole part")
       .def(
           "img_from_cam",
@@ -122,7 +188,7 @@ void BindImage(py::module_& module) {
             const double* data = n > 0 ? image.points2D[0].xy.data() : nullptr;
             return ArrayView<double>(data, {n, 2}, {sizeof(Point2D), sizeof(double)}, self);
           },
-          "The keypoints' pixels, (M, 2) float64: a strided view (no copy)")
+          "The keypoints' pixels, (M, 2) float64: a read-only strided view (no copy)")
       .def_property_readonly(
           "point3D_ids",
           [](py::object self) {
@@ -131,7 +197,8 @@ void BindImage(py::module_& module) {
             const point3D_t* data = n > 0 ? &image.points2D[0].point3D_id : nullptr;
             return ArrayView<point3D_t>(data, {n}, {sizeof(Point2D)}, self);
           },
-          "Each keypoint's 3D point id, (M,) uint64, 2**64-1 where none: a strided view")
+          "Each keypoint's 3D point id, (M,) uint64, 2**64-1 where none: a read-only strided "
+          "view")
       .def("num_points3D",
            [](const Image& image) {
              size_t n = 0;
@@ -146,19 +213,24 @@ void BindImage(py::module_& module) {
 
 void BindPoint3D(py::module_& module) {
   py::class_<Point3D>(module, "Point3D", "A 3D point: position, colour, error and track.")
-      .def_property_readonly(
+      .def_property(
           "xyz",
           [](py::object self) {
             return ArrayView<double>(self.cast<const Point3D&>().xyz.data(), {3}, {sizeof(double)},
                                      self);
           },
-          "Position in the world, (3,) float64: a view")
+          [](Point3D& point, const py::array_t<double, py::array::forcecast>& values) {
+            const std::vector<double> xyz = FiniteValues(values, 3, "Point3D.xyz");
+            point.xyz = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
+          },
+          "Position in the world, (3,) float64: a read-only view; assign 3 finite numbers to "
+          "move the point")
       .def_property_readonly(
           "color",
           [](py::object self) {
             return ArrayView<uint8_t>(self.cast<const Point3D&>().color.data(), {3}, {1}, self);
           },
-          "RGB, (3,) uint8: a view")
+          "RGB, (3,) uint8: a read-only view")
       .def_readonly("error", &Point3D::error, "Mean reprojection error in pixels, -1 if unknown")
       .def_property_readonly(
           "track",
@@ -169,7 +241,7 @@ void BindPoint3D(py::module_& module) {
             return ArrayView<uint32_t>(data, {n, 2}, {sizeof(TrackElement), sizeof(uint32_t)},
                                        self);
           },
-          "(image_id, point2D_idx) per observation, (K, 2) uint32: a view");
+          "(image_id, point2D_idx) per observation, (K, 2) uint32: a read-only view");
 }
 
 // The whole-model arrays, projection and statistics (one bulk copy each: the points
@@ -272,6 +344,11 @@ void BindModel(py::module_& module) {
             if (format != "binary" && format != "text") {
               throw InputError("format: '" + format + "' is neither 'binary' nor 'text'");
             }
+            if (const std::string bad = FirstNonFinite(handle.model); !bad.empty()) {
+              throw py::value_error("write: " + bad +
+                                    ", not a finite number; a COLMAP model holds finite numbers "
+                                    "only (nothing was written)");
+            }
             const py::gil_scoped_release release;
             WriteColmapModel(
                 handle.model, path,
@@ -279,7 +356,8 @@ void BindModel(py::module_& module) {
                 &handle.order);
           },
           py::arg("path"), py::arg("format") = "binary",
-          "Writes the model into a folder in COLMAP 3.8's layout, records in the order read")
+          "Writes the model into a folder in COLMAP 3.8's layout, records in the order read; "
+          "ValueError naming the record for a value that is not finite")
       .def_property_readonly(
           "cameras", [](ModelHandle & handle) -> auto& { return handle.model.cameras; },
           py::return_value_policy::reference_internal, "camera_id -> Camera")

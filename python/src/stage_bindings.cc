@@ -186,6 +186,11 @@ void BindStages(py::module_& module) {
       [](const std::filesystem::path& model, const std::string& format,
          const std::filesystem::path& output, const OptionalPath& images, const py::object& options,
          int model_index, const OptionalPath& masks) {
+        // Refused as the command line refuses --model-index -1, before the child starts.
+        if (model_index < 0) {
+          throw InputError("model_index: Value " + std::to_string(model_index) +
+                           " is not a whole number of at least 0");
+        }
         ExportArguments arguments;
         arguments.model = model;
         arguments.format = format;

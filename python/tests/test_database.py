@@ -52,3 +52,16 @@ def test_a_file_that_is_not_a_database_raises_input_error(sample, tmp_path):
     not_a_database.write_text("hello")
     with pytest.raises(tessera.InputError, match="not_a.db"):
         tessera.Database(not_a_database)
+
+
+def test_database_arrays_are_read_only(sample):
+    database = tessera.Database(sample[2] / "database.db")
+    image_id = next(iter(database.images))
+    pair = database.matched_pairs()[0]
+    for name, array in {"keypoints": database.keypoints(image_id),
+                        "descriptors": database.descriptors(image_id),
+                        "matches": database.matches(*pair),
+                        "inlier_matches": database.two_view_geometry(*pair)["inlier_matches"]}.items():
+        assert not array.flags.writeable, name
+        with pytest.raises(ValueError, match="read-only"):
+            array[0] = 0

@@ -113,3 +113,61 @@ def test_bad_path_corrupt_model_and_format_raise_input_error(model_dir, tmp_path
         tessera.Reconstruction(model_dir).write(tmp_path / "x", format="png")
     assert issubclass(tessera.InputError, tessera.Error)
     assert tessera.InputError.exit_code == 2
+
+
+def test_views_are_read_only_and_setters_check_what_they_are_given(model_dir, tmp_path):
+    model = tessera.Reconstruction(model_dir)
+    camera = model.cameras[next(iter(model.cameras.keys()))]
+    image = model.images[next(iter(model.images.keys()))]
+    point3D_id = next(iter(model.points3D.keys()))
+    point = model.points3D[point3D_id]
+    views = {"Camera.params": camera.params, "Image.keypoints": image.keypoints,
+             "Image.point3D_ids": image.point3D_ids, "Point3D.xyz": point.xyz,
+             "Point3D.color": point.color, "Point3D.track": point.track}
+    for name, view in views.items():
+        assert not view.flags.writeable, name
+        with pytest.raises(ValueError, match="read-only"):
+            view[0] = 0
+        # Nor can it be made writeable again: its memory is the model's.
+        with pytest.raises(ValueError):
+            view.setflags(write=True)
+    # The explicit setters change the model, and refuse what a model cannot hold.
+    point.xyz = [1.0, 2.0, 3.0]
+    np.testing.assert_array_equal(model.points3D[point3D_id].xyz, [1.0, 2.0, 3.0])
+    with pytest.raises(ValueError, match=r"Point3D.xyz: value 1 is nan, not a finite number"):
+        point.xyz = [1.0, float("nan"), 3.0]
+    with pytest.raises(ValueError, match=r"Point3D.xyz: expected 3 numbers"):
+        point.xyz = [1.0, 2.0]
+    params = camera.params.copy()
+    params[0] *= 1.5
+    camera.params = params
+    np.testing.assert_array_equal(model.cameras[camera.camera_id].params, params)
+    with pytest.raises(ValueError, match=rf"Camera {camera.camera_id}.params: value 0 is inf"):
+        camera.params = [float("inf")] + list(params[1:])
+    with pytest.raises(ValueError, match=r"expected 4 numbers"):
+        camera.params = params[:3]
+    # What was set is written and read back.
+    model.write(tmp_path / "moved")
+    again = tessera.Reconstruction(tmp_path / "moved")
+    np.testing.assert_array_equal(again.points3D[point3D_id].xyz, [1.0, 2.0, 3.0])
+    np.testing.assert_array_equal(again.cameras[camera.camera_id].params, params)
+
+
+def test_write_refuses_a_value_that_is_not_finite(model_dir, tmp_path):
+    import ctypes
+
+    model = tessera.Reconstruction(model_dir)
+    point3D_id = next(iter(model.points3D.keys()))
+    point = model.points3D[point3D_id]
+    # Past the read-only view, as a C extension could: a NaN in the model's memory.
+    ctypes.c_double.from_address(point.xyz.ctypes.data + 8).value = float("nan")
+    with pytest.raises(ValueError,
+                       match=rf"write: point3D {point3D_id}: xyz\[1\] is nan, not a finite number"):
+        model.write(tmp_path / "nan")
+    assert not (tmp_path / "nan").exists()
+    image_id = next(iter(model.images.keys()))
+    image = model.images[image_id]
+    ctypes.c_double.from_address(point.xyz.ctypes.data + 8).value = 0.0
+    ctypes.c_double.from_address(image.keypoints.ctypes.data).value = float("inf")
+    with pytest.raises(ValueError, match=rf"write: image {image_id} \('{image.name}'\): keypoint 0\[0\] is inf"):
+        model.write(tmp_path / "inf")

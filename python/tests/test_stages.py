@@ -121,6 +121,21 @@ def test_export_writes_the_model_with_a_plugin(sample, tmp_path):
                        output=tmp_path / "x")
 
 
+def test_python_refuses_the_arguments_the_cli_refuses(sample, tmp_path):
+    images, _, cli_output = sample
+    # `tessera export --model-index -1` is exit 2; the module wrote sparse/-1 (issue 47).
+    with pytest.raises(tessera.InputError,
+                       match="model_index: Value -1 is not a whole number of at least 0"):
+        tessera.export(model=cli_output / "sparse" / "0", format="colmap_binary",
+                       output=tmp_path / "neg", model_index=-1)
+    assert not (tmp_path / "neg").exists()
+    for threads in (-1, 1025):
+        with pytest.raises(tessera.InputError, match=f"threads: {threads} is not in 0..1024"):
+            tessera.map(output=tmp_path / "t", threads=threads)
+        with pytest.raises(tessera.InputError, match=f"threads: {threads} is not in 0..1024"):
+            tessera.bench(images=images, manifests=[], output=tmp_path / "b", threads=threads)
+
+
 @pytest.mark.parametrize("target", ["interpreter", "process_group"])
 def test_ctrl_c_while_a_stage_runs_raises_keyboard_interrupt(sample, tmp_path, target):
     # SIGINT to the interpreter (its handler only sets a flag while C++ runs), which

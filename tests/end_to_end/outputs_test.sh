@@ -12,7 +12,10 @@
 #     before anything is replaced, the database intact;
 #  7. a failing exporter stops the ones after it; the earlier set stays whole;
 #  8. a rerun that builds no model (exit 3) leaves no model of an earlier run;
-#  9. a gaussian_splatting re-export of a smaller model leaves none of the old images.
+#  9. a gaussian_splatting re-export of a smaller model leaves none of the old images;
+# 10. run_summary.json never describes models that are not there (issue 47): `map` with
+#     another mapper, and a `map` that builds no model (exit 3), remove it; `run` writes
+#     its own, naming its mapper and its models.
 # usage: outputs_test.sh TESSERA DOWNSCALE SOURCE_DIR FAILING_PLUGIN_DIR
 set -uo pipefail
 tessera=$1
@@ -190,4 +193,44 @@ tess "$work/small.log" "$work/bin.json" run --images "$work/d4" --output "$work/
 [ "$(ls "$work/gs/gaussian_splatting/images" | wc -l)" = 4 ] && [ ! -e "$work/gs/gaussian_splatting/images/0007.jpg" ] ||
   fail "the re-export of a smaller model left old images: $(ls "$work/gs/gaussian_splatting/images")"
 echo "3DGS re-export of a smaller model: the old images gone"
+
+# 10. run_summary.json follows the model set.
+with_mapper() {  # with_mapper FILE MAPPER_JSON: bin.json with that mapper
+  python3 - "$work/bin.json" "$1" "$2" <<'PY'
+import json, sys
+m = json.load(open(sys.argv[1]))
+m["pipeline"]["mapper"] = json.loads(sys.argv[3])
+json.dump(m, open(sys.argv[2], "w"))
+PY
+}
+summary_mapper() {  # summary_mapper RUN_SUMMARY: the mapper it names
+  python3 -c 'import json,sys; print([p["plugin"] for p in json.load(open(sys.argv[1]))["plugins"] if p["slot"] == "mapper"][0])' "$1"
+}
+fresh "$work/s"
+[ "$(summary_mapper "$work/s/run_summary.json")" = incremental ] || fail "run_summary.json of the first run"
+with_mapper "$work/global.json" '{"plugin": "global"}'
+tess "$work/s1.log" "$work/global.json" map --images "$work/d" --output "$work/s" ||
+  { cat "$work/s1.log"; fail "map with the global mapper"; }
+[ ! -e "$work/s/run_summary.json" ] ||
+  fail "map with the global mapper: run_summary.json left, naming the $(summary_mapper "$work/s/run_summary.json") mapper"
+with_mapper "$work/none.json" '{"plugin": "incremental", "options": {"init_min_num_inliers": 1000000}}'
+tess "$work/s2.log" "$work/bin.json" run --images "$work/d" --output "$work/s" ||
+  { cat "$work/s2.log"; fail "run again"; }
+[ -f "$work/s/run_summary.json" ] || fail "run again: no run_summary.json"
+tess "$work/s3.log" "$work/none.json" map --images "$work/d" --output "$work/s"
+code=$?
+[ "$code" = 3 ] || { cat "$work/s3.log"; fail "map with no initial pair: exit $code, expected 3"; }
+[ ! -e "$work/s/sparse" ] || fail "map with no model: sparse/ left"
+[ ! -e "$work/s/run_summary.json" ] ||
+  fail "map with no model: run_summary.json left, saying $(python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["map"]["num_models"])' "$work/s/run_summary.json") models"
+tess "$work/s4.log" "$work/global.json" run --images "$work/d" --output "$work/s" ||
+  { cat "$work/s4.log"; fail "run with the global mapper"; }
+[ "$(summary_mapper "$work/s/run_summary.json")" = global ] || fail "run with the global mapper: run_summary.json"
+python3 - "$work/s" <<'PY' || fail "run with the global mapper: run_summary.json and mapping_summary.json disagree"
+import json, sys
+run = json.load(open(sys.argv[1] + "/run_summary.json"))
+mapping = json.load(open(sys.argv[1] + "/mapping_summary.json"))
+assert run["map"]["num_models"] == len(mapping["models"]), (run["map"], len(mapping["models"]))
+PY
+echo "run_summary.json: removed by map (another mapper; no model, exit 3), rewritten by run"
 echo "PASS"

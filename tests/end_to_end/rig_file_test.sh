@@ -2,13 +2,16 @@
 # Rig files that cannot be used (`--rig rig.json`) end the run with exit code 2 and one
 # line naming the file and the JSON field. On a 512 px copy of images of the sample
 # examples/fountain-P11-small (in the repository), with ORB for speed:
-#  1. malformed JSON, two reference cameras, a bad rotation: exit 2 before an image is
-#     read (no workspace is made);
+#  1. malformed JSON, two reference cameras, a bad rotation, a translation no rig can
+#     have (1e300 m, issue 47): exit 2 before an image is read (no workspace is made);
 #  2. `run --rig` naming a camera folder that is not there: exit 2 before an image is
 #     read; one that has no images: exit 2 from the map stage; both naming
 #     cameras[1].folder;
 #  3. `map --rig` on that workspace, the two cameras' folders with different image
-#     counts: exit 2 naming the moment that one camera has no image of.
+#     counts: exit 2 naming the moment that one camera has no image of;
+#  5. a given pose that the mapper does not hold (the global mapper maps the images one
+#     by one): mapping_summary.json says "not applied" for the camera, never "given",
+#     and a warning names the rig file and the camera (issue 47).
 # usage: rig_file_test.sh TESSERA DOWNSCALE SOURCE_DIR
 set -uo pipefail
 tessera=$1
@@ -66,6 +69,14 @@ cat > "$work/bad_rotation.json" <<'JSON'
 JSON
 expect_exit_2 "$work/bad_rotation.json" \
   "cameras[1].cam_from_rig.rotation_wxyz: must be an array of 4 numbers" run --images "$work/images"
+cat > "$work/far.json" <<'JSON'
+{"cameras": [{"folder": "left", "reference": true},
+             {"folder": "right", "cam_from_rig": {"rotation_wxyz": [1, 0, 0, 0],
+                                                  "translation": [1e300, 0, 0]}}]}
+JSON
+expect_exit_2 "$work/far.json" \
+  "cameras[1].cam_from_rig.translation: 1e+300 m from the reference camera is beyond what a rig can be (at most 100 m) (camera 'right')" \
+  run --images "$work/images"
 [ ! -e "$work/out/database.db" ] || fail "a bad rig file: the workspace was made all the same"
 
 # 2. A camera folder that is not there (before an image is read), then one with no images.
@@ -91,3 +102,32 @@ code=$?
 grep -qF -- "--rig: partitioned mapping (--cluster, --cluster-shard, --hierarchical) does not hold rigs yet" \
   "$work/log" || { tail -5 "$work/log"; fail "map --rig --hierarchical: not refused as expected"; }
 echo "map --rig --hierarchical: exit 2, refused"
+
+# 5. A given pose the mapper does not hold is "not applied", with a warning.
+cp "$work/all/0005.jpg" "$work/images/right/0002.jpg"
+cat > "$work/given.json" <<'JSON'
+{"cameras": [{"folder": "left", "reference": true},
+             {"folder": "right", "cam_from_rig": {"rotation_wxyz": [1, 0, 0, 0],
+                                                  "translation": [-0.5, 0, 0]}}]}
+JSON
+python3 - "$work/m.json" "$work/global.json" <<'PY'
+import json, sys
+m = json.load(open(sys.argv[1]))
+m["pipeline"]["mapper"] = {"plugin": "global"}
+json.dump(m, open(sys.argv[2], "w"))
+PY
+rm -rf "$work/out"
+"$tessera" run --images "$work/images" --output "$work/out" --manifest "$work/global.json" \
+  --threads 2 --rig "$work/given.json" > "$work/log" 2>&1
+code=$?
+[ "$code" = 0 ] || { tail -20 "$work/log"; fail "run --rig with the global mapper: exit $code"; }
+grep -qF "$work/given.json: cameras[1] ('right', camera " "$work/log" &&
+  grep -qF "the given cam_from_rig was not applied by mapper 'global'" "$work/log" ||
+  { grep -i rig "$work/log"; fail "run --rig with the global mapper: no warning that the pose was not applied"; }
+python3 - "$work/out/mapping_summary.json" <<'PY' || fail "mapping_summary.json: the rig's pose not reported as not applied"
+import json, sys
+rig = json.load(open(sys.argv[1]))["rig"]
+right = [c for c in rig["cameras"] if c["folder"] == "right"][0]
+assert right["cam_from_rig"] == "not applied", rig
+PY
+echo "run --rig, global mapper: the given pose reported 'not applied', with a warning"

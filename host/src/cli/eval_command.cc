@@ -12,6 +12,13 @@
 #include "util/exit_codes.h"
 
 namespace tessera {
+namespace {
+
+// The altitudes georeference.json may hold (io/georeference_io.cc), so that the origin
+// given here is checked as the one Tessera writes.
+constexpr double kMaxAltitudeM = 1e5;
+
+}  // namespace
 
 CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions&) {
   struct Options {
@@ -45,10 +52,10 @@ CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions&) {
       if (std::sscanf(options->gt_origin.c_str(), "%lf,%lf,%lf%c", &values[0], &values[1],
                       &values[2], &tail) != 3 ||
           !(std::abs(values[0]) <= 90) || !(std::abs(values[1]) <= 180) ||
-          !std::isfinite(values[2])) {
+          !(std::abs(values[2]) <= kMaxAltitudeM)) {
         throw InputError(
             "--gt-origin: expected LAT,LON,ALT (latitude in [-90, 90], longitude "
-            "in [-180, 180] degrees, altitude in metres), got '" +
+            "in [-180, 180] degrees, altitude in [-100000, 100000] metres), got '" +
             options->gt_origin + "'");
       }
       gt_origin = Georeference{values[0], values[1], values[2], "ENU"};

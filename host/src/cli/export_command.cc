@@ -42,7 +42,7 @@ CommandRegistration RegisterExportCommand(CLI::App& app, const GlobalOptions&) {
   sub->add_option("--options", options->options, "The exporter's options as a JSON object");
   sub->add_option("--model-index", options->model_index,
                   "Model number, for exporters that write per model (sparse/N)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(AtLeast(0));
 
   auto run = [options]() {
     ExportArguments arguments;

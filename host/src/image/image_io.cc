@@ -217,6 +217,30 @@ bool SkipFolder(const fs::directory_entry& entry, const std::string& name,
   return false;
 }
 
+// One line for the hidden folders and image files the scan passed over (a name starting
+// with '.': .thumbnails/, .Trash-1000/, ._IMG_0001.jpg), naming the first few.
+std::string DescribeHidden(std::vector<std::string> hidden) {
+  constexpr size_t kNamed = 3;
+  std::sort(hidden.begin(), hidden.end(), NaturalLess);
+  const size_t num_folders = static_cast<size_t>(std::count_if(
+      hidden.begin(), hidden.end(), [](const std::string& name) { return name.back() == '/'; }));
+  const size_t num_files = hidden.size() - num_folders;
+  std::string what;
+  if (num_folders > 0)
+    what = std::to_string(num_folders) + (num_folders == 1 ? " folder" : " folders");
+  if (num_files > 0) {
+    what += (what.empty() ? "" : " and ") + std::to_string(num_files) +
+            (num_files == 1 ? " image file" : " image files");
+  }
+  std::string names;
+  for (size_t k = 0; k < std::min(kNamed, hidden.size()); ++k) {
+    names += (k == 0 ? "'" : ", '") + EscapeControlCharacters(hidden[k]) + "'";
+  }
+  if (hidden.size() > kNamed) names += ", ...";
+  return "Skipped " + what + " whose names start with '.' (" + names +
+         "): hidden files and folders are never scanned for images; rename them to use them.";
+}
+
 // The image file `name` at `path`: its entry, or nullopt and `problem` saying why it is
 // not used.
 std::optional<ImageEntry> ReadImageEntry(const std::string& name, const fs::path& path,
@@ -263,7 +287,8 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
 
   ImageScan scan;
   std::vector<std::pair<std::string, fs::path>> candidates;
-  SkippedEntries skipped;  // sorted at the end
+  SkippedEntries skipped;           // sorted at the end
+  std::vector<std::string> hidden;  // hidden folders ("x/.y/") and image files
   fs::recursive_directory_iterator it(root, fs::directory_options::skip_permission_denied, error);
   if (error)
     throw InputError(dir.string() + ": cannot list the image folder (" + error.message() + ")");
@@ -272,7 +297,12 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
     const fs::path& path = it->path();
     std::error_code entry_error;  // a broken link is no image, not a failed listing
     if (IsHidden(path)) {
-      if (it->is_directory(entry_error)) it.disable_recursion_pending();
+      if (it->is_directory(entry_error)) {
+        it.disable_recursion_pending();
+        hidden.push_back(path.lexically_relative(root).generic_string() + "/");
+      } else if (HasImageExtension(path)) {
+        hidden.push_back(path.lexically_relative(root).generic_string());
+      }
       continue;
     }
     const std::string name = path.lexically_relative(root).generic_string();
@@ -290,6 +320,7 @@ ImageScan ScanImageFolder(const fs::path& dir, const ImageScanOptions& options) 
   if (error) {
     throw InputError(dir.string() + ": cannot list the image folder (" + error.message() + ")");
   }
+  if (!hidden.empty()) scan.skipped_folders.push_back(DescribeHidden(std::move(hidden)));
   std::sort(candidates.begin(), candidates.end(),
             [](const auto& a, const auto& b) { return NaturalLess(a.first, b.first); });
   for (const auto& [name, path] : candidates) {

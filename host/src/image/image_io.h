@@ -34,7 +34,8 @@ struct ImageScanOptions {
 // A folder holding a Tessera workspace (a database.db or a .tessera.lock file).
 bool IsTesseraWorkspace(const std::filesystem::path& dir);
 
-// Scans `dir` and its sub-folders (hidden files and folders excepted) for files ending
+// Scans `dir` and its sub-folders (hidden files and folders excepted, counted in one
+// line of skipped_folders) for files ending
 // in .jpg, .jpeg, .png, .tif or .tiff in any case; names are relative to `dir`. The
 // format is told by the file's signature, not its extension. Sizes come from the
 // headers (JPEG SOF, PNG IHDR); JPEG and PNG files are also checked to be complete

@@ -62,6 +62,27 @@ TEST(ScanImageFolder, NaturalOrderRecursiveSkipsHiddenAndOtherFiles) {
   EXPECT_EQ(Names(scan), expected);
   EXPECT_TRUE(scan.warnings.empty());
   EXPECT_EQ(scan.images[4].path, fs::absolute(dir.path()) / "sub" / "img5.png");
+  // Passed over, but said in one line (issue 46: no log line at all).
+  EXPECT_EQ(scan.skipped_folders,
+            (std::vector<std::string>{
+                "Skipped 1 folder and 1 image file whose names start with '.' ('.cache/', "
+                "'.hidden.png'): hidden files and folders are never scanned for images; rename "
+                "them to use them."}));
+}
+
+TEST(ScanImageFolder, HiddenFoldersDeepDownAreCountedAndTheFirstNamed) {
+  TemporaryDir dir;
+  Write(dir.path() / "a.png", Pattern(8, 6));
+  for (const char* name : {"sub/.thumbs/t.png", ".b/x.png", ".a/y.png", ".c/z.png"}) {
+    Write(dir.path() / name, Pattern(8, 6));
+  }
+  std::ofstream(dir.path() / ".DS_Store") << "not an image, not counted";
+  const ImageScan scan = ScanImageFolder(dir.path());
+  EXPECT_EQ(Names(scan), (std::vector<std::string>{"a.png"}));
+  EXPECT_EQ(scan.skipped_folders,
+            (std::vector<std::string>{
+                "Skipped 4 folders whose names start with '.' ('.a/', '.b/', '.c/', ...): hidden "
+                "files and folders are never scanned for images; rename them to use them."}));
 }
 
 TEST(ScanImageFolder, ListsGoodImagesWithSizesAndWarnsOncePerBadFile) {

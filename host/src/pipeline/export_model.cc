@@ -4,6 +4,7 @@
 #include "pipeline/workspace.h"
 #include "plugin/plugin_call.h"
 #include "plugin/plugin_registry.h"
+#include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
 #include "tessera/io/georeference_io.h"
@@ -15,6 +16,11 @@ namespace tessera {
 
 ExportSummary ExportModel(const ExportArguments& arguments) {
   const Timer timer;
+  // As the command line refuses --model-index -1, for every caller (the Python module).
+  if (arguments.model_index < 0) {
+    throw InputError("model_index: Value " + std::to_string(arguments.model_index) +
+                     " is not a whole number of at least 0");
+  }
   // The plugin and its options are checked before the model is read.
   const PluginRegistry registry = PluginRegistry::Discover(PluginSearchPath({}));
   PluginInstance<Exporter> exporter =

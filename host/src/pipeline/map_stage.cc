@@ -74,18 +74,64 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
   return summary;
 }
 
+// How the models hold rig camera `camera_id` (mapper_details.rigs, rig_poses.h:
+// DescribeRigs): "given", "estimated", "not applied" (in some model; `held` says where),
+// or "not reported" by a mapper that gives no details of rigs.
+std::string RigCameraSource(const MapperResult& result, camera_t camera_id, std::string* held) {
+  const auto rigs = result.details.find("rigs");
+  if (rigs == result.details.end() || !rigs->is_array()) return "not reported";
+  std::string source = "not reported";
+  for (const nlohmann::json& model : *rigs) {
+    for (const nlohmann::json& rig : model.value("rigs", nlohmann::json::array())) {
+      for (const nlohmann::json& camera : rig.value("cameras", nlohmann::json::array())) {
+        if (camera.value("camera_id", kInvalidCameraId) != camera_id ||
+            !camera.contains("source")) {
+          continue;
+        }
+        if (source == "not applied") continue;
+        source = camera.at("source").get<std::string>();
+        if (source == "not applied") {
+          *held = fmt::format("in model {}: {} of {} frames registered whole hold it",
+                              model.value("model", 0), camera.value("num_frames_holding", 0),
+                              camera.value("num_frames_registered", 0));
+        }
+      }
+    }
+  }
+  return source;
+}
+
 // The mapping summary's rig section: which file, which content, which camera is which
-// folder.
-nlohmann::json SummarizeRig(const RigFile& file, const CameraRig& rig, const MapperInput& input) {
+// folder, and how the models hold each camera's cam_from_rig ("cam_from_rig": "given",
+// "estimated", "not applied" or "not reported"). A given pose that was not applied is
+// a warning naming the file and the camera.
+nlohmann::json SummarizeRig(const RigFile& file, const CameraRig& rig, const MapperInput& input,
+                            const MapperResult& result, const std::string& mapper) {
   std::map<std::string, camera_t> camera_of_folder;
   for (const auto& [image_id, image] : input.images) {
     camera_of_folder.emplace(ImageFolder(image.name), image.camera_id);
   }
   nlohmann::json cameras = nlohmann::json::array();
-  for (const RigFileCamera& camera : file.cameras()) {
-    cameras.push_back({{"folder", camera.folder},
-                       {"camera_id", camera_of_folder.at(camera.folder)},
-                       {"reference", camera.reference}});
+  for (size_t k = 0; k < file.cameras().size(); ++k) {
+    const RigFileCamera& camera = file.cameras()[k];
+    const camera_t camera_id = camera_of_folder.at(camera.folder);
+    nlohmann::json entry = {
+        {"folder", camera.folder}, {"camera_id", camera_id}, {"reference", camera.reference}};
+    if (!camera.reference && !result.models.empty()) {
+      std::string held;
+      const std::string source = RigCameraSource(result, camera_id, &held);
+      entry["cam_from_rig"] = source;
+      if (source == "not applied" || (source == "not reported" && rig.poses_known)) {
+        spdlog::warn(
+            "map: {}: cameras[{}] ('{}', camera {}): the given cam_from_rig was not applied {}",
+            file.path().string(), k, camera.folder, camera_id,
+            source == "not applied"
+                ? held
+                : "by mapper '" + mapper + "': it reports no rig held (mapper_details.rigs)");
+        entry["cam_from_rig"] = "not applied";
+      }
+    }
+    cameras.push_back(entry);
   }
   return {{"file", file.path().string()},       {"digest", file.digest()},
           {"frames", file.FramesDescription()}, {"poses_known", rig.poses_known},
@@ -101,7 +147,8 @@ MapperInput LoadMapperInputWithRig(const Database& database, const RigFile* rig)
   spdlog::info("map: rig {} (digest {}): {} cameras, {} frames ({}), cam_from_rig {}",
                rig->path().string(), rig->digest(), input.rigs.back().cam_from_rig.size(),
                input.rigs.back().frames.size(), rig->FramesDescription(),
-               input.rigs.back().poses_known ? "given" : "estimated");
+               input.rigs.back().poses_known ? "in the file, to be held"
+                                             : "to be estimated from the frames");
   return input;
 }
 
@@ -169,6 +216,22 @@ void ColorModels(const std::filesystem::path& image_dir, int num_threads,
   }
 }
 
+// Removes OUTPUT/run_summary.json, a file of the workspace that only Tessera writes
+// (outputs/output_transaction.h: IsWorkspaceFile), when it is a file; logs that it did.
+void RemoveRunSummary(const std::filesystem::path& output_dir) {
+  const std::filesystem::path file = output_dir / kRunSummaryFileName;
+  std::error_code error;
+  if (std::filesystem::symlink_status(file, error).type() != std::filesystem::file_type::regular) {
+    return;
+  }
+  if (std::filesystem::remove(file, error)) {
+    spdlog::debug("map: removed {}: it described the models this map replaces", file.string());
+  } else if (error) {
+    throw InputError(file.string() + ": cannot remove it (" + error.message() +
+                     "); it would describe models that are no longer there");
+  }
+}
+
 // Places the models of `result`, their exports and OUTPUT/mapping_summary.json as one
 // set (OutputTransaction): with no model, what the earlier runs wrote is removed.
 // Returns false when cancelled before the set was placed (nothing of it is).
@@ -184,7 +247,8 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
       settings.mapper != nullptr ? settings.mapper->EffectiveOptions() : nlohmann::json::object(),
       settings.seed);
   if (settings.rig != nullptr && !input.rigs.empty()) {
-    mapping.rig = SummarizeRig(*settings.rig, input.rigs.front(), input);
+    mapping.rig = SummarizeRig(*settings.rig, input.rigs.front(), input, result,
+                               settings.mapper != nullptr ? settings.mapper->name() : "");
   }
   mapping.partition = target.partition;
   summary->num_models = result.models.size();
@@ -214,6 +278,10 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
   }
   mapping.seconds = summary->seconds;
   mapping.Write(outputs.StageFor("tessera") / "mapping_summary.json");
+  // run_summary.json describes the set this one replaces (its mapper, its models): it
+  // goes before the set is placed, so that it never names models that are not there,
+  // and `run` writes its own once its set is in place.
+  RemoveRunSummary(output_dir);
   const OutputTransaction::Result placed = outputs.Commit();
   for (const auto& [writer, entries] : placed.entries_by_writer) {
     if (writer == "tessera") continue;

@@ -128,7 +128,7 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
         summary.map.images_per_model.size(), summary.map.images_per_model[0],
         summary.extract.num_images);
   }
-  WriteFileAtomically(options.output_dir / "run_summary.json", summary.ToJson().dump(2) + "\n");
+  WriteFileAtomically(options.output_dir / kRunSummaryFileName, summary.ToJson().dump(2) + "\n");
   return run;
 }
 

@@ -12,6 +12,11 @@
 
 namespace tessera {
 
+// OUTPUT/run_summary.json: written by `run` once its models are placed; every placed
+// model set (map, run, merge) removes the earlier one first, so that it never describes
+// models that are not there.
+constexpr const char* kRunSummaryFileName = "run_summary.json";
+
 struct ExtractionSummary {
   StageStatus status = StageStatus::kCompleted;
   size_t num_images = 0;         // usable images in the folder

@@ -54,16 +54,31 @@ Rigid3d ReadCamFromRig(const nlohmann::json& json, const std::string& field) {
   const std::vector<double> q = ReadNumbers(json, "rotation_wxyz", 4, field + ".rotation_wxyz");
   const std::vector<double> t = ReadNumbers(json, "translation", 3, field + ".translation");
   const Eigen::Quaterniond rotation(q[0], q[1], q[2], q[3]);
-  if (std::abs(rotation.norm() - 1) > kUnitQuaternionTolerance) {
+  if (!std::isfinite(rotation.norm()) || std::abs(rotation.norm() - 1) > kUnitQuaternionTolerance) {
     throw InputError(field + ".rotation_wxyz: not a unit quaternion (norm " +
-                     std::to_string(rotation.norm()) + ")");
+                     std::to_string(rotation.norm()) + "), so not a rotation");
   }
-  return Rigid3d(rotation.normalized(), Eigen::Vector3d(t[0], t[1], t[2]));
+  const Eigen::Vector3d translation(t[0], t[1], t[2]);
+  // A rig is one physical object: its cameras are metres apart at most. Beyond that the
+  // pose is a typo or a unit error, which every bundle adjustment would fail on.
+  if (!(translation.stableNorm() <= kMaxRigTranslationM)) {
+    char norm[32];
+    std::snprintf(norm, sizeof(norm), "%g", translation.stableNorm());
+    throw InputError(field + ".translation: " + norm +
+                     " m from the reference camera is beyond what a rig can be (at most " +
+                     std::to_string(static_cast<int>(kMaxRigTranslationM)) + " m)");
+  }
+  return Rigid3d(rotation.normalized(), translation);
 }
 
 RigFileCamera ReadCamera(const nlohmann::json& json, const std::string& field) {
   if (!json.is_object()) throw InputError(field + ": must be an object");
   RigFileCamera camera;
+  const auto folder = json.find("folder");
+  // Named in the errors of its pose, which the reader meets before the folder otherwise.
+  const std::string camera_name = folder != json.end() && folder->is_string()
+                                      ? " (camera '" + folder->get<std::string>() + "')"
+                                      : "";
   for (const auto& [key, value] : json.items()) {
     if (key == "folder") {
       if (!value.is_string() || value.get<std::string>().empty()) {
@@ -75,7 +90,11 @@ RigFileCamera ReadCamera(const nlohmann::json& json, const std::string& field) {
       if (!value.is_boolean()) throw InputError(field + ".reference: must be true or false");
       camera.reference = value.get<bool>();
     } else if (key == "cam_from_rig") {
-      camera.cam_from_rig = ReadCamFromRig(value, field + ".cam_from_rig");
+      try {
+        camera.cam_from_rig = ReadCamFromRig(value, field + ".cam_from_rig");
+      } catch (const InputError& error) {
+        throw InputError(error.what() + camera_name);
+      }
     } else {
       throw InputError(field + "." + key + ": unknown field (folder, reference, cam_from_rig)");
     }

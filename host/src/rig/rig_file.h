@@ -22,6 +22,10 @@
 
 namespace tessera {
 
+// The farthest a rig camera may be from the reference camera (|cam_from_rig.translation|,
+// metres): a rig is one physical object, a car or a backpack at most.
+constexpr double kMaxRigTranslationM = 100;
+
 struct RigFileCamera {
   std::string folder;  // relative to the images folder ("left", "rig/cam1")
   bool reference = false;
@@ -32,7 +36,9 @@ struct RigFileCamera {
 class RigFile {
  public:
   // Reads and checks FILE; throws InputError naming the file and the JSON field
-  // ("rig.json: cameras[1].cam_from_rig.rotation_wxyz: ...") on any problem.
+  // ("rig.json: cameras[1].cam_from_rig.rotation_wxyz: ...") on any problem, and the
+  // camera's folder for a pose that is no rig's: a quaternion not of unit norm (not a
+  // rotation), a translation longer than kMaxRigTranslationM.
   static RigFile Read(const std::filesystem::path& file);
   // Checks `text` as the content of `file` (named in errors only).
   static RigFile Parse(const std::string& text, const std::filesystem::path& file);

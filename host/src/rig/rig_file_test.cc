@@ -90,14 +90,16 @@ TEST(RigFile, BadFilesNameTheFileAndField) {
             "rig.json: cameras: exactly one camera must be \"reference\": true (0 are)");
   EXPECT_EQ(ParseError(R"j({"cameras": [{"folder": "a", "reference": true}, {"folder": "b",
               "cam_from_rig": {"rotation_wxyz": [1, 0, 0], "translation": [0, 0, 0]}}]})j"),
-            "rig.json: cameras[1].cam_from_rig.rotation_wxyz: must be an array of 4 numbers");
+            "rig.json: cameras[1].cam_from_rig.rotation_wxyz: must be an array of 4 numbers "
+            "(camera 'b')");
   EXPECT_EQ(ParseError(R"j({"cameras": [{"folder": "a", "reference": true}, {"folder": "b",
               "cam_from_rig": {"rotation_wxyz": [2, 0, 0, 0], "translation": [0, 0, 0]}}]})j"),
             "rig.json: cameras[1].cam_from_rig.rotation_wxyz: not a unit quaternion (norm "
-            "2.000000)");
+            "2.000000), so not a rotation (camera 'b')");
   EXPECT_EQ(ParseError(R"j({"cameras": [{"folder": "a", "reference": true}, {"folder": "b",
               "cam_from_rig": {"rotation_wxyz": [1, 0, 0, 0], "translation": [0, "x", 0]}}]})j"),
-            "rig.json: cameras[1].cam_from_rig.translation: must be an array of 3 finite numbers");
+            "rig.json: cameras[1].cam_from_rig.translation: must be an array of 3 finite numbers "
+            "(camera 'b')");
   EXPECT_EQ(ParseError(R"j({"cameras": [{"folder": "a", "reference": true}, {"fodler": "b"}]})j"),
             "rig.json: cameras[1].fodler: unknown field (folder, reference, cam_from_rig)");
   EXPECT_EQ(ParseError(R"j({"cameras": [{"folder": "a", "reference": true}, {}]})j"),
@@ -113,6 +115,43 @@ TEST(RigFile, BadFilesNameTheFileAndField) {
               "frames": "by_time"})j"),
             "rig.json: frames: must be \"same_name\" or {\"pattern\": \"REGEX with one capture "
             "group\"}");
+}
+
+// The rig file's text with camera "b"'s cam_from_rig as given.
+std::string WithCamFromRig(const std::string& rotation_wxyz, const std::string& translation) {
+  return R"j({"cameras": [{"folder": "a", "reference": true}, {"cam_from_rig": {"rotation_wxyz": )j" +
+         rotation_wxyz + ", \"translation\": " + translation + R"j(}, "folder": "b"}]})j";
+}
+
+TEST(RigFile, PosesNoRigCanHaveNameTheFileAndTheCamera) {
+  // A translation that is finite but no rig's (issue 47: 1e300 passed, and every
+  // bundle adjustment failed on it), or a metre past the bound.
+  EXPECT_EQ(ParseError(WithCamFromRig("[1, 0, 0, 0]", "[1e300, 0, 0]")),
+            "rig.json: cameras[1].cam_from_rig.translation: 1e+300 m from the reference camera "
+            "is beyond what a rig can be (at most 100 m) (camera 'b')");
+  EXPECT_EQ(ParseError(WithCamFromRig("[1, 0, 0, 0]", "[0, 80, 61]")),
+            "rig.json: cameras[1].cam_from_rig.translation: 100.603 m from the reference camera "
+            "is beyond what a rig can be (at most 100 m) (camera 'b')");
+  EXPECT_EQ(ParseError(WithCamFromRig("[1, 0, 0, 0]", "[1e200, 1e200, 0]")),
+            "rig.json: cameras[1].cam_from_rig.translation: 1.41421e+200 m from the reference "
+            "camera is beyond what a rig can be (at most 100 m) (camera 'b')");
+  // Quaternions of no rotation: too long, too short, all zero, or so large that the
+  // norm overflows.
+  EXPECT_EQ(ParseError(WithCamFromRig("[0.7, 0.7, 0, 0]", "[0.5, 0, 0]")),
+            "rig.json: cameras[1].cam_from_rig.rotation_wxyz: not a unit quaternion (norm "
+            "0.989949), so not a rotation (camera 'b')");
+  EXPECT_EQ(ParseError(WithCamFromRig("[0, 0, 0, 0]", "[0.5, 0, 0]")),
+            "rig.json: cameras[1].cam_from_rig.rotation_wxyz: not a unit quaternion (norm "
+            "0.000000), so not a rotation (camera 'b')");
+  EXPECT_EQ(ParseError(WithCamFromRig("[1e200, 1e200, 0, 0]", "[0.5, 0, 0]")),
+            "rig.json: cameras[1].cam_from_rig.rotation_wxyz: not a unit quaternion (norm inf), "
+            "so not a rotation (camera 'b')");
+  // Within the bounds: a rig 99 m long, a quaternion rounded to three digits.
+  const RigFile long_rig = RigFile::Parse(WithCamFromRig("[1, 0, 0, 0]", "[0, 0, 99]"), "rig.json");
+  EXPECT_NEAR(long_rig.cameras()[1].cam_from_rig->translation.z(), 99, 1e-12);
+  const RigFile rounded =
+      RigFile::Parse(WithCamFromRig("[0.707, 0, 0.707, 0]", "[0.5, 0, 0]"), "rig.json");
+  EXPECT_NEAR(rounded.cameras()[1].cam_from_rig->rotation.norm(), 1, 1e-12);
 }
 
 TEST(RigFile, AFolderThatIsNotThereIsNamedBeforeAnyImageIsRead) {

@@ -459,9 +459,11 @@ nlohmann::json DescribeModelRigs(const std::vector<CameraRig>& rigs,
                                  const std::vector<Reconstruction>& models) {
   nlohmann::json described = nlohmann::json::array();
   for (size_t index = 0; index < models.size(); ++index) {
-    std::vector<std::string> lines;
-    described.push_back({{"model", index}, {"rigs", DescribeRigs(rigs, models[index], &lines)}});
+    std::vector<std::string> lines, warnings;
+    described.push_back(
+        {{"model", index}, {"rigs", DescribeRigs(rigs, models[index], &lines, &warnings)}});
     for (const std::string& line : lines) spdlog::info("map: model {}: {}", index, line);
+    for (const std::string& line : warnings) spdlog::warn("map: model {}: {}", index, line);
   }
   return described;
 }

@@ -118,5 +118,62 @@ TEST(RigMapping, GivenPosesAreKeptAndGiveTheModelTheirScale) {
             "given");
 }
 
+// The Ceres adjuster, but a problem with a rig is refused (usable = false), as the
+// contract lets an adjuster that cannot keep a rig do: every frame then stays as it was
+// registered.
+class RigRefusingAdjuster : public BundleAdjuster {
+ public:
+  BundleAdjustmentSummary Adjust(const BundleAdjustmentConfig& config,
+                                 Reconstruction* reconstruction) const override {
+    if (!config.rigs.empty()) {
+      ++num_refused;
+      BundleAdjustmentSummary summary;
+      summary.message = "cannot keep rigs";
+      return summary;
+    }
+    return testing::CeresAdjusterOnOneThread().Adjust(config, reconstruction);
+  }
+  mutable int num_refused = 0;
+};
+
+TEST(RigMapping, AGivenPoseBundleAdjustmentCannotKeepIsReportedNotApplied) {
+  // The file's pose is 2 units off the truth and turned 20 degrees: no frame's images
+  // agree with it, so each is registered on its own, and no adjustment holds the rig.
+  SyntheticScene scene = MakeRigScene();
+  const Rigid3d given(
+      Eigen::Quaterniond(Eigen::AngleAxisd(12 * M_PI / 180, Eigen::Vector3d::UnitY())),
+      Eigen::Vector3d(1.2, 0.05, 0.1));
+  scene.input.rigs[0].cam_from_rig[2] = given;
+  scene.input.rigs[0].poses_known = true;
+  const RigRefusingAdjuster adjuster;
+  const MapperResult result = IncrementalPipeline({}, adjuster, 0).Reconstruct(scene.input);
+  EXPECT_GT(adjuster.num_refused, 0);
+  ASSERT_EQ(result.models.size(), 1u);
+  const Reconstruction& model = result.models[0];
+  ASSERT_GE(model.images.size(), 10u);
+  const nlohmann::json& camera =
+      result.details.at("rigs").at(0).at("rigs").at(0).at("cameras").at(1);
+  EXPECT_EQ(camera.at("source"), "not applied") << camera.dump();
+  EXPECT_LT(camera.at("num_frames_holding").get<int>(),
+            camera.at("num_frames_registered").get<int>());
+  EXPECT_NEAR(camera.at("given_cam_from_rig").at("translation").at(0).get<double>(), 1.2, 1e-12);
+  // What the summary reports is the model's pose, not the file's.
+  EXPECT_GT(std::abs(camera.at("cam_from_rig").at("translation").at(0).get<double>() - 1.2), 0.1);
+}
+
+TEST(RigMapping, AGivenPoseTheAdjustmentHoldsCountsEveryFrame) {
+  SyntheticScene scene = MakeRigScene();
+  scene.input.rigs[0].cam_from_rig[2] = TrueCamFromRig();
+  scene.input.rigs[0].poses_known = true;
+  const MapperResult result = Map(scene);
+  ASSERT_EQ(result.models.size(), 1u);
+  const nlohmann::json& camera =
+      result.details.at("rigs").at(0).at("rigs").at(0).at("cameras").at(1);
+  EXPECT_EQ(camera.at("source"), "given");
+  EXPECT_EQ(camera.at("num_frames_registered"), kNumFrames);
+  EXPECT_EQ(camera.at("num_frames_holding"), kNumFrames);
+  EXPECT_FALSE(camera.contains("given_cam_from_rig"));
+}
+
 }  // namespace
 }  // namespace tessera

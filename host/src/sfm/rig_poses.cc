@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
+#include <utility>
 
 namespace tessera {
 namespace {
@@ -34,6 +36,36 @@ bool IsRegistered(const Reconstruction& model, image_t image_id) {
 
 }  // namespace
 
+namespace {
+
+// Camera `camera_id`'s cam_from_rig as `model`'s frames with both images registered give
+// it (rotation averaged, translation's median per axis), and how many frames that is;
+// nullopt with no such frame.
+std::optional<Rigid3d> EstimateCamFromRig(const CameraRig& rig, camera_t camera_id,
+                                          const Reconstruction& model, size_t* num_frames) {
+  std::vector<Eigen::Quaterniond> rotations;
+  std::vector<double> translations[3];
+  for (const auto& frame : rig.frames) {
+    const auto reference = frame.find(rig.reference_camera);
+    const auto other = frame.find(camera_id);
+    if (reference == frame.end() || other == frame.end() ||
+        !IsRegistered(model, reference->second) || !IsRegistered(model, other->second)) {
+      continue;
+    }
+    const Rigid3d cam_from_rig = model.images.at(other->second).cam_from_world *
+                                 model.images.at(reference->second).cam_from_world.Inverse();
+    rotations.push_back(cam_from_rig.rotation);
+    for (int i = 0; i < 3; ++i) translations[i].push_back(cam_from_rig.translation(i));
+  }
+  *num_frames = rotations.size();
+  if (rotations.empty()) return std::nullopt;
+  return Rigid3d(
+      MeanRotation(rotations),
+      Eigen::Vector3d(Median(translations[0]), Median(translations[1]), Median(translations[2])));
+}
+
+}  // namespace
+
 std::optional<RigPoses> CamFromRig(const CameraRig& rig, const Reconstruction& model,
                                    size_t min_frames) {
   RigPoses poses;
@@ -47,25 +79,11 @@ std::optional<RigPoses> CamFromRig(const CameraRig& rig, const Reconstruction& m
       poses.cam_from_rig[camera_id] = Rigid3d();
       continue;
     }
-    std::vector<Eigen::Quaterniond> rotations;
-    std::vector<double> translations[3];
-    for (const auto& frame : rig.frames) {
-      const auto reference = frame.find(rig.reference_camera);
-      const auto other = frame.find(camera_id);
-      if (reference == frame.end() || other == frame.end() ||
-          !IsRegistered(model, reference->second) || !IsRegistered(model, other->second)) {
-        continue;
-      }
-      const Rigid3d cam_from_rig = model.images.at(other->second).cam_from_world *
-                                   model.images.at(reference->second).cam_from_world.Inverse();
-      rotations.push_back(cam_from_rig.rotation);
-      for (int i = 0; i < 3; ++i) translations[i].push_back(cam_from_rig.translation(i));
-    }
-    if (rotations.size() < min_frames) return std::nullopt;
-    poses.cam_from_rig[camera_id] = Rigid3d(
-        MeanRotation(rotations),
-        Eigen::Vector3d(Median(translations[0]), Median(translations[1]), Median(translations[2])));
-    poses.num_frames[camera_id] = rotations.size();
+    size_t num_frames = 0;
+    const std::optional<Rigid3d> estimate = EstimateCamFromRig(rig, camera_id, model, &num_frames);
+    if (!estimate || num_frames < min_frames) return std::nullopt;
+    poses.cam_from_rig[camera_id] = *estimate;
+    poses.num_frames[camera_id] = num_frames;
   }
   return poses;
 }
@@ -119,8 +137,95 @@ std::vector<image_t> FrameMates(const std::vector<CameraRig>& rigs, image_t imag
   return mates;
 }
 
+namespace {
+
+// How far a frame's relative pose may be from a given cam_from_rig and still hold it:
+// a frame that bundle adjustment held rigid agrees to rounding; one registered on its
+// own (the adjustment failed, or the mapper ignores rigs) is off by far more.
+constexpr double kHeldRotationDeg = 0.1;
+constexpr double kHeldTranslationFraction = 0.01;
+
+bool HoldsPose(const Rigid3d& measured, const Rigid3d& given) {
+  return measured.rotation.angularDistance(given.rotation) * 180 / M_PI <= kHeldRotationDeg &&
+         (measured.translation - given.translation).norm() <=
+             kHeldTranslationFraction * given.translation.norm() + 1e-6;
+}
+
+// Of `rig`'s frames with the reference's and `camera_id`'s images registered in `model`:
+// how many there are, and how many hold the given cam_from_rig.
+std::pair<size_t, size_t> FramesHoldingGivenPose(const CameraRig& rig, camera_t camera_id,
+                                                 const Reconstruction& model) {
+  size_t num_whole = 0, num_held = 0;
+  for (const auto& frame : rig.frames) {
+    const auto reference = frame.find(rig.reference_camera);
+    const auto other = frame.find(camera_id);
+    if (reference == frame.end() || other == frame.end() ||
+        !IsRegistered(model, reference->second) || !IsRegistered(model, other->second)) {
+      continue;
+    }
+    ++num_whole;
+    const Rigid3d measured = model.images.at(other->second).cam_from_world *
+                             model.images.at(reference->second).cam_from_world.Inverse();
+    num_held += HoldsPose(measured, rig.cam_from_rig.at(camera_id)) ? 1 : 0;
+  }
+  return {num_whole, num_held};
+}
+
+nlohmann::json PoseJson(const Rigid3d& pose) {
+  const Eigen::Quaterniond& q = pose.rotation;
+  const Eigen::Vector3d& t = pose.translation;
+  return {{"rotation_wxyz", {q.w(), q.x(), q.y(), q.z()}}, {"translation", {t.x(), t.y(), t.z()}}};
+}
+
+std::string PoseText(const Rigid3d& pose) {
+  const Eigen::Vector3d& t = pose.translation;
+  return fmt::format("rotation {:.3f} deg, translation [{:.4f}, {:.4f}, {:.4f}]",
+                     pose.rotation.angularDistance(Eigen::Quaterniond::Identity()) * 180 / M_PI,
+                     t.x(), t.y(), t.z());
+}
+
+// A given camera's entry: "given" when every frame registered whole holds the pose,
+// else "not applied", with what the model's frames say instead and a warning.
+void DescribeGivenCamera(const CameraRig& rig, size_t r, camera_t camera_id,
+                         const Reconstruction& model, nlohmann::json* camera,
+                         std::vector<std::string>* log_lines, std::vector<std::string>* warnings) {
+  const Rigid3d& given = rig.cam_from_rig.at(camera_id);
+  const auto [num_whole, num_held] = FramesHoldingGivenPose(rig, camera_id, model);
+  (*camera)["num_frames"] = 0;
+  (*camera)["num_frames_registered"] = num_whole;
+  (*camera)["num_frames_holding"] = num_held;
+  if (num_held == num_whole) {
+    (*camera)["cam_from_rig"] = PoseJson(given);
+    (*camera)["source"] = "given";
+    if (log_lines != nullptr) {
+      log_lines->push_back(fmt::format(
+          "rig {}, camera {}: cam_from_rig given, {}: {}", r, camera_id,
+          num_whole == 0 ? "held in no frame (none has both images in this model)"
+                         : fmt::format("held in all {} frames registered whole", num_whole),
+          PoseText(given)));
+    }
+    return;
+  }
+  // What the model's frames say (num_whole > num_held: there is a frame).
+  size_t num_frames = 0;
+  const Rigid3d measured = EstimateCamFromRig(rig, camera_id, model, &num_frames).value();
+  (*camera)["cam_from_rig"] = PoseJson(measured);
+  (*camera)["given_cam_from_rig"] = PoseJson(given);
+  (*camera)["source"] = "not applied";
+  if (warnings != nullptr) {
+    warnings->push_back(fmt::format(
+        "rig {}, camera {}: the given cam_from_rig ({}) was not applied: {} of {} frames "
+        "registered whole hold it (bundle adjustment could not keep it); the model's frames "
+        "give {}",
+        r, camera_id, PoseText(given), num_held, num_whole, PoseText(measured)));
+  }
+}
+
+}  // namespace
+
 nlohmann::json DescribeRigs(const std::vector<CameraRig>& rigs, const Reconstruction& model,
-                            std::vector<std::string>* log_lines) {
+                            std::vector<std::string>* log_lines,
+                            std::vector<std::string>* warnings) {
   nlohmann::json described = nlohmann::json::array();
   for (size_t r = 0; r < rigs.size(); ++r) {
     const CameraRig& rig = rigs[r];
@@ -131,28 +236,24 @@ nlohmann::json DescribeRigs(const std::vector<CameraRig>& rigs, const Reconstruc
       });
     }
     // Estimated from every frame of the model, with no minimum: what the model says.
-    const std::optional<RigPoses> poses = CamFromRig(rig, model, 1);
+    const std::optional<RigPoses> poses =
+        rig.poses_known ? std::nullopt : CamFromRig(rig, model, 1);
     nlohmann::json cameras = nlohmann::json::array();
-    for (const auto& [camera_id, given] : rig.cam_from_rig) {
+    for (const auto& [camera_id, initial] : rig.cam_from_rig) {
       nlohmann::json camera = {{"camera_id", camera_id},
                                {"reference", camera_id == rig.reference_camera}};
-      if (poses && camera_id != rig.reference_camera) {
+      if (rig.poses_known && camera_id != rig.reference_camera) {
+        DescribeGivenCamera(rig, r, camera_id, model, &camera, log_lines, warnings);
+      } else if (poses && camera_id != rig.reference_camera) {
         const Rigid3d& cam_from_rig = poses->cam_from_rig.at(camera_id);
-        const Eigen::Quaterniond& q = cam_from_rig.rotation;
-        const Eigen::Vector3d& t = cam_from_rig.translation;
-        camera["cam_from_rig"] = {{"rotation_wxyz", {q.w(), q.x(), q.y(), q.z()}},
-                                  {"translation", {t.x(), t.y(), t.z()}}};
-        camera["source"] = rig.poses_known ? "given" : "estimated";
+        camera["cam_from_rig"] = PoseJson(cam_from_rig);
+        camera["source"] = "estimated";
         camera["num_frames"] = poses->num_frames.at(camera_id);
         if (log_lines != nullptr) {
-          const std::string source = rig.poses_known ? "given"
-                                                     : fmt::format("estimated from {} frames",
-                                                                   poses->num_frames.at(camera_id));
-          log_lines->push_back(fmt::format(
-              "rig {}, camera {}: cam_from_rig {}: rotation {:.3f} deg, translation [{:.4f}, "
-              "{:.4f}, {:.4f}]",
-              r, camera_id, source, q.angularDistance(Eigen::Quaterniond::Identity()) * 180 / M_PI,
-              t.x(), t.y(), t.z()));
+          log_lines->push_back(
+              fmt::format("rig {}, camera {}: cam_from_rig estimated from {} "
+                          "frames: {}",
+                          r, camera_id, poses->num_frames.at(camera_id), PoseText(cam_from_rig)));
         }
       }
       cameras.push_back(camera);

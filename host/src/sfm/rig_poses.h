@@ -51,9 +51,14 @@ std::optional<Rigid3d> RigPoseOfImage(const std::vector<CameraRig>& rigs,
 std::vector<image_t> FrameMates(const std::vector<CameraRig>& rigs, image_t image_id);
 
 // For the mapping summary: each rig's cameras with cam_from_rig ({"rotation_wxyz",
-// "translation"}), whether given or estimated and from how many frames, and the
-// frames registered whole; one line per camera in `log_lines`.
+// "translation"}) and its "source": "estimated" (and from how many frames), "given" when
+// every frame of the model with both images registered holds the given pose, or "not
+// applied" when some do not (bundle adjustment could not keep it): then cam_from_rig is
+// what the model's frames give, given_cam_from_rig the file's, and a line in `warnings`
+// says so. A given camera also has num_frames_registered and num_frames_holding. One
+// line per camera otherwise in `log_lines`.
 nlohmann::json DescribeRigs(const std::vector<CameraRig>& rigs, const Reconstruction& model,
-                            std::vector<std::string>* log_lines);
+                            std::vector<std::string>* log_lines,
+                            std::vector<std::string>* warnings = nullptr);
 
 }  // namespace tessera

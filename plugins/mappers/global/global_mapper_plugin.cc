@@ -37,6 +37,26 @@ bool IsVerified(int config) {
          config == TwoViewGeometry::PLANAR_OR_PANORAMIC;
 }
 
+// An unknown key among `options`, named with the closest of all the mapper's keys (its
+// own and GlobalMapperOptions'), or the whole list: GlobalMapperOptions::FromJson,
+// which reads the rest, knows only its own.
+void CheckKnownKeys(const nlohmann::json& options, const std::vector<std::string>& own) {
+  std::vector<std::string> known = own;
+  const nlohmann::json defaults = GlobalMapperOptions().ToJson();
+  for (auto it = defaults.begin(); it != defaults.end(); ++it) known.push_back(it.key());
+  for (const auto& [key, value] : options.items()) {
+    if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+    std::string message = "unknown key" + DidYouMean(key, known);
+    if (message == "unknown key") {
+      std::sort(known.begin(), known.end());
+      std::string list;
+      for (const std::string& name : known) list += (list.empty() ? "" : ", ") + name;
+      message += " (known: " + list + ")";
+    }
+    throw OptionError(key, message);
+  }
+}
+
 }  // namespace
 
 class GlobalMapperPlugin : public Mapper {
@@ -54,10 +74,11 @@ class GlobalMapperPlugin : public Mapper {
     gps_.vertical_sigma_m =
         reader.Get<double>("gps_vertical_sigma", gps_.vertical_sigma_m, 1e-3, 1e6);
     gps_.min_num_images = reader.Get<int>("gps_min_images", gps_.min_num_images, 3, 1000000);
-    for (const char* own : {"reg_max_rotation_error", "min_model_agreement", "use_gps_prior",
-                            "gps_horizontal_sigma", "gps_vertical_sigma", "gps_min_images"}) {
-      mapper.erase(own);
-    }
+    const std::vector<std::string> own = {"reg_max_rotation_error", "min_model_agreement",
+                                          "use_gps_prior",          "gps_horizontal_sigma",
+                                          "gps_vertical_sigma",     "gps_min_images"};
+    CheckKnownKeys(mapper, own);
+    for (const std::string& key : own) mapper.erase(key);
     options_ = GlobalMapperOptions::FromJson(mapper);
     gps_.ba_max_num_iterations = options_.final_ba_max_num_iterations;
     effective_options_ = options_.ToJson();
