@@ -33,7 +33,7 @@ std::vector<std::string> Names(const std::vector<size_t>& nodes,
   return out;
 }
 
-ClustersFile ToClustersFile(const ViewGraphPartition& partition, const ViewGraph& graph) {
+ClustersFile ToClustersFile(const ViewGraphPartition& partition, const PairGraph& graph) {
   ClustersFile file;
   file.pairs_fingerprint = graph.fingerprint;
   file.tree = partition.tree;
@@ -60,7 +60,7 @@ ClustersFile ToClustersFile(const ViewGraphPartition& partition, const ViewGraph
 // The edges of `graph` whose pairs' rotations agree with the rest
 // (rotation_consistent_pairs.h), the relative rotations taken with `input`'s cameras.
 std::vector<WeightedEdge> EdgesThatWeighInTheCut(const MapperInput& input, const Manifest& manifest,
-                                                 const ViewGraph& graph) {
+                                                 const PairGraph& graph) {
   const RotationConsistentPairs consistent =
       FindRotationConsistentPairs(input, DeriveSeed(manifest.seed, kRotationConsistencyStream));
   std::set<std::pair<std::string, std::string>> kept;
@@ -106,8 +106,8 @@ std::vector<FocalLengthReport> CalibrateForClusters(const PipelineContext& conte
 
 }  // namespace
 
-ViewGraph LoadViewGraph(const Database& database) {
-  ViewGraph graph;
+PairGraph LoadPairGraph(const Database& database) {
+  PairGraph graph;
   std::map<image_t, std::string> name_of;
   for (const Image& image : database.ReadAllImages()) {
     name_of[image.image_id] = image.name;
@@ -144,7 +144,7 @@ ClustersFile PartitionWorkspace(const Workspace& workspace, const PipelineContex
   context.Require("bundle_adjuster", "partition");
   const Manifest& manifest = context.manifest;
   const Database& database = workspace.database();
-  const ViewGraph graph = LoadViewGraph(database);
+  const PairGraph graph = LoadPairGraph(database);
   if (graph.edges.empty()) {
     throw InputError(database.path().string() +
                      ": no verified image pairs in the workspace; run match first");
@@ -227,7 +227,7 @@ ClustersFile ReadWorkspaceClusters(const std::filesystem::path& workspace_folder
                      ": made with another manifest than this one; run `tessera partition` "
                      "again with it");
   }
-  if (file.pairs_fingerprint != LoadViewGraph(database).fingerprint) {
+  if (file.pairs_fingerprint != LoadPairGraph(database).fingerprint) {
     throw InputError(path.string() + ": made from other verified pairs than those of " +
                      database.path().string() + "; run `tessera partition` again");
   }
