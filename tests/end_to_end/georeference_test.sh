@@ -3,7 +3,7 @@
 # (downscaled here to 768 px; GPS tags written by tessera_test_geotag from the
 # ground-truth camera centres, taken as east/north/up metres about 46.52 N 6.57 E 400 m,
 # with 0.25 m of noise in each axis). `fast.json` with use_gps_prior:
-#  1. every image registered; sparse/0/georeference.json names the origin (the mean of
+#  1. every image registered; sparse/0/georeference.json names the origin (the median of
 #     the GPS positions) and the ENU frame; the camera centres of images.txt lie within
 #     the GPS noise of their tags converted to that frame here, with no alignment; the
 #     PLY and transforms.json say which frame they are in;

@@ -12,6 +12,8 @@
 //   --seed N            seeds the noise (default 0)
 //   --skip NAME         leaves NAME untagged (repeatable)
 //   --no-altitude       writes no GPSAltitude tags
+//   --tag NAME=LAT,LON,ALT  writes these WGS84 values for NAME instead (repeatable):
+//                       the tags of a camera without a fix (0,0,0), or a broken one
 // Prints "NAME latitude longitude altitude" per tagged image. Exit 2 on bad input.
 // For end-to-end tests and benchmarks of GPS-based pair selection.
 
@@ -20,6 +22,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
@@ -192,8 +195,12 @@ void Geotag(const fs::path& file, double latitude, double longitude,
     SetEntry(data, kGpsAltitudeRef, EXIF_FORMAT_BYTE, 1,
              [&](unsigned char* p) { p[0] = *altitude < 0 ? 1 : 0; });
     SetEntry(data, kGpsAltitude, EXIF_FORMAT_RATIONAL, 1, [&](unsigned char* p) {
-      exif_set_rational(p, order,
-                        {static_cast<ExifLong>(std::llround(std::abs(*altitude) * 1000)), 1000});
+      // Millimetres where they fit the 32-bit numerator, else metres (an altitude of
+      // -1e9 m, as a broken camera writes).
+      const ExifLong denominator = std::abs(*altitude) * 1000 < 4e9 ? 1000 : 1;
+      exif_set_rational(
+          p, order,
+          {static_cast<ExifLong>(std::llround(std::abs(*altitude) * denominator)), denominator});
     });
   }
   unsigned char* buffer = nullptr;
@@ -234,7 +241,8 @@ void Geotag(const fs::path& file, double latitude, double longitude,
 int main(int argc, char** argv) {
   if (argc < 6) {
     std::cerr << "usage: geotag_images IMAGE_DIR POSITIONS LATITUDE LONGITUDE ALTITUDE "
-                 "[--noise M] [--altitude-noise M] [--seed N] [--skip NAME]... [--no-altitude]\n";
+                 "[--noise M] [--altitude-noise M] [--seed N] [--skip NAME]... [--no-altitude]\n"
+                 "       [--tag NAME=LAT,LON,ALT]...\n";
     return 2;
   }
   try {
@@ -246,6 +254,7 @@ int main(int argc, char** argv) {
     unsigned seed = 0;
     bool with_altitude = true;
     std::set<std::string> skip;
+    std::map<std::string, std::array<double, 3>> fixed;
     for (int i = 6; i < argc; ++i) {
       const std::string flag = argv[i];
       const auto value = [&]() -> std::string {
@@ -260,6 +269,17 @@ int main(int argc, char** argv) {
         seed = static_cast<unsigned>(std::stoul(value()));
       } else if (flag == "--skip") {
         skip.insert(value());
+      } else if (flag == "--tag") {
+        const std::string tag = value();
+        const size_t equals = tag.find('=');
+        std::array<double, 3> wgs84{};
+        char tail = 0;
+        if (equals == std::string::npos ||
+            std::sscanf(tag.c_str() + equals + 1, "%lf,%lf,%lf%c", &wgs84[0], &wgs84[1], &wgs84[2],
+                        &tail) != 3) {
+          throw Failure{"--tag: expected NAME=LAT,LON,ALT, got '" + tag + "'"};
+        }
+        fixed[tag.substr(0, equals)] = wgs84;
       } else if (flag == "--no-altitude") {
         with_altitude = false;
       } else {
@@ -288,6 +308,13 @@ int main(int argc, char** argv) {
       const double east_noise = noise * gaussian(rng), north_noise = noise * gaussian(rng);
       const double up_noise = altitude_noise * gaussian(rng);
       if (skip.count(name) > 0) continue;
+      if (const auto tag = fixed.find(name); tag != fixed.end()) {
+        const auto& [latitude, longitude, altitude] = tag->second;
+        Geotag(file, latitude, longitude, altitude);
+        std::cout << name << std::setprecision(10) << " " << latitude << " " << longitude << " "
+                  << altitude << "\n";
+        continue;
+      }
       const auto it = positions.find(name);
       if (it == positions.end()) throw Failure{name + ": no position in " + std::string(argv[2])};
       const double east = it->second[0] + east_noise, north = it->second[1] + north_noise;

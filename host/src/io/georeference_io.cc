@@ -18,6 +18,28 @@ void WriteGeoreference(const Georeference& georeference, const std::filesystem::
   WriteFileAtomically(model_dir / kGeoreferenceFileName, json.dump(2) + "\n");
 }
 
+namespace {
+
+// Why `value` of field `key` is out of [low, high] (or not finite); "" when it is in.
+std::string RangeProblem(const char* key, double value, double low, double high) {
+  if (std::isfinite(value) && value >= low && value <= high) return "";
+  return std::string(key) + ": " + std::to_string(value) + " is out of range [" +
+         std::to_string(low) + ", " + std::to_string(high) + "]";
+}
+
+}  // namespace
+
+std::string GeoreferenceProblem(const Georeference& georeference) {
+  for (const std::string& problem :
+       {RangeProblem("latitude", georeference.latitude_deg, -90, 90),
+        RangeProblem("longitude", georeference.longitude_deg, -180, 180),
+        RangeProblem("altitude", georeference.altitude_m, -1e5, 1e5)}) {
+    if (!problem.empty()) return problem;
+  }
+  if (georeference.frame != "ENU") return "frame: expected \"ENU\"";
+  return "";
+}
+
 std::optional<Georeference> ReadGeoreference(const std::filesystem::path& model_dir) {
   const std::filesystem::path file = model_dir / kGeoreferenceFileName;
   std::error_code error;
@@ -28,25 +50,19 @@ std::optional<Georeference> ReadGeoreference(const std::filesystem::path& model_
   } catch (const nlohmann::json::exception& parse_error) {
     throw InputError(file.string() + ": not JSON: " + parse_error.what());
   }
-  const auto number = [&](const char* key, double low, double high) {
+  const auto number = [&](const char* key) {
     if (!json.is_object() || !json.contains(key) || !json.at(key).is_number()) {
       throw InputError(file.string() + ": " + key + ": missing, or not a number");
     }
-    const double value = json.at(key).get<double>();
-    if (!std::isfinite(value) || value < low || value > high) {
-      throw InputError(file.string() + ": " + key + ": " + std::to_string(value) +
-                       " is out of range [" + std::to_string(low) + ", " + std::to_string(high) +
-                       "]");
-    }
-    return value;
+    return json.at(key).get<double>();
   };
   Georeference georeference;
-  georeference.latitude_deg = number("latitude", -90, 90);
-  georeference.longitude_deg = number("longitude", -180, 180);
-  georeference.altitude_m = number("altitude", -1e5, 1e5);
-  if (json.value("frame", std::string()) != "ENU") {
-    throw InputError(file.string() + ": frame: expected \"ENU\"");
-  }
+  georeference.latitude_deg = number("latitude");
+  georeference.longitude_deg = number("longitude");
+  georeference.altitude_m = number("altitude");
+  georeference.frame = json.value("frame", std::string());
+  const std::string problem = GeoreferenceProblem(georeference);
+  if (!problem.empty()) throw InputError(file.string() + ": " + problem);
   return georeference;
 }
 

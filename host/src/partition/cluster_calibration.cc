@@ -12,10 +12,6 @@
 namespace tessera {
 namespace {
 
-// A view-graph focal length whose mean robust cost per pair is above this has no clear
-// minimum (FocalLengthEstimate::cost), as the mappers judge.
-constexpr double kClearFocalMinimumCost = 0.05;
-
 // The pairs the global mapper maps: verified, with enough inliers.
 std::vector<const MapperInput::Pair*> CalibrationPairs(const MapperInput& input) {
   return VerifiedPairs(input, static_cast<size_t>(GlobalMapperOptions().min_num_matches));

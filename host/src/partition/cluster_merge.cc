@@ -6,17 +6,15 @@
 #include <set>
 
 #include "geometry/similarity_transform.h"
+#include "tessera/sfm/model_finishing.h"
 
 namespace tessera {
 namespace {
 
+// Largest first (model_finishing.h), then by their clusters.
 bool Larger(const ClusterModel& a, const ClusterModel& b) {
-  if (a.model.images.size() != b.model.images.size()) {
-    return a.model.images.size() > b.model.images.size();
-  }
-  if (a.model.points3D.size() != b.model.points3D.size()) {
-    return a.model.points3D.size() > b.model.points3D.size();
-  }
+  if (IsLargerModel(a.model, b.model)) return true;
+  if (IsLargerModel(b.model, a.model)) return false;
   return a.clusters < b.clusters;
 }
 

@@ -6,7 +6,6 @@
 
 #include "partition/cluster_map.h"
 #include "partition/cluster_merge.h"
-#include "partition/merged_model_check.h"
 #include "partition/partition_stage.h"
 #include "pipeline/load_mapper_input.h"
 #include "pipeline/map_stage.h"
@@ -15,14 +14,23 @@
 #include "plugin/bundle_adjuster_guard.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
+#include "tessera/sfm/model_finishing.h"
 #include "util/random.h"
 #include "util/timer.h"
 
 namespace tessera {
 namespace {
 
-// Seed stream of the check's five-point RANSAC on pairs without E.
+// Seed stream of the finishing step (the self-check's five-point RANSAC on pairs without
+// E, the GPS anchoring).
 constexpr uint64_t kMergedModelCheckStream = 1;
+
+// The mapper's options in the manifest, and where they sit.
+const nlohmann::json& MapperOptions(const Manifest& manifest) { return manifest.mapper.options; }
+std::string MapperOptionsPath(const Manifest& manifest) {
+  return manifest.mapper.options_path.empty() ? manifest.mapper.json_path + ".options"
+                                              : manifest.mapper.options_path;
+}
 
 // The models of cluster `cluster`, checked against its summary; InputError naming its
 // folder and the command that maps it again otherwise.
@@ -115,9 +123,14 @@ MapStageSummary MergeClusterMaps(const PipelineContext& context, const RunOption
     models.push_back({{"clusters", model.clusters}, {"images", model.model.images.size()}});
     result.models.push_back(std::move(model.model));
   }
-  result.self_checks =
-      CheckMergedModels(input, result.models, MergedModelCheckOptions(),
-                        DeriveSeed(context.manifest.seed, kMergedModelCheckStream));
+  // Finished as a mapper finishes its models (model_finishing.h), with the mapper's
+  // shared options: the self-check, where a wrongly joined or folded model shows, and
+  // with use_gps_prior the merged model anchored to its images' GPS.
+  ModelFinishingOptions finishing = ModelFinishingOptions::FromJson(
+      MapperOptions(context.manifest), MapperOptionsPath(context.manifest));
+  finishing.log_prefix = "merge";
+  FinishModels(input, adjuster, finishing,
+               DeriveSeed(context.manifest.seed, kMergedModelCheckStream), &result);
   if (result.models.size() > 1) {
     spdlog::warn(
         "merge: {} models remain unmerged; mapping_summary.json says which clusters each "

@@ -34,7 +34,7 @@ std::vector<std::string> Names(const std::vector<size_t>& nodes,
   return out;
 }
 
-ClustersFile ToClustersFile(const ViewGraphPartition& partition, const ViewGraph& graph) {
+ClustersFile ToClustersFile(const ViewGraphPartition& partition, const PairGraph& graph) {
   ClustersFile file;
   file.pairs_fingerprint = graph.fingerprint;
   file.tree = partition.tree;
@@ -61,7 +61,7 @@ ClustersFile ToClustersFile(const ViewGraphPartition& partition, const ViewGraph
 // The edges of `graph` whose pairs' rotations agree with the rest
 // (rotation_consistent_pairs.h), the relative rotations taken with `input`'s cameras.
 std::vector<WeightedEdge> EdgesThatWeighInTheCut(const MapperInput& input, const Manifest& manifest,
-                                                 const ViewGraph& graph) {
+                                                 const PairGraph& graph) {
   const RotationConsistentPairs consistent =
       FindRotationConsistentPairs(input, DeriveSeed(manifest.seed, kRotationConsistencyStream));
   std::set<std::pair<std::string, std::string>> kept;
@@ -113,7 +113,7 @@ std::string Shortest(double value) { return fmt::format("{:.6g}", value); }
 // or calibrates a camera the workspace does not have, or with a focal length no lens
 // gives (IsPlausibleFocalLength, as EXIF priors are judged).
 void CheckClustersAgainstWorkspace(const std::filesystem::path& path, const ClustersFile& file,
-                                   const ViewGraph& graph, const Database& database) {
+                                   const PairGraph& graph, const Database& database) {
   const std::set<std::string> names(graph.names.begin(), graph.names.end());
   const auto check = [&](const std::vector<std::string>& images, const std::string& where) {
     for (const std::string& name : images) {
@@ -160,8 +160,8 @@ void CheckClustersAgainstWorkspace(const std::filesystem::path& path, const Clus
 
 }  // namespace
 
-ViewGraph LoadViewGraph(const Database& database) {
-  ViewGraph graph;
+PairGraph LoadPairGraph(const Database& database) {
+  PairGraph graph;
   std::map<image_t, std::string> name_of;
   for (const Image& image : database.ReadAllImages()) {
     name_of[image.image_id] = image.name;
@@ -198,7 +198,7 @@ ClustersFile PartitionWorkspace(const Workspace& workspace, const PipelineContex
   context.Require("bundle_adjuster", "partition");
   const Manifest& manifest = context.manifest;
   const Database& database = workspace.database();
-  const ViewGraph graph = LoadViewGraph(database);
+  const PairGraph graph = LoadPairGraph(database);
   if (graph.edges.empty()) {
     throw InputError(database.path().string() +
                      ": no verified image pairs in the workspace; run match first");
@@ -281,7 +281,7 @@ ClustersFile ReadWorkspaceClusters(const std::filesystem::path& workspace_folder
                              ": made with another manifest than this one; run `tessera "
                              "partition` again with it");
   }
-  const ViewGraph graph = LoadViewGraph(database);
+  const PairGraph graph = LoadPairGraph(database);
   if (file.pairs_fingerprint != graph.fingerprint) {
     throw StaleClustersError(path.string() + ": made from other verified pairs than those of " +
                              database.path().string() + "; run `tessera partition` again");

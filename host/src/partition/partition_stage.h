@@ -17,17 +17,17 @@
 
 namespace tessera {
 
-// The view graph the mapper would map: every image (node i is the i-th name in name
-// order) and each verified pair of the current selection (LoadMapperInput's rule),
-// weighted by its inliers.
-struct ViewGraph {
+// The graph of pairs the mapper would map (not sfm's ViewGraph of relative rotations): every image
+// (node i is the i-th name in name order) and each verified pair of the current selection
+// (LoadMapperInput's rule), weighted by its inliers.
+struct PairGraph {
   std::vector<std::string> names;  // sorted
   std::vector<WeightedEdge> edges;
   // A hash of the image names of each pair and its inlier count.
   std::string fingerprint;
 };
 
-ViewGraph LoadViewGraph(const Database& database);
+PairGraph LoadPairGraph(const Database& database);
 
 // Calibrates the cameras without a focal prior once for every cluster
 // (cluster_calibration.h, with the context's bundle adjuster), cuts the workspace's view

@@ -4,6 +4,8 @@
 #include <set>
 
 #include "plugin/plugin_call.h"
+#include "tessera/io/georeference_io.h"
+#include "tessera/sfm/model_finishing.h"
 
 namespace tessera {
 namespace {
@@ -86,6 +88,12 @@ void CheckMapperResult(const std::string& mapper, const MapperInput& input, Mapp
   for (size_t index = 0; index < result->models.size(); ++index) {
     const std::string fault = CheckModel(input, result->models[index]);
     if (!fault.empty()) fail("model " + std::to_string(index) + " where " + fault);
+    if (result->georeferences[index]) {
+      const std::string problem = GeoreferenceProblem(*result->georeferences[index]);
+      if (!problem.empty()) {
+        fail("model " + std::to_string(index) + "'s georeference with " + problem);
+      }
+    }
     for (const auto& [image_id, image] : result->models[index].images) {
       if (!in_models.insert(image_id).second) {
         fail("image '" + image.name + "' in two models");
@@ -108,16 +116,7 @@ void CheckMapperResult(const std::string& mapper, const MapperInput& input, Mapp
     }
   }
   // Largest first, as the summary and the folders number them.
-  std::vector<size_t> order(result->models.size());
-  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    const Reconstruction& model_a = result->models[a];
-    const Reconstruction& model_b = result->models[b];
-    if (model_a.images.size() != model_b.images.size()) {
-      return model_a.images.size() > model_b.images.size();
-    }
-    return model_a.points3D.size() > model_b.points3D.size();
-  });
+  const std::vector<size_t> order = LargestFirstOrder(result->models);
   std::vector<Reconstruction> models;
   std::vector<ModelSelfCheck> checks;
   std::vector<std::optional<Georeference>> georeferences;

@@ -125,6 +125,11 @@ TEST(CheckMapperResult, RefusesEachFaultNamingIt) {
               f.result.self_checks.resize(2);
             }).find("in two models"),
             std::string::npos);
+  // A georeference that `eval --no-align` would refuse is never written.
+  EXPECT_NE(fault([](Fixture& f) {
+              f.result.georeferences = {Georeference{38.06, 5.375, -9.09e7, "ENU"}};
+            }).find("model 0's georeference with altitude: "),
+            std::string::npos);
   EXPECT_NE(fault([](Fixture& f) {
               f.result.cancelled = true;
             }).find("plugin 'm' failed while mapping: it returned 'cancelled' without being asked"),

@@ -11,6 +11,7 @@
 #include "tessera/sfm/feature_tracks.h"
 #include "tessera/sfm/focal_length_estimation.h"
 #include "tessera/sfm/global_positioning.h"
+#include "tessera/sfm/model_finishing.h"
 #include "tessera/sfm/rotation_averaging.h"
 #include "tessera/sfm/track_filtering.h"
 #include "tessera/sfm/track_selection.h"
@@ -454,17 +455,6 @@ std::map<camera_t, Camera> CamerasWithFocalLengths(
   return cameras;
 }
 
-// Most images first, then most points.
-void SortLargestFirst(std::vector<Reconstruction>* models) {
-  std::stable_sort(models->begin(), models->end(),
-                   [](const Reconstruction& a, const Reconstruction& b) {
-                     if (a.images.size() != b.images.size()) {
-                       return a.images.size() > b.images.size();
-                     }
-                     return a.points3D.size() > b.points3D.size();
-                   });
-}
-
 RotationAveragingOptions RotationOptions(const GlobalMapperOptions& options) {
   RotationAveragingOptions rotation_options;
   rotation_options.num_l1_iterations = options.ra_num_l1_iterations;
@@ -629,7 +619,7 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
     lap(&steps.filtering);
   }
 
-  SortLargestFirst(&result.models);
+  SortModelsLargestFirst(&result.models);
   ExplainUnregistered(input, options, in_verified_pair, with_rotation_pair, reasons, &result);
   result.seconds = seconds();
   spdlog::info("global map: {} models, {} images in none, {} bundle adjustments, {:.1f} s",

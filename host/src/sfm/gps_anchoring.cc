@@ -3,7 +3,9 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numeric>
+#include <string>
 #include <vector>
 
 #include "geometry/similarity_transform.h"
@@ -74,52 +76,130 @@ GpsPosition Wgs84FromEnu(const Eigen::Vector3d& enu, const Georeference& origin)
   return position;
 }
 
-GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& metadata,
-                                    const BundleAdjuster& bundle_adjuster,
-                                    const GpsAnchoringOptions& options, uint64_t seed,
-                                    Reconstruction* model) {
-  GpsAnchoringReport report;
-  std::vector<image_t> geotagged;
-  for (const auto& [image_id, image] : model->images) {
-    const auto it = metadata.find(image_id);
-    if (image.registered && it != metadata.end() && it->second.gps) geotagged.push_back(image_id);
+namespace {
+
+std::string Metres(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.6g m", value);
+  return text;
+}
+
+// Why `gps` cannot be where a camera was; "" when it can.
+std::string ImpossibleTag(const GpsPosition& gps, const GpsAnchoringOptions& options) {
+  if (!std::isfinite(gps.latitude_deg) || !std::isfinite(gps.longitude_deg) ||
+      (gps.altitude_m && !std::isfinite(*gps.altitude_m))) {
+    return "not a finite position";
   }
-  report.num_geotagged = geotagged.size();
-  if (geotagged.size() < static_cast<size_t>(std::max(3, options.min_num_images))) {
-    report.reason = std::to_string(geotagged.size()) + " of its " +
-                    std::to_string(model->images.size()) + " images have GPS, fewer than " +
-                    std::to_string(std::max(3, options.min_num_images));
-    return report;
+  if (std::abs(gps.latitude_deg) > 90 || std::abs(gps.longitude_deg) > 180) {
+    return "latitude or longitude out of range";
   }
-  // The origin: the mean position of the geotagged images.
-  for (const image_t image_id : geotagged) {
+  if (std::abs(gps.latitude_deg) < 1e-7 && std::abs(gps.longitude_deg) < 1e-7) {
+    return "0, 0 (null island: a camera without a fix writes it)";
+  }
+  if (gps.altitude_m && *gps.altitude_m < options.min_altitude_m) {
+    return "altitude " + Metres(*gps.altitude_m) + " is below " + Metres(options.min_altitude_m);
+  }
+  if (gps.altitude_m && *gps.altitude_m > options.max_altitude_m) {
+    return "altitude " + Metres(*gps.altitude_m) + " is above " + Metres(options.max_altitude_m) +
+           ", higher than cameras fly";
+  }
+  return "";
+}
+
+// The median latitude, longitude and altitude of the tags of `images` (altitude 0 when
+// none has one).
+Georeference MedianPosition(const std::map<image_t, ImageMetadata>& metadata,
+                            const std::vector<image_t>& images) {
+  std::vector<double> latitudes, longitudes, altitudes;
+  for (const image_t image_id : images) {
     const GpsPosition& gps = *metadata.at(image_id).gps;
-    report.origin.latitude_deg += gps.latitude_deg / geotagged.size();
-    report.origin.longitude_deg += gps.longitude_deg / geotagged.size();
-    report.origin.altitude_m += gps.altitude_m.value_or(0) / geotagged.size();
+    latitudes.push_back(gps.latitude_deg);
+    longitudes.push_back(gps.longitude_deg);
+    if (gps.altitude_m) altitudes.push_back(*gps.altitude_m);
   }
-  std::vector<Eigen::Vector3d> centres, enu;
-  for (const image_t image_id : geotagged) {
-    centres.push_back(model->images.at(image_id).ProjectionCenter());
-    enu.push_back(EnuFromWgs84(*metadata.at(image_id).gps, report.origin));
+  Georeference median;
+  median.latitude_deg = Median(latitudes);
+  median.longitude_deg = Median(longitudes);
+  median.altitude_m = Median(altitudes);
+  return median;
+}
+
+// The images of `tagged` whose tag a camera can have; the others go to report->set_aside.
+std::vector<image_t> SetAsideImpossibleTags(const std::map<image_t, ImageMetadata>& metadata,
+                                            const GpsAnchoringOptions& options,
+                                            const std::vector<image_t>& tagged,
+                                            GpsAnchoringReport* report) {
+  std::map<image_t, std::string> reasons;
+  std::vector<image_t> plausible;
+  for (const image_t image_id : tagged) {
+    const std::string reason = ImpossibleTag(*metadata.at(image_id).gps, options);
+    if (reason.empty()) {
+      plausible.push_back(image_id);
+    } else {
+      reasons[image_id] = reason;
+    }
   }
-  // Positions on a line leave the rotation about it open: no anchoring from them.
+  // Far from the rest: a robust distance from the median tag.
+  if (plausible.size() >= 3) {
+    const Georeference median = MedianPosition(metadata, plausible);
+    std::vector<double> distances;
+    for (const image_t image_id : plausible) {
+      GpsPosition gps = *metadata.at(image_id).gps;
+      if (!gps.altitude_m) gps.altitude_m = median.altitude_m;
+      distances.push_back(EnuFromWgs84(gps, median).norm());
+    }
+    const double median_distance = Median(distances);
+    std::vector<double> deviations;
+    for (const double distance : distances)
+      deviations.push_back(std::abs(distance - median_distance));
+    const double limit =
+        std::max(options.far_tag_floor_m,
+                 median_distance + options.far_tag_mads * 1.4826 * Median(deviations));
+    std::vector<image_t> near;
+    for (size_t i = 0; i < plausible.size(); ++i) {
+      if (distances[i] <= limit) {
+        near.push_back(plausible[i]);
+      } else {
+        reasons[plausible[i]] = Metres(distances[i]) + " from the median of the model's tags " +
+                                "(more than " + Metres(limit) + ")";
+      }
+    }
+    plausible = std::move(near);
+  }
+  for (const auto& [image_id, reason] : reasons) {
+    report->set_aside.push_back({image_id, *metadata.at(image_id).gps, reason});
+  }
+  return plausible;
+}
+
+// Why `enu` cannot anchor a model (all at one point, or on a line, within the GPS noise);
+// "" when they can.
+std::string DegenerateSpread(const std::vector<Eigen::Vector3d>& enu, double sigma_m) {
   Eigen::MatrixXd spread(3, enu.size());
   const Eigen::Vector3d mean =
       std::accumulate(enu.begin(), enu.end(), Eigen::Vector3d(Eigen::Vector3d::Zero())) /
       enu.size();
   for (size_t i = 0; i < enu.size(); ++i) spread.col(i) = enu[i] - mean;
   const Eigen::Vector3d singular = Eigen::JacobiSVD<Eigen::MatrixXd>(spread).singularValues();
-  if (singular(1) < 2 * options.horizontal_sigma_m * std::sqrt(static_cast<double>(enu.size()))) {
-    report.reason = "the GPS positions of its images lie on a line (within the GPS noise)";
-    return report;
+  const double noise = 2 * sigma_m * std::sqrt(static_cast<double>(enu.size()));
+  if (singular(0) < noise) {
+    return "the GPS positions of its " + std::to_string(enu.size()) +
+           " geotagged images are all at one point (within the GPS noise)";
   }
+  // Positions on a line leave the rotation about it open.
+  if (singular(1) < noise) {
+    return "the GPS positions of its images lie on a line (within the GPS noise)";
+  }
+  return "";
+}
 
-  // The similarity most geotagged centres agree on: LO-RANSAC over triples.
-  const double threshold =
-      options.max_error_sigmas * std::max(options.horizontal_sigma_m, options.vertical_sigma_m);
+// The indices of the tags most centres agree on one similarity with, within
+// `threshold` metres: LO-RANSAC over triples.
+std::vector<size_t> AgreeingTags(const std::vector<Eigen::Vector3d>& centres,
+                                 const std::vector<Eigen::Vector3d>& enu, double threshold,
+                                 const GpsAnchoringOptions& options, uint64_t seed) {
   RandomEngine random(DeriveSeed(seed, 0x6a5));
-  std::uniform_int_distribution<size_t> pick(0, geotagged.size() - 1);
+  std::uniform_int_distribution<size_t> pick(0, centres.size() - 1);
   std::vector<size_t> best_inliers;
   const auto inliers_of = [&](const Similarity3d& sim) {
     std::vector<size_t> inliers;
@@ -147,24 +227,72 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
     }
     if (inliers.size() > best_inliers.size()) best_inliers = std::move(inliers);
   }
-  report.num_agreeing = best_inliers.size();
-  if (best_inliers.size() < 3 ||
-      best_inliers.size() < options.min_inlier_ratio * static_cast<double>(geotagged.size())) {
-    report.reason = "its GPS contradicts it: at most " + std::to_string(best_inliers.size()) +
+  return best_inliers;
+}
+
+}  // namespace
+
+GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& metadata,
+                                    const BundleAdjuster& bundle_adjuster,
+                                    const GpsAnchoringOptions& options, uint64_t seed,
+                                    Reconstruction* model) {
+  GpsAnchoringReport report;
+  std::vector<image_t> tagged;
+  for (const auto& [image_id, image] : model->images) {
+    const auto it = metadata.find(image_id);
+    if (image.registered && it != metadata.end() && it->second.gps) tagged.push_back(image_id);
+  }
+  report.num_geotagged = tagged.size();
+  const std::vector<image_t> geotagged = SetAsideImpossibleTags(metadata, options, tagged, &report);
+  const size_t min_num_images = static_cast<size_t>(std::max(3, options.min_num_images));
+  if (geotagged.size() < min_num_images) {
+    report.reason = std::to_string(geotagged.size()) + " of its " +
+                    std::to_string(model->images.size()) + " images have GPS" +
+                    (report.set_aside.empty()
+                         ? ""
+                         : " (" + std::to_string(report.set_aside.size()) + " more set aside)") +
+                    ", fewer than " + std::to_string(min_num_images);
+    return report;
+  }
+  // A first frame about the median tag, for the search; the final one is about the tags
+  // the similarity agrees with.
+  const Georeference median = MedianPosition(metadata, geotagged);
+  std::vector<Eigen::Vector3d> centres, enu;
+  for (const image_t image_id : geotagged) {
+    centres.push_back(model->images.at(image_id).ProjectionCenter());
+    enu.push_back(EnuFromWgs84(*metadata.at(image_id).gps, median));
+  }
+  report.reason = DegenerateSpread(enu, options.horizontal_sigma_m);
+  if (!report.reason.empty()) return report;
+
+  const double threshold =
+      options.max_error_sigmas * std::max(options.horizontal_sigma_m, options.vertical_sigma_m);
+  const std::vector<size_t> inliers = AgreeingTags(centres, enu, threshold, options, seed);
+  report.num_agreeing = inliers.size();
+  if (inliers.size() < 3 ||
+      inliers.size() < options.min_inlier_ratio * static_cast<double>(geotagged.size())) {
+    report.reason = "its GPS contradicts it: at most " + std::to_string(inliers.size()) +
                     " of its " + std::to_string(geotagged.size()) +
                     " geotagged images fit one similarity within " +
                     std::to_string(static_cast<int>(std::lround(threshold))) + " m";
     return report;
   }
+  // The origin: the median of the agreeing tags; every tag again in its frame.
+  std::vector<image_t> agreeing;
+  for (const size_t i : inliers) agreeing.push_back(geotagged[i]);
+  report.origin = MedianPosition(metadata, agreeing);
+  for (size_t i = 0; i < geotagged.size(); ++i) {
+    enu[i] = EnuFromWgs84(*metadata.at(geotagged[i]).gps, report.origin);
+  }
   std::vector<Eigen::Vector3d> src, dst;
-  for (const size_t i : best_inliers) src.push_back(centres[i]), dst.push_back(enu[i]);
+  for (const size_t i : inliers) src.push_back(centres[i]), dst.push_back(enu[i]);
   const Similarity3d sim = EstimateSimilarity(src, dst);
 
   Reconstruction anchored = *model;
   TransformModel(sim, &anchored);
   BundleAdjustmentConfig config;
   config.max_num_iterations = options.ba_max_num_iterations;
-  for (const size_t i : best_inliers) {
+  for (const size_t i : inliers) {
     PositionPrior prior;
     prior.position = enu[i];
     prior.sigma = Eigen::Vector3d(options.horizontal_sigma_m, options.horizontal_sigma_m,

@@ -14,7 +14,7 @@
 #include "tessera/sfm/first_model_calibration.h"
 #include "tessera/sfm/focal_length_estimation.h"
 #include "tessera/sfm/global_mapper_options.h"
-#include "tessera/sfm/gps_anchoring.h"
+#include "tessera/sfm/model_finishing.h"
 #include "tessera/sfm/model_merger.h"
 #include "tessera/sfm/view_graph.h"
 #include "util/random.h"
@@ -26,10 +26,6 @@ namespace {
 // Seed streams, so that no two random choices of a run share a seed (see
 // MapperRansacOptions for the mapper's own).
 constexpr uint64_t kMergeStream = 3;
-// A view-graph focal length whose mean robust cost per pair is above this has no clear
-// minimum (FocalLengthEstimate::cost): it needs a first model however many pairs it rests
-// on (a 512 px ORB copy of the sample: 221 px from 17 pairs at cost 0.15, the truth 460).
-constexpr double kClearFocalMinimumCost = 0.05;
 // Rounds of growing again after the final refinement, while images still register.
 constexpr int kMaxFinalGrowRounds = 2;
 
@@ -156,27 +152,18 @@ void AdjustWholeModel(const IncrementalMapperOptions& options,
   }
 }
 
-ModelSelfCheck SelfCheck(const ViewGraph& view_graph, const Reconstruction& model,
-                         const IncrementalMapperOptions& options) {
-  const ModelAgreement agreement =
-      ComputeModelAgreement(view_graph, model, options.reg_max_rotation_error);
-  ModelSelfCheck check;
-  check.num_pairs = agreement.num_pairs;
-  check.num_agreeing = agreement.num_agreeing;
-  check.agreement = agreement.inlier_share;
-  for (const auto& image : agreement.disagreeing_images) {
-    check.disagreeing_images.push_back(image.image_id);
-  }
-  check.possibly_folded = agreement.inlier_share < options.min_model_agreement;
-  return check;
-}
-
-// Sorts models largest first (most images, then most points).
-void SortModels(std::vector<Reconstruction>* models) {
-  std::stable_sort(models->begin(), models->end(), [](const auto& a, const auto& b) {
-    if (a.images.size() != b.images.size()) return a.images.size() > b.images.size();
-    return a.points3D.size() > b.points3D.size();
-  });
+// The finishing step's options (model_finishing.h) from the incremental mapper's own.
+ModelFinishingOptions FinishingOptions(const IncrementalMapperOptions& options) {
+  ModelFinishingOptions finishing;
+  finishing.max_rotation_error_deg = options.reg_max_rotation_error;
+  finishing.min_model_agreement = options.min_model_agreement;
+  finishing.min_num_matches = options.min_num_matches;
+  finishing.use_gps_prior = options.use_gps_prior;
+  finishing.gps.horizontal_sigma_m = options.gps_horizontal_sigma;
+  finishing.gps.vertical_sigma_m = options.gps_vertical_sigma;
+  finishing.gps.min_num_images = options.gps_min_images;
+  finishing.gps.ba_max_num_iterations = options.ba_global_max_num_iterations;
+  return finishing;
 }
 
 // Merges every pair of models that aligns, largest first, until none does; a merge that
@@ -192,7 +179,7 @@ void MergeAlignedModels(const IncrementalMapperOptions& options,
   bool merged_any = true;
   while (merged_any && models->size() > 1) {
     merged_any = false;
-    SortModels(models);
+    SortModelsLargestFirst(models);
     for (size_t a = 0; a < models->size() && !merged_any; ++a) {
       for (size_t b = a + 1; b < models->size() && !merged_any; ++b) {
         std::set<image_t> images_a, images_b;
@@ -212,9 +199,10 @@ void MergeAlignedModels(const IncrementalMapperOptions& options,
           continue;
         }
         AdjustWholeModel(options, bundle_adjuster, &merged);
-        const double agreement_a = SelfCheck(view_graph, (*models)[a], options).agreement;
-        const double agreement_b = SelfCheck(view_graph, (*models)[b], options).agreement;
-        const double agreement = SelfCheck(view_graph, merged, options).agreement;
+        const ModelFinishingOptions finishing = FinishingOptions(options);
+        const double agreement_a = SelfCheckModel(view_graph, (*models)[a], finishing).agreement;
+        const double agreement_b = SelfCheckModel(view_graph, (*models)[b], finishing).agreement;
+        const double agreement = SelfCheckModel(view_graph, merged, finishing).agreement;
         constexpr double kMaxAgreementLoss = 0.05;
         if (agreement < std::min(agreement_a, agreement_b) - kMaxAgreementLoss) {
           const std::string why = fmt::format(
@@ -239,7 +227,7 @@ void MergeAlignedModels(const IncrementalMapperOptions& options,
       }
     }
   }
-  SortModels(models);
+  SortModelsLargestFirst(models);
 }
 
 // A first model stops growing once the relative change of every camera's focal length
@@ -392,37 +380,6 @@ void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
   }
 }
 
-// Checks each model against the view graph and logs the result, with a warning that
-// names the disagreeing images of a model that may be folded.
-std::vector<ModelSelfCheck> SelfCheckModels(const IncrementalMapperOptions& options,
-                                            const MapperInput& input, const ViewGraph& view_graph,
-                                            const std::vector<Reconstruction>& models) {
-  std::vector<ModelSelfCheck> checks;
-  for (size_t m = 0; m < models.size(); ++m) {
-    ModelSelfCheck check = SelfCheck(view_graph, models[m], options);
-    if (check.possibly_folded) {
-      std::string names;
-      for (size_t i = 0; i < check.disagreeing_images.size() && i < 10; ++i) {
-        names += (i > 0 ? ", " : "") + input.images.at(check.disagreeing_images[i]).name;
-      }
-      if (check.disagreeing_images.size() > 10) names += ", ...";
-      spdlog::warn(
-          "map: model {} may be folded by symmetric or repeated structure: its poses agree "
-          "within {:g} deg with {} of its {} verified pairs, which hold only {:.0f}% of their "
-          "inliers (min_model_agreement {:.0f}%); images whose pairs mostly disagree: {}",
-          m, options.reg_max_rotation_error, check.num_agreeing, check.num_pairs,
-          100 * check.agreement, 100 * options.min_model_agreement, names.empty() ? "none" : names);
-    } else {
-      spdlog::info(
-          "map: model {}: its poses agree with {} of its {} verified pairs, {:.1f}% of their "
-          "inliers",
-          m, check.num_agreeing, check.num_pairs, 100 * check.agreement);
-    }
-    checks.push_back(std::move(check));
-  }
-  return checks;
-}
-
 // Why each input image is in no model.
 std::map<image_t, std::string> UnregisteredReasons(const IncrementalMapperOptions& options,
                                                    const MapperInput& input,
@@ -513,39 +470,6 @@ IncrementalPipeline::IncrementalPipeline(const IncrementalMapperOptions& options
       seed_(seed),
       ransac_options_(ransac_options) {}
 
-// Each model anchored to its images' GPS in a local east-north-up frame (gps_anchoring.h);
-// a model that cannot be stays in its own frame, with a warning that says why.
-void AnchorModelsToGps(const IncrementalMapperOptions& options, const MapperInput& input,
-                       const BundleAdjuster& bundle_adjuster, uint64_t seed, MapperResult* result) {
-  GpsAnchoringOptions anchoring;
-  anchoring.horizontal_sigma_m = options.gps_horizontal_sigma;
-  anchoring.vertical_sigma_m = options.gps_vertical_sigma;
-  anchoring.min_num_images = options.gps_min_images;
-  anchoring.ba_max_num_iterations = options.ba_global_max_num_iterations;
-  result->georeferences.clear();
-  for (size_t index = 0; index < result->models.size(); ++index) {
-    const GpsAnchoringReport report =
-        AnchorModelToGps(input.metadata, bundle_adjuster, anchoring,
-                         DeriveSeed(seed, 0x69700 + index), &result->models[index]);
-    if (report.anchored) {
-      spdlog::info(
-          "map: model {}: anchored to the GPS of {} of its {} geotagged images, in an "
-          "east-north-up frame in metres from {:.7f}, {:.7f}, {:.1f} m; camera centres are a "
-          "mean {:.2f} m (median {:.2f} m) from their GPS positions",
-          index, report.num_agreeing, report.num_geotagged, report.origin.latitude_deg,
-          report.origin.longitude_deg, report.origin.altitude_m, report.mean_error_m,
-          report.median_error_m);
-      result->georeferences.push_back(report.origin);
-    } else {
-      spdlog::warn(
-          "map: model {} is not georeferenced (use_gps_prior): {}; it keeps its own "
-          "frame and scale",
-          index, report.reason);
-      result->georeferences.push_back(std::nullopt);
-    }
-  }
-}
-
 MapperResult IncrementalPipeline::Reconstruct(const MapperInput& input,
                                               const MapperControl& observer) const {
   const auto start_time = std::chrono::steady_clock::now();
@@ -611,14 +535,13 @@ MapperResult IncrementalPipeline::Reconstruct(const MapperInput& input,
   if (options_.merge_models) {
     MergeAlignedModels(options_, bundle_adjuster_, run.view_graph, run.tracks, seed_,
                        &result.models, &result.merges);
-  } else {
-    SortModels(&result.models);
   }
-  result.self_checks = SelfCheckModels(options_, input, run.view_graph, result.models);
-  if (options_.use_gps_prior) AnchorModelsToGps(options_, input, bundle_adjuster_, seed_, &result);
+  result.unregistered_reasons = UnregisteredReasons(options_, input, run, result.models);
+  // Ordering, self-checks against the run's view graph, GPS anchoring (model_finishing.h).
+  FinishModels(input, bundle_adjuster_, FinishingOptions(options_), seed_, &result,
+               &run.view_graph);
   if (!input.rigs.empty()) result.details["rigs"] = DescribeModelRigs(input.rigs, result.models);
   result.num_registrations_refused = run.num_registrations_refused;
-  result.unregistered_reasons = UnregisteredReasons(options_, input, run, result.models);
   result.num_global_ba = run.num_global_ba;
   result.num_local_ba = run.num_local_ba;
   result.seconds =

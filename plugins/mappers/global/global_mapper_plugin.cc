@@ -1,16 +1,16 @@
 // The `global` mapper: Tessera::sfm's GlobalMapper (after GLOMAP: view-graph
 // calibration, rotation averaging, global positioning of cameras and points from a
 // random start, bundle adjustment with filtering and retriangulation) behind the mapper
-// interface, with the same self-check against the view graph as the incremental one.
+// interface, finished as every mapper is (tessera/sfm/model_finishing.h: ordering, the
+// self-check against the view graph, GPS anchoring, reasons).
 // Where the view graph does not determine a camera's focal length (images around an
 // object), a first model of a few images does, before rotation averaging: relative
 // rotations from a focal length far off are wrong.
-// Its options are GlobalMapperOptions (tessera/sfm/global_mapper_options.h), the
-// self-check's two and GPS anchoring's four (use_gps_prior and its sigmas and least
-// number of images, as the incremental mapper names them).
+// Its options are GlobalMapperOptions (tessera/sfm/global_mapper_options.h) and the
+// finishing step's six (ModelFinishingOptions::FromJson: the self-check's two and GPS
+// anchoring's four, as the incremental mapper names them).
 
 #include <algorithm>
-#include <cstdio>
 #include <optional>
 #include <set>
 #include <string>
@@ -20,15 +20,10 @@
 #include "tessera/sfm/first_model_calibration.h"
 #include "tessera/sfm/focal_length_estimation.h"
 #include "tessera/sfm/global_mapper.h"
-#include "tessera/sfm/gps_anchoring.h"
-#include "tessera/sfm/view_graph.h"
+#include "tessera/sfm/model_finishing.h"
 
 namespace tessera {
 namespace {
-
-// A view-graph focal length whose mean robust cost per pair is above this has no clear
-// minimum (FocalLengthEstimate::cost), as the incremental mapper also judges.
-constexpr double kClearFocalMinimumCost = 0.05;
 
 // Configurations whose matches are correspondences of one 3D point.
 bool IsVerified(int config) {
@@ -63,31 +58,14 @@ class GlobalMapperPlugin : public Mapper {
  public:
   explicit GlobalMapperPlugin(const nlohmann::json& options) {
     nlohmann::json mapper = options.is_object() ? options : nlohmann::json::object();
-    OptionReader reader(options);
-    reg_max_rotation_error_ =
-        reader.Get<double>("reg_max_rotation_error", reg_max_rotation_error_, 0.1, 180.0);
-    min_model_agreement_ =
-        reader.Get<double>("min_model_agreement", min_model_agreement_, 0.0, 1.0);
-    use_gps_prior_ = reader.GetBool("use_gps_prior", use_gps_prior_);
-    gps_.horizontal_sigma_m =
-        reader.Get<double>("gps_horizontal_sigma", gps_.horizontal_sigma_m, 1e-3, 1e6);
-    gps_.vertical_sigma_m =
-        reader.Get<double>("gps_vertical_sigma", gps_.vertical_sigma_m, 1e-3, 1e6);
-    gps_.min_num_images = reader.Get<int>("gps_min_images", gps_.min_num_images, 3, 1000000);
-    const std::vector<std::string> own = {"reg_max_rotation_error", "min_model_agreement",
-                                          "use_gps_prior",          "gps_horizontal_sigma",
-                                          "gps_vertical_sigma",     "gps_min_images"};
-    CheckKnownKeys(mapper, own);
-    for (const std::string& key : own) mapper.erase(key);
+    finishing_ = ModelFinishingOptions::FromJson(options);
+    CheckKnownKeys(mapper, ModelFinishingOptions::JsonKeys());
+    for (const std::string& own : ModelFinishingOptions::JsonKeys()) mapper.erase(own);
     options_ = GlobalMapperOptions::FromJson(mapper);
-    gps_.ba_max_num_iterations = options_.final_ba_max_num_iterations;
+    finishing_.min_num_matches = options_.min_num_matches;
+    finishing_.gps.ba_max_num_iterations = options_.final_ba_max_num_iterations;
     effective_options_ = options_.ToJson();
-    effective_options_["reg_max_rotation_error"] = reg_max_rotation_error_;
-    effective_options_["min_model_agreement"] = min_model_agreement_;
-    effective_options_["use_gps_prior"] = use_gps_prior_;
-    effective_options_["gps_horizontal_sigma"] = gps_.horizontal_sigma_m;
-    effective_options_["gps_vertical_sigma"] = gps_.vertical_sigma_m;
-    effective_options_["gps_min_images"] = gps_.min_num_images;
+    effective_options_.update(finishing_.ToJson());
   }
 
   MapperResult Map(const MapperInput& input, const MapperContext& context) const override {
@@ -142,8 +120,7 @@ class GlobalMapperPlugin : public Mapper {
     result.num_tracks = mapped.num_tracks;
     result.num_global_ba = mapped.num_bundle_adjustments;
     result.seconds = mapped.seconds;
-    result.self_checks = SelfChecks(input, context.seed, result.models);
-    if (use_gps_prior_) AnchorToGps(input, context, &result);
+    FinishModels(input, *context.bundle_adjuster, finishing_, context.seed, &result);
     result.details = {
         {"num_verified_pairs", mapped.num_verified_pairs},
         {"num_weak_pairs_set_aside", mapped.num_weak_pairs_set_aside},
@@ -224,82 +201,8 @@ class GlobalMapperPlugin : public Mapper {
     return calibrated;
   }
 
-  // Each model against the view graph of its verified pairs, with its own cameras: the
-  // incremental mapper's self-check (tessera/sfm/view_graph.h).
-  std::vector<ModelSelfCheck> SelfChecks(const MapperInput& input, uint64_t seed,
-                                         const std::vector<Reconstruction>& models) const {
-    std::vector<ModelSelfCheck> checks;
-    for (size_t index = 0; index < models.size(); ++index) {
-      const Reconstruction& model = models[index];
-      std::map<camera_t, Camera> cameras = input.cameras;
-      for (const auto& [camera_id, camera] : model.cameras) cameras[camera_id] = camera;
-      std::vector<const MapperInput::Pair*> pairs;
-      for (const MapperInput::Pair& pair : input.pairs) {
-        if (static_cast<int>(pair.geometry.inlier_matches.size()) >= options_.min_num_matches &&
-            model.images.count(pair.image_id1) > 0 && model.images.count(pair.image_id2) > 0) {
-          pairs.push_back(&pair);
-        }
-      }
-      const ViewGraph view_graph = ViewGraph::Build(input, cameras, pairs, seed);
-      const ModelAgreement agreement =
-          ComputeModelAgreement(view_graph, model, reg_max_rotation_error_);
-      ModelSelfCheck check;
-      check.num_pairs = agreement.num_pairs;
-      check.num_agreeing = agreement.num_agreeing;
-      check.agreement = agreement.inlier_share;
-      for (const auto& image : agreement.disagreeing_images) {
-        check.disagreeing_images.push_back(image.image_id);
-      }
-      check.possibly_folded = agreement.inlier_share < min_model_agreement_;
-      std::string line = "model " + std::to_string(index) + ": its poses agree with " +
-                         std::to_string(check.num_agreeing) + " of its " +
-                         std::to_string(check.num_pairs) + " verified pairs, " +
-                         std::to_string(static_cast<int>(100 * check.agreement)) +
-                         "% of their inliers";
-      if (check.possibly_folded) {
-        log().Warn(line + ": it may be folded by symmetric or repeated structure");
-      } else {
-        log().Info(line);
-      }
-      checks.push_back(std::move(check));
-    }
-    return checks;
-  }
-
-  // Each model anchored to its images' GPS in a local east-north-up frame, as the
-  // incremental mapper does with use_gps_prior (tessera/sfm/gps_anchoring.h); a model
-  // that cannot be keeps its own frame, with a warning that says why.
-  void AnchorToGps(const MapperInput& input, const MapperContext& context,
-                   MapperResult* result) const {
-    result->georeferences.clear();
-    for (size_t index = 0; index < result->models.size(); ++index) {
-      const GpsAnchoringReport report =
-          AnchorModelToGps(input.metadata, *context.bundle_adjuster, gps_,
-                           context.seed + 0x69700 + index, &result->models[index]);
-      if (report.anchored) {
-        char line[400];
-        std::snprintf(line, sizeof(line),
-                      "model %zu: anchored to the GPS of %zu of its %zu geotagged images, in an "
-                      "east-north-up frame in metres from %.7f, %.7f, %.1f m; camera centres are "
-                      "a mean %.2f m (median %.2f m) from their GPS positions",
-                      index, report.num_agreeing, report.num_geotagged, report.origin.latitude_deg,
-                      report.origin.longitude_deg, report.origin.altitude_m, report.mean_error_m,
-                      report.median_error_m);
-        log().Info(line);
-        result->georeferences.push_back(report.origin);
-      } else {
-        log().Warn("model " + std::to_string(index) + " is not georeferenced (use_gps_prior): " +
-                   report.reason + "; it keeps its own frame and scale");
-        result->georeferences.push_back(std::nullopt);
-      }
-    }
-  }
-
   GlobalMapperOptions options_;
-  double reg_max_rotation_error_ = 10.0;
-  double min_model_agreement_ = 0.75;
-  bool use_gps_prior_ = false;
-  GpsAnchoringOptions gps_;
+  ModelFinishingOptions finishing_;
 };
 
 }  // namespace tessera

@@ -4,6 +4,8 @@
 #include <string>
 
 #include "tessera/sfm/export.h"
+#include "tessera/sfm/gps_anchoring.h"
+#include "tessera/sfm/model_finishing.h"
 
 namespace tessera {
 
@@ -93,8 +95,9 @@ struct TESSERA_SFM_EXPORT IncrementalMapperOptions {
   double reg_max_rotation_error = 10.0;  // degrees
   double reg_min_agreement = 0.6;
   // A model whose agreeing pairs (rotation within reg_max_rotation_error) hold a smaller
-  // share of its pairs' inliers may be folded: it is flagged in the log and the summary.
-  double min_model_agreement = 0.75;
+  // share of its pairs' inliers may be folded: it is flagged in the log and the summary
+  // (the finishing step, model_finishing.h).
+  double min_model_agreement = kMinModelAgreement;
 
   // Models sharing at least merge_min_shared_points points (one feature track in
   // both) that one similarity aligns within merge_max_reproj_error px are merged and
@@ -115,9 +118,9 @@ struct TESSERA_SFM_EXPORT IncrementalMapperOptions {
   // than gps_min_images geotagged images, or whose GPS contradicts it, keeps its own
   // frame, with a warning.
   bool use_gps_prior = false;
-  double gps_horizontal_sigma = 5.0;
-  double gps_vertical_sigma = 10.0;
-  int gps_min_images = 3;
+  double gps_horizontal_sigma = GpsAnchoringOptions().horizontal_sigma_m;
+  double gps_vertical_sigma = GpsAnchoringOptions().vertical_sigma_m;
+  int gps_min_images = GpsAnchoringOptions().min_num_images;
 
   // Reads the `incremental` mapper's options; unknown keys and out-of-range values throw
   // OptionError naming "<path>.<key>" ("<key>" when `path` is empty, as a plugin's
