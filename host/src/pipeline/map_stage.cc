@@ -105,14 +105,15 @@ MapperInput LoadMapperInputWithRig(const Database& database, const RigFile* rig)
   return input;
 }
 
-// Writes model `index` into the transaction: with each exporter in its own staging
-// folder, or as COLMAP binary in sparse/<index> when there is none. A failing exporter
-// stops the set: its error is thrown, the earlier outputs stay whole, and what this run
-// wrote is kept in the staging folder until the next run.
+// Writes model `index` into the transaction of `output_dir`: with each exporter in its
+// own staging folder, or as COLMAP binary in sparse/<index> when there is none. A failing
+// exporter stops the set: its error is thrown, the earlier outputs stay whole, and what
+// this run wrote is kept in the staging folder until the next run.
 void ExportModel(const Reconstruction& model, size_t index,
                  const std::optional<Georeference>& georeference, const MapSettings& settings,
-                 const std::filesystem::path& image_dir, const PluginCrashLog& crash_log,
-                 OutputTransaction* outputs, std::vector<std::string>* quarantined) {
+                 const std::filesystem::path& image_dir, const std::filesystem::path& output_dir,
+                 const PluginCrashLog& crash_log, OutputTransaction* outputs,
+                 std::vector<std::string>* quarantined) {
   if (settings.exporters == nullptr || settings.exporters->empty()) {
     const std::filesystem::path dir =
         outputs->StageFor("tessera") / "sparse" / std::to_string(index);
@@ -132,10 +133,15 @@ void ExportModel(const Reconstruction& model, size_t index,
     }
     const std::filesystem::path staged = outputs->StageFor(exporter.name(), k);
     try {
-      exporter.Call(PluginStage::kExport, subject, [&](auto& plugin) {
-        plugin.Export(
-            model, {staged, image_dir, static_cast<int>(index), settings.mask_dir, georeference});
-      });
+      ExportContext context;
+      context.output_dir = staged;
+      context.image_dir = image_dir;
+      context.model_index = static_cast<int>(index);
+      context.mask_dir = settings.mask_dir;
+      context.georeference = georeference;
+      context.placed_output_dir = output_dir;
+      exporter.Call(PluginStage::kExport, subject,
+                    [&](auto& plugin) { plugin.Export(model, context); });
     } catch (const PluginError& error) {
       outputs->Keep();
       spdlog::info(
@@ -198,7 +204,8 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
     const Reconstruction& model = result.models[index];
     ExportModel(model, index,
                 index < result.georeferences.size() ? result.georeferences[index] : std::nullopt,
-                settings, image_dir, workspace.crash_log(), &outputs, &mapping.quarantined);
+                settings, image_dir, output_dir, workspace.crash_log(), &outputs,
+                &mapping.quarantined);
     summary->num_registered += model.images.size();
     summary->images_per_model.push_back(model.images.size());
     const MappingSummary::Model& entry = mapping.models[index];
