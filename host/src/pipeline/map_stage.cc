@@ -39,6 +39,7 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
     const ModelStatistics statistics = ComputeModelStatistics(model);
     entry.mean_track_length = statistics.mean_track_length;
     entry.mean_reprojection_error = statistics.mean_reprojection_error;
+    entry.mean_observation_reprojection_error = statistics.mean_observation_reprojection_error;
     const ModelSelfCheck& check = result.self_checks.at(index);
     entry.view_graph_check.verified_pairs = check.num_pairs;
     entry.view_graph_check.agreeing_pairs = check.num_agreeing;
@@ -211,9 +212,9 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
     const MappingSummary::Model& entry = mapping.models[index];
     spdlog::info(
         "map: model {}: {} images, {} points, mean track length {:.2f}, mean reprojection "
-        "error {:.3f} px",
+        "error {:.3f} px (COLMAP's, over points; over observations {:.3f} px)",
         index, entry.num_images, entry.num_points3D, entry.mean_track_length,
-        entry.mean_reprojection_error);
+        entry.mean_reprojection_error, entry.mean_observation_reprojection_error);
     control.Report("export", index + 1, result.models.size());
   }
   for (const MappingSummary::Unregistered& image : mapping.unregistered) {
