@@ -9,12 +9,15 @@
 # and, in the read-back section on clusters.json and the cluster processes (issue 46),
 #   models removed by a failed run, orphans after kill -9 of a parent, and cluster
 #   processes left 20 s after a signal to their parent.
+# Issue 47's hand-offs are read as their readers read them: transforms.json's file_path
+# joined to the JSON's folder, the 3DGS trainer's camera (check_3dgs_scene.py) on a
+# principal point moved off the centre, and the mean error against colmap model_analyzer.
 # Every count but the first ("cases tried") must be 0. On a 512 px copy of
 # examples/fountain-P11-small with ORB (a few seconds per case).
 # usage: benchmarks/bad_outputs.sh [TESSERA]
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-tessera=${1:-$root/build/bin/tessera}
+tessera=$(realpath "${1:-$root/build/bin/tessera}")
 bin=$(dirname "$tessera")
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -176,6 +179,34 @@ t run --images "$work/d4" --output "$work/small" --manifest "$work/bin.json" > /
 "$tessera" export --model "$work/base/sparse/0" --format gaussian_splatting --images "$work/d" --output "$work/gs" > /dev/null 2>&1
 check "3DGS re-export of a smaller model: no old image left" 0 '[ "$(ls "$work/gs/gaussian_splatting/images" | wc -l)" = 4 ] && [ ! -e "$work/gs/gaussian_splatting/images/0007.jpg" ]' "" -- \
   "$tessera" export --model "$work/small/sparse/0" --format gaussian_splatting --images "$work/d4" --output "$work/gs"
+# --- Hand-offs read by their readers (issue 47) -----------------------------------------
+# file_path joined to the JSON's folder as nerfstudio joins it names the image, byte for byte.
+resolves() {
+  python3 - "$@" << 'PY'
+import filecmp, json, os, sys
+images = sys.argv[1]
+for frame in json.load(open(sys.argv[2]))["frames"]:
+    path = os.path.join(os.path.dirname(sys.argv[2]), frame["file_path"])
+    assert filecmp.cmp(path, os.path.join(images, os.path.basename(path)), shallow=False), path
+PY
+}
+check "transforms.json of a run: file_path resolves" 0 'resolves "$work/d" "$work/base/transforms.json"' "" -- true
+check "transforms.json export, relative paths" 0 'resolves "$work/d" "$work/tj/transforms.json"' "" -- \
+  bash -c "cd '$work' && '$tessera' export --model base/sparse/0 --format transforms_json --images d --output tj"
+check "transforms.json export without --images" 2 '[ ! -e "$work/tj2/transforms.json" ]' "" -- \
+  "$tessera" export --model "$work/base/sparse/0" --format transforms_json --output "$work/tj2"
+# A principal point 7 px off the centre (as bundle adjustment may refine it): the 3DGS
+# trainer's camera (principal point at the image centre) must agree with the model's.
+"$tessera" export --model "$work/base/sparse/0" --format colmap_text --output "$work/offc" > /dev/null 2>&1
+awk '!/^#/ && NF { $6 += 7 } { print }' "$work/offc/sparse/0/cameras.txt" > "$work/offc/cameras.txt" &&
+  mv "$work/offc/cameras.txt" "$work/offc/sparse/0/cameras.txt"
+check "3DGS export of an off-centre principal point" 0 'python3 "$root/tests/tools/check_3dgs_scene.py" "$work/gs_offc/gaussian_splatting" > /dev/null' "" -- \
+  "$tessera" export --model "$work/offc/sparse/0" --format gaussian_splatting --images "$work/d" --output "$work/gs_offc"
+# The mean reprojection error is COLMAP's: mapping_summary.json against model_analyzer.
+if colmap help > /dev/null 2>&1; then
+  check "mean reprojection error = colmap model_analyzer's" 0 'python3 -c "import json,sys; assert abs(json.load(open(sys.argv[1]))[\"models\"][0][\"mean_reprojection_error\"] - float(sys.argv[2])) < 1e-6" "$work/base/mapping_summary.json" "$(sed -n "s/.*Mean reprojection error: \([0-9.]*\)px.*/\1/p" "$work/case.log")"' "" -- \
+    colmap model_analyzer --path "$work/base/sparse/0"
+fi
 check "--threads 65537" 2 "" "" -- \
   "$tessera" run --images "$work/d" --output "$work/thr" --manifest "$work/bin.json" --threads 65537
 

@@ -302,9 +302,15 @@ void BindModelArrays(py::class_<ModelHandle, std::shared_ptr<ModelHandle>>& mode
             result["num_observations"] = statistics.num_observations;
             result["mean_track_length"] = statistics.mean_track_length;
             result["mean_reprojection_error"] = statistics.mean_reprojection_error;
+            result["mean_observation_reprojection_error"] =
+                statistics.mean_observation_reprojection_error;
             return result;
           },
-          "What `colmap model_analyzer` reports, as the host computes it");
+          "What `colmap model_analyzer` reports, as the host computes it: "
+          "mean_reprojection_error is COLMAP's (and pycolmap's "
+          "compute_mean_reprojection_error): the mean over points of each point's mean error "
+          "over its track. mean_observation_reprojection_error is the mean over the "
+          "observations in front of their camera, each weighing the same.");
 }
 
 }  // namespace

@@ -76,15 +76,27 @@ def test_poses_and_projection_agree_with_the_host(model_dir):
         np.testing.assert_allclose(rotation @ rotation.T, np.eye(3), atol=1e-12)
         np.testing.assert_allclose(image.projection_center(), -rotation.T @ translation,
                                    atol=1e-9)
-    # The mean reprojection error over every observation, projected from Python, is the
-    # host's figure (what `colmap model_analyzer` reports).
+    # Projected from Python: the mean over points of each point's mean error over its
+    # track is the host's mean_reprojection_error (COLMAP's figure, what `colmap
+    # model_analyzer` and pycolmap's compute_mean_reprojection_error report); the mean over
+    # every observation is mean_observation_reprojection_error.
     errors = []
+    point_errors = []
     for point in model.points3D.values():
+        track_errors = []
         for image_id, point2D_idx in point.track:
             pixel = model.project(int(image_id), point.xyz.reshape(1, 3))[0]
-            errors.append(np.linalg.norm(pixel - model.images[image_id].keypoints[point2D_idx]))
-    assert np.mean(errors) == pytest.approx(model.statistics()["mean_reprojection_error"],
+            track_errors.append(
+                np.linalg.norm(pixel - model.images[image_id].keypoints[point2D_idx]))
+        errors.extend(track_errors)
+        point_errors.append(np.mean(track_errors))
+    statistics = model.statistics()
+    assert np.mean(point_errors) == pytest.approx(statistics["mean_reprojection_error"],
+                                                  rel=1e-9)
+    assert np.mean(errors) == pytest.approx(statistics["mean_observation_reprojection_error"],
                                             rel=1e-9)
+    # The two differ on a real model: the test tells them apart.
+    assert abs(np.mean(point_errors) - np.mean(errors)) > 1e-6
     assert np.mean(errors) < 4.0
 
 

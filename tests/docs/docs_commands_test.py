@@ -558,6 +558,14 @@ def run_documented(cli, source, command, work, xvfb, failures):
                              f"{scores['registered']} registered, position error "
                              f"{scores['pos_mean_rel']} of the extent, rotation error up to "
                              f"{scores['rot_max_deg']} deg")
+        # Each file_path, resolved as nerfstudio resolves it, names an image that is there.
+        with open(transforms, encoding="utf-8") as file:
+            for frame in json.load(file)["frames"]:
+                path = os.path.join(os.path.dirname(transforms), frame["file_path"])
+                if not os.path.isfile(path):
+                    failures.add(f"{command.where()}: file_path {frame['file_path']} of "
+                                 f"{transforms} resolves to {path}, which does not exist")
+                    break
     elif verb == "gui":
         with open(shot, "rb") as file:
             header = file.read(24)

@@ -10,9 +10,11 @@
 namespace tessera {
 
 struct ExportContext {
-  std::filesystem::path output_dir;  // the run's output folder
-  std::filesystem::path image_dir;   // where the images named in the model live
-  int model_index = 0;               // 0 is the largest model
+  // The folder to write into: a staging folder of the run's output folder, whose files
+  // the host moves to placed_output_dir when the whole set succeeded.
+  std::filesystem::path output_dir;
+  std::filesystem::path image_dir;  // where the images named in the model live
+  int model_index = 0;              // 0 is the largest model
   // The run's mask folder (camera.mask_path or --masks): the mask of image NAME is
   // MASK_DIR/NAME.png, else MASK_DIR/NAME with the image's extension replaced by .png;
   // white keeps, black masks out. Empty: the run has no masks.
@@ -21,6 +23,12 @@ struct ExportContext {
   // position when the mapper anchored it to GPS; absent: an arbitrary frame and scale.
   // Exporters that can say which frame they write say so.
   std::optional<Georeference> georeference;
+  // The run's output folder as the user named it (relative to the working folder, or
+  // absolute), where the files of output_dir end up (PlacedPath of
+  // tessera/io/exporter_paths.h). A path that a written file holds to something outside
+  // it (transforms.json's file_path) is computed from there, never from output_dir.
+  // Empty: output_dir itself (a caller that does not stage).
+  std::filesystem::path placed_output_dir;
 };
 
 // Writes a reconstruction to files. `reconstruction` may hold images that are not

@@ -58,9 +58,10 @@ struct EvaluationResult {
   size_t num_points3D = 0;
   size_t num_observations = 0;  // track elements
   double mean_track_length = 0;
-  // Mean distance in pixels between the observed keypoints and the projections of
-  // their 3D points, recomputed from the points and cameras (not the stored errors);
-  // observations behind their camera are left out and counted.
+  // COLMAP's mean reprojection error in pixels (ModelStatistics: each point's mean
+  // distance between its keypoints and its projections, then the mean over points),
+  // recomputed from the points and cameras (not the stored errors); observations behind
+  // their camera are left out and counted.
   double mean_reprojection_error = std::numeric_limits<double>::quiet_NaN();
   size_t num_observations_behind_camera = 0;
 

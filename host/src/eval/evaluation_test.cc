@@ -544,13 +544,13 @@ TEST_P(ColmapAnchorEvaluation, AgreesWithReferenceScript) {
   // The figures of anchors/README.md (eval_gt.py's rounding): 6.2 mm and 7.9 mm.
   const double expected_mean = GetParam() == "fountain-P11" ? 0.00623 : 0.00794;
   EXPECT_NEAR(result.position_error_mean, expected_mean, 5e-6);
-  // COLMAP's stored per-point errors (a mean over points, not observations) come within
-  // 10% of the recomputed mean: 0.42 vs 0.45 px on fountain-P11, 0.45 vs 0.47 px on
-  // Herz-Jesus-P8. A wrong camera model or pixel convention would be far off.
+  // The mean reprojection error is COLMAP's: the mean of its stored per-point errors
+  // (what model_analyzer prints), recomputed: 0.421867 px on fountain-P11, 0.448163 px on
+  // Herz-Jesus-P8. The mean over observations is not it (0.45 and 0.47 px).
   double stored_error_sum = 0;
   for (const auto& [point3D_id, point3D] : model.points3D) stored_error_sum += point3D.error;
   const double stored_error_mean = stored_error_sum / model.points3D.size();
-  EXPECT_NEAR(result.mean_reprojection_error, stored_error_mean, 0.1 * stored_error_mean);
+  EXPECT_NEAR(result.mean_reprojection_error, stored_error_mean, 1e-6);
   EXPECT_EQ(result.num_observations_behind_camera, 0u);
   RecordProperty("mean_reprojection_error", std::to_string(result.mean_reprojection_error));
   RecordProperty("mean_stored_error", std::to_string(stored_error_mean));

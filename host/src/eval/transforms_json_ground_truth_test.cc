@@ -106,6 +106,10 @@ TEST(TransformsJsonGroundTruth, FoxPosesAndIntrinsicsRoundTrip) {
     model.images[image.image_id] = image;
   }
   testing::TemporaryDir output;
+  fs::create_directories(output.path() / "images");  // the exporter names only images it finds
+  for (const auto& [image_id, image] : model.images) {
+    std::ofstream(output.path() / "images" / image.name) << image.name;
+  }
   auto exporter = testing::LoadBundledPlugin<Exporter>("exporter", "transforms_json",
                                                        {{"file", "nerf/transforms.json"}});
   testing::Unguarded(exporter).Export(model, ContextFor(output.path(), output.path() / "images"));

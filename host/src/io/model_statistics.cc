@@ -47,9 +47,13 @@ ModelStatistics ComputeModelStatistics(const Reconstruction& reconstruction) {
     statistics.mean_track_length = static_cast<double>(statistics.num_observations) /
                                    static_cast<double>(statistics.num_points3D);
   }
+  double point_error_sum = 0;
+  size_t num_point_errors = 0;
   double error_sum = 0;
   size_t num_errors = 0;
   for (const auto& [point3D_id, point3D] : reconstruction.points3D) {
+    double track_error_sum = 0;
+    size_t track_num_errors = 0;
     for (const TrackElement& element : point3D.track) {
       const ObservationError error = ComputeObservationError(reconstruction, point3D, element);
       if (!error.usable) continue;
@@ -57,11 +61,22 @@ ModelStatistics ComputeModelStatistics(const Reconstruction& reconstruction) {
         ++statistics.num_observations_behind_camera;
         continue;
       }
-      error_sum += error.error_px;
-      ++num_errors;
+      track_error_sum += error.error_px;
+      ++track_num_errors;
     }
+    if (track_num_errors > 0) {
+      point_error_sum += track_error_sum / static_cast<double>(track_num_errors);
+      ++num_point_errors;
+    }
+    error_sum += track_error_sum;
+    num_errors += track_num_errors;
   }
-  if (num_errors > 0) statistics.mean_reprojection_error = error_sum / num_errors;
+  if (num_point_errors > 0) {
+    statistics.mean_reprojection_error = point_error_sum / static_cast<double>(num_point_errors);
+  }
+  if (num_errors > 0) {
+    statistics.mean_observation_reprojection_error = error_sum / static_cast<double>(num_errors);
+  }
   return statistics;
 }
 

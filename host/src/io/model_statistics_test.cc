@@ -74,8 +74,36 @@ TEST(ModelStatistics, ModelMeansLeaveOutObservationsBehindTheCamera) {
   EXPECT_EQ(statistics.num_observations, 4u);
   EXPECT_EQ(NumObservations(MakeModel()), 4u);
   EXPECT_DOUBLE_EQ(statistics.mean_track_length, 2.0);
+  // Only point 1 has an observation in front of its camera: both means are its 5 px.
   EXPECT_DOUBLE_EQ(statistics.mean_reprojection_error, 5.0);
+  EXPECT_DOUBLE_EQ(statistics.mean_observation_reprojection_error, 5.0);
   EXPECT_EQ(statistics.num_observations_behind_camera, 1u);
+}
+
+// COLMAP's model_analyzer averages the points' errors, each point once: a point seen
+// 3 times 3 px off and one seen once 1 px off give 2 px, where the mean over the four
+// observations is 2.5 px.
+TEST(ModelStatistics, MeanReprojectionErrorWeighsEachPointOnceAsColmapDoes) {
+  Reconstruction model;
+  model.cameras[1] = Camera::Create(1, CameraModelId::kSimplePinhole, 100, 200, 100);
+  Point3D& long_track = model.points3D[1];
+  long_track.xyz = Eigen::Vector3d(0, 0, 1);  // projects to (100, 50)
+  Point3D& short_track = model.points3D[2];
+  short_track.xyz = Eigen::Vector3d(0.1, 0, 1);  // projects to (110, 50)
+  for (image_t image_id = 1; image_id <= 3; ++image_id) {
+    Image& image = model.images[image_id];
+    image.image_id = image_id;
+    image.camera_id = 1;
+    image.registered = true;
+    image.points2D.resize(2);
+    image.points2D[0].xy = Eigen::Vector2d(103, 50);
+    image.points2D[1].xy = Eigen::Vector2d(111, 50);
+    long_track.track.push_back({image_id, 0});
+  }
+  short_track.track = {{1, 1}};
+  const ModelStatistics statistics = ComputeModelStatistics(model);
+  EXPECT_DOUBLE_EQ(statistics.mean_reprojection_error, 2.0);
+  EXPECT_DOUBLE_EQ(statistics.mean_observation_reprojection_error, 2.5);
 }
 
 TEST(ModelStatistics, EmptyModelHasNoMeanError) {
@@ -83,6 +111,7 @@ TEST(ModelStatistics, EmptyModelHasNoMeanError) {
   EXPECT_EQ(statistics.num_observations, 0u);
   EXPECT_EQ(statistics.mean_track_length, 0.0);
   EXPECT_TRUE(std::isnan(statistics.mean_reprojection_error));
+  EXPECT_TRUE(std::isnan(statistics.mean_observation_reprojection_error));
 }
 
 }  // namespace

@@ -44,6 +44,7 @@ ExportSummary ExportModel(const ExportArguments& arguments) {
   context.model_index = arguments.model_index;
   context.mask_dir = arguments.masks;
   context.georeference = georeference;
+  context.placed_output_dir = arguments.output;
   try {
     exporter.Call(PluginStage::kExport, "model " + std::to_string(context.model_index),
                   [&](auto& plugin) { plugin.Export(reconstruction, context); });

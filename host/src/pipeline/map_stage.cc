@@ -39,6 +39,7 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
     const ModelStatistics statistics = ComputeModelStatistics(model);
     entry.mean_track_length = statistics.mean_track_length;
     entry.mean_reprojection_error = statistics.mean_reprojection_error;
+    entry.mean_observation_reprojection_error = statistics.mean_observation_reprojection_error;
     const ModelSelfCheck& check = result.self_checks.at(index);
     entry.view_graph_check.verified_pairs = check.num_pairs;
     entry.view_graph_check.agreeing_pairs = check.num_agreeing;
@@ -152,14 +153,15 @@ MapperInput LoadMapperInputWithRig(const Database& database, const RigFile* rig)
   return input;
 }
 
-// Writes model `index` into the transaction: with each exporter in its own staging
-// folder, or as COLMAP binary in sparse/<index> when there is none. A failing exporter
-// stops the set: its error is thrown, the earlier outputs stay whole, and what this run
-// wrote is kept in the staging folder until the next run.
+// Writes model `index` into the transaction of `output_dir`: with each exporter in its
+// own staging folder, or as COLMAP binary in sparse/<index> when there is none. A failing
+// exporter stops the set: its error is thrown, the earlier outputs stay whole, and what
+// this run wrote is kept in the staging folder until the next run.
 void ExportModel(const Reconstruction& model, size_t index,
                  const std::optional<Georeference>& georeference, const MapSettings& settings,
-                 const std::filesystem::path& image_dir, const PluginCrashLog& crash_log,
-                 OutputTransaction* outputs, std::vector<std::string>* quarantined) {
+                 const std::filesystem::path& image_dir, const std::filesystem::path& output_dir,
+                 const PluginCrashLog& crash_log, OutputTransaction* outputs,
+                 std::vector<std::string>* quarantined) {
   if (settings.exporters == nullptr || settings.exporters->empty()) {
     const std::filesystem::path dir =
         outputs->StageFor("tessera") / "sparse" / std::to_string(index);
@@ -179,10 +181,15 @@ void ExportModel(const Reconstruction& model, size_t index,
     }
     const std::filesystem::path staged = outputs->StageFor(exporter.name(), k);
     try {
-      exporter.Call(PluginStage::kExport, subject, [&](auto& plugin) {
-        plugin.Export(
-            model, {staged, image_dir, static_cast<int>(index), settings.mask_dir, georeference});
-      });
+      ExportContext context;
+      context.output_dir = staged;
+      context.image_dir = image_dir;
+      context.model_index = static_cast<int>(index);
+      context.mask_dir = settings.mask_dir;
+      context.georeference = georeference;
+      context.placed_output_dir = output_dir;
+      exporter.Call(PluginStage::kExport, subject,
+                    [&](auto& plugin) { plugin.Export(model, context); });
     } catch (const PluginError& error) {
       outputs->Keep();
       spdlog::info(
@@ -262,15 +269,16 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
     const Reconstruction& model = result.models[index];
     ExportModel(model, index,
                 index < result.georeferences.size() ? result.georeferences[index] : std::nullopt,
-                settings, image_dir, workspace.crash_log(), &outputs, &mapping.quarantined);
+                settings, image_dir, output_dir, workspace.crash_log(), &outputs,
+                &mapping.quarantined);
     summary->num_registered += model.images.size();
     summary->images_per_model.push_back(model.images.size());
     const MappingSummary::Model& entry = mapping.models[index];
     spdlog::info(
         "map: model {}: {} images, {} points, mean track length {:.2f}, mean reprojection "
-        "error {:.3f} px",
+        "error {:.3f} px (COLMAP's, over points; over observations {:.3f} px)",
         index, entry.num_images, entry.num_points3D, entry.mean_track_length,
-        entry.mean_reprojection_error);
+        entry.mean_reprojection_error, entry.mean_observation_reprojection_error);
     control.Report("export", index + 1, result.models.size());
   }
   for (const MappingSummary::Unregistered& image : mapping.unregistered) {

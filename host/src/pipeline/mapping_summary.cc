@@ -15,15 +15,17 @@ nlohmann::json MappingSummary::ToJson() const {
                                        {"agreement", check.agreement},
                                        {"possibly_folded", check.possibly_folded},
                                        {"disagreeing_images", check.disagreeing_images}};
-    json["models"].push_back({{"index", model.index},
-                              {"folder", model.folder},
-                              {"num_images", model.num_images},
-                              {"num_points3D", model.num_points3D},
-                              {"mean_track_length", model.mean_track_length},
-                              {"mean_reprojection_error", model.mean_reprojection_error},
-                              {"view_graph_check", self_check},
-                              {"images", model.images},
-                              {"georeference", model.georeference}});
+    json["models"].push_back(
+        {{"index", model.index},
+         {"folder", model.folder},
+         {"num_images", model.num_images},
+         {"num_points3D", model.num_points3D},
+         {"mean_track_length", model.mean_track_length},
+         {"mean_reprojection_error", model.mean_reprojection_error},
+         {"mean_observation_reprojection_error", model.mean_observation_reprojection_error},
+         {"view_graph_check", self_check},
+         {"images", model.images},
+         {"georeference", model.georeference}});
   }
   for (const Unregistered& image : unregistered) {
     json["unregistered"].push_back({{"image", image.image}, {"reason", image.reason}});
@@ -61,6 +63,9 @@ MappingSummary MappingSummary::FromJson(const nlohmann::json& json) {
     model.num_points3D = entry.at("num_points3D").get<size_t>();
     model.mean_track_length = entry.at("mean_track_length").get<double>();
     model.mean_reprojection_error = entry.at("mean_reprojection_error").get<double>();
+    // Absent in summaries written before it had a name of its own.
+    model.mean_observation_reprojection_error =
+        entry.value("mean_observation_reprojection_error", model.mean_reprojection_error);
     const nlohmann::json& check = entry.at("view_graph_check");
     model.view_graph_check.verified_pairs = check.at("verified_pairs").get<size_t>();
     model.view_graph_check.agreeing_pairs = check.at("agreeing_pairs").get<size_t>();

@@ -29,7 +29,8 @@ struct MappingSummary {
     size_t num_images = 0;
     size_t num_points3D = 0;
     double mean_track_length = 0;
-    double mean_reprojection_error = 0;  // px
+    double mean_reprojection_error = 0;              // px, COLMAP's: over points (ModelStatistics)
+    double mean_observation_reprojection_error = 0;  // px, over observations
     ViewGraphCheck view_graph_check;
     std::vector<std::string> images;  // registered, by name, in image id order
     // The frame's WGS84 origin ({"latitude", "longitude", "altitude", "frame": "ENU"})

@@ -18,6 +18,7 @@ MappingSummary Example() {
   model.num_points3D = 1200;
   model.mean_track_length = 2.75;
   model.mean_reprojection_error = 0.625;
+  model.mean_observation_reprojection_error = 0.75;
   model.view_graph_check = {3, 2, 0.875, true, {"c.jpg"}};
   model.images = {"a.jpg", "b.jpg", "c.jpg"};
   summary.models.push_back(model);
@@ -38,6 +39,8 @@ TEST(MappingSummary, JsonKeys) {
   const nlohmann::json& model = json.at("models").at(0);
   EXPECT_EQ(model.at("num_points3D").get<size_t>(), 1200u);
   EXPECT_DOUBLE_EQ(model.at("view_graph_check").at("agreement").get<double>(), 0.875);
+  EXPECT_DOUBLE_EQ(model.at("mean_reprojection_error").get<double>(), 0.625);
+  EXPECT_DOUBLE_EQ(model.at("mean_observation_reprojection_error").get<double>(), 0.75);
   EXPECT_EQ(model.at("view_graph_check").at("disagreeing_images").at(0), "c.jpg");
   EXPECT_EQ(json.at("unregistered").at(0).at("reason"), "no verified pair");
   EXPECT_EQ(json.at("focal_lengths_estimated").at(0).at("method"), "view graph");

@@ -28,16 +28,58 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// The camera of the undistorted images with field_of_view "crop". Size, focal lengths
-// and principal point stay those of the original camera, as COLMAP's image_undistorter
-// keeps them by default: nothing is scaled, and only the corners that barrel distortion
-// pulls in are left black (for pincushion distortion or a fisheye lens, the border of
-// the original is cut off).
+// The reference 3DGS trainer's COLMAP loader keeps only the focal lengths (its field of
+// view is 2 atan(size / 2f)) and puts the principal point at the image centre, so every
+// exported camera has it there: within this many pixels counts as there.
+constexpr double kCentredPx = 1e-6;
+
+bool PrincipalPointCentred(const Camera& camera) {
+  return std::abs(camera.PrincipalPointX() - static_cast<double>(camera.width) / 2) <= kCentredPx &&
+         std::abs(camera.PrincipalPointY() - static_cast<double>(camera.height) / 2) <= kCentredPx;
+}
+
+// "(dx, dy) px": how far the principal point is from the image centre.
+std::string FormatOffset(const Camera& camera) {
+  char text[64];
+  std::snprintf(text, sizeof(text), "(%+.2f, %+.2f) px",
+                camera.PrincipalPointX() - static_cast<double>(camera.width) / 2,
+                camera.PrincipalPointY() - static_cast<double>(camera.height) / 2);
+  return text;
+}
+
+// The pixels of the undistorted image differ from the original's: resampled.
+bool NeedsResampling(const Camera& camera) {
+  return camera.HasDistortion() || !PrincipalPointCentred(camera);
+}
+
+// The camera of the undistorted images with field_of_view "crop": the original's focal
+// lengths, as COLMAP's image_undistorter keeps them (nothing is scaled; the corners that
+// barrel distortion pulls in are black, and pincushion distortion or a fisheye lens
+// loses the original's border). The principal point is the image centre: an off-centre
+// one (refined by bundle adjustment) keeps the largest window of the original centred on
+// it, width 2 min(cx, W - cx) and height 2 min(cy, H - cy) rounded down to even pixels,
+// so that no pixel is blank. Throws InputError when no pixel is left.
 Camera PinholeCamera(const Camera& camera) {
   Camera pinhole = camera;
   pinhole.model_id = CameraModelId::kPinhole;
-  pinhole.params = {camera.FocalLengthX(), camera.FocalLengthY(), camera.PrincipalPointX(),
-                    camera.PrincipalPointY()};
+  if (!PrincipalPointCentred(camera)) {
+    const double cx = camera.PrincipalPointX(), cy = camera.PrincipalPointY();
+    const double half_width =
+        std::floor(std::min(cx, static_cast<double>(camera.width) - cx) + kCentredPx);
+    const double half_height =
+        std::floor(std::min(cy, static_cast<double>(camera.height) - cy) + kCentredPx);
+    if (half_width < 1 || half_height < 1) {
+      throw InputError("camera " + std::to_string(camera.camera_id) + ": its principal point (" +
+                       std::to_string(cx) + ", " + std::to_string(cy) + ") lies outside its " +
+                       std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                       " image: no centred window of it is left");
+    }
+    pinhole.width = static_cast<size_t>(2 * half_width);
+    pinhole.height = static_cast<size_t>(2 * half_height);
+  }
+  pinhole.params = {camera.FocalLengthX(), camera.FocalLengthY(),
+                    static_cast<double>(pinhole.width) / 2,
+                    static_cast<double>(pinhole.height) / 2};
   return pinhole;
 }
 
@@ -277,10 +319,17 @@ class GaussianSplattingExporter : public Exporter {
     CheckImageNames(reconstruction, root);
     Reconstruction undistorted = reconstruction;
     for (auto& [camera_id, camera] : undistorted.cameras) {
-      // A camera without distortion loses nothing: it is kept as it is in both modes.
-      camera = full_field_ && camera.HasDistortion()
+      // A camera without distortion, its principal point centred, is kept as it is.
+      camera = full_field_ && NeedsResampling(camera)
                    ? FullFieldPinholeCamera(camera, max_scale_, max_ray_angle_degrees_ * kPi / 180)
                    : PinholeCamera(camera);
+      if (!PrincipalPointCentred(reconstruction.cameras.at(camera_id))) {
+        const Camera& original = reconstruction.cameras.at(camera_id);
+        log().Info("camera " + std::to_string(camera_id) + ": principal point " +
+                   FormatOffset(original) + " off the image centre; written centred, " +
+                   std::to_string(camera.width) + "x" + std::to_string(camera.height) +
+                   ", as 3DGS trainers assume it");
+      }
     }
     std::map<camera_t, UndistortionMaps> maps;
     for (auto& [image_id, image] : undistorted.images) {
@@ -299,7 +348,7 @@ class GaussianSplattingExporter : public Exporter {
                          std::to_string(camera.camera_id) + " is " + std::to_string(camera.width) +
                          "x" + std::to_string(camera.height));
       }
-      if (camera.HasDistortion()) {
+      if (NeedsResampling(camera)) {
         auto it = maps.find(camera.camera_id);
         if (it == maps.end()) {
           it = maps.emplace(camera.camera_id, MakeUndistortionMaps(camera, pinhole)).first;
@@ -325,14 +374,14 @@ class GaussianSplattingExporter : public Exporter {
           mask = cv::Mat();
         }
       }
-      const bool blank_borders = full_field_ && camera.HasDistortion();
+      const bool blank_borders = full_field_ && NeedsResampling(camera);
       if (mask.empty() && blank_borders) {
         // The blank borders of the larger image are masked out: the original, all white.
         mask = cv::Mat(static_cast<int>(camera.height), static_cast<int>(camera.width), CV_8UC1,
                        cv::Scalar(255));
       }
       if (!mask.empty()) {
-        if (camera.HasDistortion()) {
+        if (NeedsResampling(camera)) {
           const UndistortionMaps& map = maps.at(camera.camera_id);
           cv::Mat remapped;  // black outside the original
           cv::remap(mask, remapped, map.map_x, map.map_y, cv::INTER_NEAREST, cv::BORDER_CONSTANT,

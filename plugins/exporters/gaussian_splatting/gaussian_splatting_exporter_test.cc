@@ -2,12 +2,13 @@
 
 #include <cmath>
 #include <functional>
+#include <limits>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "tessera/testing/synthetic_model.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/model_statistics.h"
+#include "tessera/testing/synthetic_model.h"
 #include "test_support.h"
 
 namespace tessera {
@@ -31,6 +32,61 @@ cv::Mat RenderPattern(const Camera& camera,
     }
   }
   return image;
+}
+
+// The reference 3DGS trainer's camera (graphdeco-inria/gaussian-splatting,
+// scene/dataset_readers.py readColmapCameras and utils/graphics_utils.py): the field of
+// view from the focal lengths of the PINHOLE or SIMPLE_PINHOLE model alone,
+// FovX = 2 atan(width / 2 fx) with the model's width, and a symmetric frustum over the
+// image as read, so its principal point is the centre of the image file.
+struct TrainerCamera {
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  Eigen::Vector2d Project(const Eigen::Vector3d& point_in_cam) const {
+    return {fx * point_in_cam.x() / point_in_cam.z() + cx,
+            fy * point_in_cam.y() / point_in_cam.z() + cy};
+  }
+};
+
+TrainerCamera TrainerCameraOf(const Camera& camera, const cv::Mat& image) {
+  EXPECT_TRUE(camera.model_id == CameraModelId::kPinhole ||
+              camera.model_id == CameraModelId::kSimplePinhole)
+      << camera.ModelName();
+  const bool simple = camera.model_id == CameraModelId::kSimplePinhole;
+  const double fov_x = 2 * std::atan(static_cast<double>(camera.width) / (2 * camera.params[0]));
+  const double fov_y =
+      2 * std::atan(static_cast<double>(camera.height) / (2 * camera.params[simple ? 0 : 1]));
+  TrainerCamera trainer;
+  trainer.fx = image.cols / (2 * std::tan(fov_x / 2));
+  trainer.fy = image.rows / (2 * std::tan(fov_y / 2));
+  trainer.cx = image.cols / 2.0;
+  trainer.cy = image.rows / 2.0;
+  return trainer;
+}
+
+// The largest distance, over every registered image of the 3DGS workspace `root` and
+// every point of its model in front of it, between where the trainer's camera projects
+// the point and where the exported model's own camera does.
+double WorstTrainerOffset(const fs::path& root) {
+  const Reconstruction model = ReadColmapModel(root / "sparse" / "0");
+  double worst = 0;
+  size_t num_projected = 0;
+  for (const auto& [image_id, image] : model.images) {
+    if (!image.registered) continue;
+    const cv::Mat pixels = cv::imread((root / "images" / image.name).string(), cv::IMREAD_COLOR);
+    EXPECT_FALSE(pixels.empty()) << image.name;
+    if (pixels.empty()) return std::numeric_limits<double>::infinity();
+    const Camera& camera = model.cameras.at(image.camera_id);
+    const TrainerCamera trainer = TrainerCameraOf(camera, pixels);
+    for (const auto& [point3D_id, point3D] : model.points3D) {
+      const Eigen::Vector3d point_in_cam = image.cam_from_world * point3D.xyz;
+      if (point_in_cam.z() <= 0) continue;
+      worst =
+          std::max(worst, (trainer.Project(point_in_cam) - camera.ImgFromCam(point_in_cam)).norm());
+      ++num_projected;
+    }
+  }
+  EXPECT_GT(num_projected, 0u);
+  return worst;
 }
 
 TEST(GaussianSplattingExporter, UndistortsASimpleRadialCameraToPinhole) {
@@ -443,10 +499,102 @@ TEST(GaussianSplattingExporter, FountainImagesKeepTheirSizeAndPointsReproject) {
     EXPECT_EQ(written.cols, static_cast<int>(camera.width)) << image.name;
     EXPECT_EQ(written.rows, static_cast<int>(camera.height)) << image.name;
   }
+  EXPECT_LT(WorstTrainerOffset(root), 0.5);  // COLMAP's principal point is the centre
   const double error = ComputeModelStatistics(undistorted).mean_reprojection_error;
   EXPECT_LT(error, 1.0);
   // Undistortion moves the points with the images: the error stays COLMAP's.
   EXPECT_NEAR(error, ComputeModelStatistics(model).mean_reprojection_error, 1e-3);
+}
+
+// A principal point that bundle adjustment moved off the centre (here 6.3 px right and
+// 4.2 px up): the trainer would place every point that far from where the model puts it.
+// The exporter writes the largest centred window instead, resampled, so the trainer's
+// camera and the model's agree, and the pixels show what that camera sees.
+TEST(GaussianSplattingExporter, AnOffCentrePrincipalPointIsWrittenCentredForTheTrainer) {
+  for (const CameraModelId model_id : {CameraModelId::kSimpleRadial, CameraModelId::kPinhole}) {
+    for (const std::string field_of_view : {"crop", "full"}) {
+      SCOPED_TRACE(std::to_string(static_cast<int>(model_id)) + " " + field_of_view);
+      Camera camera = Camera::Create(3, model_id, 140, 160, 120);
+      camera.params = model_id == CameraModelId::kPinhole
+                          ? std::vector<double>{140, 138, 86.3, 55.8}
+                          : std::vector<double>{140, 86.3, 55.8, -0.05};
+      const Reconstruction model = testing::MakeSyntheticModel(camera, 3, 150);
+      testing::TemporaryDir images, output;
+      const cv::Mat original =
+          RenderPattern(camera, [&](const Eigen::Vector2d& xy) { return camera.CamFromImg(xy); });
+      for (const auto& [image_id, image] : model.images) {
+        ASSERT_TRUE(cv::imwrite((images.path() / image.name).string(), original));
+      }
+      auto exporter = testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting",
+                                                           {{"field_of_view", field_of_view}});
+      ExportContext context;
+      context.output_dir = output.path();
+      context.image_dir = images.path();
+      testing::Unguarded(exporter).Export(model, context);
+
+      const fs::path root = output.path() / "gaussian_splatting";
+      EXPECT_LT(WorstTrainerOffset(root), 0.5);
+      const Reconstruction exported = ReadColmapModel(root / "sparse" / "0");
+      const Camera& pinhole = exported.cameras.at(3);
+      if (field_of_view == "crop") {
+        // The largest window centred on (86.3, 55.8): 2 x 73 by 2 x 55 pixels.
+        EXPECT_EQ(pinhole.width, 146u);
+        EXPECT_EQ(pinhole.height, 110u);
+        EXPECT_EQ(pinhole.params[2], 73.0);
+        EXPECT_EQ(pinhole.params[3], 55.0);
+      }
+      // The pixels are the pattern seen through the exported camera, away from the
+      // border (where bilinear sampling and, with "full", the blank border lie).
+      const cv::Mat written =
+          cv::imread((root / "images" / "img_1.png").string(), cv::IMREAD_COLOR);
+      ASSERT_EQ(written.cols, static_cast<int>(pinhole.width));
+      ASSERT_EQ(written.rows, static_cast<int>(pinhole.height));
+      const cv::Mat expected =
+          RenderPattern(pinhole, [&](const Eigen::Vector2d& xy) { return pinhole.CamFromImg(xy); });
+      const cv::Rect inner(static_cast<int>(pinhole.params[2]) - 50,
+                           static_cast<int>(pinhole.params[3]) - 40, 100, 80);
+      cv::Mat difference;
+      cv::absdiff(written(inner), expected(inner), difference);
+      EXPECT_LT(cv::mean(difference)[0], 1.0);
+      // The keypoints moved with the pixels: the points reproject onto them.
+      double max_error = 0;
+      for (const auto& [point3D_id, point3D] : exported.points3D) {
+        for (const TrackElement& element : point3D.track) {
+          const Image& image = exported.images.at(element.image_id);
+          max_error = std::max(max_error, (pinhole.ImgFromCam(image.cam_from_world * point3D.xyz) -
+                                           image.points2D.at(element.point2D_idx).xy)
+                                              .norm());
+        }
+      }
+      EXPECT_LT(max_error, 1e-3);
+    }
+  }
+}
+
+// A principal point outside the image leaves no centred window: refused, naming the camera.
+TEST(GaussianSplattingExporter, APrincipalPointOutsideTheImageIsRefusedNamingTheCamera) {
+  Camera camera = Camera::Create(5, CameraModelId::kPinhole, 140, 160, 120);
+  camera.params = {140, 140, -3, 60};
+  const Reconstruction model = testing::MakeSyntheticModel(camera, 2, 50);
+  testing::TemporaryDir images, output;
+  for (const auto& [image_id, image] : model.images) {
+    ASSERT_TRUE(cv::imwrite((images.path() / image.name).string(),
+                            cv::Mat(120, 160, CV_8UC3, cv::Scalar::all(90))));
+  }
+  ExportContext context;
+  context.output_dir = output.path();
+  context.image_dir = images.path();
+  try {
+    testing::Unguarded(testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting"))
+        .Export(model, context);
+    ADD_FAILURE() << "expected an InputError";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("camera 5: its principal point (-3.000000, "
+                        "60.000000) lies outside its 160x120 image"),
+              std::string::npos)
+        << error.what();
+  }
 }
 
 }  // namespace

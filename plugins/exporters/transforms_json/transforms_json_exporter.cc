@@ -89,11 +89,31 @@ nlohmann::json TransformMatrix(const Rigid3d& cam_from_world) {
   return rows;
 }
 
-// Where the image lies, relative to the folder of the JSON file, with '/' separators.
+// `path` made absolute and with every link resolved: a reader opens
+// dirname(transforms.json)/file_path through the file system, which follows a link
+// before it applies "..", so the relative path is computed between real folders.
+fs::path RealPath(const fs::path& path) { return fs::weakly_canonical(fs::absolute(path)); }
+
+// Where image `name` lies, relative to `json_dir` (the JSON's folder once placed: where
+// its readers resolve file_path), with '/' separators. Without an image folder:
+// nerfstudio's layout, images/<name> beside the JSON. Either way the image must be there:
+// a path that resolves to nothing is an InputError, never written.
 std::string FilePath(const fs::path& json_dir, const fs::path& image_dir, const std::string& name) {
+  const fs::path image = (image_dir.empty() ? json_dir / "images" : image_dir) / name;
+  std::error_code error;
+  if (!fs::is_regular_file(image, error)) {
+    throw InputError(image_dir.empty()
+                         ? "the image folder is unknown (tessera export --images "
+                           "DIR) and " +
+                               image.string() + " does not exist: file_path would name no image"
+                         : "image '" + name + "': " + image.string() +
+                               " does not exist: file_path would name no image");
+  }
   if (image_dir.empty()) return (fs::path("images") / name).generic_string();
-  const fs::path image = fs::absolute(image_dir / name).lexically_normal();
-  return image.lexically_relative(fs::absolute(json_dir).lexically_normal()).generic_string();
+  // Its file name kept, even if it is a link.
+  return (RealPath(image.parent_path()) / image.filename())
+      .lexically_relative(RealPath(json_dir))
+      .generic_string();
 }
 
 }  // namespace
@@ -147,7 +167,8 @@ class TransformsJsonExporter : public Exporter {
         nlohmann::json frame = shared_camera
                                    ? nlohmann::json::object()
                                    : Intrinsics(reconstruction.cameras.at(image->camera_id));
-        frame["file_path"] = FilePath(path.parent_path(), context.image_dir, image->name);
+        frame["file_path"] =
+            FilePath(PlacedPath(context, path).parent_path(), context.image_dir, image->name);
         frame["transform_matrix"] = TransformMatrix(image->cam_from_world);
         frame["colmap_im_id"] = image->image_id;
         json["frames"].push_back(frame);

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
 
 #include "tessera/testing/synthetic_model.h"
 #include "test_support.h"
@@ -23,6 +26,32 @@ ExportContext ContextFor(const fs::path& output, const fs::path& images) {
   return context;
 }
 
+// A file per image of `model` in `dir`, holding the image's name.
+void WriteImages(const Reconstruction& model, const fs::path& dir) {
+  fs::create_directories(dir);
+  for (const auto& [image_id, image] : model.images) std::ofstream(dir / image.name) << image.name;
+}
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream file(path);
+  return std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+}
+
+// Each frame's file_path read as nerfstudio and instant-ngp read it,
+// os.path.join(dirname(transforms.json), file_path), names a file that is that frame's
+// image (the file holds the image's name).
+void ExpectFilePathsResolve(const Reconstruction& model, const fs::path& json_file) {
+  const nlohmann::json json = ReadJson(json_file);
+  ASSERT_FALSE(json["frames"].empty());
+  for (const nlohmann::json& frame : json["frames"]) {
+    const std::string file_path = frame["file_path"].get<std::string>();
+    const fs::path resolved = json_file.parent_path() / file_path;
+    const Image& image = model.images.at(frame["colmap_im_id"].get<image_t>());
+    ASSERT_TRUE(fs::is_regular_file(resolved)) << json_file << ": " << file_path;
+    EXPECT_EQ(ReadText(resolved), image.name) << json_file << ": " << file_path;
+  }
+}
+
 TEST(TransformsJsonExporter, PerFrameIntrinsicsForSeveralCamerasAndModelIndex) {
   Reconstruction model = testing::MakeSyntheticModel(
       Camera::Create(1, CameraModelId::kSimpleRadial, 100, 80, 60), 3, 30);
@@ -33,6 +62,7 @@ TEST(TransformsJsonExporter, PerFrameIntrinsicsForSeveralCamerasAndModelIndex) {
   model.images.at(2).camera_id = 2;
   model.images.at(3).registered = false;
   testing::TemporaryDir output;
+  WriteImages(model, output.path() / "images");  // nerfstudio's layout, beside the JSON
   ExportContext context = ContextFor(output.path(), "");
   context.model_index = 1;
   testing::Unguarded(testing::LoadBundledPlugin<Exporter>("exporter", "transforms_json"))
@@ -91,8 +121,9 @@ TEST(TransformsJsonExporter, FisheyeCamerasAreWrittenAsOpenCVFisheye) {
   fisheye.params = {100, 101, 40, 30, 0.04, -0.01, 0.002, -0.0003};
   Reconstruction model = testing::MakeSyntheticModel(fisheye, 2, 30);
   testing::TemporaryDir output;
+  WriteImages(model, output.path() / "photos");
   const auto exporter = testing::LoadBundledPlugin<Exporter>("exporter", "transforms_json");
-  testing::Unguarded(exporter).Export(model, ContextFor(output.path(), ""));
+  testing::Unguarded(exporter).Export(model, ContextFor(output.path(), output.path() / "photos"));
   const nlohmann::json json = ReadJson(output.path() / "transforms.json");
   EXPECT_EQ(json["camera_model"], "OPENCV_FISHEYE");
   EXPECT_EQ(json["fl_y"].get<double>(), 101.0);
@@ -104,13 +135,92 @@ TEST(TransformsJsonExporter, FisheyeCamerasAreWrittenAsOpenCVFisheye) {
   model.cameras[2] = Camera::Create(2, CameraModelId::kPinhole, 90, 80, 60);
   model.images.at(2).camera_id = 2;
   try {
-    testing::Unguarded(exporter).Export(model, ContextFor(output.path(), ""));
+    testing::Unguarded(exporter).Export(model, ContextFor(output.path(), output.path() / "photos"));
     ADD_FAILURE() << "expected an InputError";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what()).find("transforms.json: fisheye and other cameras"),
               std::string::npos)
         << error.what();
   }
+}
+
+// The host stages the exporter in OUTPUT/.tessera_staging/PID/writer-K and moves the
+// JSON to OUTPUT: file_path is relative to OUTPUT (and the file option's folder), for
+// image and output folders given relative and absolute, inside and outside each other.
+TEST(TransformsJsonExporter, FilePathsResolveFromThePlacedJsonFolder) {
+  const Reconstruction model = testing::MakeSyntheticModel(
+      Camera::Create(1, CameraModelId::kSimpleRadial, 100, 80, 60), 3, 30);
+  testing::TemporaryDir root;
+  const fs::path working = fs::current_path();
+  fs::current_path(root.path());
+  struct Case {
+    fs::path output, images, file;
+  };
+  const fs::path absolute = root.path();
+  for (const Case& test : std::vector<Case>{
+           {"proj/out", "proj/photos", "transforms.json"},
+           {absolute / "proj/out", absolute / "proj/photos", "transforms.json"},
+           {"proj/out", absolute / "proj/photos", "nerf/transforms.json"},
+           {absolute / "proj/out", "proj/photos", "transforms.json"},
+           {"proj/photos/out", "proj/photos", "transforms.json"},  // output inside the images
+           {"proj/out2", "proj/out2/frames", "transforms.json"},   // images inside the output
+           {"proj/sub/../out3", "./proj//photos/", "a/b/transforms.json"}}) {
+    WriteImages(model, test.images);
+    const fs::path staging = test.output / ".tessera_staging" / "123" / "writer-0";
+    fs::create_directories(staging);
+    ExportContext context = ContextFor(staging, test.images);
+    context.placed_output_dir = test.output;
+    testing::Unguarded(testing::LoadBundledPlugin<Exporter>("exporter", "transforms_json",
+                                                            {{"file", test.file.string()}}))
+        .Export(model, context);
+    // Placed as the host places it: the staged file at the same path below the output.
+    const fs::path placed = test.output / test.file;
+    fs::create_directories(placed.parent_path());
+    fs::rename(staging / test.file, placed);
+    SCOPED_TRACE(placed.string() + " with images " + test.images.string());
+    ExpectFilePathsResolve(model, placed);
+  }
+  // Through a link to the output folder: the reader follows the link before "..".
+  fs::create_directories("elsewhere/out");
+  fs::create_directory_symlink(absolute / "elsewhere/out", "proj/linked");
+  ExportContext context = ContextFor("proj/linked/.tessera_staging/1/writer-0", "proj/photos");
+  fs::create_directories(context.output_dir);
+  context.placed_output_dir = "proj/linked";
+  testing::Unguarded(testing::LoadBundledPlugin<Exporter>("exporter", "transforms_json"))
+      .Export(model, context);
+  fs::rename(context.output_dir / "transforms.json", "proj/linked/transforms.json");
+  ExpectFilePathsResolve(model, "proj/linked/transforms.json");
+  fs::current_path(working);
+}
+
+// Without an image folder the path is nerfstudio's images/<name> beside the JSON when the
+// image is there; when it is not, the export is refused, naming where it looked.
+TEST(TransformsJsonExporter, WithoutAnImageFolderOnlyPathsThatResolve) {
+  const Reconstruction model = testing::MakeSyntheticModel(
+      Camera::Create(1, CameraModelId::kSimpleRadial, 100, 80, 60), 2, 30);
+  testing::TemporaryDir output;
+  const fs::path staging = output.path() / ".tessera_staging" / "7" / "writer-0";
+  fs::create_directories(staging);
+  ExportContext context = ContextFor(staging, "");
+  context.placed_output_dir = output.path();
+  const auto exporter = testing::LoadBundledPlugin<Exporter>("exporter", "transforms_json");
+  try {
+    testing::Unguarded(exporter).Export(model, context);
+    ADD_FAILURE() << "a file_path naming no image was written";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("the image folder is unknown (tessera export --images DIR) and " +
+                        (output.path() / "images" / "img_1.png").string() + " does not exist"),
+              std::string::npos)
+        << error.what();
+  }
+  EXPECT_FALSE(fs::exists(staging / "transforms.json"));
+  WriteImages(model, output.path() / "images");
+  testing::Unguarded(exporter).Export(model, context);
+  fs::rename(staging / "transforms.json", output.path() / "transforms.json");
+  ExpectFilePathsResolve(model, output.path() / "transforms.json");
+  EXPECT_EQ(ReadJson(output.path() / "transforms.json")["frames"][0]["file_path"],
+            "images/img_1.png");
 }
 
 }  // namespace

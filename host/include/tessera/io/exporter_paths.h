@@ -26,4 +26,15 @@ inline std::filesystem::path PerModelPath(const ExportContext& context,
                                path.extension().string());
 }
 
+// Where `path` (below context.output_dir, the staging folder) lies once the host has
+// placed the set: the same relative path below context.placed_output_dir. A path that a
+// file holds to something outside the output folder is relative to the file's placed
+// folder, since that is where its reader resolves it.
+inline std::filesystem::path PlacedPath(const ExportContext& context,
+                                        const std::filesystem::path& path) {
+  if (context.placed_output_dir.empty()) return path;
+  return (context.placed_output_dir / path.lexically_relative(context.output_dir))
+      .lexically_normal();
+}
+
 }  // namespace tessera

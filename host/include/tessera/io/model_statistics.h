@@ -38,9 +38,17 @@ struct ModelStatistics {
   size_t num_points3D = 0;
   size_t num_observations = 0;   // NumObservations
   double mean_track_length = 0;  // observations per point; 0 without points
-  // Over the usable observations in front of their camera, in the order of the points
-  // and their tracks; NaN when there is none.
+  // COLMAP's "Mean reprojection error" (model_analyzer, pycolmap's
+  // compute_mean_reprojection_error, which average Point3D::error): each point's mean
+  // error over its usable observations in front of their camera, then the mean over the
+  // points that have one; NaN when none has. Recomputed from the poses, cameras and
+  // keypoints, so it equals COLMAP's figure wherever the stored errors are current and no
+  // observation is behind its camera, as in every model Tessera or COLMAP writes.
   double mean_reprojection_error = std::numeric_limits<double>::quiet_NaN();
+  // Another average: over the same observations, each weighing the same (a point counts
+  // as often as its track is long); NaN when there is none. Not COLMAP's figure: above
+  // it when long tracks have larger errors.
+  double mean_observation_reprojection_error = std::numeric_limits<double>::quiet_NaN();
   size_t num_observations_behind_camera = 0;  // usable, but behind the camera: left out
 };
 TESSERA_IO_EXPORT ModelStatistics ComputeModelStatistics(const Reconstruction& reconstruction);
