@@ -201,18 +201,18 @@ PY
 }
 readback_forged_ledgers() {
   local o before named
-  # forged NAME ENTRY FILE FOREIGN [VERB] [CHECK]: a fresh workspace with ENTRY forged for
+  # forged NAME ENTRY FILE KEEP [VERB] [CHECK]: a fresh workspace with ENTRY forged for
   # FILE (none: a folder entry); then VERB (map) must exit 2 naming the ledger and the
-  # entry, with the outputs, the FOREIGN files and what CHECK tests as they were.
+  # entry, with the outputs, the files KEEP and what CHECK tests as they were.
   forged() {
-    local name=$1 entry=$2 file=$3 foreign=$4 verb=${5:-map} also=${6:-true}
+    local name=$1 entry=$2 file=$3 keep=$4 verb=${5:-map} also=${6:-true}
     o="$work/forged"; fresh "$o"
     forge "$o" "$entry" ${file:+"$file"}
     before=$(outputs_of "$o")
     named="grep -qF \"tessera_outputs.json: the entry '$entry'\" \"\$work/case.log\""
     local images=""; [ "$verb" = run ] && images="--images $work/d"
     check "forged ledger: $name ($verb)" 2 "$named"' && [ "$(outputs_of "$o")" = "$before" ] && '"$also" \
-      "$foreign" -- t $verb $images --output "$o" --manifest "$work/bin.json"
+      "$keep" -- t $verb $images --output "$o" --manifest "$work/bin.json"
   }
   forged "../victim.txt" "../outside/victim.txt" "$work/outside/victim.txt" ""
   forged "../victim.txt" "../outside/victim.txt" "$work/outside/victim.txt" "" run
