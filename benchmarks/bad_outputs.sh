@@ -323,6 +323,78 @@ parent_case "SIGINT to the main process alone" INT 130
 parent_case "kill -9 of the main process" KILL 137
 parent_case "kill -9 of the main process, children stopped" KILL 137 stop
 # === End of the read-back section on clusters.json and cluster processes ===============
+# --- Read-back: forged ledgers (issue 46) ------------------------------------------------
+# OUTPUT/.tessera_outputs.json edited as a forger would: each entry below carries the real
+# size and XXH3 of the file it names. Tessera must refuse the ledger (exit 2, naming it and
+# the entry) and delete nothing. Kept in one function so that other read-back sections
+# (clusters.json, signals) sit beside it.
+forge() {  # forge OUTPUT ENTRY [FILE]: ENTRY added with FILE's size and XXH3; no FILE: a folder
+  python3 - "$@" <<'PY'
+import ctypes, ctypes.util, json, os, sys
+out, entry = sys.argv[1], sys.argv[2]
+path = os.path.join(out, ".tessera_outputs.json")
+ledger = json.load(open(path))
+if len(sys.argv) > 3:
+    data = open(sys.argv[3], "rb").read()
+    xxhash = ctypes.CDLL(ctypes.util.find_library("xxhash"))
+    xxhash.XXH3_64bits.restype = ctypes.c_uint64
+    xxhash.XXH3_64bits.argtypes = [ctypes.c_char_p, ctypes.c_size_t]
+    ledger["files"].append({"path": entry, "size": len(data),
+                            "xxh3": "%016x" % xxhash.XXH3_64bits(data, len(data))})
+else:
+    ledger["folders"].append(entry)
+json.dump(ledger, open(path, "w"), indent=1)
+PY
+}
+readback_forged_ledgers() {
+  local o before named
+  # forged NAME ENTRY FILE KEEP [VERB] [CHECK]: a fresh workspace with ENTRY forged for
+  # FILE (none: a folder entry); then VERB (map) must exit 2 naming the ledger and the
+  # entry, with the outputs, the files KEEP and what CHECK tests as they were.
+  forged() {
+    local name=$1 entry=$2 file=$3 keep=$4 verb=${5:-map} also=${6:-true}
+    o="$work/forged"; fresh "$o"
+    forge "$o" "$entry" ${file:+"$file"}
+    before=$(outputs_of "$o")
+    named="grep -qF \"tessera_outputs.json: the entry '$entry'\" \"\$work/case.log\""
+    local images=""; [ "$verb" = run ] && images="--images $work/d"
+    check "forged ledger: $name ($verb)" 2 "$named"' && [ "$(outputs_of "$o")" = "$before" ] && '"$also" \
+      "$keep" -- t $verb $images --output "$o" --manifest "$work/bin.json"
+  }
+  forged "../victim.txt" "../outside/victim.txt" "$work/outside/victim.txt" ""
+  forged "../victim.txt" "../outside/victim.txt" "$work/outside/victim.txt" "" run
+  forged "an absolute path" "$work/outside/victim.txt" "$work/outside/victim.txt" ""
+  forged "sparse/0/../../../x" "sparse/0/../../../outside/victim.txt" "$work/outside/victim.txt" ""
+  forged "database.db" "database.db" "$work/forged/database.db" "$work/forged/database.db"
+  forged "an input image" "../d/0003.jpg" "$work/d/0003.jpg" "$work/d/0003.jpg"
+  forged "an input image (absolute)" "$work/d/0004.jpg" "$work/d/0004.jpg" "$work/d/0004.jpg"
+  # ORB and brute_force cache nothing: a search index as flann leaves it stands for one.
+  mkdir -p "$work/base/cache/matcher/flann"; echo index > "$work/base/cache/matcher/flann/1.idx"
+  forged "a file under cache/" "cache/matcher/flann/1.idx" "$work/base/cache/matcher/flann/1.idx" \
+    "$work/forged/cache/matcher/flann/1.idx"
+  # The images inside OUTPUT, given with --images: an entry naming one, with its digest,
+  # passes the checks of the path, but an input is never removed: left, with a warning.
+  o="$work/forged"; fresh "$o"; cp -r "$work/d" "$o/photos"
+  forge "$o" "photos/0003.jpg" "$o/photos/0003.jpg"; forge "$o" "photos"
+  check "forged ledger: an input image inside OUTPUT (map)" 0 'grep -q "photos/0003.jpg is left as it is: .tessera_outputs.json records it as Tessera.s, but it is, holds or lies in the input folder" "$work/case.log"' \
+    "$o/photos/0003.jpg" -- t map --images "$o/photos" --output "$o" --manifest "$work/bin.json"
+  mkdir -p "$work/empty_folder"
+  forged "an empty folder outside (folders)" "../empty_folder" "" "" map '[ -d "$work/empty_folder" ]'
+  forged "the ledger itself" ".tessera_outputs.json" "$work/base/.tessera_outputs.json" ""
+  # OUTPUT/sparse moved away and replaced by a link to it: every recorded digest matches
+  # through the link, and nothing may be removed or replaced through it.
+  o="$work/forged"; fresh "$o"; rm -rf "$work/moved_sparse"; mv "$o/sparse" "$work/moved_sparse"
+  ln -s "$work/moved_sparse" "$o/sparse"
+  local moved; moved=$(sums_of "$work/moved_sparse")
+  check "ledger entries through a link (OUTPUT/sparse)" 2 'grep -q "a symbolic link" "$work/case.log" && [ "$(sums_of "$work/moved_sparse")" = "$moved" ]' "" -- \
+    t map --output "$o" --manifest "$work/bin.json"
+  # A file Tessera wrote, edited since: named as that, not as "not in the ledger".
+  o="$work/forged"; fresh "$o"; echo '{"edited": true}' > "$o/transforms.json"
+  check "an edited output is told from a foreign one" 2 'grep -q "Tessera wrote but that has changed since" "$work/case.log" && ! grep -q "not in .tessera_outputs.json" "$work/case.log"' "$o/transforms.json" -- \
+    t map --output "$o" --manifest "$work/bin.json"
+}
+readback_forged_ledgers
+# --- End of read-back: forged ledgers ---------------------------------------------------
 
 echo
 echo "cases tried: $tried"

@@ -16,6 +16,9 @@
 # 10. run_summary.json never describes models that are not there (issue 47): `map` with
 #     another mapper, and a `map` that builds no model (exit 3), remove it; `run` writes
 #     its own, naming its mapper and its models.
+# 11. a forged ledger (issue 46): entries naming a file outside OUTPUT, database.db and an
+#     input image, each with its real size and XXH3: exit 2 naming the ledger and the
+#     entry, nothing deleted; a file Tessera wrote and the user edited is named as that.
 # usage: outputs_test.sh TESSERA DOWNSCALE SOURCE_DIR FAILING_PLUGIN_DIR
 set -uo pipefail
 tessera=$1
@@ -80,7 +83,7 @@ ln -s "$work/elsewhere" "$work/l/sparse"
 tess "$work/l.log" "$work/bin.json" map --images "$work/d" --output "$work/l"
 code=$?
 [ "$code" = 2 ] || { cat "$work/l.log"; fail "sparse a link: exit $code, expected 2"; }
-grep -q "\[error\] $work/l/sparse is a symbolic link that Tessera did not write" "$work/l.log" ||
+grep -q "\[error\] $work/l/.tessera_outputs.json: the entry 'sparse/0/[a-zA-Z0-9]*\.[a-z]*' lies through $work/l/sparse, a symbolic link" "$work/l.log" ||
   { cat "$work/l.log"; fail "sparse a link: message"; }
 [ "$(ls "$work/elsewhere")" = 0 ] && [ "$(cat "$work/elsewhere/0/images.bin")" = precious ] ||
   fail "the folder behind the link was changed"
@@ -233,4 +236,47 @@ mapping = json.load(open(sys.argv[1] + "/mapping_summary.json"))
 assert run["map"]["num_models"] == len(mapping["models"]), (run["map"], len(mapping["models"]))
 PY
 echo "run_summary.json: removed by map (another mapper; no model, exit 3), rewritten by run"
+# 11. A forged ledger.
+forge() {  # forge OUTPUT ENTRY FILE: ENTRY added to OUTPUT's ledger with FILE's size and XXH3
+  python3 - "$@" <<'PY'
+import ctypes, ctypes.util, json, os, sys
+out, entry, file = sys.argv[1:4]
+path = os.path.join(out, ".tessera_outputs.json")
+ledger = json.load(open(path))
+data = open(file, "rb").read()
+xxhash = ctypes.CDLL(ctypes.util.find_library("xxhash"))
+xxhash.XXH3_64bits.restype = ctypes.c_uint64
+xxhash.XXH3_64bits.argtypes = [ctypes.c_char_p, ctypes.c_size_t]
+ledger["files"].append({"path": entry, "size": len(data),
+                        "xxh3": "%016x" % xxhash.XXH3_64bits(data, len(data))})
+json.dump(ledger, open(path, "w"))
+PY
+}
+echo "precious" > "$work/victim.txt"
+for entry in ../victim.txt "$work/victim.txt" sparse/0/../../../victim.txt database.db ../d/0003.jpg; do
+  fresh "$work/x"
+  case $entry in
+    database.db) file="$work/x/database.db" ;;
+    ../d/*) file="$work/d/0003.jpg" ;;
+    *) file="$work/victim.txt" ;;
+  esac
+  forge "$work/x" "$entry" "$file" || fail "forging the ledger"
+  before=$(sha1sum < "$file")
+  tess "$work/x.log" "$work/bin.json" map --output "$work/x"
+  code=$?
+  [ "$code" = 2 ] || { cat "$work/x.log"; fail "forged entry $entry: exit $code, expected 2"; }
+  grep -qF "[error] $work/x/.tessera_outputs.json: the entry '$entry'" "$work/x.log" ||
+    { cat "$work/x.log"; fail "forged entry $entry: message"; }
+  [ "$(sha1sum < "$file")" = "$before" ] || fail "forged entry $entry: $file was deleted"
+  [ "$(digests "$work/x/sparse")" = "$(digests "$work/base/sparse")" ] ||
+    fail "forged entry $entry: the earlier model changed"
+done
+fresh "$work/e"
+echo '{"edited": true}' > "$work/e/transforms.json"
+tess "$work/e.log" "$work/bin.json" map --output "$work/e"
+code=$?
+[ "$code" = 2 ] && grep -q "transforms.json is a file that Tessera wrote but that has changed since" "$work/e.log" ||
+  { cat "$work/e.log"; fail "an edited output: exit $code or message"; }
+[ "$(cat "$work/e/transforms.json")" = '{"edited": true}' ] || fail "an edited output was replaced"
+echo "forged ledger: each entry refused by name (exit 2), nothing deleted; an edited output named so"
 echo "PASS"

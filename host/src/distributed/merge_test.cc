@@ -227,6 +227,28 @@ TEST_F(MergeTest, AShardRunAgainSkipsWhatItFinished) {
   EXPECT_GT(again.num_pairs, 0u);
 }
 
+// OUTPUT/shards a link to another folder: a shard of other inputs there is not removed
+// through it, nor a shard written there.
+TEST_F(MergeTest, NoShardIsWrittenOrRemovedThroughALink) {
+  const std::filesystem::path elsewhere = dir_.path() / "elsewhere";
+  std::filesystem::create_directories(elsewhere);
+  std::ofstream(elsewhere / "extract-0-of-2.db") << "precious";
+  std::filesystem::create_directories(output());
+  std::filesystem::create_directory_symlink(elsewhere, output() / "shards");
+  try {
+    RunExtractShard(context_, run(), {0, 2});
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what()).find((output() / "shards").string() + ", a symbolic link"),
+              std::string::npos)
+        << error.what();
+  }
+  std::ifstream file(elsewhere / "extract-0-of-2.db");
+  std::string text;
+  std::getline(file, text);
+  EXPECT_EQ(text, "precious");
+}
+
 TEST_F(MergeTest, MissingShardsAreNamedByIndex) {
   RunExtractShard(context_, run(), {1, 4});
   EXPECT_NE(MergeError(output(), kExtractStage).find("extract shards 0, 2, 3 of 4 missing"),

@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "io/names.h"
 #include "tessera/errors.h"
 
 namespace tessera {
@@ -130,7 +131,15 @@ std::unique_ptr<Database> OpenShardDatabase(const std::filesystem::path& output_
                                             const ShardRecord& expected) {
   const std::filesystem::path path = ShardDatabasePath(output_dir, expected.stage, expected.shard);
   const std::string where = "on host " + HostName() + ": cannot write " + path.string() + ": ";
+  // Written and maybe removed: never through a link (Tessera makes none).
+  const std::string relative = "shards/" + path.filename().string();
+  CheckPathBelow(output_dir, relative, "on host " + HostName());
   std::error_code error;
+  if (std::filesystem::symlink_status(path, error).type() == std::filesystem::file_type::symlink) {
+    throw InputError(where +
+                     "it is a symbolic link; Tessera makes none and writes no shard "
+                     "through one: move it away");
+  }
   std::filesystem::create_directories(path.parent_path(), error);
   if (error) throw InputError(where + error.message());
   if (std::filesystem::exists(path)) {

@@ -154,6 +154,10 @@ std::vector<SlurmScript> MakeSlurmScripts(const SlurmOptions& options, const Slu
 void WriteSlurmScripts(const std::vector<SlurmScript>& scripts) {
   for (const SlurmScript& script : scripts) {
     std::error_code error;
+    // OUTPUT/slurm/: nothing is written through a link (Tessera makes none).
+    const std::filesystem::path folder = script.path.parent_path();
+    CheckPathBelow(folder.parent_path(), (folder.filename() / script.path.filename()).string(),
+                   script.path.string());
     std::filesystem::create_directories(script.path.parent_path() / "logs", error);
     if (error) {
       throw InputError((script.path.parent_path() / "logs").string() +

@@ -188,6 +188,24 @@ TEST(Slurm, ScriptsAreWrittenExecutable) {
   EXPECT_TRUE(std::filesystem::is_directory(dir.path() / "out" / "slurm" / "logs"));
 }
 
+// OUTPUT/slurm a link to another folder: no script is written through it.
+TEST(Slurm, NoScriptIsWrittenThroughALink) {
+  testing::TemporaryDir dir;
+  SlurmOptions options = Options();
+  options.output_dir = dir.path() / "out";
+  std::filesystem::create_directories(dir.path() / "elsewhere");
+  std::filesystem::create_directories(options.output_dir);
+  std::filesystem::create_directory_symlink(dir.path() / "elsewhere", options.output_dir / "slurm");
+  try {
+    WriteSlurmScripts(MakeSlurmScripts(options, {{0}, {0}}));
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_TRUE(Has(error.what(), (options.output_dir / "slurm").string() + ", a symbolic link"))
+        << error.what();
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(dir.path() / "elsewhere"));
+}
+
 TEST(Slurm, FindsProgramsInPath) {
   EXPECT_FALSE(FindInPath("sh").empty());
   EXPECT_TRUE(FindInPath("no-such-program-tessera").empty());

@@ -7,6 +7,7 @@
 // only: this header is not part of the SDK (host/include/tessera), and no plugin may
 // include it.
 
+#include <filesystem>
 #include <string>
 #include <string_view>
 
@@ -29,5 +30,26 @@ TESSERA_IO_EXPORT std::string ImageNameProblem(std::string_view name);
 // Throws InputError "<where>: the image name '<name, escaped>' <problem>." when `name`
 // has an ImageNameProblem. `where` names the file and record, e.g. "x/images.bin: image 3".
 TESSERA_IO_EXPORT void CheckImageName(std::string_view name, const std::string& where);
+
+// Paths Tessera reads back from its own files (the outputs ledger, frames.json) and then
+// deletes, replaces or reads: the one check each passes before anything acts on it.
+// Tessera writes such paths relative and lexically normal, so anything else was edited.
+
+// Why `path` cannot be such a path below a folder, as a phrase that follows "the path"
+// ("is an absolute path", "has a '..' component, ..."): empty, absolute, not lexically
+// normal (an empty, '.' or '..' component: "a//b", "a/", "./a"), a backslash (another
+// system's separator), a control character. Empty when the path is fine.
+TESSERA_IO_EXPORT std::string RelativePathProblem(std::string_view path);
+
+// The first of folder/C1, folder/C1/C2, ... (every folder on the way to folder/relative,
+// not folder/relative itself) that is a symbolic link now; empty when none is. Tessera
+// makes no links, and acts on nothing through one.
+TESSERA_IO_EXPORT std::filesystem::path LinkOnTheWay(const std::filesystem::path& folder,
+                                                     const std::filesystem::path& relative);
+
+// Throws InputError "<where>: the path '<path, escaped>' <problem>" when `path` has a
+// RelativePathProblem, or lies through a link (LinkOnTheWay of `folder`).
+TESSERA_IO_EXPORT void CheckPathBelow(const std::filesystem::path& folder, std::string_view path,
+                                      const std::string& where);
 
 }  // namespace tessera

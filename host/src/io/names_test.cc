@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <string>
 
 #include "tessera/errors.h"
+#include "test_support.h"
 
 namespace tessera {
 namespace {
@@ -57,6 +59,54 @@ TEST(ImageNames, EscapesEveryControlCharacter) {
   EXPECT_TRUE(HasControlCharacter("a\nb"));
   EXPECT_TRUE(HasControlCharacter("a\0b"s));
   EXPECT_FALSE(HasControlCharacter("a b$`'\"\\"));
+}
+
+TEST(ReadBackPaths, OnlyRelativeNormalPathsPass) {
+  using namespace std::string_literals;
+  for (const std::string path : {"model.ply", "sparse/0/images.bin", "..a", "a../b", "a b"}) {
+    EXPECT_EQ(RelativePathProblem(path), "") << path;
+  }
+  const std::pair<std::string, std::string> cases[] = {
+      {"", "is empty"},
+      {"/etc/passwd", "is an absolute path"},
+      {"../victim.txt", "has a '..' component"},
+      {"sparse/0/../../../x", "has a '..' component"},
+      {"./a", "not in normal form"},
+      {"a//b", "not in normal form"},
+      {"sparse/", "not in normal form"},
+      {"a/./b", "not in normal form"},
+      {"..\\victim.txt", "has a backslash"},
+      {"a\nb", "control character \\n"},
+      {"a\0b"s, "control character \\0"},
+  };
+  for (const auto& [path, problem] : cases) {
+    EXPECT_NE(RelativePathProblem(path).find(problem), std::string::npos)
+        << EscapeControlCharacters(path) << ": " << RelativePathProblem(path);
+  }
+}
+
+TEST(ReadBackPaths, ALinkOnTheWayIsFoundAndRefused) {
+  const testing::TemporaryDir dir;
+  std::filesystem::create_directories(dir.path() / "elsewhere/0");
+  std::filesystem::create_directories(dir.path() / "out/real/0");
+  std::filesystem::create_directory_symlink(dir.path() / "elsewhere", dir.path() / "out/sparse");
+  const std::filesystem::path out = dir.path() / "out";
+  EXPECT_EQ(LinkOnTheWay(out, "sparse/0/images.bin"), out / "sparse");
+  EXPECT_EQ(LinkOnTheWay(out, "real/0/images.bin"), std::filesystem::path());
+  EXPECT_EQ(LinkOnTheWay(out, "sparse"), std::filesystem::path());  // the entry itself
+  try {
+    CheckPathBelow(out, "sparse/0/images.bin", "L.json");
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what())
+                  .rfind("L.json: the path 'sparse/0/images.bin' lies through " +
+                             (out / "sparse").string() + ", a symbolic link",
+                         0),
+              0u)
+        << error.what();
+  }
+  EXPECT_THROW(CheckPathBelow(out, "../x", "L.json"), InputError);
+  EXPECT_NO_THROW(CheckPathBelow(out, "real/0/images.bin", "L.json"));
 }
 
 }  // namespace

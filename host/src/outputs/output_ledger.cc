@@ -10,8 +10,10 @@
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <sstream>
 
+#include "io/names.h"
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
 
@@ -35,7 +37,28 @@ bool ParseHex(const std::string& text, uint64_t* value) {
   return true;
 }
 
+// Why `path`, an entry of the ledger, is not one Tessera writes; empty when it is.
+std::string EntryProblem(const std::string& path) {
+  if (std::string problem = RelativePathProblem(path); !problem.empty()) return problem;
+  const std::string top = path.substr(0, path.find('/'));
+  if (IsWorkspaceFile(top)) {
+    return (top == path ? "is the workspace's own " + top
+                        : "lies in the workspace's own " + top + "/") +
+           ", which Tessera never records as an output";
+  }
+  return "";
+}
+
 }  // namespace
+
+bool IsWorkspaceFile(const std::string& name) {
+  static const std::set<std::string> kFolders = {"cache", "clusters", "shards", "slurm",
+                                                 "video_frames"};
+  static const std::set<std::string> kFiles = {"clusters.json", "frames.json", "run_summary.json"};
+  return kFolders.count(name) != 0 || kFiles.count(name) != 0 ||
+         name.rfind("database.db", 0) == 0 || name.rfind(".tessera", 0) == 0 ||
+         name.rfind("plugin_crashes", 0) == 0;
+}
 
 FileDigest DigestFile(const fs::path& path) {
   const int fd = open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
@@ -43,7 +66,7 @@ FileDigest DigestFile(const fs::path& path) {
     throw InputError(path.string() + ": cannot read it to check it: " + std::strerror(errno));
   }
   std::unique_ptr<XXH3_state_t, decltype(&XXH3_freeState)> state(XXH3_createState(),
-                                                                  &XXH3_freeState);
+                                                                 &XXH3_freeState);
   XXH3_64bits_reset(state.get());
   FileDigest digest;
   std::vector<char> buffer(1 << 20);
@@ -76,6 +99,15 @@ OutputLedger OutputLedger::Read(const fs::path& output_folder) {
                      "those outputs");
   };
   if (status.type() != fs::file_type::regular) fail("is not a regular file");
+  // An entry Tessera never writes: the ledger was edited, and nothing it names is acted on.
+  const auto check_entry = [&](const std::string& path) {
+    if (const std::string problem = EntryProblem(path); !problem.empty()) {
+      throw InputError(file.string() + ": the entry '" + EscapeControlCharacters(path) + "' " +
+                       problem + "; Tessera writes no such entry, so nothing was removed: " +
+                       "delete the entry (or the whole ledger: then nothing here counts as "
+                       "Tessera's)");
+    }
+  };
   std::ifstream stream(file);
   nlohmann::json json;
   try {
@@ -88,9 +120,11 @@ OutputLedger OutputLedger::Read(const fs::path& output_folder) {
       if (!ParseHex(entry.at("xxh3").get<std::string>(), &digest.xxh3) || path.empty()) {
         fail("has a malformed file entry");
       }
+      check_entry(path);
       ledger.AddFile(path, digest);
     }
     for (const nlohmann::json& folder : json.at("folders")) {
+      check_entry(folder.get<std::string>());
       ledger.AddFolder(folder.get<std::string>());
     }
   } catch (const nlohmann::json::exception& exception) {
@@ -135,8 +169,7 @@ bool OutputLedger::Owns(const fs::path& output_folder, const fs::path& relative)
     if (!size_matches) return false;
     try {
       const FileDigest digest = DigestFile(path);
-      return std::find(found->second.begin(), found->second.end(), digest) !=
-             found->second.end();
+      return std::find(found->second.begin(), found->second.end(), digest) != found->second.end();
     } catch (const InputError&) {
       return false;
     }

@@ -24,6 +24,12 @@ struct FileDigest {
   }
 };
 
+// Whether `name`, a top-level entry of a workspace, is one of the workspace's own files
+// (database.db and its journals, the lock, the ledger, the staging folder, caches,
+// shards, clusters, Slurm scripts, video frames, frames.json, clusters.json, crash
+// records, run_summary.json), which no exporter may write and no ledger may name.
+bool IsWorkspaceFile(const std::string& name);
+
 // The digest of the regular file `path` (not followed when a link). Throws InputError
 // naming the file when it cannot be read.
 FileDigest DigestFile(const std::filesystem::path& path);
@@ -33,7 +39,11 @@ class OutputLedger {
   static constexpr const char* kFileName = ".tessera_outputs.json";
 
   // The ledger of `output_folder`; empty when it has none. Throws InputError naming the
-  // file when it is unreadable or not a ledger.
+  // file when it is unreadable or not a ledger, and naming the file and the entry when an
+  // entry is not one Tessera writes: a path that is not relative and lexically normal
+  // (RelativePathProblem: absolute, '..', ...), or one in or of a workspace file
+  // (IsWorkspaceFile: database.db, cache/, the ledger itself, ...). Nothing a ledger
+  // names is acted on before the whole of it has passed.
   static OutputLedger Read(const std::filesystem::path& output_folder);
   // Writes it atomically (a new file renamed over the old; no link followed).
   void Write(const std::filesystem::path& output_folder) const;

@@ -12,6 +12,7 @@
 #include <iterator>
 #include <set>
 
+#include "io/names.h"
 #include "tessera/errors.h"
 
 namespace tessera {
@@ -45,6 +46,11 @@ void ListTree(const fs::path& root, const std::string& writer, std::vector<std::
        !error && it != fs::recursive_directory_iterator(); it.increment(error)) {
     const std::string relative = fs::relative(it->path(), root).generic_string();
     const fs::file_type type = it->symlink_status().type();
+    // Recorded in the ledger, which refuses what Tessera never writes when read back.
+    if (const std::string problem = RelativePathProblem(relative); !problem.empty()) {
+      throw InputError("exporter '" + writer + "' wrote '" + EscapeControlCharacters(relative) +
+                       "': the path " + problem + "; give it another file or folder");
+    }
     if (type == fs::file_type::directory) {
       folders->push_back(relative);
     } else if (type == fs::file_type::regular) {
@@ -103,17 +109,9 @@ void RemoveLeftoverTemporaries(const fs::path& folder) {
 
 }  // namespace
 
-bool IsWorkspaceFile(const std::string& name) {
-  static const std::set<std::string> kFolders = {"cache", "clusters", "shards", "slurm",
-                                                 "video_frames"};
-  static const std::set<std::string> kFiles = {"clusters.json", "frames.json", "run_summary.json"};
-  return kFolders.count(name) != 0 || kFiles.count(name) != 0 ||
-         name.rfind("database.db", 0) == 0 || name.rfind(".tessera", 0) == 0 ||
-         name.rfind("plugin_crashes", 0) == 0;
-}
-
 OutputTransaction::OutputTransaction(fs::path output_folder, Mode mode)
     : output_(std::move(output_folder)), mode_(mode), ledger_(OutputLedger::Read(output_)) {
+  CheckNoLinkOnTheWay();
   const fs::path root = output_ / kStagingFolderName;
   const fs::file_type type = TypeOf(root);
   if (type != fs::file_type::not_found && type != fs::file_type::directory) {
@@ -153,6 +151,20 @@ fs::path OutputTransaction::StageFor(const std::string& writer, size_t slot) {
   if (error) throw InputError(folder.string() + ": cannot create it: " + error.message());
   writers_.push_back({writer, slot, folder});
   return folder;
+}
+
+void OutputTransaction::CheckNoLinkOnTheWay() const {
+  const auto check = [&](const std::string& relative) {
+    const fs::path link = LinkOnTheWay(output_, relative);
+    if (link.empty()) return;
+    throw InputError((output_ / OutputLedger::kFileName).string() + ": the entry '" + relative +
+                     "' lies through " + link.string() +
+                     ", a symbolic link; Tessera makes none and removes or replaces nothing "
+                     "through one, so nothing was: replace the link with a folder, or move it "
+                     "away");
+  };
+  for (const auto& [relative, digests] : ledger_.files()) check(relative);
+  for (const std::string& relative : ledger_.folders()) check(relative);
 }
 
 void OutputTransaction::Protect(const fs::path& folder) {
@@ -264,12 +276,27 @@ void OutputTransaction::Plan(const fs::path& set, const fs::path& relative,
                TypeOf(set / child) == fs::file_type::directory) {
       Plan(set, child, placements, refusals);  // a folder shared with others: place inside
     } else {
-      refusals->push_back(target.string() + " is " + Describe(type) +
-                          " that Tessera did not write (not in " + OutputLedger::kFileName +
-                          "), and exporter '" + WriterOf(key) +
+      refusals->push_back(target.string() + " is " + Describe(type) + NotTesserasBecause(key) +
+                          ", and exporter '" + WriterOf(key) +
                           "' would replace it; move it away or choose another output folder");
     }
   }
+}
+
+std::string OutputTransaction::NotTesserasBecause(const std::string& relative) const {
+  const std::string ledger = OutputLedger::kFileName;
+  const fs::file_type type = TypeOf(output_ / relative);
+  if (type == fs::file_type::regular && ledger_.HasFile(relative)) {
+    return " that Tessera wrote but that has changed since (its size or XXH3 is not the one "
+           "in " +
+           ledger + ")";
+  }
+  if (type == fs::file_type::directory && ledger_.HasFolder(relative)) {
+    return " that Tessera made, but that now holds entries it did not write or that "
+           "changed since (see " +
+           ledger + ")";
+  }
+  return " that Tessera did not write (not in " + ledger + ")";
 }
 
 void OutputTransaction::Place(const fs::path& set, const Placement& placement) const {
@@ -290,6 +317,14 @@ OutputTransaction::Result OutputTransaction::Commit() {
   if (error) throw InputError(set.string() + ": cannot create it: " + error.message());
   try {
     MergeWriters(set);
+  } catch (...) {
+    keep_ = true;
+    throw;
+  }
+  // The ledger's entries again, as they lie now: nothing is removed or replaced through a
+  // link made while the run went on.
+  try {
+    CheckNoLinkOnTheWay();
   } catch (...) {
     keep_ = true;
     throw;
@@ -334,14 +369,17 @@ OutputTransaction::Result OutputTransaction::Commit() {
     result.files_removed = RemoveStale(previous, placed, &result.warnings);
   } else {  // the earlier files that remain as they were stay Tessera's
     for (const auto& [relative, digests] : previous.files()) {
-      if (!placed.HasFile(relative) && previous.Owns(output_, relative)) {
+      if (!placed.HasFile(relative) && ProtectedAt(relative).empty() &&
+          previous.Owns(output_, relative)) {
         for (const FileDigest& digest : digests) final_ledger.AddFile(relative, digest);
       }
     }
   }
   // The ledger now holds the set, and the earlier folders that remain.
   for (const std::string& folder : previous.folders()) {
-    if (TypeOf(output_ / folder) == fs::file_type::directory) final_ledger.AddFolder(folder);
+    if (TypeOf(output_ / folder) == fs::file_type::directory && ProtectedAt(folder).empty()) {
+      final_ledger.AddFolder(folder);
+    }
   }
   final_ledger.Write(output_);
   ledger_ = final_ledger;
@@ -355,12 +393,19 @@ size_t OutputTransaction::RemoveStale(const OutputLedger& previous, const Output
                                       std::vector<std::string>* warnings) const {
   size_t removed = 0;
   std::error_code error;
+  const auto left_as_input = [&](const std::string& relative, const std::string& input) {
+    warnings->push_back((output_ / relative).string() +
+                        " is left as it is: " + OutputLedger::kFileName +
+                        " records it as Tessera's, but it is, holds or lies in the input folder " +
+                        input + ", and Tessera never removes its inputs");
+  };
   for (const auto& [relative, digests] : previous.files()) {
-    if (placed.HasFile(relative) || TypeOf(output_ / relative) == fs::file_type::not_found ||
-        !ProtectedAt(relative).empty()) {
+    if (placed.HasFile(relative) || TypeOf(output_ / relative) == fs::file_type::not_found) {
       continue;
     }
-    if (previous.Owns(output_, relative)) {
+    if (const std::string input = ProtectedAt(relative); !input.empty()) {
+      left_as_input(relative, input);
+    } else if (previous.Owns(output_, relative)) {
       if (fs::remove(output_ / relative, error)) ++removed;
     } else {
       warnings->push_back((output_ / relative).string() +
@@ -372,7 +417,11 @@ size_t OutputTransaction::RemoveStale(const OutputLedger& previous, const Output
   const std::set<std::string>& folders = previous.folders();
   for (auto it = folders.rbegin(); it != folders.rend(); ++it) {
     if (placed.HasFolder(*it) || TypeOf(output_ / *it) != fs::file_type::directory) continue;
-    if (fs::is_empty(output_ / *it, error)) fs::remove(output_ / *it, error);
+    if (const std::string input = ProtectedAt(*it); !input.empty()) {
+      if (fs::is_empty(output_ / *it, error)) left_as_input(*it, input);
+    } else if (fs::is_empty(output_ / *it, error)) {
+      fs::remove(output_ / *it, error);
+    }
   }
   return removed;
 }

@@ -105,6 +105,12 @@ class OutputTransaction {
                      std::vector<std::string>* warnings) const;
   std::vector<std::string> ShadowWarnings(const OutputLedger& placed) const;
   std::string WriterOf(const std::string& relative) const;
+  // Throws InputError naming the ledger and the entry when an entry of the ledger lies
+  // through a symbolic link (LinkOnTheWay): checked before anything is removed.
+  void CheckNoLinkOnTheWay() const;
+  // Why OUTPUT/relative, which the set would replace, is not Tessera's: a phrase after
+  // "is a file" (not in the ledger; in it, but changed since; ...).
+  std::string NotTesserasBecause(const std::string& relative) const;
   // The protected folder that OUTPUT/relative is, holds or lies in; empty when none.
   std::string ProtectedAt(const std::string& relative) const;
 
@@ -117,16 +123,11 @@ class OutputTransaction {
     std::filesystem::path folder;
   };
   std::vector<Writer> writers_;
-  std::map<std::string, std::string> writer_of_file_;                   // relative: writer
+  std::map<std::string, std::string> writer_of_file_;  // relative: writer
   OutputLedger ledger_;
   std::vector<std::filesystem::path> protected_;  // absolute, lexically normal
   bool committed_ = false;
   bool keep_ = false;
 };
-
-// Whether `name`, a top-level entry of a workspace, is one of the workspace's own files
-// (database.db, the lock, the ledger, caches, shards, Slurm scripts, video frames, crash
-// records, run_summary.json), which no exporter may write.
-bool IsWorkspaceFile(const std::string& name);
 
 }  // namespace tessera

@@ -261,8 +261,11 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
   summary->num_models = result.models.size();
   CreateFolder(output_dir);
   OutputTransaction outputs(output_dir);
+  // The inputs: whatever the ledger says, never replaced or removed.
   outputs.Protect(image_dir);
+  outputs.Protect(ImageFolder({}, workspace.database()));  // the one extract read
   outputs.Protect(settings.mask_dir);
+  for (const std::filesystem::path& video : settings.videos) outputs.Protect(video);
   if (result.models.empty()) control.Report("export", 0, 0);
   for (size_t index = 0; index < result.models.size(); ++index) {
     if (control.Cancelled()) return false;

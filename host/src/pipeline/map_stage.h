@@ -33,6 +33,9 @@ struct MapSettings {
   std::filesystem::path image_dir;
   // The mask folder, if any: like the image folder, never written or deleted in.
   std::filesystem::path mask_dir;
+  // The videos the image folder's frames came from (run --video): never written or
+  // deleted either.
+  std::vector<std::filesystem::path> videos;
   // A camera rig over the workspace's images (`--rig`), or null; must outlive the stage.
   const RigFile* rig = nullptr;
 };

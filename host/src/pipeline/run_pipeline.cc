@@ -106,7 +106,9 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
     run.status = StageStatus::kCancelled;
     return run;
   }
-  summary.map = MapWorkspace(*workspace, context.MakeMapSettings(image_dir), {}, control);
+  MapSettings map_settings = context.MakeMapSettings(image_dir);
+  map_settings.videos = options.videos;
+  summary.map = MapWorkspace(*workspace, map_settings, {}, control);
   if (summary.map.status == StageStatus::kCancelled) {
     run.status = StageStatus::kCancelled;
     return run;

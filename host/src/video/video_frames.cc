@@ -118,6 +118,34 @@ nlohmann::json Record(const VideoFrames& result, const VideoFrameOptions& option
           {"frames", frames}};
 }
 
+// Throws InputError naming frames.json when `image`, a kept frame it records, is not one
+// Tessera writes: a relative, normal path (CheckPathBelow: nothing through a link) right
+// in its video's folder. The frame is read as an image of the run.
+void CheckRecordedFrame(const std::string& image, const std::string& folder,
+                        const fs::path& frames_dir) {
+  const std::string where = (frames_dir.parent_path() / "frames.json").string();
+  CheckPathBelow(frames_dir, image, where);
+  const std::string prefix = folder + "/";
+  if (image.compare(0, prefix.size(), prefix) != 0 ||
+      image.find('/', prefix.size()) != std::string::npos) {
+    throw InputError(where + ": the frame '" + image + "' does not lie in " +
+                     (frames_dir / folder).string() +
+                     ", where Tessera writes its video's frames; delete frames.json to decode "
+                     "the videos again");
+  }
+}
+
+// Throws InputError when `folder`, one Tessera writes frames in and removes old ones
+// from, is a symbolic link: nothing is written or removed through one.
+void RefuseLink(const fs::path& folder) {
+  std::error_code error;
+  if (fs::symlink_status(folder, error).type() == fs::file_type::symlink) {
+    throw InputError(folder.string() +
+                     " is a symbolic link; Tessera writes video frames there and removes old "
+                     "ones, never through a link: move it away");
+  }
+}
+
 // The earlier run's selection of this video, when nothing it depends on changed: the
 // same file with the same content (its hash: a file replaced by another of the same size
 // and modification time is decoded again) and options.
@@ -149,7 +177,7 @@ std::optional<VideoFrames> Reuse(const nlohmann::json& recorded, const VideoFram
         if (frame.at("selected").get<bool>()) {
           result.selection.selected.push_back(result.frames.size() - 1);
           result.images.push_back(frame.at("image").get<std::string>());
-          CheckImageName(result.images.back(), (frames_dir.parent_path() / "frames.json").string());
+          CheckRecordedFrame(result.images.back(), probe.folder, frames_dir);
           std::error_code error;
           if (!fs::is_regular_file(frames_dir / result.images.back(), error)) return std::nullopt;
         }
@@ -249,6 +277,7 @@ VideoFrames ExtractVideoFrames(const fs::path& video, const std::string& folder,
 
   // Second pass: write the selected frames.
   const fs::path dir = frames_dir / folder;
+  RefuseLink(dir);
   CreateFolder(dir);
   std::set<std::string> names;
   for (const size_t i : result.selection.selected) {
@@ -325,6 +354,8 @@ fs::path IngestVideos(const std::vector<fs::path>& videos, const fs::path& outpu
     }
   }
   const std::vector<std::string> folders = VideoFolders(videos);  // before anything is written
+  RefuseLink(frames_dir);
+  for (const std::string& folder : folders) RefuseLink(frames_dir / folder);
   CreateFolder(frames_dir);
   nlohmann::json record = {{"videos", nlohmann::json::array()}};
   for (size_t index = 0; index < videos.size(); ++index) {

@@ -254,9 +254,50 @@ TEST(VideoFrames, AnUnsafeImageNameInFramesJsonIsAnInputError) {
   } catch (const InputError& error) {
     EXPECT_EQ(std::string(error.what()),
               record_file.string() +
-                  ": the image name '../../outside.jpg' has a '..' component, which leads out "
-                  "of the image folder.");
+                  ": the path '../../outside.jpg' has a '..' component, which leads out of its "
+                  "folder");
   }
+  // A frame of another folder (another video's) is not one Tessera wrote for this one.
+  record["videos"][0]["frames"][0]["image"] = "other/frame_000000_0.000s.jpg";
+  WriteFileAtomically(record_file, record.dump(2));
+  try {
+    IngestVideos({dir.path() / "short.mp4"}, dir.path(), {});
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("the frame 'other/frame_000000_0.000s.jpg' does not "
+                        "lie in " +
+                        (dir.path() / "video_frames/short").string()),
+              std::string::npos)
+        << error.what();
+  }
+}
+
+// OUTPUT/video_frames, or a video's folder in it, a link to another folder: no frame is
+// written or removed through it.
+TEST(VideoFrames, NothingIsWrittenOrRemovedThroughALink) {
+  const testing::TemporaryDir dir;
+  WritePanVideo(dir.path() / "short.mp4", 4);
+  fs::create_directories(dir.path() / "elsewhere");
+  std::ofstream(dir.path() / "elsewhere/holiday.jpg") << "precious";
+  fs::create_directories(dir.path() / "out/video_frames");
+  fs::create_directory_symlink(dir.path() / "elsewhere", dir.path() / "out/video_frames/short");
+  try {
+    IngestVideos({dir.path() / "short.mp4"}, dir.path() / "out", {});
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find((dir.path() / "out/video_frames/short").string() + " is a symbolic link"),
+              std::string::npos)
+        << error.what();
+  }
+  fs::remove(dir.path() / "out/video_frames/short");
+  fs::remove(dir.path() / "out/video_frames");
+  fs::create_directory_symlink(dir.path() / "elsewhere", dir.path() / "out/video_frames");
+  EXPECT_THROW(IngestVideos({dir.path() / "short.mp4"}, dir.path() / "out", {}), InputError);
+  EXPECT_EQ(ReadFileContents(dir.path() / "elsewhere/holiday.jpg"), "precious");
+  EXPECT_EQ(
+      std::distance(fs::directory_iterator(dir.path() / "elsewhere"), fs::directory_iterator()), 1);
 }
 
 TEST(VideoFrames, OptionsComeFromTheManifestsVideoObject) {
