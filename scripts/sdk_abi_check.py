@@ -6,7 +6,9 @@ of every file under host/include/tessera (io/ included). This script recomputes 
   - same version, same hashes: exit 0;
   - same version, other hashes: exit 1 naming the files changed, added or removed
     ("bump it and run scripts/sdk_abi_check.py --update");
-  - another version: exit 1 until --update records it.
+  - another version: exit 1 until --update records it;
+  - docs/plugin_authors_guide.md not stating the version, its SONAME and a changelog
+    entry for it: exit 1 naming what it lacks.
 --update rewrites the record, and refuses (exit 1) when the headers changed but the
 version did not, or when the version went down.
 
@@ -160,6 +162,20 @@ def differences(recorded, current):
     return "; ".join(parts)
 
 
+def guide_problem(guide, version):
+    """What the plugin author's guide says of the ABI that plugin.h contradicts, or None:
+    its current number, the SONAME it names, and a changelog entry for the version."""
+    try:
+        text = guide.read_text(encoding="utf-8")
+    except OSError as error:
+        return f"cannot read {guide}: {error.strerror}"
+    for expected in (f"It is now {version}", f"libtessera_io.so.{version}`", f"  - {version}: "):
+        if expected not in text:
+            return (f"{guide.name} does not say '{expected.strip()}' (plugin.h's "
+                    f"TESSERA_PLUGIN_ABI_VERSION is {version}): update its ABI paragraph")
+    return None
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--update", action="store_true", help="rewrite the record")
@@ -200,7 +216,14 @@ def main():
                   f"to {version} in {display_dir}/plugin.h; it only goes up")
             return 1
         if version == recorded_version:
-            print(f"sdk_abi_check: ABI {version}, {len(hashes)} headers as recorded")
+            guide = repository / "docs" / "plugin_authors_guide.md"
+            problem = guide_problem(guide, version) if include_dir.resolve() == (
+                repository / "host" / "include" / "tessera").resolve() else None
+            if problem:
+                print(f"sdk_abi_check: docs/{problem}")
+                return 1
+            print(f"sdk_abi_check: ABI {version}, {len(hashes)} headers as recorded; "
+                  "the plugin author's guide states it")
             return 0
         if not args.update:
             print(f"sdk_abi_check: TESSERA_PLUGIN_ABI_VERSION is {version} but {display_record} "
