@@ -104,8 +104,10 @@ void BM_CancelDuringMatching(benchmark::State& state) {
            status.stages.back().done >= 1;
   };
   for (auto _ : state) {
-    controller.Start({dir.path() / "images", dir.path() / ("out" + std::to_string(runs++)),
-                      dir.path() / "manifest.json", {}});
+    controller.Start({dir.path() / "images",
+                      dir.path() / ("out" + std::to_string(runs++)),
+                      dir.path() / "manifest.json",
+                      {}});
     while (controller.Running() && !matching()) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }

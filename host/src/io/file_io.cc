@@ -5,7 +5,6 @@
 
 #include <cerrno>
 #include <cstring>
-
 #include <fstream>
 #include <iterator>
 #include <system_error>
@@ -31,7 +30,8 @@ void WriteFileAtomically(const fs::path& path, const std::string& contents) {
   const fs::path temporary = path.parent_path() / ("." + path.filename().string() + ".tmp-" +
                                                    std::to_string(static_cast<long>(getpid())));
   unlink(temporary.c_str());
-  const int fd = open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  const int fd =
+      open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
   if (fd < 0) {
     throw InputError("Cannot create " + temporary.string() + " to write " + path.string() + ": " +
                      std::strerror(errno) + ".");
@@ -50,8 +50,8 @@ void WriteFileAtomically(const fs::path& path, const std::string& contents) {
   if (close(fd) != 0 && error_number == 0) error_number = errno;
   if (error_number != 0) {
     unlink(temporary.c_str());
-    throw InputError("Cannot write " + path.string() + " (is the disk full?): " +
-                     std::strerror(error_number) + ".");
+    throw InputError("Cannot write " + path.string() +
+                     " (is the disk full?): " + std::strerror(error_number) + ".");
   }
   if (rename(temporary.c_str(), path.c_str()) != 0) {
     const int rename_error = errno;

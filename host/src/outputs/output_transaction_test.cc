@@ -7,8 +7,8 @@
 #include <map>
 #include <sstream>
 
-#include "test_support.h"
 #include "tessera/errors.h"
+#include "test_support.h"
 
 namespace tessera {
 namespace {
@@ -63,12 +63,11 @@ TEST(OutputTransaction, PlacesTheSetAndRecordsIt) {
 // is left to be read in place of the second.
 TEST(OutputTransaction, ARerunRemovesWhatItsSetNoLongerHolds) {
   const testing::TemporaryDir dir;
-  CommitSet(dir.path(), {{"colmap_binary",
-                          {{"sparse/0/images.bin", "0"}, {"sparse/1/images.bin", "1"}}},
-                         {"ply", {{"model.ply", "p"}}},
-                         {"transforms_json", {{"transforms_1.json", "t"}}}});
-  const auto result =
-      CommitSet(dir.path(), {{"colmap_text", {{"sparse/0/images.txt", "text"}}}});
+  CommitSet(dir.path(),
+            {{"colmap_binary", {{"sparse/0/images.bin", "0"}, {"sparse/1/images.bin", "1"}}},
+             {"ply", {{"model.ply", "p"}}},
+             {"transforms_json", {{"transforms_1.json", "t"}}}});
+  const auto result = CommitSet(dir.path(), {{"colmap_text", {{"sparse/0/images.txt", "text"}}}});
   EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.txt"), "text");
   EXPECT_FALSE(fs::exists(dir.path() / "sparse/0/images.bin"));
   EXPECT_FALSE(fs::exists(dir.path() / "sparse/1"));
@@ -166,8 +165,7 @@ TEST(OutputTransaction, NothingIsWrittenOrDeletedThroughALink) {
   const fs::path output = dir.path() / "out";
   fs::create_directories(output);
   fs::create_directory_symlink(elsewhere, output / "sparse");
-  EXPECT_THROW(CommitSet(output, {{"colmap_binary", {{"sparse/0/images.bin", "a"}}}}),
-               InputError);
+  EXPECT_THROW(CommitSet(output, {{"colmap_binary", {{"sparse/0/images.bin", "a"}}}}), InputError);
   EXPECT_EQ(ReadText(elsewhere / "0/images.bin"), "precious");
   // A link where Tessera's file was: not Tessera's any more, not followed.
   const fs::path output2 = dir.path() / "out2";
@@ -224,10 +222,11 @@ TEST(OutputTransaction, LeftoversOfAKilledRunAreRemovedAndItsOutputsStayTesseras
 
 TEST(OutputTransaction, AddingToTheSetKeepsTheOtherModels) {
   const testing::TemporaryDir dir;
-  CommitSet(dir.path(), {{"colmap_binary",
-                          {{"sparse/0/images.bin", "0"}, {"sparse/1/images.bin", "1"}}},
-                         {"gaussian_splatting", {{"gaussian_splatting/images/a.jpg", "a"},
-                                                 {"gaussian_splatting/images/b.jpg", "b"}}}});
+  CommitSet(
+      dir.path(),
+      {{"colmap_binary", {{"sparse/0/images.bin", "0"}, {"sparse/1/images.bin", "1"}}},
+       {"gaussian_splatting",
+        {{"gaussian_splatting/images/a.jpg", "a"}, {"gaussian_splatting/images/b.jpg", "b"}}}});
   CommitSet(dir.path(),
             {{"colmap_text", {{"sparse/1/images.txt", "1"}}},
              {"gaussian_splatting", {{"gaussian_splatting/images/a.jpg", "a2"}}}},

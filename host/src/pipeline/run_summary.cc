@@ -78,8 +78,7 @@ RunSummary RunSummary::FromJson(const nlohmann::json& json) {
   summary.map.images_per_model =
       map.value("images_per_model", nlohmann::json::array()).get<std::vector<size_t>>();
   summary.total_seconds = json.at("total_seconds").get<double>();
-  summary.plugins =
-      json.value("plugins", nlohmann::json::array()).get<std::vector<PluginUsed>>();
+  summary.plugins = json.value("plugins", nlohmann::json::array()).get<std::vector<PluginUsed>>();
   return summary;
 }
 

@@ -272,10 +272,8 @@ TEST(GlobalMapper, StopsWithinASecondOfBeingAsked) {
   // bundle adjustments: the run returns at once, with nothing.
   for (const int stop_at : {1, 4, num_polls / 2, num_polls - 2}) {
     int polls = 0;
-    const GlobalMapperResult result =
-        GlobalMapper::Reconstruct(scene.input, testing::CeresAdjusterOnOneThread(), {}, [&] {
-          return ++polls >= stop_at;
-        });
+    const GlobalMapperResult result = GlobalMapper::Reconstruct(
+        scene.input, testing::CeresAdjusterOnOneThread(), {}, [&] { return ++polls >= stop_at; });
     EXPECT_TRUE(result.cancelled) << stop_at;
     EXPECT_TRUE(result.models.empty());
     EXPECT_TRUE(result.unregistered_reasons.empty());

@@ -145,7 +145,7 @@ ViewGraph ModelViewGraph(const MapperInput& input, const Reconstruction& model, 
 }
 
 ModelSelfCheck SelfCheckModel(const ViewGraph& view_graph, const Reconstruction& model,
-                          const ModelFinishingOptions& options) {
+                              const ModelFinishingOptions& options) {
   const ModelAgreement agreement =
       ComputeModelAgreement(view_graph, model, options.max_rotation_error_deg);
   ModelSelfCheck check;
@@ -170,7 +170,7 @@ void FinishModels(const MapperInput& input, const BundleAdjuster& bundle_adjuste
         view_graph != nullptr
             ? SelfCheckModel(*view_graph, model, options)
             : SelfCheckModel(ModelViewGraph(input, model, options.min_num_matches, seed), model,
-                         options);
+                             options);
     LogSelfCheck(options, index, model, check);
     result->self_checks.push_back(check);
   }

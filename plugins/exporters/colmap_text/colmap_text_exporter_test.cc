@@ -1,8 +1,8 @@
 #include <gtest/gtest.h>
 
-#include "tessera/testing/synthetic_model.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
+#include "tessera/testing/synthetic_model.h"
 #include "test_support.h"
 
 namespace tessera {

@@ -71,8 +71,8 @@ TESSERA_SFM_EXPORT ViewGraph ModelViewGraph(const MapperInput& input, const Reco
 
 // The self-check of `model` against `view_graph` (the edges between its images).
 TESSERA_SFM_EXPORT ModelSelfCheck SelfCheckModel(const ViewGraph& view_graph,
-                                             const Reconstruction& model,
-                                             const ModelFinishingOptions& options);
+                                                 const Reconstruction& model,
+                                                 const ModelFinishingOptions& options);
 
 // Finishes `result`: sorts its models largest first, sets one self-check per model
 // (against `view_graph`, the mapper's own, when given; else each against
