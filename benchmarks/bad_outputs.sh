@@ -207,6 +207,44 @@ if colmap help > /dev/null 2>&1; then
   check "mean reprojection error = colmap model_analyzer's" 0 'python3 -c "import json,sys; assert abs(json.load(open(sys.argv[1]))[\"models\"][0][\"mean_reprojection_error\"] - float(sys.argv[2])) < 1e-6" "$work/base/mapping_summary.json" "$(sed -n "s/.*Mean reprojection error: \([0-9.]*\)px.*/\1/p" "$work/case.log")"' "" -- \
     colmap model_analyzer --path "$work/base/sparse/0"
 fi
+# A rig no rig can be (a camera 1e300 m from the reference): refused naming the file and
+# the camera, never mapped and reported "given".
+mkdir -p "$work/rigimg/left" "$work/rigimg/right"
+cp "$work/d/0003.jpg" "$work/d/0004.jpg" "$work/rigimg/left/"
+cp "$work/d/0005.jpg" "$work/d/0006.jpg" "$work/rigimg/right/"
+cat > "$work/far_rig.json" << 'JSON'
+{"cameras": [{"folder": "left", "reference": true},
+             {"folder": "right", "cam_from_rig": {"rotation_wxyz": [1, 0, 0, 0],
+                                                  "translation": [1e300, 0, 0]}}]}
+JSON
+check "rig camera 1e300 m from the reference" 2 'grep -q "far_rig.json: .*camera .right." "$work/case.log"' "" -- \
+  t run --images "$work/rigimg" --output "$work/rig" --manifest "$work/bin.json" --rig "$work/far_rig.json"
+# run_summary.json follows the model set: a map that builds no model (exit 3) leaves none
+# that names the models of the run before it.
+python3 - "$work/bin.json" "$work/nomodel.json" << 'PY'
+import json, sys
+m = json.load(open(sys.argv[1]))
+m["pipeline"]["mapper"] = {"plugin": "incremental", "options": {"init_min_num_inliers": 1000000}}
+json.dump(m, open(sys.argv[2], "w"))
+PY
+fresh "$work/stale"
+check "run_summary.json after a map with no model" 3 '[ ! -e "$work/stale/run_summary.json" ] && [ ! -e "$work/stale/sparse" ]' "" -- \
+  t map --images "$work/d" --output "$work/stale" --manifest "$work/nomodel.json"
+# Python's views of a model are read-only: writing one raises, and the model is unchanged.
+pythonpath=$(ls -d "$(dirname "$(dirname "$tessera")")"/lib/python3*/dist-packages 2> /dev/null | head -1)
+if [ -n "$pythonpath" ]; then
+  check "Python: a model's arrays are read-only" 0 "" "" -- env PYTHONPATH="$pythonpath" python3 -c "
+import tessera, sys
+rec = tessera.Reconstruction('$work/base/sparse/0')
+point = next(iter(rec.points3D.values()))
+assert not point.xyz.flags.writeable
+try:
+    point.xyz[0] = float('nan')
+    sys.exit('a write went through')
+except ValueError:
+    pass
+"
+fi
 check "--threads 65537" 2 "" "" -- \
   "$tessera" run --images "$work/d" --output "$work/thr" --manifest "$work/bin.json" --threads 65537
 

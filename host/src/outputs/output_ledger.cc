@@ -54,10 +54,14 @@ std::string EntryProblem(const std::string& path) {
 bool IsWorkspaceFile(const std::string& name) {
   static const std::set<std::string> kFolders = {"cache", "clusters", "shards", "slurm",
                                                  "video_frames"};
-  static const std::set<std::string> kFiles = {"clusters.json", "frames.json", "run_summary.json"};
+  static const std::set<std::string> kFiles = {"clusters.json", "frames.json"};
   return kFolders.count(name) != 0 || kFiles.count(name) != 0 ||
          name.rfind("database.db", 0) == 0 || name.rfind(".tessera", 0) == 0 ||
          name.rfind("plugin_crashes", 0) == 0;
+}
+
+bool IsHostSummaryFile(const std::string& name) {
+  return name == "run_summary.json" || name == "mapping_summary.json";
 }
 
 FileDigest DigestFile(const fs::path& path) {

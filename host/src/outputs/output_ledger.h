@@ -27,8 +27,12 @@ struct FileDigest {
 // Whether `name`, a top-level entry of a workspace, is one of the workspace's own files
 // (database.db and its journals, the lock, the ledger, the staging folder, caches,
 // shards, clusters, Slurm scripts, video frames, frames.json, clusters.json, crash
-// records, run_summary.json), which no exporter may write and no ledger may name.
+// records), which no exporter may write and no ledger may name.
 bool IsWorkspaceFile(const std::string& name);
+// Whether `name`, a top-level entry of an output folder, is a summary the host writes of
+// its own outputs (run_summary.json, mapping_summary.json): an output in the ledger like
+// the others, placed and removed with every set, which only the writer "tessera" writes.
+bool IsHostSummaryFile(const std::string& name);
 
 // The digest of the regular file `path` (not followed when a link). Throws InputError
 // naming the file when it cannot be read.

@@ -264,6 +264,9 @@ void OutputTransaction::Plan(const fs::path& set, const fs::path& relative,
     if (relative.empty() && IsWorkspaceFile(key)) {
       refusals->push_back("exporter '" + WriterOf(key) + "' writes " + target.string() +
                           ", a file of the workspace itself; give it another file or folder");
+    } else if (relative.empty() && IsHostSummaryFile(key) && WriterOf(key) != "tessera") {
+      refusals->push_back("exporter '" + WriterOf(key) + "' writes " + target.string() +
+                          ", the summary Tessera writes there; give it another file or folder");
     } else if (const std::string held = ProtectedAt(key); !held.empty()) {
       refusals->push_back("exporter '" + WriterOf(key) + "' writes " + target.string() +
                           ", which is, holds or lies in the input folder " + held +

@@ -137,10 +137,25 @@ TEST(OutputTransaction, ChangedOutputsOfAnEarlierRunAreLeftWithAWarning) {
 TEST(OutputTransaction, AnExporterMayNotWriteTheWorkspacesOwnFiles) {
   const testing::TemporaryDir dir;
   WriteText(dir.path() / "database.db", "db");
-  for (const std::string name : {"database.db", "cache/x", ".tessera.lock", "run_summary.json"}) {
+  for (const std::string name :
+       {"database.db", "cache/x", ".tessera.lock", "run_summary.json", "mapping_summary.json"}) {
     EXPECT_THROW(CommitSet(dir.path(), {{"transforms_json", {{name, "{}"}}}}), InputError) << name;
   }
   EXPECT_EQ(ReadText(dir.path() / "database.db"), "db");
+}
+
+// run_summary.json: the host's, recorded like any output, and removed by the next whole
+// set (a map that does not write one), so that it never describes models not there.
+TEST(OutputTransaction, TheRunSummaryIsAnOutputRemovedWithTheNextSet) {
+  const testing::TemporaryDir dir;
+  CommitSet(dir.path(), {{"tessera", {{"sparse/0/images.bin", "a"}}}});
+  CommitSet(dir.path(), {{"tessera", {{"run_summary.json", "{}"}}}},
+            OutputTransaction::Mode::kAddToSet);
+  EXPECT_TRUE(OutputLedger::Read(dir.path()).Owns(dir.path(), "run_summary.json"));
+  EXPECT_TRUE(fs::exists(dir.path() / "sparse/0/images.bin"));
+  CommitSet(dir.path(), {{"tessera", {{"sparse/0/images.bin", "b"}}}});
+  EXPECT_FALSE(fs::exists(dir.path() / "run_summary.json"));
+  EXPECT_FALSE(OutputLedger::Read(dir.path()).HasFile("run_summary.json"));
 }
 
 TEST(OutputTransaction, TwoWritersOfOneFileAreRefusedNamingBoth) {

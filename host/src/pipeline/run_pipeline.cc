@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include "database/database.h"
+#include "outputs/output_transaction.h"
 #include "pipeline/extract_stage.h"
 #include "pipeline/map_stage.h"
 #include "pipeline/match_stage.h"
@@ -130,7 +131,12 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
         summary.map.images_per_model.size(), summary.map.images_per_model[0],
         summary.extract.num_images);
   }
-  WriteFileAtomically(options.output_dir / kRunSummaryFileName, summary.ToJson().dump(2) + "\n");
+  // An output like the models (in the ledger, removed with the next model set), placed
+  // once the set it describes is.
+  OutputTransaction outputs(options.output_dir, OutputTransaction::Mode::kAddToSet);
+  WriteFileAtomically(outputs.StageFor("tessera") / kRunSummaryFileName,
+                      summary.ToJson().dump(2) + "\n");
+  outputs.Commit();
   return run;
 }
 
