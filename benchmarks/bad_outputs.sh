@@ -230,10 +230,13 @@ PY
 fresh "$work/stale"
 check "run_summary.json after a map with no model" 3 '[ ! -e "$work/stale/run_summary.json" ] && [ ! -e "$work/stale/sparse" ]' "" -- \
   t map --images "$work/d" --output "$work/stale" --manifest "$work/nomodel.json"
-# Python's views of a model are read-only: writing one raises, and the model is unchanged.
-pythonpath=$(ls -d "$(dirname "$(dirname "$tessera")")"/lib/python3*/dist-packages 2> /dev/null | head -1)
-if [ -n "$pythonpath" ]; then
-  check "Python: a model's arrays are read-only" 0 "" "" -- env PYTHONPATH="$pythonpath" python3 -c "
+# Python's views of a model are read-only: writing into one raises.
+# (the module is built for the Python CMake found: Debian's /usr/bin/python3, with numpy).
+build_dir=$(dirname "$(dirname "$tessera")")
+pythonpath=$(ls -d "$build_dir"/lib/python3*/dist-packages 2> /dev/null | head -1)
+python=$(sed -n 's/^Python3_EXECUTABLE:FILEPATH=//p' "$build_dir/CMakeCache.txt" 2> /dev/null)
+if [ -n "$pythonpath" ] && [ -n "$python" ]; then
+  check "Python: a model's arrays are read-only" 0 "" "" -- env PYTHONPATH="$pythonpath" "$python" -c "
 import tessera, sys
 rec = tessera.Reconstruction('$work/base/sparse/0')
 point = next(iter(rec.points3D.values()))
