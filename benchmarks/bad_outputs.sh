@@ -6,6 +6,11 @@
 #                                 or removed (a sentinel tree is checked after each case)
 #   foreign files deleted         a file in the output folder that Tessera did not write
 #                                 changed or removed
+#   unclear messages              exit 2 or 3 whose last error line (the verdict; a
+#                                 multi-process run may print its children's above it)
+#                                 names no file, option, image or plugin (no path, quoted
+#                                 name or --option in it), or an error the process said
+#                                 twice
 # and, in the read-back section on clusters.json and the cluster processes (issue 46),
 #   models removed by a failed run, orphans after kill -9 of a parent, and cluster
 #   processes left 20 s after a signal to their parent.
@@ -54,7 +59,7 @@ tess_base() {  # a finished workspace with a binary model, PLY and transforms.js
 tess_base
 fresh() { rm -rf "$1"; cp -a "$work/base" "$1"; }
 
-tried=0 crashes=0 silent=0 outside=0 foreign=0
+tried=0 crashes=0 silent=0 outside=0 foreign=0 unclear=0
 # check NAME EXPECTED_CODES RESULT_CHECK FOREIGN_FILES -- COMMAND...
 #   EXPECTED_CODES: e.g. "2" or "0 3"; RESULT_CHECK: a shell test of the result ("" none);
 #   FOREIGN_FILES: files Tessera did not write that must stay as they are ("" none).
@@ -75,6 +80,14 @@ check() {
     fi
   elif [ -n "$result_check" ] && ! eval "$result_check"; then
     verdict="silent wrong output"; silent=$((silent + 1))
+  fi
+  if [ "$code" = 2 ] || [ "$code" = 3 ]; then
+    local verdict_line repeated
+    verdict_line=$(grep -E '^\[error\]|^--[a-z-]+: ' "$work/case.log" | tail -1)
+    repeated=$(grep '^\[error\]' "$work/case.log" | sort | uniq -d | head -1)
+    if ! grep -qE "/|'|--[a-z]" <<< "$verdict_line" || [ -n "$repeated" ]; then
+      verdict="unclear message"; unclear=$((unclear + 1))
+    fi
   fi
   if [ "$(snapshot "$work/outside")" != "$sentinel" ]; then
     verdict="files outside touched"; outside=$((outside + 1))
@@ -443,7 +456,8 @@ echo "crashes: $crashes"
 echo "silent wrong outputs: $silent"
 echo "files outside the output folder touched: $outside"
 echo "files not written by Tessera deleted: $foreign"
+echo "unclear messages: $unclear"
 echo "models removed by a failed run: $removed"
 echo "orphans after kill -9 of a parent: $orphans"
 echo "cluster processes left 20 s after a signal to their parent: $left_running"
-[ $((crashes + silent + outside + foreign + removed + orphans + left_running)) = 0 ]
+[ $((crashes + silent + outside + foreign + unclear + removed + orphans + left_running)) = 0 ]

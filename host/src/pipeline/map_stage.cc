@@ -345,7 +345,7 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
     }
     // Matching ran and verified no pair: no model can be built (exit 3), and none of an
     // earlier run's is left to be taken for this run's.
-    spdlog::error("map: {}: matching verified none of the {} matched image pairs",
+    spdlog::warn("map: {}: matching verified none of the {} matched image pairs",
                   database->path().string(), database->NumMatchedPairs());
     summary.num_images = database->NumImages();
     summary.seconds = timer.ElapsedSeconds();
