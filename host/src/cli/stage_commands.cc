@@ -160,6 +160,14 @@ CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
             }
             if (cluster->count() > 0) {
               summary = MapCluster(context, run, options->cluster, InterruptibleControl());
+              if (summary.status == StageStatus::kCompleted && summary.num_models == 0) {
+                // Named by its cluster: the processes of map --hierarchical share one log.
+                spdlog::error(
+                    "map --cluster {}: no model could be built from the images of cluster {} "
+                    "of {} (see the warnings above); the merge leaves it out",
+                    options->cluster, options->cluster, options->output);
+                return static_cast<int>(kExitNoModel);
+              }
             } else if (hierarchical->count() > 0) {
               summary = MapHierarchically(context, run, HierarchicalOptions(*options, *jobs),
                                           InterruptibleControl());

@@ -346,7 +346,7 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
     // Matching ran and verified no pair: no model can be built (exit 3), and none of an
     // earlier run's is left to be taken for this run's.
     spdlog::warn("map: {}: matching verified none of the {} matched image pairs",
-                  database->path().string(), database->NumMatchedPairs());
+                 database->path().string(), database->NumMatchedPairs());
     summary.num_images = database->NumImages();
     summary.seconds = timer.ElapsedSeconds();
     if (!PlaceMapOutputs(workspace, settings, {}, input, image_dir, control, target, &summary)) {
