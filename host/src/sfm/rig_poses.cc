@@ -34,6 +34,24 @@ bool IsRegistered(const Reconstruction& model, image_t image_id) {
   return it != model.images.end() && it->second.registered;
 }
 
+// Camera `camera_id`'s cam_from_rig in each of `rig`'s frames whose reference and
+// `camera_id` images are both registered in `model`, in frame order.
+std::vector<Rigid3d> MeasuredCamFromRig(const CameraRig& rig, camera_t camera_id,
+                                        const Reconstruction& model) {
+  std::vector<Rigid3d> measured;
+  for (const auto& frame : rig.frames) {
+    const auto reference = frame.find(rig.reference_camera);
+    const auto other = frame.find(camera_id);
+    if (reference == frame.end() || other == frame.end() ||
+        !IsRegistered(model, reference->second) || !IsRegistered(model, other->second)) {
+      continue;
+    }
+    measured.push_back(model.images.at(other->second).cam_from_world *
+                       model.images.at(reference->second).cam_from_world.Inverse());
+  }
+  return measured;
+}
+
 }  // namespace
 
 namespace {
@@ -45,15 +63,7 @@ std::optional<Rigid3d> EstimateCamFromRig(const CameraRig& rig, camera_t camera_
                                           const Reconstruction& model, size_t* num_frames) {
   std::vector<Eigen::Quaterniond> rotations;
   std::vector<double> translations[3];
-  for (const auto& frame : rig.frames) {
-    const auto reference = frame.find(rig.reference_camera);
-    const auto other = frame.find(camera_id);
-    if (reference == frame.end() || other == frame.end() ||
-        !IsRegistered(model, reference->second) || !IsRegistered(model, other->second)) {
-      continue;
-    }
-    const Rigid3d cam_from_rig = model.images.at(other->second).cam_from_world *
-                                 model.images.at(reference->second).cam_from_world.Inverse();
+  for (const Rigid3d& cam_from_rig : MeasuredCamFromRig(rig, camera_id, model)) {
     rotations.push_back(cam_from_rig.rotation);
     for (int i = 0; i < 3; ++i) translations[i].push_back(cam_from_rig.translation(i));
   }
@@ -155,20 +165,12 @@ bool HoldsPose(const Rigid3d& measured, const Rigid3d& given) {
 // how many there are, and how many hold the given cam_from_rig.
 std::pair<size_t, size_t> FramesHoldingGivenPose(const CameraRig& rig, camera_t camera_id,
                                                  const Reconstruction& model) {
-  size_t num_whole = 0, num_held = 0;
-  for (const auto& frame : rig.frames) {
-    const auto reference = frame.find(rig.reference_camera);
-    const auto other = frame.find(camera_id);
-    if (reference == frame.end() || other == frame.end() ||
-        !IsRegistered(model, reference->second) || !IsRegistered(model, other->second)) {
-      continue;
-    }
-    ++num_whole;
-    const Rigid3d measured = model.images.at(other->second).cam_from_world *
-                             model.images.at(reference->second).cam_from_world.Inverse();
-    num_held += HoldsPose(measured, rig.cam_from_rig.at(camera_id)) ? 1 : 0;
+  const std::vector<Rigid3d> measured = MeasuredCamFromRig(rig, camera_id, model);
+  size_t num_held = 0;
+  for (const Rigid3d& cam_from_rig : measured) {
+    num_held += HoldsPose(cam_from_rig, rig.cam_from_rig.at(camera_id)) ? 1 : 0;
   }
-  return {num_whole, num_held};
+  return {measured.size(), num_held};
 }
 
 nlohmann::json PoseJson(const Rigid3d& pose) {
