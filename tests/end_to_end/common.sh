@@ -35,6 +35,20 @@ skip_part_or_fail() {
   echo "SKIPPED (visible): $*"
 }
 
+# wait_until_paused PID: returns once PID has stopped itself at the place that
+# TESSERA_TEST_PAUSE names (util/test_pause.h); fails if it ends first. The test then acts
+# at a known point in the run (kill -9, SIGINT, a second writer) and resumes it with
+# `kill -CONT`, instead of racing a timer against the process.
+wait_until_paused() {
+  local state
+  while kill -0 "$1" 2> /dev/null; do
+    state=$(awk '{print $3}' "/proc/$1/stat" 2> /dev/null)
+    [ "$state" = T ] && return 0
+    sleep 0.02
+  done
+  fail "process $1 ended before it paused where TESSERA_TEST_PAUSE asked"
+}
+
 # True when colmap runs (not merely when a file of that name is on the PATH).
 have_colmap() { colmap help > /dev/null 2>&1; }
 

@@ -1,12 +1,13 @@
 #!/bin/bash
 # Ctrl-C during `tessera run` stops cleanly and loses nothing. On a 512 px copy of the
-# in-repository sample, one thread: SIGINT as soon as matching reports progress gives
+# in-repository sample, one thread: SIGINT after matching has stored its third pair gives
 # exit 130 and one line saying how to resume; the workspace keeps every image and every
 # pair finished; the same command then completes (exit 0), detecting no image again and
 # matching only the pairs left, and its model equals an uninterrupted run's. Then the
-# same for the global mapper: SIGINT once rotation averaging has logged (during global
+# same for the global mapper: SIGINT once rotation averaging is done (during global
 # positioning or the adjustments after it) gives exit 130, and the same `tessera map`
-# then gives an uninterrupted map's model.
+# then gives an uninterrupted map's model. The signals are sent where the run pauses for
+# the test (TESSERA_TEST_PAUSE), not on a timer.
 # usage: interrupt_test.sh TESSERA DOWNSCALE SOURCE_DIR
 set -uo pipefail
 tessera=$1
@@ -17,27 +18,16 @@ work=$(mktemp -d)
 pid=""
 trap '[ -n "$pid" ] && kill -9 "$pid" 2> /dev/null; rm -rf "$work"' EXIT
 
-# Polls FILE every SECONDS until a line matches PATTERN or the process $pid has ended
-# (at most 60 s).
-wait_for_line() {
-  local pattern=$1 file=$2 seconds=$3 deadline=$((SECONDS + 60))
-  while [ "$SECONDS" -lt "$deadline" ]; do
-    grep -q "$pattern" "$file" && return
-    kill -0 "$pid" 2> /dev/null || return
-    sleep "$seconds"
-  done
-}
-
 "$downscale" "$source_dir/examples/fountain-P11-small/images" "$work/images" 512 90 > /dev/null ||
   fail "downscale"
 manifest="$source_dir/manifests/default.json"
 
-"$tessera" run --images "$work/images" --output "$work/ws" --manifest "$manifest" \
-  --threads 1 > "$work/first.log" 2>&1 &
+TESSERA_TEST_PAUSE=match.pair_committed:3 "$tessera" run --images "$work/images" \
+  --output "$work/ws" --manifest "$manifest" --threads 1 > "$work/first.log" 2>&1 &
 pid=$!
-wait_for_line "match: \[" "$work/first.log" 0.1
-grep -q "match: \[" "$work/first.log" || { cat "$work/first.log"; fail "no match progress"; }
+wait_until_paused "$pid"
 kill -INT "$pid"
+kill -CONT "$pid"
 wait "$pid"
 code=$?
 pid=""
@@ -46,8 +36,8 @@ grep -q "run: interrupted; the images and pairs finished are kept" "$work/first.
   { tail -5 "$work/first.log"; fail "no line saying how to resume"; }
 [ ! -f "$work/ws/run_summary.json" ] || fail "an interrupted run wrote run_summary.json"
 pairs_done=$(sqlite3 "$work/ws/database.db" "SELECT COUNT(*) FROM two_view_geometries")
-[ "$pairs_done" -ge 1 ] && [ "$pairs_done" -lt 55 ] ||
-  fail "expected some of the 55 pairs kept, found $pairs_done"
+[ "$pairs_done" -ge 3 ] && [ "$pairs_done" -lt 55 ] ||
+  fail "expected the 3 pairs stored before the interrupt kept, and fewer than 55, found $pairs_done"
 
 "$tessera" run --images "$work/images" --output "$work/ws" --manifest "$manifest" \
   --threads 1 > "$work/second.log" 2>&1 || { tail -5 "$work/second.log"; fail "resumed run"; }
@@ -63,14 +53,15 @@ for file in cameras.bin images.bin points3D.bin; do
     fail "sparse/0/$file differs from an uninterrupted run's"
 done
 
-# The global mapper, interrupted after rotation averaging: the log is polled every 10 ms,
-# and what is left of the map (positioning, four adjustments) takes over a second here.
+# The global mapper, interrupted as it starts to position the cameras, rotations averaged
+# (it pauses there for the test; SIGINT is delivered as it continues).
 global_manifest="$source_dir/manifests/global.json"
-"$tessera" map --output "$work/ws" --manifest "$global_manifest" --threads 1 \
-  > "$work/global_first.log" 2>&1 &
+TESSERA_TEST_PAUSE=global_map.positioning_part:1 "$tessera" map --output "$work/ws" \
+  --manifest "$global_manifest" --threads 1 > "$work/global_first.log" 2>&1 &
 pid=$!
-wait_for_line "global map: 11 images, .* verified pairs" "$work/global_first.log" 0.01
-kill -INT "$pid" 2> /dev/null
+wait_until_paused "$pid"
+kill -INT "$pid"
+kill -CONT "$pid"
 wait "$pid"
 code=$?
 pid=""

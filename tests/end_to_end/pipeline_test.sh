@@ -76,20 +76,15 @@ fi
 # 3. kill -9 during matching, then resume.
 "$tessera" extract --images "$work/images" --output "$work/killed" --camera-K "$work/K.txt" \
   2> "$work/extract.log" || { cat "$work/extract.log"; fail "extract"; }
-"$tessera" match --output "$work/killed" --threads 1 2> "$work/match1.log" &
+TESSERA_TEST_PAUSE=match.pair_committed:5 "$tessera" match --output "$work/killed" --threads 1 \
+  2> "$work/match1.log" &
 pid=$!
-for _ in $(seq 1 600); do
-  done_pairs=$(sqlite3 -cmd ".timeout 2000" "$work/killed/database.db" \
-    "SELECT COUNT(*) FROM two_view_geometries" 2>/dev/null || echo 0)
-  [ "${done_pairs:-0}" -ge 5 ] && break
-  kill -0 $pid 2>/dev/null || break
-  sleep 0.05
-done
+wait_until_paused $pid
 kill -9 $pid 2>/dev/null && killed=yes || killed=no
 wait $pid 2>/dev/null
 partial=$(sqlite3 "$work/killed/database.db" "SELECT COUNT(*) FROM two_view_geometries")
 echo "killed: $killed after $partial of 55 pairs"
-[ "$killed" = yes ] && [ "$partial" -lt 55 ] || fail "the match did not get killed mid-way"
+[ "$killed" = yes ] && [ "$partial" = 5 ] || fail "the match was not killed after its fifth pair ($partial of 55 kept)"
 { "$tessera" extract --images "$work/images" --output "$work/killed" --camera-K "$work/K.txt" &&
   "$tessera" match --output "$work/killed" --threads 2; } 2> "$work/resume.log" ||
   { cat "$work/resume.log"; fail "resume"; }

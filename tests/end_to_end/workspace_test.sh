@@ -153,25 +153,23 @@ tess "$work/g2.log" run --images "$work/d" --output "$work/out_g" || { cat "$wor
 echo "disk full: exit 2 naming $(grep -o "$work/out_g/[^ ']*" "$work/g1.log" | head -1 | sed "s|$work/||"), rerun completes"
 
 # 7. Two writers.
-"$tessera" run --images "$work/all" --output "$work/out_h" --manifest "$work/m.json" \
-  --threads 2 > "$work/h1.log" 2>&1 &
+TESSERA_TEST_PAUSE=workspace.locked:1 "$tessera" run --images "$work/all" --output "$work/out_h" \
+  --manifest "$work/m.json" --threads 2 > "$work/h1.log" 2>&1 &
 first=$!
-for _ in $(seq 1 200); do [ -s "$work/out_h/.tessera.lock" ] && break; sleep 0.05; done
+wait_until_paused $first
 "$tessera" run --images "$work/all" --output "$work/out_h" > "$work/h2.log" 2>&1
 code=$?
+kill -CONT $first
 [ "$code" = 2 ] || { cat "$work/h2.log"; fail "second writer: exit $code, expected 2"; }
 grep -q "workspace $work/out_h is in use by process $first (since " "$work/h2.log" ||
   { cat "$work/h2.log"; fail "second writer: message"; }
 wait $first || { cat "$work/h1.log"; fail "the first writer failed"; }
 [ "$(registered "$work/out_h")" = 11 ] || fail "the first writer registered $(registered "$work/out_h") of 11"
 echo "two writers: the second refused naming the first, the first registered 11 of 11"
-"$tessera" run --images "$work/all" --output "$work/out_i" --manifest "$work/m.json" \
-  --threads 2 > "$work/i1.log" 2>&1 &
+TESSERA_TEST_PAUSE=workspace.locked:1 "$tessera" run --images "$work/all" --output "$work/out_i" \
+  --manifest "$work/m.json" --threads 2 > "$work/i1.log" 2>&1 &
 victim=$!
-for _ in $(seq 1 400); do
-  [ -s "$work/out_i/.tessera.lock" ] && grep -q "features" "$work/i1.log" && break
-  sleep 0.02
-done
+wait_until_paused $victim
 kill -9 $victim; wait $victim 2> /dev/null
 tess "$work/i2.log" extract --images "$work/all" --output "$work/out_i" || { cat "$work/i2.log"; fail "extract after kill -9"; }
 grep -q "taking over the lock left by process $victim" "$work/i2.log" ||

@@ -7,7 +7,7 @@
 #include "tessera/sfm/first_model_calibration.h"
 #include "tessera/sfm/global_mapper_options.h"
 #include "tessera/sfm/incremental_mapper_options.h"
-#include "verified_pairs/verified_pairs.h"
+#include "tessera/sfm/verified_pairs.h"
 
 namespace tessera {
 namespace {

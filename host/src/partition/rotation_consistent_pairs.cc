@@ -7,8 +7,8 @@
 #include "tessera/sfm/focal_length_estimation.h"
 #include "tessera/sfm/global_mapper_options.h"
 #include "tessera/sfm/rotation_averaging.h"
+#include "tessera/sfm/verified_pairs.h"
 #include "tessera/sfm/view_graph.h"
-#include "verified_pairs/verified_pairs.h"
 
 namespace tessera {
 namespace {

@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "feature/database_feature_reader.h"
+#include "database/database_feature_reader.h"
 #include "image/camera_assignment.h"
 #include "io/keypoint_color_sampler.h"
 #include "outputs/output_transaction.h"

@@ -10,12 +10,14 @@
 #include <unordered_map>
 #include <unordered_set>
 
-#include "feature/database_feature_reader.h"
+#include "database/database_feature_reader.h"
 #include "geometry/two_view_geometry_estimation.h"
+#include "pipeline/pair_selection_input.h"
 #include "plugin/plugin_call.h"
 #include "util/parallel.h"
 #include "util/random.h"
 #include "util/strings.h"
+#include "util/test_pause.h"
 #include "util/timer.h"
 
 namespace tessera {
@@ -224,27 +226,11 @@ MatchPlan PlanMatching(const Workspace& workspace, const MatchSettings& settings
   const Database& results = workspace.database();
   const Database& source = scope.source != nullptr ? *scope.source : results;
   MatchPlan plan;
-  // Images in capture order: pair selectors such as `sequential` rely on it.
-  plan.images = source.ReadAllImages();
-  std::vector<Image>& images = plan.images;
-  std::sort(images.begin(), images.end(),
-            [](const Image& a, const Image& b) { return NaturalLess(a.name, b.name); });
-  for (const Camera& camera : source.ReadAllCameras()) plan.cameras[camera.camera_id] = camera;
-  // Workspaces made before metadata was stored have none: selectors see empty metadata.
-  const std::map<image_t, ImageMetadata> metadata = source.ReadAllImageMetadata();
-
-  PairSelectionInput input;
+  PairSelectionInput input = ReadPairSelectionInput(source, &plan.images, &plan.cameras);
+  const std::vector<Image>& images = plan.images;
   input.num_threads = settings.num_threads;
   std::vector<image_t> image_ids;
-  for (const Image& image : images) {
-    PairSelectionImage entry;
-    entry.image_id = image.image_id;
-    entry.name = image.name;
-    entry.camera = plan.cameras.at(image.camera_id);
-    if (auto it = metadata.find(image.image_id); it != metadata.end()) entry.metadata = it->second;
-    input.images.push_back(std::move(entry));
-    image_ids.push_back(image.image_id);
-  }
+  for (const PairSelectionImage& image : input.images) image_ids.push_back(image.image_id);
   const DatabaseFeatureReader feature_reader(&source, image_ids, descriptors.metric,
                                              descriptors.dimension);
   input.features = &feature_reader;
@@ -353,6 +339,7 @@ PairResult PairMatchVerifier::Run(const ImageIndexPair& pair) {
     database_->WriteTwoViewGeometry(image1.image_id, image2.image_id, geometry);
     transaction.Commit();
   }
+  PauseIfTestAsks("match.pair_committed");
   result.num_putative_matches = matches.size();
   result.num_inlier_matches = geometry.inlier_matches.size();
   spdlog::debug(

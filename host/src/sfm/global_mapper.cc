@@ -16,9 +16,10 @@
 #include "tessera/sfm/track_filtering.h"
 #include "tessera/sfm/track_selection.h"
 #include "tessera/sfm/track_triangulation.h"
+#include "tessera/sfm/verified_pairs.h"
 #include "tessera/sfm/view_graph.h"
 #include "util/random.h"
-#include "verified_pairs/verified_pairs.h"
+#include "util/test_pause.h"
 
 namespace tessera {
 namespace {
@@ -188,6 +189,7 @@ enum class PartOutcome { kModel, kNoModel, kCancelled };
 PartOutcome PositionPart(const PartRun& run, size_t part_index, const std::set<image_t>& part,
                          const FeatureTracks& tracks, const RotationAveragingResult& rotations,
                          Reconstruction* model_out) {
+  PauseIfTestAsks("global_map.positioning_part");
   const MapperInput& input = run.input;
   const std::map<camera_t, Camera>& cameras = run.cameras;
   const GlobalMapperOptions& options = run.options;

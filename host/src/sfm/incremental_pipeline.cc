@@ -16,9 +16,9 @@
 #include "tessera/sfm/global_mapper_options.h"
 #include "tessera/sfm/model_finishing.h"
 #include "tessera/sfm/model_merger.h"
+#include "tessera/sfm/verified_pairs.h"
 #include "tessera/sfm/view_graph.h"
 #include "util/random.h"
-#include "verified_pairs/verified_pairs.h"
 
 namespace tessera {
 namespace {

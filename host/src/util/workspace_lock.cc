@@ -10,6 +10,7 @@
 #include <system_error>
 
 #include "tessera/errors.h"
+#include "util/test_pause.h"
 
 namespace tessera {
 namespace {
@@ -92,6 +93,7 @@ WorkspaceLock::WorkspaceLock(const std::filesystem::path& workspace, std::string
     throw InputError(file_.string() +
                      ": cannot write the workspace lock file: " + std::strerror(write_errno));
   }
+  PauseIfTestAsks("workspace.locked");
 }
 
 WorkspaceLock::~WorkspaceLock() {

@@ -21,16 +21,10 @@
 #include "tessera/sfm/focal_length_estimation.h"
 #include "tessera/sfm/global_mapper.h"
 #include "tessera/sfm/model_finishing.h"
+#include "tessera/sfm/verified_pairs.h"
 
 namespace tessera {
 namespace {
-
-// Configurations whose matches are correspondences of one 3D point.
-bool IsVerified(int config) {
-  return config == TwoViewGeometry::CALIBRATED || config == TwoViewGeometry::UNCALIBRATED ||
-         config == TwoViewGeometry::PLANAR || config == TwoViewGeometry::PANORAMIC ||
-         config == TwoViewGeometry::PLANAR_OR_PANORAMIC;
-}
 
 // An unknown key among `options`, named with the closest of all the mapper's keys (its
 // own and GlobalMapperOptions'), or the whole list: GlobalMapperOptions::FromJson,
@@ -152,14 +146,8 @@ class GlobalMapperPlugin : public Mapper {
       const MapperInput& input, const MapperContext& context,
       std::vector<FocalLengthReport>* reports) const {
     if (!options_.estimate_focal_length) return std::nullopt;
-    std::vector<const MapperInput::Pair*> pairs;
-    for (const MapperInput::Pair& pair : input.pairs) {
-      if (static_cast<int>(pair.geometry.inlier_matches.size()) >= options_.min_num_matches &&
-          IsVerified(pair.geometry.config) && input.images.count(pair.image_id1) > 0 &&
-          input.images.count(pair.image_id2) > 0) {
-        pairs.push_back(&pair);
-      }
-    }
+    const std::vector<const MapperInput::Pair*> pairs =
+        VerifiedPairs(input, static_cast<size_t>(options_.min_num_matches));
     const std::map<camera_t, FocalLengthEstimate> from_view_graph =
         EstimateFocalLengths(input, pairs, FocalLengthEstimationOptions());
     std::set<camera_t> undetermined;

@@ -1,4 +1,4 @@
-#include "feature/database_feature_reader.h"
+#include "database/database_feature_reader.h"
 
 #include <gtest/gtest.h>
 

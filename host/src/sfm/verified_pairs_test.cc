@@ -1,4 +1,4 @@
-#include "verified_pairs/verified_pairs.h"
+#include "tessera/sfm/verified_pairs.h"
 
 #include <gtest/gtest.h>
 
