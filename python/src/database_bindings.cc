@@ -1,7 +1,7 @@
 // tessera.Database: a workspace's database.db (COLMAP 3.8's schema) read from Python:
 // cameras, images, keypoints and descriptors as numpy, matches, and two-view geometries
-// with their kind. Opened read-only (database/database.h, Mode::kReadOnly): it takes no
-// lock and writes nothing, so it reads a workspace that no run is writing.
+// with their kind. Opened read-only (database/database.h, Mode::kReadOnly): it writes
+// nothing, and reads each committed state whole even while a run writes the workspace.
 
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>

@@ -132,7 +132,7 @@ nlohmann::json ReadJsonFile(const fs::path& file) {
 
 // Pairs matched, pairs verified and their mean number of inliers, from a workspace.
 void ReadMatchingFigures(const fs::path& database_file, BenchRow* row) {
-  const Database database(database_file);
+  const Database database(database_file, Database::Mode::kReadOnly);
   row->num_images = database.NumImages();
   row->num_pairs = database.NumMatchedPairs();
   size_t num_inliers = 0;

@@ -15,7 +15,10 @@
 namespace tessera {
 
 struct Database::Impl {
-  Impl(const std::filesystem::path& path, Mode mode) : connection(path, mode == Mode::kReadOnly) {
+  Impl(const std::filesystem::path& path, Mode mode)
+      : connection(path, mode == Mode::kReadWrite  ? SqliteConnection::Access::kReadWrite
+                         : mode == Mode::kReadOnly ? SqliteConnection::Access::kReadOnly
+                                                   : SqliteConnection::Access::kImmutable) {
     connection.EndOpening();
   }
 

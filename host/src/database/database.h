@@ -51,12 +51,17 @@ class Database {
   // InputError naming the file if it cannot be opened or is not a SQLite database /
   // has an incompatible schema.
   //
-  // Mode::kReadOnly opens an existing file for reading only, without taking a lock or
-  // writing anything (SQLite's immutable mode, no -wal or -shm file), so that readers on
-  // several hosts of a network filesystem are safe while no one writes the file (the
-  // matching shards of `tessera slurm` read database.db so). The schema is checked, not
-  // created; a write fails.
-  enum class Mode { kReadWrite, kReadOnly };
+  // The one writer of a workspace opens its database kReadWrite (pipeline/workspace.h).
+  // Every reader opens an existing file read only, and the schema is checked, not
+  // created; a write fails:
+  //   kReadOnly   with SQLite's shared locks: safe beside a writer on this host, each
+  //               read seeing a committed state (the GUI's match matrix during a run,
+  //               bench, the Python module, the cluster processes of a partitioned map);
+  //   kImmutable  without taking a lock or writing anything (SQLite's immutable mode, no
+  //               -wal or -shm file), so that readers on several hosts of a network
+  //               filesystem are safe while no one writes the file (the matching shards
+  //               of `tessera slurm` read database.db so).
+  enum class Mode { kReadWrite, kReadOnly, kImmutable };
   explicit Database(const std::filesystem::path& path, Mode mode = Mode::kReadWrite);
   ~Database();
   Database(const Database&) = delete;

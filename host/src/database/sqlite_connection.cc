@@ -28,14 +28,18 @@ std::string DatabaseUri(const std::filesystem::path& path, const std::string& qu
 
 }  // namespace
 
-SqliteConnection::SqliteConnection(const std::filesystem::path& path, bool read_only)
-    : path_(path), read_only_(read_only) {
+SqliteConnection::SqliteConnection(const std::filesystem::path& path, Access access)
+    : path_(path), read_only_(access != Access::kReadWrite) {
   if (read_only_ && !std::filesystem::exists(path_)) {
     throw InputError("Cannot open database file '" + path_.string() + "': it does not exist.");
   }
-  // Read only: SQLite's immutable mode takes no lock and writes nothing (no -shm, no
-  // -wal), so readers on network filesystems are safe while no one writes the file.
-  const std::string uri = read_only_ ? DatabaseUri(path_, "immutable=1") : path_.string();
+  // Immutable: SQLite takes no lock and writes nothing (no -shm, no -wal), so readers on
+  // network filesystems are safe while no one writes the file. Read only: SQLite's shared
+  // locks and the writer's WAL index, so a reader beside a running writer sees each
+  // committed state whole.
+  const std::string uri = access == Access::kImmutable  ? DatabaseUri(path_, "immutable=1")
+                          : access == Access::kReadOnly ? DatabaseUri(path_, "mode=ro")
+                                                        : path_.string();
   const int flags = read_only_ ? SQLITE_OPEN_READONLY | SQLITE_OPEN_URI
                                : SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE;
   const int rc = sqlite3_open_v2(uri.c_str(), &db_, flags, nullptr);

@@ -14,10 +14,14 @@ namespace tessera {
 
 class SqliteConnection {
  public:
-  // Opens the file: read-write (created if missing) with WAL journal, or read only in
-  // SQLite's immutable mode (no lock, no -wal/-shm file; the file must exist). Throws
-  // InputError naming the file if it cannot be opened or is not a SQLite database.
-  SqliteConnection(const std::filesystem::path& path, bool read_only);
+  // How the file is opened (Database::Mode's meanings).
+  enum class Access { kReadWrite, kReadOnly, kImmutable };
+  // Opens the file: read-write (created if missing) with WAL journal; read only, with
+  // SQLite's locks, beside a writer on this host (the file must exist); or read only in
+  // SQLite's immutable mode (no lock, no -wal/-shm file; the file must exist, and no one
+  // may write it meanwhile). Throws InputError naming the file if it cannot be opened or
+  // is not a SQLite database.
+  SqliteConnection(const std::filesystem::path& path, Access access);
   // Rolls back an open transaction and closes (after every statement is finalized).
   ~SqliteConnection();
   SqliteConnection(const SqliteConnection&) = delete;

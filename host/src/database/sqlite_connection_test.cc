@@ -220,7 +220,9 @@ TEST_F(DatabaseTest, AFullDiskIsAnInputErrorAndKeepsTheCommittedState) {
   EXPECT_FALSE(database.ExistsDescriptors(1));
 }
 
-TEST(DatabaseReadOnly, ReadsWithoutWritingAndRefusesWrites) {
+// Both read-only modes read an existing file without changing it, refuse writes, and
+// never create a missing file; the immutable one also leaves no -wal or -shm file.
+void ExpectReadsWithoutWriting(Database::Mode mode) {
   testing::TemporaryDir dir;
   const fs::path path = dir.path() / "what?#%.db";  // characters a URI must encode
   std::mt19937 rng(3);
@@ -239,22 +241,60 @@ TEST(DatabaseReadOnly, ReadsWithoutWritingAndRefusesWrites) {
   ASSERT_FALSE(fs::exists(path.string() + "-wal"));
   const auto modified = fs::last_write_time(path);
   {
-    const Database reader(path, Database::Mode::kReadOnly);
-    const Database other(path, Database::Mode::kReadOnly);
+    const Database reader(path, mode);
+    const Database other(path, mode);
     EXPECT_EQ(reader.ReadAllImages().size(), 1u);
     EXPECT_EQ(reader.ReadNumKeypointsPerImage(), (std::map<image_t, size_t>{{1, 7}}));
     EXPECT_EQ(other.ReadKeypoints(1).size(), 7u);
     EXPECT_EQ(reader.ReadStageProvenance("x"), nlohmann::json({{"a", 1}}));
     EXPECT_FALSE(reader.ReadStageProvenance("y"));
-    Database writer(path, Database::Mode::kReadOnly);
+    Database writer(path, mode);
     EXPECT_THROW(writer.WriteKeypoints(1, RandomKeypoints(2, &rng)), std::exception);
-    EXPECT_FALSE(fs::exists(path.string() + "-wal"));
-    EXPECT_FALSE(fs::exists(path.string() + "-shm"));
+    if (mode == Database::Mode::kImmutable) {
+      EXPECT_FALSE(fs::exists(path.string() + "-wal"));
+      EXPECT_FALSE(fs::exists(path.string() + "-shm"));
+    }
   }
   EXPECT_EQ(fs::last_write_time(path), modified);
   EXPECT_EQ(Database(path).ReadKeypoints(1).size(), 7u);
-  EXPECT_THROW(Database(dir.path() / "missing.db", Database::Mode::kReadOnly), InputError);
+  EXPECT_THROW(Database(dir.path() / "missing.db", mode), InputError);
   EXPECT_FALSE(fs::exists(dir.path() / "missing.db"));
+}
+
+TEST(DatabaseReadOnly, ReadsWithoutWritingAndRefusesWrites) {
+  ExpectReadsWithoutWriting(Database::Mode::kReadOnly);
+}
+
+TEST(DatabaseImmutable, ReadsWithoutWritingOrLockingAndRefusesWrites) {
+  ExpectReadsWithoutWriting(Database::Mode::kImmutable);
+}
+
+// A reader beside the workspace's writer (the GUI's match matrix during a run): it sees
+// each committed state, never a transaction in progress, and sees new commits as they
+// land, which the immutable mode does not promise.
+TEST(DatabaseReadOnly, ReadsEachCommittedStateBesideAWriter) {
+  testing::TemporaryDir dir;
+  const fs::path path = dir.path() / "database.db";
+  std::mt19937 rng(5);
+  Database writer(path);
+  writer.WriteCamera(Camera::Create(kInvalidCameraId, CameraModelId::kPinhole, 500, 640, 480));
+  for (const char* name : {"a.jpg", "b.jpg"}) {
+    Image image;
+    image.name = name;
+    image.camera_id = 1;
+    writer.WriteImage(image);
+  }
+  writer.WriteKeypoints(1, RandomKeypoints(5, &rng));
+  const Database reader(path, Database::Mode::kReadOnly);
+  EXPECT_EQ(reader.ReadNumKeypointsPerImage(), (std::map<image_t, size_t>{{1, 5}}));
+  {
+    Database::Transaction transaction(&writer);
+    writer.WriteKeypoints(2, RandomKeypoints(9, &rng));
+    EXPECT_FALSE(reader.ExistsKeypoints(2)) << "a transaction in progress was seen";
+    transaction.Commit();
+  }
+  EXPECT_TRUE(reader.ExistsKeypoints(2));
+  EXPECT_EQ(reader.ReadKeypoints(2).size(), 9u);
 }
 
 }  // namespace

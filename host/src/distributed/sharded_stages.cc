@@ -140,7 +140,7 @@ MatchingSummary RunMatchShard(const PipelineContext& context, const RunOptions& 
                      " has changes a killed writer did not fold in; run `tessera merge --output " +
                      options.output_dir.string() + "` again, then the matching shards");
   }
-  const Database source(source_file, Database::Mode::kReadOnly);
+  const Database source(source_file, Database::Mode::kImmutable);
   const MatchSettings settings = context.MakeMatchSettings();
   const WorkspaceDescriptors descriptors = ReadWorkspaceDescriptors(source);
   CheckPairSelectors(settings, descriptors.metric, descriptors.dimension);

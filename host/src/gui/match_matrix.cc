@@ -23,7 +23,7 @@ fs::path DatabaseFile(const fs::path& path) {
 MatchMatrix ReadMatchMatrix(const fs::path& path) {
   MatchMatrix matrix;
   matrix.database = DatabaseFile(path);
-  const Database database(matrix.database);
+  const Database database(matrix.database, Database::Mode::kReadOnly);
   std::vector<Image> images = database.ReadAllImages();
   std::sort(images.begin(), images.end(),
             [](const Image& a, const Image& b) { return a.image_id < b.image_id; });
@@ -53,7 +53,7 @@ MatchMatrix ReadMatchMatrix(const fs::path& path) {
 }
 
 PairInliers ReadPairInliers(const fs::path& path, image_t image_id1, image_t image_id2) {
-  const Database database(DatabaseFile(path));
+  const Database database(DatabaseFile(path), Database::Mode::kReadOnly);
   PairInliers pair;
   for (const Image& image : database.ReadAllImages()) {
     if (image.image_id == image_id1) pair.name1 = image.name;
