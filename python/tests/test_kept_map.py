@@ -3,6 +3,7 @@
 
 import copy
 import json
+import shutil
 
 import tessera
 from conftest import MANIFEST, model_digests
@@ -34,3 +35,13 @@ def test_an_unchanged_map_is_kept_and_a_changed_one_mapped_again(sample, tmp_pat
     assert remapped["kept"] is False
     assert remapped["num_models"] >= 1
     assert mapping_summary != (output / "mapping_summary.json").read_bytes()
+
+
+def test_the_cli_model_is_kept_by_python(sample, tmp_path):
+    images, manifest, cli_output = sample
+    output = tmp_path / "copy"
+    shutil.copytree(cli_output, output)
+    digests = model_digests(output)
+    mapped = tessera.map(output=output, manifest=manifest, threads=2)
+    assert mapped["kept"] is True
+    assert model_digests(output) == digests

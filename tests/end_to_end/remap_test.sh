@@ -111,10 +111,9 @@ cp -a "$work/out" "$work/base"
 killed=0
 for n in 1 2 3 4 5 6 7 8; do
   rm -rf "$work/out" && cp -a "$work/base" "$work/out"
-  # In a subshell, so that the shell's "Killed" goes to the log too.
-  (strace -f -qq -e trace=renameat2 -e inject=renameat2:signal=SIGKILL:when=$n -o /dev/null \
+  strace -f -qq -e trace=renameat2 -e inject=renameat2:signal=SIGKILL:when=$n -o /dev/null \
     "$tessera" map --output "$work/out" --manifest "$work/mapper.json" --threads 2 \
-    > "$work/k$n.log" 2>&1) 2>> "$work/k$n.log"
+    > "$work/k$n.log" 2>&1
   code=$?
   [ "$code" = 137 ] || [ "$code" = 9 ] || break
   killed=$((killed + 1))

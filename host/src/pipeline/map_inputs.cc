@@ -1,10 +1,10 @@
 #include "pipeline/map_inputs.h"
 
-#include <dlfcn.h>
 #include <link.h>
 #include <spdlog/spdlog.h>
 #include <xxhash.h>
 
+#include <algorithm>
 #include <ctime>
 #include <memory>
 #include <type_traits>
@@ -87,17 +87,12 @@ void AddPlugin(const PluginInstance<Interface>* plugin, PartDigest* digest) {
   digest->File(plugin->file());
 }
 
-// The files of the code the mapper and the bundle adjuster call besides their own: the
-// object holding this host (the CLI or the Python module) and the SDK's libraries.
-std::vector<fs::path> HostFiles() {
+// The SDK's libraries that the mapper, the bundle adjuster and the exporters call
+// besides their own code (the sfm building blocks, Ceres, the model writers), as loaded.
+// The host's own binary is left out: the CLI and the Python module keep each other's
+// models.
+std::vector<fs::path> SdkLibraries() {
   std::vector<fs::path> files;
-  Dl_info info{};
-  if (dladdr(reinterpret_cast<void*>(&DigestMapInputs), &info) != 0 && info.dli_fname != nullptr &&
-      fs::is_regular_file(info.dli_fname)) {
-    files.emplace_back(info.dli_fname);
-  } else {
-    files.emplace_back("/proc/self/exe");
-  }
   dl_iterate_phdr(
       [](dl_phdr_info* object, size_t, void* data) {
         const std::string name = fs::path(object->dlpi_name).filename().string();
@@ -110,6 +105,7 @@ std::vector<fs::path> HostFiles() {
         return 0;
       },
       &files);
+  std::sort(files.begin(), files.end());
   return files;
 }
 
@@ -260,7 +256,7 @@ MapInputs DigestMapInputs(const MapperInput& input, const MapSettings& settings,
   outputs.Text(FolderText(settings.mask_dir));
   inputs.parts["outputs"] = outputs.Hex();
   PartDigest tessera;
-  for (const fs::path& file : HostFiles()) tessera.File(file);
+  for (const fs::path& file : SdkLibraries()) tessera.File(file);
   inputs.parts["tessera"] = tessera.Hex();
   return inputs;
 }

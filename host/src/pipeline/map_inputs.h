@@ -26,8 +26,8 @@ namespace tessera {
 // geometries and inliers, and the provenance of matches, geometries and selection),
 // "rig", "mapper" and "bundle_adjuster" (plugin, version, effective options, the file's
 // digest; the mapper's with the seed), "outputs" (the exporters likewise, the mask
-// folder) and "tessera" (the digests of the host and of the SDK libraries the plugins
-// call).
+// folder) and "tessera" (the digests of the SDK libraries the plugins call: sfm,
+// Ceres, io).
 struct MapInputs {
   std::map<std::string, std::string> parts;
   std::string mapped_at;  // UTC, "2026-12-06 04:51:02 UTC": when the map that used them ran

@@ -349,8 +349,8 @@ std::optional<MapStageSummary> KeepUnchangedModels(const Workspace& workspace,
   for (const MappingSummary::Model& model : recorded->models) {
     summary.num_registered += model.num_images;
     summary.images_per_model.push_back(model.num_images);
-    spdlog::info("map: model {} ({}): {} images, {} points", model.index, model.folder,
-                 model.num_images, model.num_points3D);
+    spdlog::info("map: model {}: {} images, {} points (kept)", model.index, model.num_images,
+                 model.num_points3D);
   }
   control.Report("map", input.images.size(), input.images.size());
   spdlog::info(
