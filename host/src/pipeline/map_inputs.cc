@@ -326,6 +326,11 @@ std::optional<MappingSummary> FindUnchangedModels(const fs::path& output_dir,
     spdlog::info("map: inputs unchanged since {}, but {}; mapping again", before->mapped_at, why);
     return std::nullopt;
   }
+  // As a map that places its set warns (OutputTransaction::Commit).
+  for (const std::string& warning :
+       ForeignModelFolderWarnings(output_dir, OutputLedger::Read(output_dir))) {
+    spdlog::warn("{}", warning);
+  }
   return recorded;
 }
 

@@ -47,7 +47,9 @@ MapInputs DigestMapInputs(const MapperInput& input, const MapSettings& settings,
 // and unchanged: every file and folder of the ledger (outputs/output_ledger.h) is there
 // with its recorded digest, each file with one (a set whose placing was stopped holds
 // two), and mapping_summary.json is among them (run_summary.json, which `run` rewrites,
-// is not checked). Else nullopt, with a line saying why when a record was found.
+// is not checked). Else nullopt, with a line saying why when a record was found. A
+// folder of OUTPUT/sparse that Tessera did not make is named in a warning, as a map that
+// places its set names it.
 std::optional<MappingSummary> FindUnchangedModels(const std::filesystem::path& output_dir,
                                                   const MapInputs& inputs);
 
