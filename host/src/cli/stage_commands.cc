@@ -31,6 +31,7 @@ struct StageOptions {
   StageArguments arguments;  // --manifest, --camera-K, --masks, --video, --threads, ...
   std::string shard;         // extract and match: "K/N", one shard (distributed/)
   int cluster = -1;          // map: one cluster of OUTPUT/clusters.json (partition/)
+  bool force_map = false;    // map and run: map even when the models in place are kept
 };
 
 void AddShardOption(CLI::App* sub, StageOptions* options) {
@@ -70,10 +71,14 @@ void AddCommonOptions(CLI::App* sub, StageOptions* options, bool needs_images) {
 }
 
 // `--rig` (map and run): the mapper keeps each moment's images in their rig's poses.
-void AddRigOption(CLI::App* sub, StageOptions* options) {
+// `--force-map` (map and run): models made from the same inputs are mapped again.
+void AddMapOptions(CLI::App* sub, StageOptions* options) {
   sub->add_option("--rig", options->arguments.rig,
                   "Rig file: cameras (subfolders), reference, poses, frames; implies "
                   "--camera-per-folder");
+  sub->add_flag("--force-map", options->force_map,
+                "Map even when the models in place were made from the same inputs (else "
+                "they are kept)");
 }
 
 PipelineContext LoadContext(const StageOptions& options) {
@@ -124,7 +129,7 @@ CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
   auto jobs = std::make_shared<int>(0);
   CLI::App* sub = app.add_subcommand("map", "Reconstruct cameras and points from a workspace");
   AddCommonOptions(sub, options.get(), /*needs_images=*/false);
-  AddRigOption(sub, options.get());
+  AddMapOptions(sub, options.get());
   CLI::Option* cluster =
       sub->add_option("--cluster", options->cluster,
                       "K: only cluster K of OUTPUT/clusters.json (tessera partition), into "
@@ -149,7 +154,8 @@ CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
                   "does not hold rigs yet; map without them");
             }
             const PipelineContext context = LoadContext(*options);
-            const RunOptions run{options->images, options->output};
+            RunOptions run{options->images, options->output};
+            run.force_map = options->force_map;
             MapStageSummary summary;
             if (cluster_shard->count() > 0) {
               const MapStageSummary shard =
@@ -242,15 +248,15 @@ CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions&) {
   auto options = std::make_shared<StageOptions>();
   CLI::App* sub = app.add_subcommand("run", "Run every stage: images in, model out");
   AddCommonOptions(sub, options.get(), /*needs_images=*/true);
-  AddRigOption(sub, options.get());
+  AddMapOptions(sub, options.get());
   return {sub, [options]() {
             const PipelineContext context = LoadContext(*options);
-            const RunResult run =
-                RunPipeline(context,
-                            {options->images,
-                             options->output,
-                             {options->arguments.videos.begin(), options->arguments.videos.end()}},
-                            InterruptibleControl());
+            RunOptions run_options{
+                options->images,
+                options->output,
+                {options->arguments.videos.begin(), options->arguments.videos.end()}};
+            run_options.force_map = options->force_map;
+            const RunResult run = RunPipeline(context, run_options, InterruptibleControl());
             if (run.status == StageStatus::kCancelled) return ReportInterrupted("run");
             return MappingExitCode(run.summary.map,
                                    std::filesystem::path(options->output) / "database.db");

@@ -64,6 +64,20 @@ bool IsHostSummaryFile(const std::string& name) {
   return name == "run_summary.json" || name == "mapping_summary.json";
 }
 
+std::vector<std::string> ForeignModelFolderWarnings(const fs::path& output_folder,
+                                                    const OutputLedger& ledger) {
+  std::vector<std::string> warnings;
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(output_folder / "sparse", error)) {
+    const std::string relative = "sparse/" + entry.path().filename().string();
+    if (!ledger.HasFolder(relative)) {
+      warnings.push_back(entry.path().string() + " was not written by Tessera; readers of " +
+                         (output_folder / "sparse").string() + " will take it for a model");
+    }
+  }
+  return warnings;
+}
+
 FileDigest DigestFile(const fs::path& path) {
   const int fd = open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
   if (fd < 0) {

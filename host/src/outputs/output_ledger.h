@@ -74,4 +74,9 @@ class OutputLedger {
   std::set<std::string> folders_;                         // relative paths
 };
 
+// One warning for each entry of OUTPUT/sparse that `ledger` does not record as a folder
+// Tessera made: readers of OUTPUT/sparse take it for one of the models.
+std::vector<std::string> ForeignModelFolderWarnings(const std::filesystem::path& output_folder,
+                                                    const OutputLedger& ledger);
+
 }  // namespace tessera

@@ -434,13 +434,7 @@ std::vector<std::string> OutputTransaction::ShadowWarnings(const OutputLedger& p
   std::error_code error;
   // A model folder in sparse/ that is not Tessera's is read as one of its models.
   if (placed.HasFolder("sparse") || TypeOf(output_ / "sparse") == fs::file_type::directory) {
-    for (const fs::directory_entry& entry : fs::directory_iterator(output_ / "sparse", error)) {
-      const std::string relative = "sparse/" + entry.path().filename().string();
-      if (!ledger_.HasFolder(relative)) {
-        warnings.push_back(entry.path().string() + " was not written by Tessera; readers of " +
-                           (output_ / "sparse").string() + " will take it for a model");
-      }
-    }
+    warnings = ForeignModelFolderWarnings(output_, ledger_);
   }
   // images.bin beside a new images.txt (or the reverse): readers take the .bin first.
   for (const auto& [relative, digests] : placed.files()) {

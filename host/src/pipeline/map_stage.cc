@@ -11,6 +11,7 @@
 #include "io/keypoint_color_sampler.h"
 #include "outputs/output_transaction.h"
 #include "pipeline/load_mapper_input.h"
+#include "pipeline/map_inputs.h"
 #include "pipeline/mapper_result_check.h"
 #include "pipeline/workspace.h"
 #include "plugin/bundle_adjuster_guard.h"
@@ -239,13 +240,15 @@ void RemoveRunSummary(const std::filesystem::path& output_dir) {
   }
 }
 
-// Places the models of `result`, their exports and OUTPUT/mapping_summary.json as one
-// set (OutputTransaction): with no model, what the earlier runs wrote is removed.
+// Places the models of `result`, their exports and OUTPUT/mapping_summary.json (with
+// `inputs`, what they were made from, or null) as one set (OutputTransaction): with no
+// model, what the earlier runs wrote is removed.
 // Returns false when cancelled before the set was placed (nothing of it is).
 bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
                      const MapperResult& result, const MapperInput& input,
                      const std::filesystem::path& image_dir, const StageControl& control,
-                     const MapTarget& target, MapStageSummary* summary) {
+                     const MapTarget& target, const nlohmann::json& inputs,
+                     MapStageSummary* summary) {
   const std::filesystem::path output_dir =
       target.output_dir.empty() ? workspace.folder() : target.output_dir;
   MappingSummary mapping = SummarizeMapping(
@@ -258,6 +261,7 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
                                settings.mapper != nullptr ? settings.mapper->name() : "");
   }
   mapping.partition = target.partition;
+  mapping.inputs = inputs;
   summary->num_models = result.models.size();
   CreateFolder(output_dir);
   OutputTransaction outputs(output_dir);
@@ -303,6 +307,60 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
   return true;
 }
 
+// `mapper`'s Map, its own bad options (found only now) named as the manifest names them.
+MapperResult CallMapper(const PluginInstance<Mapper>& mapper, const std::string& subject,
+                        const MapperInput& input, const MapperContext& context) {
+  try {
+    // The building blocks the mapper calls (Tessera::sfm) use the stage's threads too.
+    const ScopedMapperThreads threads(context.num_threads);
+    return mapper.Call(PluginStage::kMap, subject,
+                       [&](const Mapper& plugin) { return plugin.Map(input, context); });
+  } catch (const PluginError& error) {
+    if (error.plugin() == mapper.name() && error.option_error()) {
+      throw error.AsSlotError("pipeline.mapper", "mapper '" + mapper.name() + "'");
+    }
+    throw;
+  }
+}
+
+// Crashed twice on these images: refused by name, the stage cannot go on without it.
+void CheckNotQuarantined(const Workspace& workspace, const PluginInstance<Mapper>& mapper,
+                         const std::string& subject) {
+  if (workspace.crash_log().IsQuarantined(mapper.name(), PluginStage::kMap, subject)) {
+    throw InputError("pipeline.mapper: mapper '" + mapper.name() + "' crashed twice mapping " +
+                     subject +
+                     " in this workspace (plugin_crashes.tsv) and is not run on them "
+                     "again; choose another mapper, or fix the plugin");
+  }
+}
+
+// The models in place, kept when `inputs` are those they were made from and the set is
+// unchanged since (FindUnchangedModels); nullopt otherwise.
+std::optional<MapStageSummary> KeepUnchangedModels(const Workspace& workspace,
+                                                   const MapInputs& inputs,
+                                                   const MapperInput& input,
+                                                   const StageControl& control) {
+  const std::optional<MappingSummary> recorded = FindUnchangedModels(workspace.folder(), inputs);
+  if (!recorded) return std::nullopt;
+  MapStageSummary summary;
+  summary.kept = true;
+  summary.num_images = input.images.size();
+  summary.num_models = recorded->models.size();
+  for (const MappingSummary::Model& model : recorded->models) {
+    summary.num_registered += model.num_images;
+    summary.images_per_model.push_back(model.num_images);
+    spdlog::info("map: model {}: {} images, {} points (kept)", model.index, model.num_images,
+                 model.num_points3D);
+  }
+  control.Report("map", input.images.size(), input.images.size());
+  spdlog::info(
+      "map: inputs unchanged since {}; kept the {} model(s) in {} (pass --force-map or change "
+      "an option to re-map)",
+      MapInputs::FromJson(recorded->inputs)->mapped_at, summary.num_models,
+      workspace.folder().string());
+  return summary;
+}
+
 MapStageSummary PlaceMapResult(const Workspace& workspace, const MapSettings& settings,
                                const MapperResult& result, const MapperInput& input,
                                const MapTarget& target, const StageControl& control) {
@@ -310,7 +368,8 @@ MapStageSummary PlaceMapResult(const Workspace& workspace, const MapSettings& se
   MapStageSummary summary;
   summary.num_images = input.images.size();
   const std::filesystem::path image_dir = ImageFolder(settings.image_dir, workspace.database());
-  if (!PlaceMapOutputs(workspace, settings, result, input, image_dir, control, target, &summary)) {
+  if (!PlaceMapOutputs(workspace, settings, result, input, image_dir, control, target, {},
+                       &summary)) {
     summary.status = StageStatus::kCancelled;
   }
   summary.seconds = timer.ElapsedSeconds();
@@ -349,13 +408,25 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
                  database->path().string(), database->NumMatchedPairs());
     summary.num_images = database->NumImages();
     summary.seconds = timer.ElapsedSeconds();
-    if (!PlaceMapOutputs(workspace, settings, {}, input, image_dir, control, target, &summary)) {
+    if (!PlaceMapOutputs(workspace, settings, {}, input, image_dir, control, target, {},
+                         &summary)) {
       cancelled();
     }
     return summary;
   }
   summary.num_images = input.images.size();
   if (cancelled()) return summary;
+  // Only the whole workspace's map is recorded, and kept; a cluster's always maps.
+  std::optional<MapInputs> inputs;
+  if (target.input == nullptr && target.output_dir.empty()) {
+    inputs = DigestMapInputs(input, settings, *database, image_dir);
+    std::optional<MapStageSummary> kept;
+    if (!settings.force) kept = KeepUnchangedModels(workspace, *inputs, input, control);
+    if (kept) {
+      kept->seconds = timer.ElapsedSeconds();
+      return *kept;
+    }
+  }
   control.Report("map", 0, input.images.size());
   const BundleAdjusterGuard bundle_adjuster(*settings.bundle_adjuster, &workspace.crash_log());
   std::vector<image_t> image_ids;
@@ -385,33 +456,15 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
   };
   const PluginInstance<Mapper>& mapper = *settings.mapper;
   if (!mapper) throw std::logic_error("MapWorkspace: the mapper slot is empty");
-  // Crashed twice on these images: refused by name, the stage cannot go on without it.
   const std::string subject = std::to_string(input.images.size()) + " images";
-  if (workspace.crash_log().IsQuarantined(mapper.name(), PluginStage::kMap, subject)) {
-    throw InputError("pipeline.mapper: mapper '" + mapper.name() + "' crashed twice mapping " +
-                     subject +
-                     " in this workspace (plugin_crashes.tsv) and is not run on them "
-                     "again; choose another mapper, or fix the plugin");
-  }
+  CheckNotQuarantined(workspace, mapper, subject);
   // The keypoints' colours, sampled on the core the mapper leaves idle; stopped (and
   // joined) before colouring, or when the stage ends otherwise.
   std::optional<KeypointColorSampler> colors;
   if (!image_dir.empty()) {
     colors.emplace(image_dir, input.images, input.cameras, kMaxKeypointColorBytes);
   }
-  MapperResult result;
-  try {
-    // The building blocks the mapper calls (Tessera::sfm) use the stage's threads too.
-    const ScopedMapperThreads threads(context.num_threads);
-    result = mapper.Call(PluginStage::kMap, subject,
-                         [&](const Mapper& plugin) { return plugin.Map(input, context); });
-  } catch (const PluginError& error) {
-    // Its own bad options, found only now, are named as the manifest names them.
-    if (error.plugin() == mapper.name() && error.option_error()) {
-      throw error.AsSlotError("pipeline.mapper", "mapper '" + mapper.name() + "'");
-    }
-    throw;
-  }
+  MapperResult result = CallMapper(mapper, subject, input, context);
   // Asked to stop: whatever the mapper returned is dropped, and the old outputs stay.
   if (cancelled()) return summary;
   CheckMapperResult(mapper.name(), input, &result);
@@ -421,7 +474,8 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
 
   ColorModels(image_dir, settings.num_threads, colors ? &*colors : nullptr, &result.models);
   summary.seconds = timer.ElapsedSeconds();
-  if (!PlaceMapOutputs(workspace, settings, result, input, image_dir, control, target, &summary)) {
+  if (!PlaceMapOutputs(workspace, settings, result, input, image_dir, control, target,
+                       inputs ? inputs->ToJson() : nlohmann::json(), &summary)) {
     cancelled();
     return summary;
   }

@@ -38,6 +38,9 @@ struct MapSettings {
   std::vector<std::filesystem::path> videos;
   // A camera rig over the workspace's images (`--rig`), or null; must outlive the stage.
   const RigFile* rig = nullptr;
+  // Map even when the models in place were made from the same inputs (`--force-map`);
+  // else such models are kept (map_inputs.h).
+  bool force = false;
 };
 
 // The mapping summary of a mapper result: models (sparse_dir/<index>), why images were
@@ -61,6 +64,10 @@ struct MapTarget {
 // (outputs/output_transaction.h): placed whole, each entry with one rename, or not at
 // all; what earlier runs wrote and this set no longer holds is removed, and nothing
 // Tessera did not write is replaced or removed. `scope` must be whole.
+// A whole-workspace map whose inputs (map_inputs.h) are those the models in place were
+// made from, the set unchanged since, keeps them unless `settings.force`: nothing is
+// mapped or written, and the summary says `kept` (logged with the time they were made).
+// A cluster's map (target.input given) always maps.
 // No verified pair after matching: a summary with no model (the caller exits 3), and
 // the earlier runs' models are removed. Throws InputError when matching has not run or
 // the set cannot be placed, and the first failing exporter's PluginError (the

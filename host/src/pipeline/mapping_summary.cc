@@ -50,6 +50,7 @@ nlohmann::json MappingSummary::ToJson() const {
   json["seed"] = seed;
   if (!rig.is_null()) json["rig"] = rig;
   if (!partition.is_null()) json["partition"] = partition;
+  if (!inputs.is_null()) json["inputs"] = inputs;
   return json;
 }
 
@@ -106,6 +107,7 @@ MappingSummary MappingSummary::FromJson(const nlohmann::json& json) {
   summary.seed = json.at("seed").get<uint64_t>();
   summary.rig = json.value("rig", nlohmann::json());
   summary.partition = json.value("partition", nlohmann::json());
+  summary.inputs = json.value("inputs", nlohmann::json());
   return summary;
 }
 

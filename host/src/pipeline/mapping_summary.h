@@ -72,6 +72,10 @@ struct MappingSummary {
   // clusters.json it is ({"cluster", "clusters_json"}); the merged set lists every
   // merge decision ({"clusters_json", "merges": [...]}). Null otherwise.
   nlohmann::json partition;
+  // What the map that made this set was made from (map_inputs.h: MapInputs::ToJson,
+  // {"mapped_at", "parts": {part: digest}}), so that a rerun with the same inputs keeps
+  // the set; null for a set made otherwise (a merge of clusters, a cluster's map).
+  nlohmann::json inputs;
 
   // The file's JSON, keys as documented in the README.
   nlohmann::json ToJson() const;

@@ -71,7 +71,9 @@ MapStageSummary RunMap(const PipelineContext& context, const RunOptions& options
   CheckImagesUnchanged(
       *workspace, options.image_dir,
       workspace->ScanOptions(context.manifest.camera.mask_path, context.manifest.max_image_pixels));
-  return MapWorkspace(*workspace, context.MakeMapSettings(options.image_dir), {}, control);
+  MapSettings settings = context.MakeMapSettings(options.image_dir);
+  settings.force = options.force_map;
+  return MapWorkspace(*workspace, settings, {}, control);
 }
 
 RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
@@ -109,6 +111,7 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
   }
   MapSettings map_settings = context.MakeMapSettings(image_dir);
   map_settings.videos = options.videos;
+  map_settings.force = options.force_map;
   summary.map = MapWorkspace(*workspace, map_settings, {}, control);
   if (summary.map.status == StageStatus::kCancelled) {
     run.status = StageStatus::kCancelled;

@@ -27,6 +27,8 @@ struct RunOptions {
   // Videos instead of image_dir: their keyframes go to OUTPUT/video_frames (see
   // video/video_frames.h), which then is the image folder.
   std::vector<std::filesystem::path> videos;
+  // Map even when the models in place were made from the same inputs (MapSettings::force).
+  bool force_map = false;
 };
 
 struct RunResult {

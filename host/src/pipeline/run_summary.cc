@@ -45,7 +45,8 @@ nlohmann::json RunSummary::ToJson() const {
             {"num_models", map.num_models},
             {"num_registered", map.num_registered},
             {"num_images", map.num_images},
-            {"images_per_model", map.images_per_model}}},
+            {"images_per_model", map.images_per_model},
+            {"kept", map.kept}}},
           {"total_seconds", total_seconds},
           {"plugins", plugins}};
 }
@@ -77,6 +78,7 @@ RunSummary RunSummary::FromJson(const nlohmann::json& json) {
   summary.map.num_images = map.at("num_images").get<size_t>();
   summary.map.images_per_model =
       map.value("images_per_model", nlohmann::json::array()).get<std::vector<size_t>>();
+  summary.map.kept = map.value("kept", false);
   summary.total_seconds = json.at("total_seconds").get<double>();
   summary.plugins = json.value("plugins", nlohmann::json::array()).get<std::vector<PluginUsed>>();
   return summary;

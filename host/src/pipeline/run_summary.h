@@ -72,13 +72,15 @@ struct MapStageSummary {
   size_t num_images = 0;      // images the mapper was given
   double seconds = 0;
   std::vector<size_t> images_per_model;  // registered images of model 0, 1, ...
+  // The models in place were made from the same inputs and kept (map_inputs.h).
+  bool kept = false;
 };
 
 // run_summary.json. ToJson writes, of each stage, the fields listed there (the status
 // is not written: the file exists only for a run that went to its end); FromJson reads
 // them back and leaves the others at their defaults. FromJson throws
 // nlohmann::json::exception for a missing or mistyped field; `pairs_per_selector`,
-// `images_per_model` and `plugins`, absent from files of older versions, may be missing.
+// `images_per_model`, `kept` and `plugins`, absent from files of older versions, may be missing.
 struct RunSummary {
   ExtractionSummary extract;
   MatchingSummary match;

@@ -15,7 +15,7 @@ RunSummary Example() {
   summary.match.num_reused = 5;
   summary.match.num_verified = 53;
   summary.match.seconds = 2.25;
-  summary.map = {StageStatus::kCompleted, 2, 10, 11, 3.5, {7, 3}};
+  summary.map = {StageStatus::kCompleted, 2, 10, 11, 3.5, {7, 3}, true};
   summary.total_seconds = 7.75;
   summary.plugins = {{"detector", "orb", "1.0.0"},
                      {"pair_selector", "spatial", "1.0.0"},
@@ -35,13 +35,14 @@ TEST(RunSummary, JsonHasTheKeysBenchReads) {
   EXPECT_EQ(json.at("match").at("pairs_per_selector").at(1).at("plugin"), "sequential");
   EXPECT_EQ(json.at("map").at("num_models").get<size_t>(), 2u);
   EXPECT_EQ(json.at("map").at("images_per_model"), nlohmann::json({7, 3}));
+  EXPECT_EQ(json.at("map").at("kept"), true);
   EXPECT_DOUBLE_EQ(json.at("total_seconds").get<double>(), 7.75);
   EXPECT_EQ(json.at("plugins").at(5),
             nlohmann::json({{"slot", "exporter"}, {"plugin", "ply"}, {"version", "1.1.0"}}));
   // What the file has is exactly this (status and in-memory figures stay out).
   EXPECT_EQ(json.at("extract").size(), 7u);
   EXPECT_EQ(json.at("match").size(), 6u);
-  EXPECT_EQ(json.at("map").size(), 5u);
+  EXPECT_EQ(json.at("map").size(), 6u);
   EXPECT_EQ(json.size(), 5u);
 }
 
@@ -56,6 +57,7 @@ TEST(RunSummary, RoundTrip) {
   EXPECT_EQ(back.match.pairs_per_selector[0].num_pairs, 40u);
   EXPECT_EQ(back.map.num_registered, 10u);
   EXPECT_EQ(back.map.images_per_model, (std::vector<size_t>{7, 3}));
+  EXPECT_TRUE(back.map.kept);
   ASSERT_EQ(back.plugins.size(), 6u);
   EXPECT_EQ(back.plugins[2].plugin, "sequential");
   EXPECT_EQ(back.plugins[5].version, "1.1.0");
@@ -65,11 +67,13 @@ TEST(RunSummary, OlderFilesWithoutPairsPerSelectorOrImagesPerModelRead) {
   nlohmann::json json = Example().ToJson();
   json["match"].erase("pairs_per_selector");
   json["map"].erase("images_per_model");
+  json["map"].erase("kept");
   json.erase("plugins");
   const RunSummary back = RunSummary::FromJson(json);
   EXPECT_TRUE(back.plugins.empty());
   EXPECT_TRUE(back.match.pairs_per_selector.empty());
   EXPECT_TRUE(back.map.images_per_model.empty());
+  EXPECT_FALSE(back.map.kept);
   EXPECT_EQ(back.match.num_pairs, 55u);
 }
 
