@@ -507,10 +507,10 @@ void LogViewGraph(const MapperInput& input, size_t num_pairs, const GlobalMapper
 
 }  // namespace
 
-GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
-                                             const BundleAdjuster& bundle_adjuster,
-                                             const GlobalMapperOptions& options,
-                                             std::function<bool()> should_stop) {
+GlobalMapperResult GlobalMapper::Reconstruct(
+    const MapperInput& input, const BundleAdjuster& bundle_adjuster,
+    const GlobalMapperOptions& options, std::function<bool()> should_stop,
+    const std::function<void(const std::string&, size_t, size_t)>& on_progress) {
   const auto start_time = std::chrono::steady_clock::now();
   GlobalMapperResult result;
   const auto seconds = [&start_time] {
@@ -525,6 +525,9 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   };
   GlobalMapperResult::StepSeconds& steps = result.step_seconds;
   const auto stop = [&should_stop] { return should_stop && should_stop(); };
+  const auto progress = [&on_progress](const char* step, size_t done, size_t total) {
+    if (on_progress) on_progress(step, done, total);
+  };
   const auto cancelled = [&] {
     GlobalMapperResult empty;
     empty.cancelled = true;
@@ -553,6 +556,7 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   }
   if (stop()) return cancelled();
   lap(&steps.view_graph);
+  progress("view graph", 1, 1);
 
   // 4. Rotation averaging.
   std::vector<const MapperInput::Pair*> pair_of_rotation;
@@ -563,6 +567,7 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   if (rotations.cancelled || stop()) return cancelled();
   result.num_pairs_dropped_by_rotation_averaging = rotations.num_dropped;
   lap(&steps.rotation_averaging);
+  progress("rotation averaging", 1, 1);
   std::set<image_t> with_rotation_pair;
   for (const RelativeRotation& rotation : relative_rotations) {
     with_rotation_pair.insert(rotation.image_id1);
@@ -589,12 +594,15 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
       options.retriangulate ? BuildFeatureTracks(VerifiedPairMatches(input, options), num_points2D)
                             : FeatureTracks();
   lap(&steps.tracks);
+  progress("tracks", 1, 1);
   LogViewGraph(input, pairs.size(), options, result, rotations);
 
   std::map<image_t, std::string> reasons;
   const PartRun run{input, cameras, options, should_stop, &result, &reasons, lap};
   const std::vector<std::set<image_t>> parts = groups.Groups();
+  size_t registered = 0;
   for (size_t part_index = 0; part_index < parts.size(); ++part_index) {
+    progress("positioning", part_index, parts.size());
     const std::set<image_t>& part = parts[part_index];
     if (part.size() < static_cast<size_t>(options.min_model_size)) {
       for (const image_t image_id : part) {
@@ -615,9 +623,12 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
     if (outcome == PartOutcome::kCancelled) return cancelled();
     if (outcome == PartOutcome::kNoModel) continue;
     FinishModel(&model);
+    registered += model.NumRegisteredImages();
+    progress("registration", registered, input.images.size());
     result.models.push_back(std::move(model));
     lap(&steps.filtering);
   }
+  progress("positioning", parts.size(), parts.size());
 
   SortModelsLargestFirst(&result.models);
   ExplainUnregistered(input, options, in_verified_pair, with_rotation_pair, reasons, &result);
