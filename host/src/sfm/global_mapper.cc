@@ -505,6 +505,25 @@ void LogViewGraph(const MapperInput& input, size_t num_pairs, const GlobalMapper
       result.num_tracks);
 }
 
+// The name a step's time goes by in GlobalMapperResult::StepSeconds, as its progress
+// reports it.
+const char* StepName(const GlobalMapperResult::StepSeconds& steps, const double* step) {
+  if (step == &steps.view_graph) return "view graph";
+  if (step == &steps.rotation_averaging) return "rotation averaging";
+  if (step == &steps.tracks) return "tracks";
+  if (step == &steps.positioning) return "positioning";
+  if (step == &steps.bundle_adjustment) return "bundle adjustment";
+  return "filtering";
+}
+
+GlobalMapperResult CancelledResult(double seconds) {
+  GlobalMapperResult empty;
+  empty.cancelled = true;
+  empty.seconds = seconds;
+  spdlog::info("global map: stopped after {:.1f} s", empty.seconds);
+  return empty;
+}
+
 }  // namespace
 
 GlobalMapperResult GlobalMapper::Reconstruct(
@@ -517,24 +536,16 @@ GlobalMapperResult GlobalMapper::Reconstruct(
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   };
   auto lap_start = start_time;
-  // Adds the time since the last lap to `step`.
-  const auto lap = [&lap_start](double* step) {
+  GlobalMapperResult::StepSeconds& steps = result.step_seconds;
+  // Adds the time since the last lap to `step`, and reports the step done.
+  const auto lap = [&lap_start, &steps, &on_progress](double* step) {
     const auto now = std::chrono::steady_clock::now();
     *step += std::chrono::duration<double>(now - lap_start).count();
     lap_start = now;
+    if (on_progress) on_progress(StepName(steps, step), 1, 1);
   };
-  GlobalMapperResult::StepSeconds& steps = result.step_seconds;
   const auto stop = [&should_stop] { return should_stop && should_stop(); };
-  const auto progress = [&on_progress](const char* step, size_t done, size_t total) {
-    if (on_progress) on_progress(step, done, total);
-  };
-  const auto cancelled = [&] {
-    GlobalMapperResult empty;
-    empty.cancelled = true;
-    empty.seconds = seconds();
-    spdlog::info("global map: stopped after {:.1f} s", empty.seconds);
-    return empty;
-  };
+  const auto cancelled = [&] { return CancelledResult(seconds()); };
   if (stop()) return cancelled();
 
   // 1. The pairs that map.
@@ -556,7 +567,6 @@ GlobalMapperResult GlobalMapper::Reconstruct(
   }
   if (stop()) return cancelled();
   lap(&steps.view_graph);
-  progress("view graph", 1, 1);
 
   // 4. Rotation averaging.
   std::vector<const MapperInput::Pair*> pair_of_rotation;
@@ -567,7 +577,6 @@ GlobalMapperResult GlobalMapper::Reconstruct(
   if (rotations.cancelled || stop()) return cancelled();
   result.num_pairs_dropped_by_rotation_averaging = rotations.num_dropped;
   lap(&steps.rotation_averaging);
-  progress("rotation averaging", 1, 1);
   std::set<image_t> with_rotation_pair;
   for (const RelativeRotation& rotation : relative_rotations) {
     with_rotation_pair.insert(rotation.image_id1);
@@ -594,7 +603,6 @@ GlobalMapperResult GlobalMapper::Reconstruct(
       options.retriangulate ? BuildFeatureTracks(VerifiedPairMatches(input, options), num_points2D)
                             : FeatureTracks();
   lap(&steps.tracks);
-  progress("tracks", 1, 1);
   LogViewGraph(input, pairs.size(), options, result, rotations);
 
   std::map<image_t, std::string> reasons;
@@ -602,7 +610,6 @@ GlobalMapperResult GlobalMapper::Reconstruct(
   const std::vector<std::set<image_t>> parts = groups.Groups();
   size_t registered = 0;
   for (size_t part_index = 0; part_index < parts.size(); ++part_index) {
-    progress("positioning", part_index, parts.size());
     const std::set<image_t>& part = parts[part_index];
     if (part.size() < static_cast<size_t>(options.min_model_size)) {
       for (const image_t image_id : part) {
@@ -624,11 +631,10 @@ GlobalMapperResult GlobalMapper::Reconstruct(
     if (outcome == PartOutcome::kNoModel) continue;
     FinishModel(&model);
     registered += model.NumRegisteredImages();
-    progress("registration", registered, input.images.size());
+    if (on_progress) on_progress("registration", registered, input.images.size());
     result.models.push_back(std::move(model));
     lap(&steps.filtering);
   }
-  progress("positioning", parts.size(), parts.size());
 
   SortModelsLargestFirst(&result.models);
   ExplainUnregistered(input, options, in_verified_pair, with_rotation_pair, reasons, &result);

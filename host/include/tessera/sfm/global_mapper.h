@@ -71,9 +71,9 @@ class TESSERA_SFM_EXPORT GlobalMapper {
   // Maps `input`; `bundle_adjuster` must be usable from this thread. Throws OptionError
   // for nothing (the options are checked by FromJson) and InputError for a pair naming
   // a keypoint an image lacks. on_progress (may be empty) hears each step as it ends
-  // ("view graph", "rotation averaging", "tracks": 1 of 1; "positioning": parts done of
-  // parts; "registration": the images of the models finished so far, of the input's),
-  // as MapperControl::on_progress.
+  // ("view graph", "rotation averaging", "tracks", then per connected part "positioning",
+  // "bundle adjustment", "filtering": 1 of 1) and "registration" (the images of the
+  // models finished so far, of the input's), as MapperControl::on_progress.
   static GlobalMapperResult Reconstruct(
       const MapperInput& input, const BundleAdjuster& bundle_adjuster,
       const GlobalMapperOptions& options, std::function<bool()> should_stop = {},
