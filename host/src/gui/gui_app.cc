@@ -12,6 +12,8 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "gui/checked_read.h"
+#include "gui/export_panel.h"
 #include "gui/gl.h"
 #include "gui/log_pane.h"
 #include "gui/match_matrix_panel.h"
@@ -86,6 +88,9 @@ GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;
   ImGui::StyleColorsDark();
+  // Opaque windows: a window's text never shows through another over it.
+  ImGui::GetStyle().Colors[ImGuiCol_WindowBg].w = 1.0f;
+  ImGui::GetStyle().Colors[ImGuiCol_PopupBg].w = 1.0f;
   float scale = options.ui_scale;
   if (scale <= 0) {
     float y_scale = 1;
@@ -115,12 +120,14 @@ GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
       std::make_unique<SetupPanel>(RunRequest{options.images, options.output, options.manifest, {}},
                                    options.follow_run, controller_.get(), [this]() {
                                      view_->ForgetPicks();
-                                     model_panel_->ForgetModels();
-                                     if (setup_->follow_run()) view_->Show(nullptr, false);
+                                     if (!setup_->follow_run()) return;
+                                     model_panel_->RunStarted(setup_->OutputField());
+                                     view_->Show(nullptr, false);
                                    });
   picking_ = std::make_unique<Picking>(view_.get());
   match_matrix_ = std::make_unique<MatchMatrixPanel>();
   log_pane_ = std::make_unique<LogPane>(log_sink_);
+  export_panel_ = std::make_unique<ExportPanel>();
   if (!options.model.empty()) OpenModel(options.model);
 }
 
@@ -134,6 +141,7 @@ GuiApp::~GuiApp() {
   sinks.erase(std::remove(sinks.begin(), sinks.end(), log_sink_), sinks.end());
   // The panels' textures and the renderer's buffers go while the context is current.
   log_pane_.reset();
+  export_panel_.reset();
   match_matrix_.reset();
   picking_.reset();
   setup_.reset();
@@ -201,6 +209,9 @@ RunStatus GuiApp::FollowRun() {
       model_panel_->ShowRunModels(status.output_dir);
     }
     if (status.state == RunState::kFailed) setup_->ShowRunError(status.error);
+    if (status.state == RunState::kFailed || status.state == RunState::kCancelled) {
+      model_panel_->RunStopped(status.state == RunState::kFailed, view_->scene() != nullptr);
+    }
   }
   return status;
 }
@@ -215,9 +226,31 @@ void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
     io.MouseDown[0] = input->left_down;
     for (int button = 1; button < 5; ++button) io.MouseDown[button] = false;
     if (!input->text.empty()) io.AddInputCharactersUTF8(input->text.c_str());
+    for (int key = 0; key < ImGuiKey_COUNT; ++key) {
+      const int index = io.KeyMap[key];
+      if (index < 0 || index >= IM_ARRAYSIZE(io.KeysDown)) continue;
+      io.KeysDown[index] =
+          std::find(input->keys.begin(), input->keys.end(), key) != input->keys.end();
+    }
+    io.KeyCtrl = input->ctrl;
+    io.MouseWheel += input->wheel;
   }
   ImGui::NewFrame();
   widgets_.Clear();
+  // The last net under the checked reads: whatever a panel throws is a message in the
+  // log, the windows it left open are closed, and the window stays.
+  std::string error;
+  if (!CheckedRead(
+          {}, [&] { DrawWindows(status); }, &error)) {
+    ImGui::ErrorCheckEndFrameRecover(nullptr);
+    frame_error_ = error;
+    spdlog::error("gui: {}", error);
+  }
+  ImGui::Render();
+  Render(capture);
+}
+
+void GuiApp::DrawWindows(const RunStatus& status) {
   const WidgetRect view = ViewRect();
   if (!options_.view_only) {
     const fs::path images(setup_->ImagesField());
@@ -242,8 +275,6 @@ void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
                  {(view.min_x + view.max_x - size.x) / 2, (view.min_y + view.max_y - size.y) / 2,
                   (view.min_x + view.max_x + size.x) / 2, (view.min_y + view.max_y + size.y) / 2});
   }
-  ImGui::Render();
-  Render(capture);
 }
 
 void GuiApp::DrawSetupWindow(const RunStatus& status) {
@@ -267,6 +298,8 @@ void GuiApp::DrawSetupWindow(const RunStatus& status) {
   }
   const std::string output = setup_->OutputField();
   match_matrix_->DrawOpenButton(output.empty() ? model_panel_->ModelField() : output, &widgets_);
+  export_panel_->Draw(model_panel_->WrittenModel(), model_panel_->model_index(),
+                      fs::path(setup_->ImagesField()), &widgets_);
   ImGui::Separator();
   // What reaches past the visible area (the log is a child window of its own).
   const ImGuiWindow* window = ImGui::GetCurrentWindow();
@@ -280,6 +313,9 @@ void GuiApp::DrawSetupWindow(const RunStatus& status) {
 void GuiApp::CheckImageFolderOfModel(const fs::path& images) {
   // Not while a run grows its model: its images are the Images field's by construction.
   if (controller_->Running()) return;
+  // Nor while the field is being typed in: one check (and one warning in the log) for
+  // the path typed, not one per keystroke.
+  if (setup_->ImagesFieldActive()) return;
   const Scene* scene = view_->scene();
   std::shared_ptr<const Reconstruction> model = scene == nullptr ? nullptr : scene->model;
   if (model == folder_check_.model && images == folder_check_.image_dir) return;
@@ -293,13 +329,12 @@ fs::path GuiApp::MaskDir() {
   if (manifest != mask_manifest_) {
     mask_manifest_ = manifest;
     manifest_mask_dir_.clear();
-    std::error_code error;
-    if (!manifest.empty() && fs::is_regular_file(manifest, error)) {
-      try {
-        manifest_mask_dir_ = Manifest::Load(manifest).camera.mask_path;
-      } catch (const std::exception&) {
-        // A manifest that does not parse: the Run button says why; no masks here.
-      }
+    // A manifest that cannot be read or does not parse: the Run button says why; no masks.
+    std::string problem = NotAFileProblem(manifest, "the manifest");
+    if (problem.empty()) {
+      CheckedRead(
+          manifest, [&] { manifest_mask_dir_ = Manifest::Load(manifest).camera.mask_path; },
+          &problem);
     }
   }
   return manifest_mask_dir_;
@@ -333,6 +368,11 @@ void GuiApp::SaveScreenshot(const fs::path& file) {
 bool GuiApp::OpenModel(const fs::path& path) { return model_panel_->Open(path); }
 const std::string& GuiApp::ModelError() const { return model_panel_->Error(); }
 std::string GuiApp::ModelField() const { return model_panel_->ModelField(); }
+const std::string& GuiApp::ModelShowing() const { return model_panel_->Showing(); }
+const std::string& GuiApp::ModelStale() const { return model_panel_->Stale(); }
+const std::string& GuiApp::ExportMessage() const { return export_panel_->Message(); }
+bool GuiApp::ExportFailed() const { return export_panel_->failed(); }
+size_t GuiApp::LogFirstLineShown() const { return log_pane_->first_line_shown(); }
 const std::string& GuiApp::SetupError() const { return setup_->Error(); }
 const std::string& GuiApp::FieldError(const std::string& field) const {
   return setup_->FieldError(field);
@@ -346,6 +386,9 @@ bool GuiApp::LoadManifestIntoEditor() { return setup_->editor().Load(); }
 bool GuiApp::CheckEditedManifest() { return setup_->editor().Check(); }
 bool GuiApp::SaveEditedManifest(const fs::path& file) { return setup_->editor().Save(file); }
 void GuiApp::SetEditorText(const std::string& text) { setup_->editor().SetText(text); }
+const std::string& GuiApp::EditorQuestion() const { return setup_->editor().Question(); }
+void GuiApp::AnswerEditor(bool replace) { setup_->editor().Answer(replace); }
+const std::string& GuiApp::RecipeShown() const { return setup_->RecipeShown(); }
 std::string GuiApp::EditorText() const { return setup_->editor().Text(); }
 const std::string& GuiApp::EditorError() const { return setup_->editor().Error(); }
 bool GuiApp::SetEditorPlugin(const std::string& slot, const std::string& plugin) {
@@ -363,6 +406,10 @@ const std::string& GuiApp::MatchError() const { return match_matrix_->Error(); }
 std::pair<int, int> GuiApp::SelectedPair() const { return match_matrix_->SelectedPair(); }
 size_t GuiApp::PairLinesDrawn() const { return match_matrix_->pair_view().lines_drawn(); }
 bool GuiApp::PairShowsPutatives() const { return match_matrix_->pair_view().show_putatives; }
+const std::vector<WidgetRect>& GuiApp::MatrixColumnLabels() const {
+  return match_matrix_->column_labels();
+}
+const std::string& GuiApp::PairPhotoProblem() const { return match_matrix_->pair_view().problem(); }
 const PairInliers& GuiApp::SelectedPairInliers() const {
   return match_matrix_->SelectedPairInliers();
 }

@@ -28,6 +28,7 @@ struct GLFWwindow;
 
 namespace tessera::gui {
 
+class ExportPanel;
 class LogPane;
 class MatchMatrixPanel;
 class ModelPanel;
@@ -59,6 +60,11 @@ struct SyntheticInput {
   float y = 0;
   bool left_down = false;
   std::string text;  // characters typed this frame
+  // Keys held this frame, as ImGuiKey_ values (ImGuiKey_A, ImGuiKey_Enter, ...), and
+  // Ctrl; a key not held in the next synthetic frame is released.
+  std::vector<int> keys;
+  bool ctrl = false;
+  float wheel = 0;  // mouse wheel notches this frame (positive: up)
 };
 
 class GuiApp {
@@ -94,6 +100,14 @@ class GuiApp {
   const std::string& ModelError() const;
   // The "Open a model" field: the model opened, or the workspace of the run shown.
   std::string ModelField() const;
+  // What the 3D view shows, as the line under the model field says it (ModelPanel::Showing).
+  const std::string& ModelShowing() const;
+  // Why the written model shown is stale (ModelPanel::Stale); empty when it is not.
+  const std::string& ModelStale() const;
+  // The export section's last message ("exported N images, ..." or why not) and whether
+  // it failed.
+  const std::string& ExportMessage() const;
+  bool ExportFailed() const;
   const std::string& SetupError() const;
   // The message beside the set-up field "images" or "manifest"; empty when none.
   const std::string& FieldError(const std::string& field) const;
@@ -105,6 +119,12 @@ class GuiApp {
   bool CheckEditedManifest();
   bool SaveEditedManifest(const std::filesystem::path& file);
   void SetEditorText(const std::string& text);
+  // The editor's question before it replaces unsaved text or an existing file (empty:
+  // none), and its answer (true: replace).
+  const std::string& EditorQuestion() const;
+  void AnswerEditor(bool replace);
+  // The Recipe box's text in the last frame ("default", "default (edited)", ...).
+  const std::string& RecipeShown() const;
   std::string EditorText() const;
   const std::string& EditorError() const;
   std::string ImagesField() const;
@@ -133,6 +153,8 @@ class GuiApp {
   // shows the putative matches rather than the inliers.
   size_t PairLinesDrawn() const;
   bool PairShowsPutatives() const;
+  // Why the pair view shows no photographs (PairView::problem); empty when it does.
+  const std::string& PairPhotoProblem() const;
   std::optional<WidgetRect> Widget(const std::string& name) const { return widgets_.Find(name); }
   // The 3D view's rectangle in window pixels.
   WidgetRect ViewRect() const;
@@ -147,8 +169,14 @@ class GuiApp {
     return widgets_.Elided();
   }
   const std::string& Tooltip() const { return widgets_.tooltip(); }
+  // The error messages drawn in the last frame, once per time each was drawn.
+  const std::vector<std::string>& ErrorsShown() const { return widgets_.Errors(); }
+  // Where the match matrix drew its column numbers in the last frame.
+  const std::vector<WidgetRect>& MatrixColumnLabels() const;
   float UiScale() const;
   std::vector<LogLine> LogLines() const { return log_sink_->Lines(); }
+  // The number (since the first line logged) of the log pane's first line in sight.
+  size_t LogFirstLineShown() const;
   size_t NumScenePoints() const;
   size_t NumSceneCameras() const;
   void SetViewOrbit(float dx_px, float dy_px);
@@ -172,6 +200,8 @@ class GuiApp {
   bool PhotoMasked() const;
   std::filesystem::path MaskDir();
   point3D_t selected_point() const;
+  // What a frame's panels threw last (logged, the window kept); empty when none did.
+  const std::string& FrameError() const { return frame_error_; }
   // For the window system's callbacks.
   void MarkChangedFromInput();
 
@@ -182,6 +212,8 @@ class GuiApp {
   // The set-up window on the left: the run's set-up, the model opener, the match
   // matrix button and the log.
   void DrawSetupWindow(const RunStatus& status);
+  // The windows of a frame, between ImGui::NewFrame and ImGui::Render.
+  void DrawWindows(const RunStatus& status);
   // Clears the window and draws the 3D view and ImGui's windows; reads the pixels back
   // into `capture` when given.
   void Render(RgbImage* capture);
@@ -201,6 +233,7 @@ class GuiApp {
   float panel_width_ = 0;      // set when the user resized the set-up window; 0: automatic
   float panel_set_width_ = 0;  // the width the last frame asked for
   float panel_overflow_ = 0;
+  std::string frame_error_;
 
   // The panels (destroyed before the OpenGL context: they hold textures).
   std::unique_ptr<SceneView> view_;
@@ -209,6 +242,7 @@ class GuiApp {
   std::unique_ptr<Picking> picking_;
   std::unique_ptr<MatchMatrixPanel> match_matrix_;
   std::unique_ptr<LogPane> log_pane_;
+  std::unique_ptr<ExportPanel> export_panel_;
   WidgetRects widgets_;
   ImageFolderCheck folder_check_;
   // The manifest field's camera.mask_path, read when the field changes.

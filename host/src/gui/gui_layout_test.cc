@@ -127,5 +127,53 @@ TEST_F(GuiLayoutTest, DraggingTheRightEdgeResizesTheSetUpWindow) {
   EXPECT_EQ(app.PanelOverflow(), 0.0f);
 }
 
+// Issue 52 item 6: the log keeps its place when its width changes: the line first in
+// sight stays first (its lines wrap anew), not the pixel the pane was scrolled to.
+TEST_F(GuiLayoutTest, TheLogKeepsItsPlaceWhenTheWindowIsResized) {
+  GuiOptions options;
+  options.width = 1280;
+  options.height = 800;
+  options.ui_scale = 1;
+  GuiApp app(options);
+  for (int i = 0; i < 200; ++i) {
+    spdlog::info("line {}: {}", i, std::string(150, 'a' + static_cast<char>(i % 26)));
+  }
+  app.Frame();
+  app.Frame();
+  const WidgetRect log = app.Widget("log").value();
+  // Scrolled up from the end, by the wheel over the log.
+  SyntheticInput wheel;
+  wheel.x = log.CenterX();
+  wheel.y = log.CenterY();
+  wheel.wheel = 20;
+  for (int i = 0; i < 3; ++i) app.Frame(&wheel);
+  wheel.wheel = 0;
+  app.Frame(&wheel);
+  app.Frame(&wheel);
+  const size_t before = app.LogFirstLineShown();
+  const size_t last = app.LogLines().size();
+  ASSERT_LT(before + 20, last);  // well above the end
+  // The right edge dragged 300 pixels right: the lines wrap less.
+  SyntheticInput input;
+  input.x = app.PanelWidth() - 1;
+  input.y = 300;
+  app.Frame(&input);
+  app.Frame(&input);
+  input.left_down = true;
+  app.Frame(&input);
+  const float start = input.x;
+  for (int step = 1; step <= 6; ++step) {
+    input.x = start + 50.0f * static_cast<float>(step);
+    app.Frame(&input);
+  }
+  input.left_down = false;
+  app.Frame(&input);
+  app.Frame();
+  app.Frame();
+  EXPECT_NEAR(app.PanelWidth(), start + 1 + 300, 2);
+  EXPECT_NEAR(static_cast<double>(app.LogFirstLineShown()), static_cast<double>(before), 1.0)
+      << "the first line in sight was " << before << " of " << last;
+}
+
 }  // namespace
 }  // namespace tessera::gui

@@ -2,6 +2,8 @@
 // a toggle between the verified inliers and the putative matches, the images' names on
 // the match matrix's axes and a colour legend.
 
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <set>
 
 #include "gui/gui_window_test_fixture.h"
@@ -103,6 +105,61 @@ TEST_F(GuiWindowTest, MatchMatrixCellsGrowWithTheUiScale) {
   app.Frame();
   const WidgetRect cells = app.Widget("match cells").value();
   EXPECT_GE((cells.max_x - cells.min_x) / 8, 2 * 13.0f);  // a line of 26 px text per row
+}
+
+// Issue 52 item 3: the pair view checks its photographs as the camera window does:
+// another set's photographs under the same names (here, the sample at another size) are
+// "does not match", with no photographs and no match lines; a folder without them is
+// "image not found".
+TEST_F(GuiWindowTest, PairViewRefusesPhotographsThatAreNotTheWorkspaces) {
+  const std::filesystem::path workspace = FinishedWorkspace();
+  const std::filesystem::path other = dir_.path() / "other set";
+  std::filesystem::create_directories(other);
+  for (const auto& entry : std::filesystem::directory_iterator(dir_.path() / "images")) {
+    const cv::Mat photo = cv::imread(entry.path().string());
+    cv::Mat smaller;
+    cv::resize(photo, smaller, cv::Size(photo.cols / 2, photo.rows / 2));
+    cv::imwrite((other / entry.path().filename()).string(), smaller);
+  }
+  const std::filesystem::path empty = dir_.path() / "empty";
+  std::filesystem::create_directories(empty);
+  for (const std::filesystem::path& images : {other, empty, dir_.path() / "images"}) {
+    GuiOptions options;
+    options.images = images;
+    options.output = workspace;
+    GuiApp app(options);
+    app.Frame();
+    Click(&app, "match matrix");
+    app.Frame();
+    const WidgetRect cells = app.Widget("match cells").value();
+    const float cell = (cells.max_x - cells.min_x) / 8;
+    Click(&app, WidgetRect{cells.min_x + 1.5f * cell, cells.min_y + 0.5f * cell,
+                           cells.min_x + 1.5f * cell, cells.min_y + 0.5f * cell});
+    app.Frame();
+    app.Frame();
+    const PairInliers& pair = app.SelectedPairInliers();
+    ASSERT_TRUE(pair.camera1.has_value());
+    if (images == dir_.path() / "images") {
+      EXPECT_EQ(app.PairPhotoProblem(), "");
+      EXPECT_TRUE(app.Widget("pair photos").has_value());
+      EXPECT_GT(app.PairLinesDrawn(), 0u);
+      continue;
+    }
+    EXPECT_FALSE(app.Widget("pair photos").has_value()) << images;
+    EXPECT_TRUE(app.Widget("pair photo problem").has_value()) << images;
+    EXPECT_EQ(app.PairLinesDrawn(), 0u);
+    if (images == other) {
+      const std::string expected =
+          pair.name1 +
+          ": image does not match the model's camera: " + std::to_string(pair.camera1->width / 2) +
+          "x" + std::to_string(pair.camera1->height / 2) + " vs " +
+          std::to_string(pair.camera1->width) + "x" + std::to_string(pair.camera1->height);
+      EXPECT_EQ(app.PairPhotoProblem().rfind(expected, 0), 0u) << app.PairPhotoProblem();
+    } else {
+      EXPECT_EQ(app.PairPhotoProblem(),
+                pair.name1 + ": image not found\n" + pair.name2 + ": image not found");
+    }
+  }
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 // the view graph as the model grows (with the time left), and a resumed run's stages that
 // had nothing left to do read "reused" rather than "0/0".
 
+#include <fstream>
 #include <set>
 #include <string>
 
@@ -30,10 +31,62 @@ TEST(StageOverlay, ReadsDoneTotalRateTimeLeftOrReused) {
   EXPECT_EQ(StageOverlay(map), "3/8 images registered  0.50/s, 10 s left");
   EXPECT_EQ(StageOverlay(map, /*with_rate=*/false), "3/8 images registered, 10 s left");
   EXPECT_FLOAT_EQ(StageFraction(map), 3.0f / 8);
+  // The mapper's step, while it goes on.
+  map.step = "rotation averaging";
+  EXPECT_EQ(StageOverlay(map), "3/8 images registered (rotation averaging)  0.50/s, 10 s left");
   map.finished = true;
   map.done = 7;
   EXPECT_EQ(StageOverlay(map), "7/8 images registered");
   EXPECT_EQ(StageFraction(map), 1.0f);
+}
+
+// Issue 52 item 2: the global mapper, which has no growing model to report, names its
+// steps on the map bar and ends with the count its models registered (was "0/8").
+TEST_F(GuiWindowTest, GlobalMapperReportsItsStepsAndTheImagesItRegistered) {
+  MakeSample();
+  std::ofstream(manifest_) << R"({
+      "pipeline": {
+        "detector": {"plugin": "orb", "options": {"max_num_features": 2000}},
+        "pair_selector": {"plugin": "exhaustive"},
+        "matcher": {"plugin": "brute_force"},
+        "mapper": {"plugin": "global"},
+        "bundle_adjuster": {"plugin": "ceres"},
+        "exporters": [{"plugin": "colmap_binary"}]
+      },
+      "threads": 2
+    })";
+  GuiOptions options;
+  options.images = dir_.path() / "images";
+  options.output = dir_.path() / "out";
+  options.manifest = manifest_;
+  GuiApp app(options);
+  app.Frame();
+  ASSERT_TRUE(app.Run()) << app.SetupError();
+  std::set<std::string> steps;
+  ASSERT_TRUE(WaitFor(
+      &app,
+      [&] {
+        const RunStatus status = app.controller().Status();
+        if (!status.stages.empty() && status.stages.back().stage == "map") {
+          steps.insert(status.stages.back().step);
+        }
+        return !app.controller().Running();
+      },
+      120));
+  const RunStatus status = app.controller().Status();
+  ASSERT_EQ(status.state, RunState::kCompleted) << status.error;
+  const StageProgress& map = status.stages.at(2);
+  ASSERT_EQ(map.stage, "map");
+  EXPECT_TRUE(map.finished);
+  EXPECT_GE(map.done, 6u);
+  EXPECT_EQ(StageOverlay(map), std::to_string(map.done) + "/8 images registered");
+  // The last step the mapper named was its registration count.
+  EXPECT_EQ(map.step, "registration");
+  // Its model reached the view as the run's (not only once written and reopened).
+  EXPECT_GE(app.NumSceneCameras(), 6u);
+  std::string seen;
+  for (const std::string& step : steps) seen += step + "; ";
+  std::printf("global mapper steps seen by the window: %s\n", seen.c_str());
 }
 
 TEST_F(GuiWindowTest, MapBarMovesWithEachRegistrationAndAResumedRunSaysReused) {

@@ -3,6 +3,7 @@
 // against a committed reference image.
 
 #include <gtest/gtest.h>
+#include <imgui.h>
 
 #include <chrono>
 #include <cmath>
@@ -287,6 +288,32 @@ TEST_F(GuiWindowTest, ImageFolderWithoutTheModelsImagesIsWarnedAbout) {
   ClickCamera(&app, 3);
   EXPECT_EQ(app.PhotoProblem(), "image not found");
   if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
+  // Issue 52: a path typed into the field, a character a frame, is checked (and warned
+  // about in the log) once, when the field is left, not once per keystroke.
+  const auto warnings = [&] {
+    size_t count = 0;
+    for (const LogLine& line : app.LogLines()) {
+      count += line.text.find("is it the model's image folder?") != std::string::npos ? 1 : 0;
+    }
+    return count;
+  };
+  const size_t before = warnings();
+  Click(&app, "images");
+  SyntheticInput select_all;
+  select_all.x = select_all.y = -1;
+  select_all.keys = {ImGuiKey_A};
+  select_all.ctrl = true;
+  app.Frame(&select_all);
+  const std::string typed = (dir_.path() / "elsewhere").string();
+  for (const char c : typed) Type(&app, std::string(1, c));
+  EXPECT_EQ(app.ImagesField(), typed);
+  EXPECT_EQ(warnings(), before);
+  Click(&app, app.ViewRect());  // the field left
+  app.Frame();
+  EXPECT_EQ(warnings(), before + 1);
+  EXPECT_NE(app.ImageFolderWarning().find("3 of 3 images of the model are not in " + typed),
+            std::string::npos)
+      << app.ImageFolderWarning();
 }
 
 // Issue 28 item 5: the manifest's camera.mask_path reaches the camera window, which

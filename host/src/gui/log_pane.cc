@@ -20,6 +20,16 @@ void LogPane::Draw() {
   // The sink keeps the newest lines: those it dropped leave the front.
   const size_t first_line = version - lines.size();
   const size_t dropped = first_line - first_line_;
+  // A new width moves every line: the scroll position follows the line that was first
+  // in sight, not the pixel it was at.
+  std::ptrdiff_t anchor = -1;
+  const bool at_end = ImGui::GetScrollY() >= ImGui::GetScrollMaxY() - 1;
+  if (width != wrap_width_ && wrap_width_ > 0 && !at_end && tops_.size() > 1) {
+    anchor =
+        static_cast<std::ptrdiff_t>(first_line_shown_) - static_cast<std::ptrdiff_t>(first_line);
+  } else if (width != wrap_width_ && at_end) {
+    lines_seen_ = 0;  // scrolled to the end again below
+  }
   if (width != wrap_width_ || first_line < first_line_ || dropped >= tops_.size()) {
     wrap_width_ = width;
     tops_.assign(1, 0.0f);
@@ -34,11 +44,16 @@ void LogPane::Draw() {
     const float height = ImGui::CalcTextSize(line.text.c_str(), nullptr, false, width).y;
     tops_.push_back(tops_.back() + height + spacing);
   }
+  float scroll = ImGui::GetScrollY();
+  if (anchor >= 0 && static_cast<size_t>(anchor) < lines.size()) {
+    scroll = tops_[static_cast<size_t>(anchor)];
+    ImGui::SetScrollY(scroll);
+  }
   // The lines in sight, between the scroll position and the pane's bottom.
-  const float scroll = ImGui::GetScrollY();
   const float bottom = scroll + ImGui::GetWindowHeight();
   const size_t first = static_cast<size_t>(std::max<std::ptrdiff_t>(
       0, std::upper_bound(tops_.begin(), tops_.end(), scroll) - tops_.begin() - 1));
+  first_line_shown_ = first_line + first;
   const float origin_y = ImGui::GetCursorPosY();
   ImGui::PushTextWrapPos(0);
   for (size_t i = first; i < lines.size() && tops_[i] < bottom; ++i) {

@@ -3,8 +3,11 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <cctype>
 #include <nlohmann/json.hpp>
 
+#include "gui/checked_read.h"
+#include "gui/json_text_edit.h"
 #include "manifest/manifest.h"
 #include "pipeline/pipeline_context.h"
 #include "plugin/plugin_call.h"
@@ -36,6 +39,28 @@ std::string PluginNamed(const nlohmann::json& slot) {
 
 }  // namespace
 
+std::string JsonErrorMessage(const std::string& text, const nlohmann::json::parse_error& error) {
+  // The library counts the character after the error (a newline puts it on the next
+  // line; the end of the text past the last line): the place is the last character read
+  // that is not white space.
+  size_t at = std::min<size_t>(error.byte > 0 ? error.byte - 1 : 0, text.size());
+  while (at > 0 && (at >= text.size() || std::isspace(static_cast<unsigned char>(text[at])))) {
+    --at;
+  }
+  const size_t line = 1 + static_cast<size_t>(std::count(
+                              text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n'));
+  const size_t line_start = text.rfind('\n', at == 0 ? 0 : at - 1);
+  const size_t column = line_start == std::string::npos || line == 1 ? at + 1 : at - line_start;
+  // "[json.exception.parse_error.101] parse error at line 3, column 1: syntax error ..."
+  // -> "syntax error ...".
+  std::string reason = error.what();
+  const size_t place = reason.find("column ");
+  const size_t colon = place == std::string::npos ? place : reason.find(": ", place);
+  if (colon != std::string::npos) reason = reason.substr(colon + 2);
+  return "invalid JSON at line " + std::to_string(line) + ", column " + std::to_string(column) +
+         ": " + reason;
+}
+
 ManifestEditorPanel::ManifestEditorPanel(PathField* manifest_field)
     : manifest_field_(manifest_field) {}
 
@@ -56,18 +81,94 @@ bool ManifestEditorPanel::Load() {
   const PathField& manifest = *manifest_field_;
   loaded_from_ = manifest.data();
   const fs::path file = manifest[0] != '\0' ? fs::path(manifest.data()) : DefaultManifestFile();
-  try {
-    const std::string text = ReadFileContents(file);
-    if (text.size() >= text_.size()) {
-      throw InputError(file.string() + ": too long for the editor (64 KiB)");
-    }
-    SetText(text);
-    status_ = "loaded " + file.string();
-    return true;
-  } catch (const InputError& error) {
-    error_ = error.what();
+  // Through the window's one checked read: a folder typed into the field is a message.
+  const std::optional<std::string> text =
+      ReadTextFile(file, "the manifest", &error_, text_.size() - 1);
+  if (!text) {
+    load_error_ = error_;
     return false;
   }
+  // A photograph or other binary file named by mistake is not put in the text box.
+  if (text->find('\0') != std::string::npos) {
+    error_ = file.string() + ": the manifest is not a text file (a JSON manifest is)";
+    load_error_ = error_;
+    return false;
+  }
+  load_error_.clear();
+  SetText(*text);
+  clean_text_ = text_.data();
+  status_ = "loaded " + file.string();
+  return true;
+}
+
+void ManifestEditorPanel::RequestLoad() {
+  if (pending_ != Pending::kNone) return;  // asking already
+  const fs::path file =
+      (*manifest_field_)[0] != '\0' ? fs::path(manifest_field_->data()) : DefaultManifestFile();
+  // A field that names no file (a folder, half a path typed) replaces nothing: Load
+  // says why, the text stays; only a file that could replace the edits is asked about.
+  if (!Edited() || !NotAFileProblem(file, "the manifest").empty()) {
+    Load();
+    return;
+  }
+  pending_ = Pending::kLoad;
+  question_ = "The editor holds unsaved changes. Replace them with " + file.string() + "?";
+}
+
+void ManifestEditorPanel::RequestSave(const fs::path& file) {
+  std::error_code error;
+  const bool exists = !file.empty() && fs::exists(file, error);
+  if (!exists || fs::path(loaded_from_) == file) {
+    Save(file);
+    return;
+  }
+  pending_ = Pending::kSave;
+  pending_save_ = file;
+  question_ = file.string() + " exists. Replace it with the editor's text?";
+}
+
+void ManifestEditorPanel::Answer(bool replace) {
+  const Pending pending = pending_;
+  pending_ = Pending::kNone;
+  question_.clear();
+  question_open_ = false;
+  if (pending == Pending::kLoad) {
+    if (replace) {
+      Load();
+    } else {
+      // The field back to the file the text came from: the two never disagree.
+      SetPathField(fs::path(loaded_from_), manifest_field_);
+      load_error_.clear();
+    }
+  } else if (pending == Pending::kSave && replace) {
+    Save(pending_save_);
+  }
+}
+
+void ManifestEditorPanel::DrawQuestion(WidgetRects* widgets) {
+  if (question_.empty()) return;
+  constexpr const char* kTitle = "Replace?##manifest editor";
+  if (!question_open_) {
+    ImGui::OpenPopup(kTitle);
+    question_open_ = true;
+  }
+  ImGui::SetNextWindowPos(ImGui::GetMainViewport()->GetCenter(), ImGuiCond_Always,
+                          ImVec2(0.5f, 0.5f));
+  if (!ImGui::BeginPopupModal(kTitle, nullptr, ImGuiWindowFlags_AlwaysAutoResize)) return;
+  ImGui::PushTextWrapPos(ImGui::GetFontSize() * 30);
+  ImGui::TextUnformatted(question_.c_str());
+  ImGui::PopTextWrapPos();
+  int answer = -1;
+  if (ImGui::Button("Replace")) answer = 1;
+  widgets->RecordLastItem("replace answer");
+  ImGui::SameLine();
+  if (ImGui::Button(pending_ == Pending::kLoad ? "Keep my text" : "Keep the file")) answer = 0;
+  widgets->RecordLastItem("keep answer");
+  if (answer >= 0) {
+    ImGui::CloseCurrentPopup();
+    Answer(answer == 1);
+  }
+  ImGui::EndPopup();
 }
 
 bool ManifestEditorPanel::Check() {
@@ -82,7 +183,7 @@ bool ManifestEditorPanel::Check() {
     status_ = "valid: every plugin was created with its options";
     return true;
   } catch (const nlohmann::json::parse_error& error) {
-    error_ = std::string("the manifest editor: invalid JSON: ") + error.what();
+    error_ = "the manifest editor: " + JsonErrorMessage(text_.data(), error);
   } catch (const PluginError& error) {
     error_ = error.what();
   } catch (const InputError& error) {
@@ -105,18 +206,28 @@ bool ManifestEditorPanel::Save(const fs::path& file) {
   }
   SetPathField(file, manifest_field_);
   loaded_from_ = manifest_field_->data();
+  clean_text_ = text_.data();
+  load_error_.clear();
   status_ = "saved " + file.string();
   return true;
 }
 
 void ManifestEditorPanel::FollowManifestField() {
-  if (Loaded() && loaded_from_ != manifest_field_->data()) Load();
+  if (Loaded() && loaded_from_ != manifest_field_->data()) RequestLoad();
 }
 
 bool ManifestEditorPanel::SetPlugin(const std::string& slot, const std::string& plugin) {
   error_.clear();
   try {
     nlohmann::json json = nlohmann::json::parse(std::string(text_.data()));
+    // In place: the rest of the text as the user wrote it, this slot's options kept
+    // (Check names any the new plugin does not take).
+    if (slot != "mapper" || !json.contains("mapper")) {
+      if (const std::optional<std::string> edited = SetPluginInText(text_.data(), slot, plugin)) {
+        SetText(*edited);
+        return true;
+      }
+    }
     json["pipeline"][slot] = {{"plugin", plugin}};
     // A top-level "mapper" (the incremental mapper's options before mappers were plugins)
     // next to pipeline.mapper is refused; the plugin is set with no options anyway.
@@ -186,7 +297,7 @@ void ManifestEditorPanel::DrawSlot(const std::string& kind, WidgetRects* widgets
       if (ImGui::Selectable(name.c_str(), name == current)) SetPlugin(kind, name);
       widgets->RecordLastItem("plugin " + kind + " " + name);
       if (ImGui::IsItemHovered() && !description.empty()) {
-        ImGui::SetTooltip("%s", description.c_str());
+        WrappedTooltip(description, widgets);
       }
     }
     ImGui::EndCombo();
@@ -203,6 +314,7 @@ void ManifestEditorPanel::DrawSlot(const std::string& kind, WidgetRects* widgets
 void ManifestEditorPanel::Draw(WidgetRects* widgets) {
   const bool open = ImGui::CollapsingHeader("Pipeline: plugins and options (manifest editor)");
   widgets->RecordLastItem("manifest editor");  // recorded closed too, to be clicked open
+  open_ = open;
   if (!open) {
     descriptions_shown_.clear();
     return;
@@ -223,15 +335,18 @@ void ManifestEditorPanel::Draw(WidgetRects* widgets) {
   HintText("Run uses this text; saving is optional");
   if (ImGui::Button("Check")) Check();
   ImGui::SameLine();
-  if (ImGui::Button("Reload")) Load();
+  if (ImGui::Button("Reload")) RequestLoad();
   ImGui::SameLine();
-  if (ImGui::Button("Save as")) Save(fs::path(save_path_.data()));
+  if (ImGui::Button("Save as")) RequestSave(fs::path(save_path_.data()));
+  widgets->RecordLastItem("save as");
   ImGui::SameLine();
   ImGui::SetNextItemWidth(-1);
   ImGui::InputTextWithHint("##save path", "manifest file to write", save_path_.data(),
                            save_path_.size());
-  ErrorText(error_);
-  HintText(status_);
+  widgets->RecordLastItem("save path");
+  ErrorText(error_, widgets);
+  // One line (a long path wrapped mid-name: "default." / "json"), whole in its tooltip.
+  if (!status_.empty()) FitText(status_, widgets, /*disabled=*/true);
 }
 
 }  // namespace tessera::gui

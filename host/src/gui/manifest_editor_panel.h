@@ -9,6 +9,8 @@
 
 #include <filesystem>
 #include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -17,6 +19,11 @@
 #include "gui/widget_rects.h"
 
 namespace tessera::gui {
+
+// A JSON parse error of `text` as one line: "invalid JSON at line L, column C: REASON",
+// the place being the last character read before the error (not the library's, which is
+// the line after it when the error comes at a line's end).
+std::string JsonErrorMessage(const std::string& text, const nlohmann::json::parse_error& error);
 
 class ManifestEditorPanel {
  public:
@@ -32,8 +39,10 @@ class ManifestEditorPanel {
   // Saves the editor's JSON to `file` (after checking) and sets the manifest field to it.
   bool Save(const std::filesystem::path& file);
   // Sets the plugin of a slot ("detector", "pair_selector", "matcher", "mapper",
-  // "bundle_adjuster") in the editor's JSON, with no options (for the mapper, a top-level
-  // "mapper" object of an older manifest is removed: it would be refused beside it).
+  // "bundle_adjuster") in the editor's JSON, in place (SetPluginInText: the rest of the
+  // text and the slot's options kept; Check names an option the new plugin does not
+  // take). For the mapper, a top-level "mapper" object of an older manifest is removed
+  // (it would be refused beside it): that JSON is written anew, the slot without options.
   bool SetPlugin(const std::string& slot, const std::string& plugin);
   // The plugin the editor's JSON names for a slot, as its dropdown shows it: when the
   // slot is absent, the plugin a run uses then (the mapper: "incremental", its dropdown
@@ -49,8 +58,29 @@ class ManifestEditorPanel {
   }
 
   // Reloads the editor when the manifest field no longer names the file it was loaded
-  // from, clearing the messages of the old file.
+  // from, clearing the messages of the old file (RequestLoad: asking first when the
+  // editor holds unsaved edits).
   void FollowManifestField();
+  // Load, unless the editor holds edits not loaded or saved (Edited()): then the editor
+  // asks first (Question()); "Replace" loads, "Keep my text" puts the manifest field back
+  // to the file the text came from, so that the field and the editor agree.
+  void RequestLoad();
+  // Save, unless `file` exists and is not the file the text came from: then it asks first.
+  void RequestSave(const std::filesystem::path& file);
+  // Whether the text differs from the file it was loaded from or saved to.
+  bool Edited() const { return Loaded() && Text() != clean_text_; }
+  // Why the manifest field's file could not be loaded last (the field then names a file
+  // the editor does not hold: Run refuses with this); empty once a file is loaded.
+  const std::string& LoadError() const { return load_error_; }
+  // The question the editor asks before it replaces text or a file; empty when none.
+  const std::string& Question() const { return question_; }
+  // Answers the question: true replaces (loads or saves), false keeps what is there.
+  void Answer(bool replace);
+  // The question's modal popup (recorded as "replace answer" and "keep answer"); drawn
+  // whether or not the section is open.
+  void DrawQuestion(WidgetRects* widgets);
+  // Whether the section was open in the last frame.
+  bool open() const { return open_; }
   // Whether the editor holds a manifest (it is loaded when first opened).
   bool Loaded() const { return text_[0] != '\0'; }
 
@@ -77,6 +107,14 @@ class ManifestEditorPanel {
   PathField save_path_{};
   std::string error_, status_;
   std::string loaded_from_;  // the manifest field's value when last loaded or saved
+  std::string clean_text_;   // the text as loaded or saved (Edited compares with it)
+  // The question asked, and what a "replace" answer does.
+  std::string question_;
+  std::string load_error_;
+  enum class Pending { kNone, kLoad, kSave } pending_ = Pending::kNone;
+  std::filesystem::path pending_save_;
+  bool question_open_ = false;
+  bool open_ = false;
   // Per kind: each plugin's name and description.
   std::map<std::string, std::vector<std::pair<std::string, std::string>>> plugins_by_kind_;
   std::map<std::string, std::string> descriptions_shown_;  // per slot, DescriptionShown

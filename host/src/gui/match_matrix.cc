@@ -56,8 +56,14 @@ PairInliers ReadPairInliers(const fs::path& path, image_t image_id1, image_t ima
   const Database database(DatabaseFile(path), Database::Mode::kReadOnly);
   PairInliers pair;
   for (const Image& image : database.ReadAllImages()) {
-    if (image.image_id == image_id1) pair.name1 = image.name;
-    if (image.image_id == image_id2) pair.name2 = image.name;
+    if (image.image_id == image_id1) {
+      pair.name1 = image.name;
+      pair.camera1 = database.ReadCamera(image.camera_id);
+    }
+    if (image.image_id == image_id2) {
+      pair.name2 = image.name;
+      pair.camera2 = database.ReadCamera(image.camera_id);
+    }
   }
   if (!database.ExistsTwoViewGeometry(image_id1, image_id2)) return pair;
   const TwoViewGeometry geometry = database.ReadTwoViewGeometry(image_id1, image_id2);

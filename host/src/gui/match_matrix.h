@@ -6,9 +6,11 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "tessera/camera.h"
 #include "tessera/ids.h"
 
 namespace tessera::gui {
@@ -30,6 +32,9 @@ MatchMatrix ReadMatchMatrix(const std::filesystem::path& path);
 
 struct PairInliers {
   std::string name1, name2;
+  // The images' cameras as the workspace records them (their photographs are checked
+  // against their sizes); nothing when the database has none.
+  std::optional<Camera> camera1, camera2;
   std::vector<Eigen::Vector2f> xy1, xy2;  // keypoint positions, one per inlier match
   // The putative matches (before geometric verification), likewise.
   std::vector<Eigen::Vector2f> putative_xy1, putative_xy2;

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "gui/checked_read.h"
 #include "gui/panel_widgets.h"
 #include "tessera/errors.h"
 
@@ -26,20 +27,28 @@ ImU32 InlierColor(int inliers, int max_inliers) {
 
 }  // namespace
 
+size_t MatrixLabelStep(float cell, float label_extent) {
+  // 1, 2, 5, 10, 20, 50, ...: labels at round numbers a reader can count on.
+  for (size_t decade = 1;; decade *= 10) {
+    for (const size_t step : {decade, 2 * decade, 5 * decade}) {
+      if (static_cast<float>(step) * cell >= label_extent) return step;
+    }
+    if (decade > 100000) return 10 * decade;
+  }
+}
+
 bool MatchMatrixPanel::Open(const fs::path& path) {
   error_.clear();
   pair_row_ = pair_column_ = -1;
   pair_view_.Clear();
-  try {
-    matrix_ = ReadMatchMatrix(path);
+  if (CheckedRead(
+          path, [&] { matrix_ = ReadMatchMatrix(path); }, &error_)) {
     show_ = true;
     return true;
-  } catch (const InputError& error) {
-    error_ = error.what();
-    spdlog::error("{}", error_);
-    matrix_.reset();
-    return false;
   }
+  spdlog::error("{}", error_);
+  matrix_.reset();
+  return false;
 }
 
 void MatchMatrixPanel::DrawOpenButton(const fs::path& workspace, WidgetRects* widgets) {
@@ -47,7 +56,7 @@ void MatchMatrixPanel::DrawOpenButton(const fs::path& workspace, WidgetRects* wi
   widgets->RecordLastItem("match matrix");
   ImGui::SameLine();
   FitText("of the output folder (else the model's workspace)", widgets, /*disabled=*/true);
-  ErrorText(error_);
+  ErrorText(error_, widgets);
 }
 
 void MatchMatrixPanel::Draw(const WidgetRect& view_rect, const fs::path& image_dir,
@@ -84,7 +93,11 @@ void MatchMatrixPanel::DrawCells(float cell, const fs::path& image_dir, WidgetRe
   // The axes: each row's number and image name on the left (at most 14 text heights
   // wide), the column numbers on top; every k-th when the cells are smaller than a line.
   const float line = ImGui::GetTextLineHeight();
-  const size_t every = static_cast<size_t>(std::ceil(line / cell));
+  // Rows need a line's height per label; columns the widest number's width and a gap
+  // (two-digit numbers on 7-pixel cells ran together: "111315...").
+  const size_t row_every = MatrixLabelStep(cell, line);
+  const float widest = ImGui::CalcTextSize(std::to_string(n).c_str()).x;
+  const size_t column_every = MatrixLabelStep(cell, widest + 0.5f * line);
   float names_width = 0;
   std::vector<std::string> row_names(n);
   for (size_t i = 0; i < n; ++i) {
@@ -97,13 +110,18 @@ void MatchMatrixPanel::DrawCells(float cell, const fs::path& image_dir, WidgetRe
   const float side = cell * static_cast<float>(n);
   ImDrawList* draw = ImGui::GetWindowDrawList();
   const ImU32 text = ImGui::GetColorU32(ImGuiCol_Text);
-  for (size_t i = 0; i < n; i += every) {
+  for (size_t i = 0; i < n; i += row_every) {
     const float y = origin.y + cell * static_cast<float>(i) + (cell - line) / 2;
     draw->AddText(ImVec2(corner.x, y), text, row_names[i].c_str());
+  }
+  column_labels_.clear();
+  for (size_t i = 0; i < n; i += column_every) {
     const std::string number = std::to_string(i + 1);
     const float x = origin.x + cell * static_cast<float>(i) +
                     (cell - ImGui::CalcTextSize(number.c_str()).x) / 2;
     draw->AddText(ImVec2(x, corner.y), text, number.c_str());
+    column_labels_.push_back(
+        {x, corner.y, x + ImGui::CalcTextSize(number.c_str()).x, corner.y + line});
   }
   widgets->Set("matrix row names", {corner.x, origin.y, origin.x, origin.y + side});
   widgets->Set("matrix column numbers", {origin.x, corner.y, origin.x + side, origin.y});
@@ -144,12 +162,13 @@ void MatchMatrixPanel::SelectPair(int row, int column, const fs::path& image_dir
   pair_row_ = row;
   pair_column_ = column;
   PairInliers pair;
-  try {
-    pair = ReadPairInliers(matrix.database, matrix.image_ids[static_cast<size_t>(row)],
-                           matrix.image_ids[static_cast<size_t>(column)]);
-  } catch (const InputError& error) {
-    error_ = error.what();
-  }
+  CheckedRead(
+      matrix.database,
+      [&] {
+        pair = ReadPairInliers(matrix.database, matrix.image_ids[static_cast<size_t>(row)],
+                               matrix.image_ids[static_cast<size_t>(column)]);
+      },
+      &error_);
   pair_view_.Show(std::move(pair), image_dir);
 }
 

@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "gui/match_matrix.h"
 #include "gui/pair_view.h"
@@ -15,8 +16,15 @@
 
 namespace tessera::gui {
 
+// Every how many rows or columns the matrix labels one (1, 2, 5, 10, 20, ...): the
+// smallest step whose cells span `label_extent` pixels (a label's height for the rows,
+// its width and a gap for the columns).
+size_t MatrixLabelStep(float cell, float label_extent);
+
 class MatchMatrixPanel {
  public:
+  // Where the column numbers were drawn in the last frame (they never overlap).
+  const std::vector<WidgetRect>& column_labels() const { return column_labels_; }
   // Opens the match matrix of the workspace `path` (its database.db); false with the
   // message in Error() (also logged) when it cannot.
   bool Open(const std::filesystem::path& path);
@@ -37,6 +45,7 @@ class MatchMatrixPanel {
   const PairView& pair_view() const { return pair_view_; }
 
  private:
+  std::vector<WidgetRect> column_labels_;
   // The cells, `cell` pixels square, as one item recorded as "match cells"; hovering
   // shows a pair's count, a click selects it.
   void DrawCells(float cell, const std::filesystem::path& image_dir, WidgetRects* widgets);

@@ -1,6 +1,8 @@
 #include "gui/model_loader.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <fstream>
 #include <string>
 
 #include "tessera/errors.h"
@@ -37,6 +39,34 @@ std::vector<fs::path> FindModelFolders(const fs::path& path) {
   std::vector<fs::path> folders;
   for (const auto& [index, folder] : models) folders.push_back(folder);
   return folders;
+}
+
+std::optional<size_t> CountModelImages(const fs::path& folder) {
+  std::error_code error;
+  if (fs::is_regular_file(folder / "images.bin", error)) {
+    // COLMAP's binary layout: a little-endian uint64 count first.
+    std::ifstream file(folder / "images.bin", std::ios::binary);
+    unsigned char bytes[8] = {};
+    if (!file.read(reinterpret_cast<char*>(bytes), sizeof(bytes))) return std::nullopt;
+    uint64_t count = 0;
+    for (int i = 7; i >= 0; --i) count = (count << 8) | bytes[i];
+    return static_cast<size_t>(count);
+  }
+  if (!fs::is_regular_file(folder / "images.txt", error)) return std::nullopt;
+  std::ifstream file(folder / "images.txt");
+  std::string line;
+  // "# Number of images: 3, mean observations per image: ..."
+  constexpr const char* kCount = "# Number of images: ";
+  while (std::getline(file, line) && !line.empty() && line[0] == '#') {
+    if (line.rfind(kCount, 0) == 0) {
+      try {
+        return static_cast<size_t>(std::stoul(line.substr(std::string(kCount).size())));
+      } catch (const std::exception&) {
+        return std::nullopt;
+      }
+    }
+  }
+  return std::nullopt;
 }
 
 }  // namespace tessera::gui

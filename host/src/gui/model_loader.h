@@ -4,7 +4,9 @@
 // by Tessera or COLMAP), a workspace folder (its sparse/0..N), or a workspace database
 // (database.db: the models of its workspace).
 
+#include <cstddef>
 #include <filesystem>
+#include <optional>
 #include <vector>
 
 namespace tessera::gui {
@@ -13,5 +15,9 @@ namespace tessera::gui {
 // else PATH/sparse/N (N = 0, 1, ...) for a workspace folder or the folder of a
 // database.db. Throws InputError naming `path` and what is missing when there is none.
 std::vector<std::filesystem::path> FindModelFolders(const std::filesystem::path& path);
+
+// The number of images a model folder holds, from the head of its images.bin (or the
+// count line of images.txt), without reading the model; nothing when it cannot tell.
+std::optional<size_t> CountModelImages(const std::filesystem::path& folder);
 
 }  // namespace tessera::gui

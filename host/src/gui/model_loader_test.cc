@@ -25,6 +25,10 @@ TEST(ModelLoader, FindsAModelFolderAWorkspaceAndItsDatabase) {
   EXPECT_EQ(FindModelFolders(dir.path()), expected);
   std::ofstream(dir.path() / "database.db") << "";
   EXPECT_EQ(FindModelFolders(dir.path() / "database.db"), expected);
+  // The model picker's counts, read from the files' heads.
+  EXPECT_EQ(CountModelImages(dir.path() / "sparse" / "0"), model.images.size());
+  EXPECT_EQ(CountModelImages(dir.path() / "sparse" / "1"), model.images.size());
+  EXPECT_EQ(CountModelImages(dir.path() / "sparse" / "2"), std::nullopt);
 }
 
 TEST(ModelLoader, RefusesWhatIsNotAModelNamingIt) {

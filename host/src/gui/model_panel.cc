@@ -3,6 +3,10 @@
 #include <imgui.h>
 #include <spdlog/spdlog.h>
 
+#include <optional>
+
+#include "gui/checked_read.h"
+#include "gui/match_matrix.h"
 #include "gui/model_loader.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
@@ -16,10 +20,9 @@ ModelPanel::ModelPanel(SceneView* view, const fs::path& path) : view_(view) {
 
 bool ModelPanel::Open(const fs::path& path) {
   error_.clear();
-  try {
-    folders_ = FindModelFolders(path);
-  } catch (const InputError& error) {
-    error_ = error.what();
+  image_counts_.clear();
+  if (!CheckedRead(
+          path, [&] { folders_ = FindModelFolders(path); }, &error_)) {
     spdlog::error("{}", error_);
     return false;
   }
@@ -32,29 +35,82 @@ void ModelPanel::ShowRunModels(const fs::path& output_dir) {
   // The written model has the points' colours; show it (and offer any others).
   try {
     folders_ = FindModelFolders(output_dir);
+    image_counts_.clear();
     SetPathField(output_dir, &path_);
     const bool moved = view_->user_moved_camera;
     LoadFolder(0);
     view_->user_moved_camera = moved;
-  } catch (const InputError&) {
-    // No exporter wrote a COLMAP model: keep the mapper's last model.
+  } catch (const std::exception&) {
+    // No exporter wrote a COLMAP model: keep the mapper's last model, and say so.
+    showing_ = "the run's last model; no COLMAP model was written to " + output_dir.string();
+    showing_written_ = false;
+  }
+}
+
+void ModelPanel::RunStarted(const fs::path& output_dir) {
+  folders_.clear();
+  image_counts_.clear();
+  error_.clear();
+  SetPathField(output_dir, &path_);
+  showing_ = "the run's model as it grows, not yet written to " + output_dir.string();
+  showing_written_ = false;
+}
+
+void ModelPanel::RunStopped(bool failed, bool has_model) {
+  if (showing_written_) return;  // a model opened since the run started
+  const std::string workspace = path_.data();
+  if (has_model) {
+    showing_ = std::string(failed ? "the failed" : "the cancelled") +
+               " run's partial model, not written to " + workspace +
+               (failed ? "" : "; Run again resumes it");
+  } else {
+    showing_ = std::string(failed ? "the run failed" : "the run was cancelled") +
+               " before a model: nothing written to " + workspace;
+  }
+}
+
+void ModelPanel::CheckStale(const fs::path& folder) {
+  stale_.clear();
+  // A workspace's sparse/N beside a database that no longer holds its matches (a run
+  // that replaced them was cancelled before it mapped): the model is not the database's.
+  const fs::path workspace = folder.parent_path().parent_path();
+  std::error_code error;
+  if (folder.parent_path().filename() != "sparse" ||
+      !fs::is_regular_file(workspace / "database.db", error)) {
+    return;
+  }
+  std::optional<MatchMatrix> matrix;
+  std::string problem;
+  if (CheckedRead(
+          workspace, [&] { matrix = ReadMatchMatrix(workspace); }, &problem) &&
+      matrix->max_inliers == 0) {
+    stale_ = "stale: " + (workspace / "database.db").string() +
+             " holds no verified pairs now (its matches were discarded after this model was "
+             "written); Run again to match and map anew";
+    spdlog::warn("gui: {}", stale_);
   }
 }
 
 void ModelPanel::LoadFolder(size_t index) {
   error_.clear();
   if (index >= folders_.size()) return;
-  try {
-    auto model = std::make_shared<const Reconstruction>(ReadColmapModel(folders_[index]));
-    index_ = static_cast<int>(index);
-    view_->ForgetPicks();
-    view_->Show(MakeScene(std::move(model)), /*frame=*/true);
-    spdlog::info("gui: opened {} ({} images, {} points)", folders_[index].string(),
-                 view_->scene()->cameras.size(), view_->scene()->NumPoints());
-  } catch (const InputError& error) {
-    error_ = error.what();
+  std::shared_ptr<const Reconstruction> model;
+  if (!CheckedRead(
+          folders_[index],
+          [&] { model = std::make_shared<const Reconstruction>(ReadColmapModel(folders_[index])); },
+          &error_)) {
     spdlog::error("{}", error_);
+    return;
   }
+  index_ = static_cast<int>(index);
+  view_->ForgetPicks();
+  showing_ = folders_[index].string() + " (" + std::to_string(model->NumRegisteredImages()) +
+             " images, as written)";
+  showing_written_ = true;
+  CheckStale(folders_[index]);
+  view_->Show(MakeScene(std::move(model)), /*frame=*/true);
+  spdlog::info("gui: opened {} ({} images, {} points)", folders_[index].string(),
+               view_->scene()->cameras.size(), view_->scene()->NumPoints());
 }
 
 void ModelPanel::Draw(WidgetRects* widgets) {
@@ -72,11 +128,25 @@ void ModelPanel::Draw(WidgetRects* widgets) {
   ImGui::SameLine();
   if (ImGui::Button("Open")) Open(fs::path(path_.data()));
   widgets->RecordLastItem("open");
-  ErrorText(error_);
+  ErrorText(error_, widgets);
   DrawModelChoice();
+  // What the view shows, after its counts: a written model, or a run's (growing,
+  // cancelled, failed); one line always, so that what is below never moves.
   const Scene* scene = view_->scene();
-  ImGui::Text("%zu points, %zu cameras", scene == nullptr ? 0 : scene->NumPoints(),
-              scene == nullptr ? 0 : scene->cameras.size());
+  const std::string counts =
+      std::to_string(scene == nullptr ? 0 : scene->NumPoints()) + " points, " +
+      std::to_string(scene == nullptr ? 0 : scene->cameras.size()) + " cameras";
+  const bool written = showing_written_ || showing_.empty();
+  if (!written) ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1, 0.75f, 0.3f, 1));
+  FitText(showing_.empty() ? counts : counts + ": " + showing_, widgets);
+  if (!written) ImGui::PopStyleColor();
+  widgets->RecordLastItem("model showing");
+  if (!stale_.empty() && showing_written_) {
+    ImGui::PushTextWrapPos(0);
+    ImGui::TextColored(ImVec4(1, 0.75f, 0.3f, 1), "%s", stale_.c_str());
+    ImGui::PopTextWrapPos();
+    widgets->RecordLastItem("model stale");
+  }
   if (ImGui::SliderFloat("Point size", &view_->point_size, 1, 10, "%.0f px")) {
     view_->point_size_chosen = true;
   }
@@ -93,11 +163,21 @@ void ModelPanel::Draw(WidgetRects* widgets) {
 
 void ModelPanel::DrawModelChoice() {
   if (folders_.size() <= 1) return;
-  const std::string current = "model " + std::to_string(index_);
+  // Each model with its images, counted from its files' heads once per folder list.
+  if (image_counts_.size() != folders_.size()) {
+    image_counts_.clear();
+    for (const fs::path& folder : folders_) {
+      const std::optional<size_t> count = CountModelImages(folder);
+      image_counts_.push_back(count ? std::to_string(*count) + " images" : "? images");
+    }
+  }
+  const auto label_of = [&](size_t i) {
+    return "model " + folders_[i].filename().string() + "  (" + image_counts_[i] + ")";
+  };
+  const std::string current = label_of(static_cast<size_t>(index_));
   if (!ImGui::BeginCombo("Model", current.c_str())) return;
   for (size_t i = 0; i < folders_.size(); ++i) {
-    const std::string label =
-        "model " + std::to_string(i) + "  (" + folders_[i].filename().string() + ")";
+    const std::string label = label_of(i);
     if (ImGui::Selectable(label.c_str(), static_cast<int>(i) == index_)) LoadFolder(i);
   }
   ImGui::EndCombo();

@@ -28,25 +28,51 @@ class ModelPanel {
   // names `output_dir`, not a model opened before), the camera left where the user moved
   // it; keeps the model shown when it wrote no COLMAP model.
   void ShowRunModels(const std::filesystem::path& output_dir);
-  // A run starts: the models opened are no longer the ones shown.
-  void ForgetModels() { folders_.clear(); }
+  // A run starts: the models opened are no longer the ones shown; the field names the
+  // run's workspace and the line under it says its model is growing, not yet written.
+  void RunStarted(const std::filesystem::path& output_dir);
+  // A run was cancelled or failed: the line says what the view shows now (the partial
+  // model, not written; or nothing). `has_model`: whether the view shows one.
+  void RunStopped(bool failed, bool has_model);
+  // What the view shows, as the line under the field says it ("sparse/0 of W (8 images)",
+  // "the run's model as it grows, not yet written to W", ...); empty before anything.
+  const std::string& Showing() const { return showing_; }
+  // Whether that is a model as written on disk (false: a run's model in memory).
+  bool ShowingWritten() const { return showing_written_; }
 
   // The section; records "model" (the field) and "open" (the button).
   void Draw(WidgetRects* widgets);
 
   const std::string& Error() const { return error_; }
+  // The model folder shown, as written (for Export); empty when the view shows a run's
+  // model in memory or nothing.
+  std::filesystem::path WrittenModel() const {
+    return showing_written_ && static_cast<size_t>(index_) < folders_.size() ? folders_[index_]
+                                                                             : "";
+  }
+  int model_index() const { return index_; }
+  // Why the written model shown is stale (its workspace's matches were discarded since);
+  // empty when it is not.
+  const std::string& Stale() const { return showing_written_ ? stale_ : kNone; }
   std::string ModelField() const { return path_.data(); }
 
  private:
   // Shows model `index` of folders_; the message in error_ when it cannot be read.
   void LoadFolder(size_t index);
   void DrawModelChoice();
+  // Sets stale_ for the model folder shown.
+  void CheckStale(const std::filesystem::path& folder);
+  static inline const std::string kNone;
 
   SceneView* view_;
   PathField path_{};
   std::vector<std::filesystem::path> folders_;  // the models found where opened
   int index_ = 0;                               // the one shown
   std::string error_;
+  std::string showing_;
+  bool showing_written_ = false;
+  std::vector<std::string> image_counts_;
+  std::string stale_;  // per folder of folders_, for the picker
 };
 
 }  // namespace tessera::gui

@@ -3,7 +3,10 @@
 #include <imgui.h>
 
 #include <algorithm>
+#include <string>
 #include <utility>
+
+#include "gui/image_folder_check.h"
 
 namespace tessera::gui {
 
@@ -18,8 +21,17 @@ std::vector<size_t> SubsampleMatches(size_t count, size_t max_lines) {
 
 void PairView::Show(PairInliers pair, const std::filesystem::path& image_dir) {
   pair_ = std::move(pair);
-  photos_[0].Load(image_dir / pair_.name1, 360);
-  photos_[1].Load(image_dir / pair_.name2, 360);
+  problem_.clear();
+  const std::string* names[2] = {&pair_.name1, &pair_.name2};
+  const std::optional<Camera>* cameras[2] = {&pair_.camera1, &pair_.camera2};
+  for (int i = 0; i < 2; ++i) {
+    const bool found = !image_dir.empty() && photos_[i].Load(image_dir / *names[i], 360);
+    const std::string problem = cameras[i]->has_value()
+                                    ? PhotoProblem(found, photos_[i].source_width(),
+                                                   photos_[i].source_height(), **cameras[i])
+                                    : (found ? "" : "image not found");
+    if (!problem.empty()) problem_ += (problem_.empty() ? "" : "\n") + *names[i] + ": " + problem;
+  }
 }
 
 void PairView::Draw(float max_width, float max_height, WidgetRects* widgets) {
@@ -37,8 +49,10 @@ void PairView::Draw(float max_width, float max_height, WidgetRects* widgets) {
     ImGui::SameLine();
     ImGui::TextDisabled("(%zu of %zu drawn)", kMaxPairLines, xy1.size());
   }
-  if (photos_[0].empty() || photos_[1].empty()) {
-    ImGui::TextDisabled("(the photographs are not in the image folder)");
+  if (!problem_.empty()) {
+    // As the camera window: another data set's photographs are never shown as these.
+    ImGui::TextColored(ImVec4(1, 0.75f, 0.3f, 1), "%s", problem_.c_str());
+    widgets->RecordLastItem("pair photo problem");
     return;
   }
   const ImVec2 left = ImGui::GetCursorScreenPos();

@@ -7,6 +7,7 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 #include "gui/image_texture.h"
@@ -22,9 +23,17 @@ std::vector<size_t> SubsampleMatches(size_t count, size_t max_lines);
 
 class PairView {
  public:
-  // Shows `pair`, its photographs read from `image_dir`.
+  // Shows `pair`, its photographs read from `image_dir` and checked as the camera
+  // window checks its photograph (PhotoProblem): a photograph of another size than its
+  // camera's is not shown, nor are the matches over either.
   void Show(PairInliers pair, const std::filesystem::path& image_dir);
-  void Clear() { pair_ = {}; }
+  void Clear() {
+    pair_ = {};
+    problem_.clear();
+  }
+  // Why the photographs are not shown ("NAME: image does not match the model's camera:
+  // WxH vs WxH"; one line per photograph); empty when both are.
+  const std::string& problem() const { return problem_; }
   // The names, the counts, the toggle (recorded as "show inliers" and "show putatives")
   // and the photographs with the lines (recorded as "pair photos"), shrunk when needed to
   // fit max_width x max_height pixels (the room left in the window), at most to a third.
@@ -38,6 +47,7 @@ class PairView {
  private:
   PairInliers pair_;
   ImageTexture photos_[2];
+  std::string problem_;
   size_t lines_drawn_ = 0;
 };
 

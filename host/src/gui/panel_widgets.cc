@@ -13,8 +13,9 @@ void SetPathField(const std::filesystem::path& path, PathField* field) {
   field->back() = '\0';
 }
 
-void ErrorText(const std::string& text) {
+void ErrorText(const std::string& text, WidgetRects* widgets) {
   if (text.empty()) return;
+  if (widgets != nullptr) widgets->AddError(text);
   ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.35f, 0.3f, 1.0f));
   ImGui::TextWrapped("%s", text.c_str());
   ImGui::PopStyleColor();
@@ -58,13 +59,24 @@ void FitText(const std::string& text, WidgetRects* widgets, bool disabled) {
   const ImVec2 max = ImGui::GetItemRectMax();
   if (widgets != nullptr) widgets->AddElided({min.x, min.y, max.x, max.y}, text);
   if (ImGui::IsItemHovered()) {
-    ImGui::BeginTooltip();
-    ImGui::PushTextWrapPos(ImGui::GetFontSize() * 40);
-    ImGui::TextUnformatted(text.c_str());
-    ImGui::PopTextWrapPos();
-    ImGui::EndTooltip();
-    if (widgets != nullptr) widgets->set_tooltip(text);
+    WrappedTooltip(text, widgets);
   }
+}
+
+void WrappedTooltip(const std::string& text, WidgetRects* widgets) {
+  ImGui::BeginTooltip();
+  // At most 40 characters' width or 90 % of the window: ImGui keeps a tooltip inside the
+  // window only when it fits in it.
+  const float window = ImGui::GetMainViewport()->Size.x;
+  ImGui::PushTextWrapPos(std::min(ImGui::GetFontSize() * 40, 0.9f * window));
+  ImGui::TextUnformatted(text.c_str());
+  ImGui::PopTextWrapPos();
+  if (widgets != nullptr) {
+    const ImVec2 at = ImGui::GetWindowPos(), size = ImGui::GetWindowSize();
+    widgets->Set("tooltip", {at.x, at.y, at.x + size.x, at.y + size.y});
+    widgets->set_tooltip(text);
+  }
+  ImGui::EndTooltip();
 }
 
 }  // namespace tessera::gui

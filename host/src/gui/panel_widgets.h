@@ -18,7 +18,7 @@ using PathField = std::array<char, 1024>;
 void SetPathField(const std::filesystem::path& path, PathField* field);
 
 // Draws `text` wrapped, in red; nothing when it is empty.
-void ErrorText(const std::string& text);
+void ErrorText(const std::string& text, WidgetRects* widgets = nullptr);
 
 // Draws `text` wrapped, greyed (a description or hint); nothing when it is empty.
 void HintText(const std::string& text);
@@ -27,6 +27,9 @@ void HintText(const std::string& text);
 // an elided text shows the whole of it in a tooltip while hovered (recorded in `widgets`:
 // WidgetRects::Elided, WidgetRects::tooltip). `disabled`: greyed.
 void FitText(const std::string& text, WidgetRects* widgets, bool disabled = false);
+// A tooltip wrapped to fit the window (a long description is never cut at its edge),
+// recorded as the tooltip shown when `widgets` is given.
+void WrappedTooltip(const std::string& text, WidgetRects* widgets = nullptr);
 
 // `text` cut to `width` pixels of the current font, with "..." at the end; unchanged when
 // it fits.

@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "gui/camera_pick.h"
 #include "gui/image_folder_check.h"
+#include "gui/pair_view.h"
 #include "image/image_masks.h"
 #include "tessera/io/model_statistics.h"
 
@@ -143,11 +145,24 @@ void Picking::DrawCameraDetails(const WidgetRect& view_rect, const fs::path& ima
     photo_.Draw();
     widgets->RecordLastItem("photo");
     ImDrawList* draw = ImGui::GetWindowDrawList();
+    std::vector<const Point2D*> observed;
     for (const Point2D& point : image.points2D) {
-      if (!point.HasPoint3D() || model.points3D.count(point.point3D_id) == 0) continue;
-      draw->AddCircle(ImVec2(origin.x + static_cast<float>(point.xy.x()) * photo_.scale(),
-                             origin.y + static_cast<float>(point.xy.y()) * photo_.scale()),
-                      2.5f, IM_COL32(60, 255, 90, 255));
+      if (point.HasPoint3D() && model.points3D.count(point.point3D_id) > 0) {
+        observed.push_back(&point);
+      }
+    }
+    // At most kMaxPhotoMarks small translucent dots, evenly chosen: thousands of circles
+    // (SIFT's 12k features) would hide the photograph under them.
+    marks_drawn_ = 0;
+    for (const size_t i : SubsampleMatches(observed.size(), kMaxPhotoMarks)) {
+      const Eigen::Vector2d& xy = observed[i]->xy;
+      draw->AddCircleFilled(ImVec2(origin.x + static_cast<float>(xy.x()) * photo_.scale(),
+                                   origin.y + static_cast<float>(xy.y()) * photo_.scale()),
+                            1.5f, IM_COL32(60, 255, 90, 170), 6);
+      ++marks_drawn_;
+    }
+    if (observed.size() > kMaxPhotoMarks) {
+      ImGui::TextDisabled("%zu of %zu observations marked", marks_drawn_, observed.size());
     }
     if (photo_.masked()) ImGui::TextDisabled("darkened: masked out by %s", mask_dir.c_str());
     if (!photo_.mask_problem().empty()) {

@@ -14,6 +14,9 @@
 
 namespace tessera::gui {
 
+// The most observations the camera window marks on its photograph.
+inline constexpr size_t kMaxPhotoMarks = 1500;
+
 class Picking {
  public:
   // The view must outlive the picking.
@@ -36,8 +39,11 @@ class Picking {
   const std::string& photo_problem() const { return photo_problem_; }
   // Whether the photograph shown has its mask's masked-out area darkened.
   bool photo_masked() const { return photo_problem_.empty() && photo_.masked(); }
+  // The observations marked on the photograph in the last frame (at most kMaxPhotoMarks).
+  size_t marks_drawn() const { return marks_drawn_; }
 
  private:
+  size_t marks_drawn_ = 0;
   void DrawCameraDetails(const WidgetRect& view_rect, const std::filesystem::path& image_dir,
                          const std::filesystem::path& mask_dir, WidgetRects* widgets);
   void DrawPointDetails(const WidgetRect& view_rect, WidgetRects* widgets);

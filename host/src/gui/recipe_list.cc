@@ -3,13 +3,12 @@
 #include <imgui.h>
 
 #include <algorithm>
-#include <fstream>
-#include <iterator>
 #include <nlohmann/json.hpp>
+#include <optional>
 
+#include "gui/checked_read.h"
 #include "gui/panel_widgets.h"
 #include "tessera/errors.h"
-#include "tessera/io/file_io.h"
 #include "util/paths.h"
 
 namespace tessera::gui {
@@ -17,10 +16,10 @@ namespace fs = std::filesystem;
 namespace {
 
 bool SameBytes(const fs::path& a, const fs::path& b) {
-  std::ifstream first(a, std::ios::binary), second(b, std::ios::binary);
-  if (!first || !second) return false;
-  return std::string(std::istreambuf_iterator<char>(first), {}) ==
-         std::string(std::istreambuf_iterator<char>(second), {});
+  std::string error;
+  const std::optional<std::string> first = ReadTextFile(a, "the manifest", &error);
+  const std::optional<std::string> second = ReadTextFile(b, "the recipe", &error);
+  return first && second && *first == *second;
 }
 
 }  // namespace
@@ -29,14 +28,15 @@ namespace {
 // The recipe's own "description"; a recipe that cannot be read says why instead, and is
 // still listed (choosing it shows the error in the editor).
 std::string ReadDescription(const fs::path& file) {
+  std::string error;
+  const std::optional<std::string> text = ReadTextFile(file, "the recipe", &error);
+  if (!text) return error;
   try {
-    const nlohmann::json json = nlohmann::json::parse(ReadFileContents(file));
+    const nlohmann::json json = nlohmann::json::parse(*text);
     if (json.is_object() && json.contains("description") && json["description"].is_string()) {
       return json["description"].get<std::string>();
     }
     return "";
-  } catch (const InputError& error) {
-    return error.what();
   } catch (const nlohmann::json::exception& error) {
     return std::string("invalid JSON: ") + error.what();
   }
@@ -92,12 +92,15 @@ const Recipe* RecipeList::Current(const std::string& manifest_field) {
   return nullptr;
 }
 
-const Recipe* RecipeList::Draw(const std::string& manifest_field, WidgetRects* widgets) {
+const Recipe* RecipeList::Draw(const std::string& manifest_field, WidgetRects* widgets,
+                               bool edited) {
   const Recipe* current = Current(manifest_field);
   const Recipe* chosen = nullptr;
-  const char* preview = current != nullptr  ? current->name.c_str()
-                        : recipes().empty() ? "(no recipes found)"
-                                            : "(another file)";
+  // The editor's text is Run's manifest: an edited recipe is no longer the recipe.
+  preview_ = current != nullptr  ? current->name + (edited ? " (edited)" : "")
+             : recipes().empty() ? "(no recipes found)"
+                                 : std::string("(another file)") + (edited ? " (edited)" : "");
+  const char* preview = preview_.c_str();
   // The combo's frame, recorded before BeginCombo: with its popup open, the last item is
   // the popup's.
   const ImVec2 at = ImGui::GetCursorScreenPos();
@@ -109,7 +112,7 @@ const Recipe* RecipeList::Draw(const std::string& manifest_field, WidgetRects* w
       if (ImGui::Selectable(recipe.name.c_str(), &recipe == current)) chosen = &recipe;
       widgets->RecordLastItem("recipe " + recipe.name);
       if (ImGui::IsItemHovered() && !recipe.description.empty()) {
-        ImGui::SetTooltip("%s", recipe.description.c_str());
+        WrappedTooltip(recipe.description, widgets);
       }
     }
     ImGui::EndCombo();

@@ -35,12 +35,16 @@ class RecipeList {
   // The dropdown "Recipe" (recorded as "recipe", its entries as "recipe <name>"), its
   // preview the recipe the manifest field names (empty: the default), with that
   // recipe's description beneath it. Returns the recipe chosen this frame, or nullptr.
-  const Recipe* Draw(const std::string& manifest_field, WidgetRects* widgets);
+  const Recipe* Draw(const std::string& manifest_field, WidgetRects* widgets, bool edited = false);
+  // The box's text in the last frame: the recipe the field names (" (edited)" when the
+  // editor's text differs from its file), "(another file)" or "(no recipes found)".
+  const std::string& preview() const { return preview_; }
   // The recipe whose file the manifest field names (or a copy of it: the same name and
   // bytes); nullptr for another file.
   const Recipe* Current(const std::string& manifest_field);
 
  private:
+  std::string preview_;
   const std::vector<Recipe>& recipes();
 
   std::filesystem::path folder_;

@@ -117,7 +117,10 @@ void RunController::UpdateLastStage(size_t done, size_t total) {
   progress.done = done;
   progress.total = total;
   progress.elapsed_s = elapsed;
-  if (done > 0 && elapsed > 0) {
+  // No rate from the first second: a stage that starts with work already done (or a
+  // burst) would read millions per second.
+  progress.rate_per_s = progress.remaining_s = -1;
+  if (done > 0 && elapsed >= kMinRateSeconds) {
     progress.rate_per_s = static_cast<double>(done) / elapsed;
     progress.remaining_s = static_cast<double>(total - std::min(done, total)) / progress.rate_per_s;
   }
@@ -187,6 +190,20 @@ void RunController::OnModelChanged(size_t model_index, const Reconstruction& mod
   Notify();
 }
 
+void RunController::OnMapStep(const std::string& step, size_t done, size_t total) {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (status_.stages.empty() || status_.stages.back().stage != "map") return;
+    StageProgress& map = status_.stages.back();
+    map.step = step;
+    if (step == "registration" && !map.unit.empty() && total > 0) {
+      const size_t count = std::min(std::max(map.done, done), map.total);
+      if (count != map.done) UpdateLastStage(count, map.total);
+    }
+  }
+  Notify();
+}
+
 void RunController::Notify() {
   if (on_change_) on_change_();
 }
@@ -212,6 +229,9 @@ void RunController::Work(RunRequest request) {
   };
   control.model_changed = [this](size_t model_index, const Reconstruction& model) {
     OnModelChanged(model_index, model);
+  };
+  control.map_step = [this](const std::string& step, size_t done, size_t total) {
+    OnMapStep(step, done, total);
   };
 
   RunState state = RunState::kFailed;
@@ -253,6 +273,10 @@ void RunController::Work(RunRequest request) {
     std::lock_guard<std::mutex> lock(mutex_);
     status_.state = state;
     status_.error = error;
+    // A stopped stage has no rate nor time left.
+    for (StageProgress& stage : status_.stages) {
+      if (!stage.finished) stage.rate_per_s = stage.remaining_s = -1;
+    }
     status_.num_models = num_models;
     status_.exit_code = exit_code;
   }

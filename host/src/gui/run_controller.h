@@ -43,6 +43,9 @@ struct StageProgress {
   // graph, those with a verified pair).
   std::string unit;
   bool finished = false;  // the stage ended (map: done stays what its models registered)
+  // The map stage: the mapper's step last reported (MapperControl::on_progress, e.g.
+  // "rotation averaging"); empty before its first.
+  std::string step;
 };
 
 enum class RunState { kIdle, kRunning, kCompleted, kCancelled, kFailed };
@@ -62,6 +65,8 @@ struct RunStatus {
 // starts from it (at most 19; the UI thread keeps its own): rendering never waits
 // behind the pipeline for a core.
 inline constexpr int kWorkerNiceness = 10;
+// A stage's rate is shown from this many seconds after its start.
+inline constexpr double kMinRateSeconds = 0.5;
 
 class RunController {
  public:
@@ -86,6 +91,10 @@ class RunController {
   // OnModelChanged).
   void OnProgress(const std::string& stage, size_t done, size_t total);
   void OnModelChanged(size_t model_index, const Reconstruction& model);
+  // The mapper's step (StageControl::map_step): named on the map bar; a registration
+  // count moves the bar as OnModelChanged does (a mapper that reports no growing model,
+  // the global one, still counts).
+  void OnMapStep(const std::string& step, size_t done, size_t total);
   // The last stage's done, rate and time left from `done` (under the mutex).
   void UpdateLastStage(size_t done, size_t total);
   void Notify();

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "gui/checked_read.h"
 #include "gui/model_loader.h"
 #include "gui/stage_progress_bars.h"
 #include "manifest/manifest.h"
@@ -67,14 +68,20 @@ bool SetupPanel::CheckFields() {
     error_ = "choose an output folder (the workspace)";
     error_field_ = ErrorField::kOutput;
   }
-  if (editor_.Loaded()) {
+  if (!editor_.LoadError().empty()) {
+    // The field names a file the editor could not load: not the editor's older text.
+    manifest_error_ = editor_.LoadError();
+  } else if (!editor_.Question().empty()) {
+    manifest_error_ = "answer the manifest editor's question first";
+  } else if (editor_.Loaded()) {
     // The editor's text is the run's manifest: checked as `tessera run` would.
     if (!editor_.Check()) manifest_error_ = editor_.Error();
   } else if (!manifest.empty()) {
-    try {
-      Manifest::Load(manifest);
-    } catch (const InputError& exception) {
-      manifest_error_ = exception.what();
+    // Through the window's checked read: a folder, a device or a pipe is a message.
+    manifest_error_ = NotAFileProblem(manifest, "the manifest");
+    if (manifest_error_.empty()) {
+      CheckedRead(
+          manifest, [&] { Manifest::Load(manifest); }, &manifest_error_);
     }
   }
   return images_error_.empty() && manifest_error_.empty() && error_.empty();
@@ -163,9 +170,11 @@ bool SetupPanel::ChooseRecipe(const std::string& name) {
   SetPathField(recipe->file, &manifest_);
   error_.clear();
   manifest_error_.clear();
-  // Loaded now, so that the editor (Run's manifest once loaded) holds the recipe.
-  if (!editor_.Load()) {
-    error_ = editor_.Error();
+  // Loaded now, so that the editor (Run's manifest once loaded) holds the recipe; asked
+  // first when the editor holds unsaved edits.
+  editor_.RequestLoad();
+  if (!editor_.LoadError().empty()) {
+    error_ = editor_.LoadError();
     error_field_ = ErrorField::kNone;
     return false;
   }
@@ -199,8 +208,12 @@ void SetupPanel::Draw(const RunStatus& status, WidgetRects* widgets) {
   editor_.Draw(widgets);
   ClearStaleErrors();  // after this frame's typing and choices
   DrawRunButtons(status, running, widgets);
-  DrawStageProgress(status.stages, widgets);
+  // From a run's start, the rows of all its bars: they fill in without moving what is
+  // below them.
+  DrawStageProgress(status.stages, widgets,
+                    /*keep_rows=*/status.state == RunState::kRunning || !status.stages.empty());
   DrawOverwriteQuestion(widgets);
+  editor_.DrawQuestion(widgets);
 }
 
 void SetupPanel::DrawFields(WidgetRects* widgets) {
@@ -214,9 +227,10 @@ void SetupPanel::DrawFields(WidgetRects* widgets) {
     images_error_.clear();
   }
   widgets->RecordLastItem("images");
+  images_active_ = ImGui::IsItemActive();
   ImGui::SameLine();
   browser_.Draw("images", &images_, widgets);
-  ErrorText(images_error_);
+  ErrorText(images_error_, widgets);
   if (ImGui::InputTextWithHint("Output", "workspace folder", output_.data(), output_.size())) {
     error_.clear();
   }
@@ -231,9 +245,12 @@ void SetupPanel::DrawFields(WidgetRects* widgets) {
   widgets->RecordLastItem("manifest");
   ImGui::SameLine();
   browser_.Draw("manifest", &manifest_, widgets, ".json");
-  if (const Recipe* recipe = recipes_.Draw(manifest_.data(), widgets)) ChooseRecipe(recipe->name);
+  if (const Recipe* recipe = recipes_.Draw(manifest_.data(), widgets, editor_.Edited())) {
+    ChooseRecipe(recipe->name);
+  }
   editor_.FollowManifestField();
-  ErrorText(manifest_error_);
+  // Shown once: the open editor shows its own message about the same text.
+  ErrorText(editor_.open() && manifest_error_ == editor_.Error() ? "" : manifest_error_, widgets);
   ImGui::PopItemWidth();
 }
 
@@ -250,8 +267,11 @@ void SetupPanel::DrawRunButtons(const RunStatus& status, bool running, WidgetRec
   ImGui::SameLine();
   ImGui::Text("%s", RunStateName(status.state));
   ImGui::Checkbox("show the model growing", &follow_run_);
-  if (status.state == RunState::kFailed || !error_.empty()) {
-    ErrorText(error_.empty() ? status.error : error_);
+  // A field's message is beside its field (the output folder's has none): not again here.
+  const bool beside_field =
+      error_field_ == ErrorField::kImages || error_field_ == ErrorField::kManifest;
+  if (status.state == RunState::kFailed || (!error_.empty() && !beside_field)) {
+    ErrorText(error_.empty() ? status.error : error_, widgets);
   }
 }
 

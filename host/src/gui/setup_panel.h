@@ -56,10 +56,14 @@ class SetupPanel {
     return field == "images" ? images_error_ : manifest_error_;
   }
   std::string ImagesField() const { return images_.data(); }
+  // Whether the Images field was being typed in (focused) in the last frame.
+  bool ImagesFieldActive() const { return images_active_; }
   std::string OutputField() const { return output_.data(); }
   std::string ManifestField() const { return manifest_.data(); }
   bool follow_run() const { return follow_run_; }
   ManifestEditorPanel& editor() { return editor_; }
+  // The Recipe box's text in the last frame (RecipeList::preview).
+  const std::string& RecipeShown() const { return recipes_.preview(); }
 
  private:
   // Sets the fields' messages; true when all are empty.
@@ -85,6 +89,7 @@ class SetupPanel {
   std::string overwrite_question_;
   bool overwrite_popup_open_ = false;
   bool follow_run_ = true;
+  bool images_active_ = false;
   FolderBrowser browser_;
   RecipeList recipes_;
   ManifestEditorPanel editor_{&manifest_};

@@ -29,6 +29,7 @@ std::string StageOverlay(const StageProgress& stage, bool with_rate) {
   std::string overlay = std::to_string(stage.done) + "/" + std::to_string(stage.total);
   if (!stage.unit.empty()) overlay += " " + stage.unit;
   if (stage.finished) return overlay;
+  if (!stage.step.empty() && stage.step != "registration") overlay += " (" + stage.step + ")";
   if (stage.rate_per_s > 0) {
     char rate[64];
     std::snprintf(rate, sizeof(rate), "  %.2f/s", stage.rate_per_s);
@@ -38,7 +39,8 @@ std::string StageOverlay(const StageProgress& stage, bool with_rate) {
   return overlay;
 }
 
-void DrawStageProgress(const std::vector<StageProgress>& stages, WidgetRects* widgets) {
+void DrawStageProgress(const std::vector<StageProgress>& stages, WidgetRects* widgets,
+                       bool keep_rows) {
   for (const StageProgress& stage : stages) {
     const std::string overlay = StageOverlay(stage);
     const float name_width = ImGui::GetFontSize() * 6;
@@ -64,6 +66,14 @@ void DrawStageProgress(const std::vector<StageProgress>& stages, WidgetRects* wi
     }
     ImGui::SameLine();
     FitText(stage.stage, widgets);
+  }
+  // The rows of the bars not there yet, kept empty: what is below them stays where it is
+  // while a run starts its stages (a click aimed at it lands on it).
+  if (keep_rows && stages.size() < kStageRows) {
+    // The dummy's own spacing below it stands for the last row's.
+    const float rows = static_cast<float>(kStageRows - stages.size());
+    ImGui::Dummy(
+        ImVec2(1, rows * ImGui::GetFrameHeightWithSpacing() - ImGui::GetStyle().ItemSpacing.y));
   }
 }
 

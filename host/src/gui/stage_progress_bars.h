@@ -20,9 +20,15 @@ float StageFraction(const StageProgress& stage);
 // "45 s", "2 min 5 s"; "?" for a negative time.
 std::string FormatSeconds(double seconds);
 
-// The bars, each named by its stage; the rectangle of each is recorded as
-// "progress <stage>". A text wider than its bar is cut at its end, recorded as elided
+// The rows kept for a run's bars before their stages start: extract, match, map, export.
+inline constexpr size_t kStageRows = 4;
+
+// The bars, each named by its stage (and, with `keep_rows`, empty rows up to kStageRows:
+// from a run's start, what is below the bars stays where it is while they appear); the rectangle of
+// each is recorded as "progress <stage>". A text wider than its bar is cut at its end, recorded as
+// elided
 // ("<stage>: <text>", WidgetRects::Elided) and shown whole in a tooltip.
-void DrawStageProgress(const std::vector<StageProgress>& stages, WidgetRects* widgets);
+void DrawStageProgress(const std::vector<StageProgress>& stages, WidgetRects* widgets,
+                       bool keep_rows = true);
 
 }  // namespace tessera::gui

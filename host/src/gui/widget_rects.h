@@ -25,6 +25,7 @@ class WidgetRects {
     rects_.clear();
     elided_.clear();
     tooltip_.clear();
+    errors_.clear();
   }
   // Records ImGui's last item under `name`.
   void RecordLastItem(const std::string& name);
@@ -38,11 +39,15 @@ class WidgetRects {
   // The text of the tooltip shown this frame for an elided text; empty when none.
   void set_tooltip(const std::string& text) { tooltip_ = text; }
   const std::string& tooltip() const { return tooltip_; }
+  // The error messages drawn this frame (ErrorText), each time it was drawn.
+  void AddError(const std::string& text) { errors_.push_back(text); }
+  const std::vector<std::string>& Errors() const { return errors_; }
 
  private:
   std::map<std::string, WidgetRect> rects_;
   std::vector<std::pair<WidgetRect, std::string>> elided_;
   std::string tooltip_;
+  std::vector<std::string> errors_;
 };
 
 }  // namespace tessera::gui

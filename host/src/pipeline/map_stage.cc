@@ -450,6 +450,7 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
   size_t reported = 0;
   context.control.on_progress = [&control, &reported](const std::string& step, size_t done,
                                                       size_t total) {
+    if (control.map_step) control.map_step(step, done, total);
     if (step != "registration" || total == 0 || std::min(done, total) <= reported) return;
     reported = std::min(done, total);
     control.Report("map", reported, total);

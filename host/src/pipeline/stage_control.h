@@ -42,6 +42,9 @@ struct StageControl {
   // The map stage's model as it grows, after each image registered (see
   // MapperControl::on_model_changed); may be empty. Called on the stage's thread.
   std::function<void(size_t model_index, const Reconstruction& model)> model_changed;
+  // The mapper's steps as it reports them (MapperControl::on_progress: "rotation
+  // averaging", "registration", ...); may be empty. Called on the stage's thread.
+  std::function<void(const std::string& step, size_t done, size_t total)> map_step;
 
   bool Cancelled() const { return cancel != nullptr && cancel->IsCancelled(); }
   void Report(const std::string& stage, size_t done, size_t total) const {

@@ -507,33 +507,47 @@ void LogViewGraph(const MapperInput& input, size_t num_pairs, const GlobalMapper
       result.num_tracks);
 }
 
+// The name a step's time goes by in GlobalMapperResult::StepSeconds, as its progress
+// reports it.
+const char* StepName(const GlobalMapperResult::StepSeconds& steps, const double* step) {
+  if (step == &steps.view_graph) return "view graph";
+  if (step == &steps.rotation_averaging) return "rotation averaging";
+  if (step == &steps.tracks) return "tracks";
+  if (step == &steps.positioning) return "positioning";
+  if (step == &steps.bundle_adjustment) return "bundle adjustment";
+  return "filtering";
+}
+
+GlobalMapperResult CancelledResult(double seconds) {
+  GlobalMapperResult empty;
+  empty.cancelled = true;
+  empty.seconds = seconds;
+  spdlog::info("global map: stopped after {:.1f} s", empty.seconds);
+  return empty;
+}
+
 }  // namespace
 
-GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
-                                             const BundleAdjuster& bundle_adjuster,
-                                             const GlobalMapperOptions& options,
-                                             std::function<bool()> should_stop) {
+GlobalMapperResult GlobalMapper::Reconstruct(
+    const MapperInput& input, const BundleAdjuster& bundle_adjuster,
+    const GlobalMapperOptions& options, std::function<bool()> should_stop,
+    const std::function<void(const std::string&, size_t, size_t)>& on_progress) {
   const auto start_time = std::chrono::steady_clock::now();
   GlobalMapperResult result;
   const auto seconds = [&start_time] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
   };
   auto lap_start = start_time;
-  // Adds the time since the last lap to `step`.
-  const auto lap = [&lap_start](double* step) {
+  GlobalMapperResult::StepSeconds& steps = result.step_seconds;
+  // Adds the time since the last lap to `step`, and reports the step done.
+  const auto lap = [&lap_start, &steps, &on_progress](double* step) {
     const auto now = std::chrono::steady_clock::now();
     *step += std::chrono::duration<double>(now - lap_start).count();
     lap_start = now;
+    if (on_progress) on_progress(StepName(steps, step), 1, 1);
   };
-  GlobalMapperResult::StepSeconds& steps = result.step_seconds;
   const auto stop = [&should_stop] { return should_stop && should_stop(); };
-  const auto cancelled = [&] {
-    GlobalMapperResult empty;
-    empty.cancelled = true;
-    empty.seconds = seconds();
-    spdlog::info("global map: stopped after {:.1f} s", empty.seconds);
-    return empty;
-  };
+  const auto cancelled = [&] { return CancelledResult(seconds()); };
   if (stop()) return cancelled();
 
   // 1. The pairs that map.
@@ -596,6 +610,7 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
   std::map<image_t, std::string> reasons;
   const PartRun run{input, cameras, options, should_stop, &result, &reasons, lap};
   const std::vector<std::set<image_t>> parts = groups.Groups();
+  size_t registered = 0;
   for (size_t part_index = 0; part_index < parts.size(); ++part_index) {
     const std::set<image_t>& part = parts[part_index];
     if (part.size() < static_cast<size_t>(options.min_model_size)) {
@@ -617,6 +632,8 @@ GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
     if (outcome == PartOutcome::kCancelled) return cancelled();
     if (outcome == PartOutcome::kNoModel) continue;
     FinishModel(&model);
+    registered += model.NumRegisteredImages();
+    if (on_progress) on_progress("registration", registered, input.images.size());
     result.models.push_back(std::move(model));
     lap(&steps.filtering);
   }

@@ -82,9 +82,9 @@ class GlobalMapperPlugin : public Mapper {
       result.cancelled = true;
       return result;
     }
-    const GlobalMapperResult mapped =
-        GlobalMapper::Reconstruct(calibrated ? *calibrated : input, *context.bundle_adjuster,
-                                  options, context.control.should_stop);
+    const GlobalMapperResult mapped = GlobalMapper::Reconstruct(
+        calibrated ? *calibrated : input, *context.bundle_adjuster, options,
+        context.control.should_stop, context.control.on_progress);
     if (mapped.cancelled) {
       result = MapperResult();
       result.cancelled = true;
@@ -130,9 +130,16 @@ class GlobalMapperPlugin : public Mapper {
           {"positioning", mapped.step_seconds.positioning},
           {"bundle_adjustment", mapped.step_seconds.bundle_adjustment},
           {"filtering", mapped.step_seconds.filtering}}}};
+    // The finished models, for a view that shows them (the incremental mapper calls it
+    // after each image; the global one has a model only once its part is positioned).
+    if (context.control.on_model_changed) {
+      for (size_t i = 0; i < result.models.size(); ++i) {
+        context.control.on_model_changed(i, result.models[i]);
+      }
+    }
     if (context.control.on_progress) {
       size_t registered = 0;
-      for (const Reconstruction& model : result.models) registered += model.images.size();
+      for (const Reconstruction& model : result.models) registered += model.NumRegisteredImages();
       context.control.on_progress("registration", registered, input.images.size());
     }
     return result;

@@ -70,11 +70,15 @@ class TESSERA_SFM_EXPORT GlobalMapper {
  public:
   // Maps `input`; `bundle_adjuster` must be usable from this thread. Throws OptionError
   // for nothing (the options are checked by FromJson) and InputError for a pair naming
-  // a keypoint an image lacks.
-  static GlobalMapperResult Reconstruct(const MapperInput& input,
-                                        const BundleAdjuster& bundle_adjuster,
-                                        const GlobalMapperOptions& options,
-                                        std::function<bool()> should_stop = {});
+  // a keypoint an image lacks. on_progress (may be empty) hears each step as it ends
+  // ("view graph", "rotation averaging", "tracks", then per connected part "positioning",
+  // "bundle adjustment", "filtering": 1 of 1) and "registration" (the images of the
+  // models finished so far, of the input's), as MapperControl::on_progress.
+  static GlobalMapperResult Reconstruct(
+      const MapperInput& input, const BundleAdjuster& bundle_adjuster,
+      const GlobalMapperOptions& options, std::function<bool()> should_stop = {},
+      const std::function<void(const std::string& step, size_t done, size_t total)>& on_progress =
+          {});
 };
 
 }  // namespace tessera

@@ -1,0 +1,108 @@
+#include "gui/json_text_edit.h"
+
+#include <cctype>
+#include <nlohmann/json.hpp>
+
+namespace tessera::gui {
+namespace {
+
+constexpr size_t kNone = std::string::npos;
+
+size_t SkipSpace(const std::string& text, size_t at) {
+  while (at < text.size() && std::isspace(static_cast<unsigned char>(text[at]))) ++at;
+  return at;
+}
+
+// The end (one past) of the string starting at `at` ('"'); kNone when unterminated.
+size_t StringEnd(const std::string& text, size_t at) {
+  for (size_t i = at + 1; i < text.size(); ++i) {
+    if (text[i] == '\\') {
+      ++i;
+    } else if (text[i] == '"') {
+      return i + 1;
+    }
+  }
+  return kNone;
+}
+
+// The end (one past) of the JSON value starting at `at`; kNone when it does not end.
+size_t ValueEnd(const std::string& text, size_t at) {
+  if (at >= text.size()) return kNone;
+  if (text[at] == '"') return StringEnd(text, at);
+  if (text[at] == '{' || text[at] == '[') {
+    int depth = 0;
+    for (size_t i = at; i < text.size(); ++i) {
+      if (text[i] == '"') {
+        i = StringEnd(text, i);
+        if (i == kNone) return kNone;
+        --i;
+      } else if (text[i] == '{' || text[i] == '[') {
+        ++depth;
+      } else if ((text[i] == '}' || text[i] == ']') && --depth == 0) {
+        return i + 1;
+      }
+    }
+    return kNone;
+  }
+  size_t i = at;
+  while (i < text.size() && text[i] != ',' && text[i] != '}' && text[i] != ']' &&
+         !std::isspace(static_cast<unsigned char>(text[i]))) {
+    ++i;
+  }
+  return i;
+}
+
+// In the object whose '{' is at `open`, where the value of `key` starts; kNone when the
+// object has no such key.
+size_t FindMember(const std::string& text, size_t open, const std::string& key) {
+  size_t at = SkipSpace(text, open + 1);
+  while (at < text.size() && text[at] == '"') {
+    const size_t key_end = StringEnd(text, at);
+    if (key_end == kNone) return kNone;
+    const std::string name = text.substr(at + 1, key_end - at - 2);
+    size_t value = SkipSpace(text, key_end);
+    if (value >= text.size() || text[value] != ':') return kNone;
+    value = SkipSpace(text, value + 1);
+    if (name == key) return value;
+    at = ValueEnd(text, value);
+    if (at == kNone) return kNone;
+    at = SkipSpace(text, at);
+    if (at >= text.size() || text[at] != ',') return kNone;
+    at = SkipSpace(text, at + 1);
+  }
+  return kNone;
+}
+
+// `member` ("KEY": VALUE) put first in the object whose '{' is at `open`.
+std::string InsertFirst(const std::string& text, size_t open, const std::string& member) {
+  const bool empty = text[SkipSpace(text, open + 1)] == '}';
+  return text.substr(0, open + 1) + member + (empty ? "" : ", ") + text.substr(open + 1);
+}
+
+}  // namespace
+
+std::optional<std::string> SetPluginInText(const std::string& text, const std::string& slot,
+                                           const std::string& plugin) {
+  const std::string name = nlohmann::json(plugin).dump();  // quoted and escaped
+  const size_t root = SkipSpace(text, 0);
+  if (root >= text.size() || text[root] != '{') return std::nullopt;
+  const size_t pipeline = FindMember(text, root, "pipeline");
+  if (pipeline == kNone || text[pipeline] != '{') return std::nullopt;
+  const size_t value = FindMember(text, pipeline, slot);
+  if (value == kNone) {
+    return InsertFirst(text, pipeline,
+                       nlohmann::json(slot).dump() + ": {\"plugin\": " + name + "}");
+  }
+  const size_t value_end = ValueEnd(text, value);
+  if (value_end == kNone) return std::nullopt;
+  if (text[value] != '{') {
+    return text.substr(0, value) + "{\"plugin\": " + name + "}" + text.substr(value_end);
+  }
+  const size_t current = FindMember(text, value, "plugin");
+  if (current == kNone) return InsertFirst(text, value, "\"plugin\": " + name);
+  const size_t current_end = ValueEnd(text, current);
+  if (current_end == kNone) return std::nullopt;
+  return text.substr(0, current) + name + text.substr(current_end);
+}
+
+}  // namespace tessera::gui

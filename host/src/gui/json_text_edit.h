@@ -1,0 +1,20 @@
+#pragma once
+
+// Edits of a JSON text in place, for the manifest editor: a slot's plugin name replaced
+// where it is written, every other character kept (the user's order, spacing and the
+// other slots' options), instead of the whole text parsed and dumped again.
+
+#include <optional>
+#include <string>
+
+namespace tessera::gui {
+
+// `text` with pipeline.SLOT's "plugin" set to `plugin`: the name replaced in place; a
+// slot without "plugin" gets it first in its object; a slot that is not an object (a
+// list of pair selectors) becomes {"plugin": PLUGIN}; an absent slot is added first in
+// "pipeline". Nothing when `text` has no "pipeline" object to edit (or is not JSON as
+// far as the edit reads it): the caller then rewrites the JSON.
+std::optional<std::string> SetPluginInText(const std::string& text, const std::string& slot,
+                                           const std::string& plugin);
+
+}  // namespace tessera::gui
