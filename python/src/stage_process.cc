@@ -164,8 +164,8 @@ nlohmann::json RunStage(const std::function<nlohmann::json(const StageControl&)>
 // done, total]} lines, each answered by one byte ('c': go on, else cancel), then one
 // line of the result, the error or the interruption. Never returns.
 [[noreturn]] void ChildMain(const std::function<nlohmann::json(const StageControl&)>& stage,
-                            bool report_progress, bool runs_to_the_end, int channel,
-                            int crash_fd, pid_t parent, int log_level) {
+                            bool report_progress, bool runs_to_the_end, int channel, int crash_fd,
+                            pid_t parent, int log_level) {
   PrepareChild(crash_fd, parent, channel, log_level);
   std::mutex progress_mutex;  // the stages report one at a time; this makes sure
   StageControl control;

@@ -40,7 +40,7 @@ def _type_name(value: object) -> str:
 
 def _path(function: str, name: str, value: object) -> Any:
     if value is None:
-        raise TypeError(f"{function}(): missing the argument {name} (a path)")
+        raise TypeError(f"{function}(): {name} is required (a path)")
     if isinstance(value, (str, os.PathLike)):
         return value
     raise TypeError(f"{function}(): {name} must be a path (str or os.PathLike), "

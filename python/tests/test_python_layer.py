@@ -25,7 +25,8 @@ def public_functions():
              if callable(getattr(tessera, name)) and not inspect.isclass(getattr(tessera, name))]
     for cls in CLASSES:
         for name, member in vars(cls).items():
-            if (name.startswith("_") and name != "__init__") or isinstance(member, property):
+            if ((name.startswith("_") and name != "__init__") or isinstance(member, property)
+                    or inspect.isclass(member)):  # the Map classes keep pybind11's own
                 continue
             if callable(getattr(cls, name)):
                 found.append((f"{cls.__name__}.{name}", getattr(cls, name)))
@@ -80,7 +81,7 @@ def test_a_dict_manifest_works_where_a_path_does():
     listed = tessera.plugins(manifest=MANIFEST)
     assert listed["plugins"] and listed == tessera.plugins()
     with pytest.raises(tessera.InputError, match="plugin_paths"):
-        tessera.plugins(manifest={"plugin_paths": ["/no/such/folder"]})
+        tessera.plugins(manifest={"plugin_paths": [42]})
 
 
 @pytest.fixture
