@@ -106,6 +106,9 @@ setup(
     # setuptools' own folders inside the build folder, not beside CMake's build/.
     options={"build": {"build_base": str(build_dir() / "setuptools")},
              "egg_info": {"egg_base": str(build_dir())}},
+    # The package comes from CMake's install (CMakeBuild.collect), not from discovery.
+    packages=[],
+    py_modules=[],
     ext_modules=[Extension("tessera._tessera", sources=[])],
     cmdclass={"build_ext": CMakeBuild},
     zip_safe=False,

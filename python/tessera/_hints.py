@@ -40,4 +40,7 @@ def for_python(text: str) -> str:
         call = f"tessera.{verb}({_keywords(match.group(3))})"
         return f"call {call}" if match.group(1) else call
 
+    # The warnings are logging records, shown only where the program shows them.
+    text = text.replace("(see the warnings above)",
+                        "(see the warnings logged on 'tessera.map' and 'tessera.match')")
     return _COMMAND.sub(replace, text)

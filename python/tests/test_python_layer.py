@@ -222,6 +222,7 @@ def test_hints_name_the_python_call(tmp_path):
         "x: no features; call tessera.extract() (or tessera.run()) first")
     assert _hints.for_python("run `tessera map --cluster 3` again") == (
         "call tessera.map(cluster=3) again")
+    assert "logged on 'tessera.map'" in _hints.for_python("no model (see the warnings above)")
     with pytest.raises(tessera.InputError) as raised:
         tessera.match(output=tmp_path / "empty", manifest=MANIFEST)
     assert "`tessera " not in str(raised.value), str(raised.value)
