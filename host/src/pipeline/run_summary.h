@@ -25,10 +25,10 @@ struct ExtractionSummary {
   size_t num_reused = 0;         // images whose features were already in the database
   size_t num_features = 0;       // keypoints found in this run
   size_t num_failed = 0;         // images skipped at decoding or detection (now or earlier)
-  size_t num_quarantined = 0;    // images skipped: they crashed the detector twice
   size_t num_changed = 0;        // images whose file changed since the workspace had them
   size_t num_removed = 0;        // images the workspace had that are no longer in the folder
   double seconds = 0;
+  size_t num_quarantined = 0;  // images skipped: they crashed the detector twice
 };
 
 // The pairs that one pair selector chose (before the union with the others').
