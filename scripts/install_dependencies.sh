@@ -15,6 +15,9 @@ packages=(
   xvfb xauth libgl1-mesa-dri
   # The Python module (python/) and its tests and example.
   pybind11-dev python3-dev python3-pytest python3-matplotlib
+  # `pip install .` offline (pyproject.toml, setup.py: --no-build-isolation) and the
+  # typing test (mypy --strict on examples/python).
+  python3-venv python3-setuptools python3-wheel mypy
 )
 # The reference system, for the interoperability tests and benchmarks, and Open3D, an
 # independent PLY reader for the ply exporter's test; optional.

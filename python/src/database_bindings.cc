@@ -65,12 +65,15 @@ py::dict GeometryDict(image_t image_id1, image_t image_id2, TwoViewGeometry geom
 }  // namespace
 
 void BindDatabase(py::module_& module) {
+  py::options options;  // signatures in the docstrings, as Python writes them (model_bindings.cc)
+  options.disable_function_signatures();
   py::class_<Database, std::shared_ptr<Database>>(
       module, "Database", "A workspace's database.db, read-only; results are numpy where arrays")
       .def(py::init([](const std::filesystem::path& path) {
              return std::make_shared<Database>(path, Database::Mode::kReadOnly);
            }),
-           py::arg("path"), "InputError names the file when it is not a usable database")
+           py::arg("path"),
+           "__init__(self, path)\n--\n\nInputError names the file when it is not a usable database")
       .def_property_readonly(
           "cameras",
           [](const Database& database) {
@@ -86,11 +89,18 @@ void BindDatabase(py::module_& module) {
           [](const Database& database) {
             py::dict images;
             for (Image& image : database.ReadAllImages()) {
+              for (const FeatureKeypoint& keypoint : database.ReadKeypoints(image.image_id)) {
+                Point2D point;
+                point.xy = Eigen::Vector2d(keypoint.x, keypoint.y);
+                image.points2D.push_back(point);
+              }
               images[py::int_(image.image_id)] = std::move(image);
             }
             return images;
           },
-          "{image_id: Image} (name, camera_id; no pose), copies")
+          "{image_id: Image}, copies, with name, camera_id and keypoints (Image.keypoints, no "
+          "3D points). The database holds no poses: cam_from_world is the identity and "
+          "registered False; a Reconstruction has the poses")
       .def(
           "keypoints",
           [](const Database& database, image_t image_id) {
@@ -101,7 +111,8 @@ void BindDatabase(py::module_& module) {
                 [](const FeatureKeypoints& k) { return k.empty() ? nullptr : &k[0].x; });
           },
           py::arg("image_id"),
-          "(M, 6) float32: x, y, a11, a12, a21, a22, COLMAP's columns; the rows read, not copied")
+          "keypoints(self, image_id)\n--\n\n(M, 6) float32: x, y, a11, a12, a21, a22, COLMAP's "
+          "columns; the rows read, not copied")
       .def(
           "descriptors",
           [](const Database& database, image_t image_id) {
@@ -113,14 +124,17 @@ void BindDatabase(py::module_& module) {
                                             return m.size() == 0 ? nullptr : m.data();
                                           });
           },
-          py::arg("image_id"), "(M, D) uint8, one descriptor per keypoint; not copied")
+          py::arg("image_id"),
+          "descriptors(self, image_id)\n--\n\n(M, D) uint8, one descriptor per keypoint; not "
+          "copied")
       .def(
           "matches",
           [](const Database& database, image_t image_id1, image_t image_id2) {
             return MatchesArray(database.ReadMatches(image_id1, image_id2));
           },
           py::arg("image_id1"), py::arg("image_id2"),
-          "(K, 2) uint32 keypoint indices into image_id1's and image_id2's keypoints")
+          "matches(self, image_id1, image_id2)\n--\n\n(K, 2) uint32 keypoint indices into "
+          "image_id1's and image_id2's keypoints")
       .def(
           "matched_pairs",
           [](const Database& database) {
@@ -131,7 +145,8 @@ void BindDatabase(py::module_& module) {
             }
             return pairs;
           },
-          "(image_id1, image_id2) of every matched pair, image_id1 < image_id2")
+          "matched_pairs(self)\n--\n\n(image_id1, image_id2) of every matched pair, image_id1 < "
+          "image_id2")
       .def(
           "two_view_geometry",
           [](const Database& database, image_t image_id1, image_t image_id2) {
@@ -139,6 +154,7 @@ void BindDatabase(py::module_& module) {
                                 database.ReadTwoViewGeometry(image_id1, image_id2));
           },
           py::arg("image_id1"), py::arg("image_id2"),
+          "two_view_geometry(self, image_id1, image_id2)\n--\n\n"
           "{'config', 'kind' ('E', 'F', 'H' or None), 'E', 'F', 'H', 'cam2_from_cam1': (R, t), "
           "'inlier_matches': (K, 2)}, relating image_id1 to image_id2")
       .def(
@@ -151,7 +167,8 @@ void BindDatabase(py::module_& module) {
             }
             return geometries;
           },
-          "Every stored geometry as two_view_geometry gives it, image_id1 < image_id2");
+          "two_view_geometries(self)\n--\n\nEvery stored geometry as two_view_geometry gives it, "
+          "image_id1 < image_id2");
 }
 
 }  // namespace tessera::python

@@ -5,6 +5,7 @@
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 #include <pybind11/stl_bind.h>
 
@@ -14,10 +15,12 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "bindings.h"
+#include "model_state.h"
 #include "numpy_views.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
@@ -48,14 +51,14 @@ using DoubleRows = py::array_t<double, py::array::c_style | py::array::forcecast
 // Rows of an (N, 3) array of points; ValueError naming the argument otherwise.
 size_t NumPointRows(const DoubleRows& points, const char* name) {
   if (points.ndim() != 2 || points.shape(1) != 3) {
-    throw py::value_error(std::string(name) + ": expected an (N, 3) array of points");
+    throw py::value_error(std::string(name) + ": expected one (3,) point or an (N, 3) array");
   }
   return static_cast<size_t>(points.shape(0));
 }
 
 // Pixels of camera-frame points; NaN for points not in front of the camera.
-py::array_t<double> ImgFromCam(const Camera& camera, const Rigid3d& cam_from_world,
-                               const DoubleRows& points) {
+py::array_t<double> ImgFromCamRows(const Camera& camera, const Rigid3d& cam_from_world,
+                                   const DoubleRows& points) {
   const size_t n = NumPointRows(points, "points");
   py::array_t<double> pixels = NewArray<double>(n, 2);
   auto in = points.unchecked<2>();
@@ -71,6 +74,23 @@ py::array_t<double> ImgFromCam(const Camera& camera, const Rigid3d& cam_from_wor
     out(i, 1) = xy.y();
   }
   return pixels;
+}
+
+// As ImgFromCamRows for (N, 3) points, (N, 2) pixels; one (3,) point gives one (2,) pixel.
+py::object ImgFromCam(const Camera& camera, const Rigid3d& cam_from_world,
+                      const DoubleRows& points) {
+  if (points.ndim() == 1 && points.shape(0) == 3) {
+    const DoubleRows row = points.attr("reshape")(1, 3);
+    return ImgFromCamRows(camera, cam_from_world, row).attr("reshape")(2);
+  }
+  return ImgFromCamRows(camera, cam_from_world, points);
+}
+
+// "Image(image_id=3, name='0003.jpg', camera_id=1, num_points3D=2087)".
+size_t NumPoints3D(const Image& image) {
+  size_t n = 0;
+  for (const Point2D& point : image.points2D) n += point.HasPoint3D() ? 1 : 0;
+  return n;
 }
 
 // `values` as `count` finite doubles; ValueError naming `what` otherwise.
@@ -151,17 +171,21 @@ void BindCamera(py::module_& module) {
           },
           "Parameters in COLMAP's order for the model, (P,) float64: a read-only view (no "
           "copy); assign P finite numbers to change them")
-      .def("calibration_matrix", &Camera::CalibrationMatrix, "K, 3x3, of the pinhole part")
+      .def("calibration_matrix", &Camera::CalibrationMatrix,
+           "calibration_matrix(self)\n--\n\nK, 3x3, of the pinhole part")
       .def(
           "img_from_cam",
           [](const Camera& camera, const DoubleRows& points) {
             return ImgFromCam(camera, Rigid3d(), points);
           },
           py::arg("points"),
-          "Pixels (N, 2) of camera-frame points (N, 3); NaN for points not in front")
+          "img_from_cam(self, points)\n--\n\nPixels (N, 2) of camera-frame points (N, 3), "
+          "or (2,) of one (3,) point; NaN for points not in front")
+      .def(py::pickle([](const Camera& camera) { return CameraState(camera); },
+                      [](const py::tuple& state) { return CameraFromState(state); }))
       .def("__repr__", [](const Camera& camera) {
-        return "Camera(camera_id=" + std::to_string(camera.camera_id) +
-               ", model=" + camera.ModelName() + ", width=" + std::to_string(camera.width) +
+        return "Camera(camera_id=" + std::to_string(camera.camera_id) + ", model='" +
+               camera.ModelName() + "', width=" + std::to_string(camera.width) +
                ", height=" + std::to_string(camera.height) + ")";
       });
 }
@@ -179,7 +203,15 @@ void BindImage(py::module_& module) {
                                   Eigen::Vector3d(image.cam_from_world.translation));
           },
           "(R, t): x_cam = R @ x_world + t, R (3, 3) and t (3,), copies")
-      .def("projection_center", &Image::ProjectionCenter, "The camera centre in the world, (3,)")
+      .def_property_readonly(
+          "_cam_from_world_quat",
+          [](const Image& image) {
+            const Eigen::Quaterniond& q = image.cam_from_world.rotation;
+            return py::make_tuple(q.x(), q.y(), q.z(), q.w());
+          },
+          "The rotation of cam_from_world as (x, y, z, w), Eigen's (and pycolmap's) order")
+      .def("projection_center", &Image::ProjectionCenter,
+           "projection_center(self)\n--\n\nThe camera centre in the world, (3,)")
       .def_property_readonly(
           "keypoints",
           [](py::object self) {
@@ -199,15 +231,15 @@ void BindImage(py::module_& module) {
           },
           "Each keypoint's 3D point id, (M,) uint64, 2**64-1 where none: a read-only strided "
           "view")
-      .def("num_points3D",
-           [](const Image& image) {
-             size_t n = 0;
-             for (const Point2D& point : image.points2D) n += point.HasPoint3D() ? 1 : 0;
-             return n;
-           })
+      .def("num_points3D", &NumPoints3D,
+           "num_points3D(self)\n--\n\nHow many keypoints have a 3D point")
+      .def(py::pickle([](const Image& image) { return ImageState(image); },
+                      [](const py::tuple& state) { return ImageFromState(state); }))
       .def("__repr__", [](const Image& image) {
-        return "Image(image_id=" + std::to_string(image.image_id) + ", name='" + image.name +
-               "', camera_id=" + std::to_string(image.camera_id) + ")";
+        return "Image(image_id=" + std::to_string(image.image_id) +
+               ", name=" + py::repr(py::str(image.name)).cast<std::string>() +
+               ", camera_id=" + std::to_string(image.camera_id) +
+               ", num_points3D=" + std::to_string(NumPoints3D(image)) + ")";
       });
 }
 
@@ -241,7 +273,39 @@ void BindPoint3D(py::module_& module) {
             return ArrayView<uint32_t>(data, {n, 2}, {sizeof(TrackElement), sizeof(uint32_t)},
                                        self);
           },
-          "(image_id, point2D_idx) per observation, (K, 2) uint32: a read-only view");
+          "(image_id, point2D_idx) per observation, (K, 2) uint32: a read-only view")
+      .def(py::pickle([](const Point3D& point) { return Point3DState(point); },
+                      [](const py::tuple& state) { return Point3DFromState(state); }))
+      .def("__repr__", [](const Point3D& point) {
+        return "Point3D(xyz=[" + std::to_string(point.xyz.x()) + ", " +
+               std::to_string(point.xyz.y()) + ", " + std::to_string(point.xyz.z()) +
+               "], error=" + std::to_string(point.error) +
+               ", track_length=" + std::to_string(point.track.size()) + ")";
+      });
+}
+
+// A read-only mapping of the model's `what` ("image", ...) by id, whose KeyError names
+// the id and the range of ids there are.
+template <typename Key, typename Value>
+void BindIdMap(py::module_& module, const char* value_class, const char* what) {
+  using Map = std::map<Key, Value>;
+  py::class_<Map> map_class = py::bind_map<Map>(module.attr(value_class), "Map");
+  py::delattr(map_class, "__setitem__");
+  py::delattr(map_class, "__delitem__");
+  py::delattr(map_class, "__getitem__");  // bind_map's KeyError says nothing
+  const std::string name = what;
+  map_class.def(
+      "__getitem__",
+      [name](Map& map, Key id) -> Value& {
+        const auto found = map.find(id);
+        if (found != map.end()) return found->second;
+        std::string message = name + "_id " + std::to_string(id) + ": no such " + name;
+        message += map.empty() ? " (the model has none)"
+                               : " (ids " + std::to_string(map.begin()->first) + ".." +
+                                     std::to_string(map.rbegin()->first) + ")";
+        throw py::key_error(message);
+      },
+      py::return_value_policy::reference_internal);
 }
 
 // The whole-model arrays, projection and statistics (one bulk copy each: the points
@@ -277,20 +341,23 @@ void BindModelArrays(py::class_<ModelHandle, std::shared_ptr<ModelHandle>>& mode
             arrays["errors"] = errors;
             return arrays;
           },
-          "{'ids': (N,) uint64, 'xyz': (N, 3) float64, 'colors': (N, 3) uint8, 'errors': "
+          "points3D_arrays(self)\n--\n\n{'ids': (N,) uint64, 'xyz': (N, 3) float64, 'colors': (N, "
+          "3) uint8, 'errors': "
           "(N,) float64}, rows by ascending id: one bulk copy each (the points are a map)")
       .def(
           "project",
           [](const ModelHandle& handle, image_t image_id, const DoubleRows& points) {
             const auto image = handle.model.images.find(image_id);
             if (image == handle.model.images.end()) {
-              throw py::key_error("no image " + std::to_string(image_id));
+              throw py::key_error("image_id " + std::to_string(image_id) + ": no such image");
             }
             const Camera& camera = handle.model.cameras.at(image->second.camera_id);
             return ImgFromCam(camera, image->second.cam_from_world, points);
           },
           py::arg("image_id"), py::arg("points"),
-          "Pixels (N, 2) of world points (N, 3) in an image; NaN for points behind it")
+          "project(self, image_id, points)\n--\n\nPixels (N, 2) of world points (N, 3) in an "
+          "image, or (2,) of one (3,) point; NaN for points behind it; KeyError naming an "
+          "unknown image_id")
       .def(
           "statistics",
           [](const ModelHandle& handle) {
@@ -306,7 +373,7 @@ void BindModelArrays(py::class_<ModelHandle, std::shared_ptr<ModelHandle>>& mode
                 statistics.mean_observation_reprojection_error;
             return result;
           },
-          "What `colmap model_analyzer` reports, as the host computes it: "
+          "statistics(self)\n--\n\nWhat `colmap model_analyzer` reports, as the host computes it: "
           "mean_reprojection_error is COLMAP's (and pycolmap's "
           "compute_mean_reprojection_error): the mean over points of each point's mean error "
           "over its track. mean_observation_reprojection_error is the mean over the "
@@ -316,6 +383,10 @@ void BindModelArrays(py::class_<ModelHandle, std::shared_ptr<ModelHandle>>& mode
 }  // namespace
 
 void BindModel(py::module_& module) {
+  // Each docstring starts with its signature in Python's own form ("name(self, x)\n--\n\n"),
+  // which inspect.signature reads (__text_signature__); pybind11's is not valid Python.
+  py::options options;
+  options.disable_function_signatures();
   BindCamera(module);
   BindImage(module);
   BindPoint3D(module);
@@ -323,26 +394,30 @@ void BindModel(py::module_& module) {
   // both uint32, and pybind11 names a map's key view after the key type.
   // Read-only: the objects and views handed out point into the maps' nodes, which a
   // deletion or replacement would free under them.
-  for (py::object map_class :
-       {py::object(py::bind_map<std::map<camera_t, Camera>>(module.attr("Camera"), "Map")),
-        py::object(py::bind_map<std::map<image_t, Image>>(module.attr("Image"), "Map")),
-        py::object(py::bind_map<std::map<point3D_t, Point3D>>(module.attr("Point3D"), "Map"))}) {
-    py::delattr(map_class, "__setitem__");
-    py::delattr(map_class, "__delitem__");
-  }
+  BindIdMap<camera_t, Camera>(module, "Camera", "camera");
+  BindIdMap<image_t, Image>(module, "Image", "image");
+  BindIdMap<point3D_t, Point3D>(module, "Point3D", "point3D");
 
   py::class_<ModelHandle, std::shared_ptr<ModelHandle>> model_class(
       module, "Reconstruction", "A COLMAP sparse model: cameras, images and 3D points.");
   model_class
-      .def(py::init([](const std::filesystem::path& path) {
+      .def(py::init([](const std::optional<std::filesystem::path>& path) {
              auto handle = std::make_shared<ModelHandle>();
+             if (!path) return handle;
              const py::gil_scoped_release release;
-             handle->model = ReadColmapModel(path, &handle->order);
+             handle->model = ReadColmapModel(*path, &handle->order);
              return handle;
            }),
-           py::arg("path"),
-           "Reads cameras, images and points3D from a folder: the .bin files when all three "
-           "are there, else the .txt files. InputError names the file on any problem.")
+           py::arg("path") = py::none(),
+           "__init__(self, path=None)\n--\n\nReads cameras, images and points3D from a "
+           "folder: the .bin files when all three are there, else the .txt files. InputError "
+           "names the file on any problem. Without a path: an empty model.")
+      .def(py::pickle([](const ModelHandle& handle) { return ReconstructionState(handle.model); },
+                      [](const py::tuple& state) {
+                        auto handle = std::make_shared<ModelHandle>();
+                        handle->model = ReconstructionFromState(state);
+                        return handle;
+                      }))
       .def(
           "write",
           [](const ModelHandle& handle, const std::filesystem::path& path,
@@ -362,7 +437,8 @@ void BindModel(py::module_& module) {
                 &handle.order);
           },
           py::arg("path"), py::arg("format") = "binary",
-          "Writes the model into a folder in COLMAP 3.8's layout, records in the order read; "
+          "write(self, path, format='binary')\n--\n\nWrites the model into a folder in COLMAP "
+          "3.8's layout, records in the order read; "
           "ValueError naming the record for a value that is not finite")
       .def_property_readonly(
           "cameras", [](ModelHandle & handle) -> auto& { return handle.model.cameras; },
@@ -373,8 +449,10 @@ void BindModel(py::module_& module) {
       .def_property_readonly(
           "points3D", [](ModelHandle & handle) -> auto& { return handle.model.points3D; },
           py::return_value_policy::reference_internal, "point3D_id -> Point3D")
-      .def("num_reg_images",
-           [](const ModelHandle& handle) { return handle.model.NumRegisteredImages(); })
+      .def(
+          "num_reg_images",
+          [](const ModelHandle& handle) { return handle.model.NumRegisteredImages(); },
+          "num_reg_images(self)\n--\n\nHow many images are registered")
       .def("__repr__", [](const ModelHandle& handle) {
         return "Reconstruction(cameras=" + std::to_string(handle.model.cameras.size()) +
                ", images=" + std::to_string(handle.model.images.size()) +

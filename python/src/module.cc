@@ -27,7 +27,7 @@ void LocateInstall() {
 }  // namespace
 }  // namespace tessera::python
 
-PYBIND11_MODULE(tessera, module) {
+PYBIND11_MODULE(_tessera, module) {
   module.doc() =
       "Tessera, Structure-from-Motion whose every stage is a plugin: COLMAP models, the "
       "pipeline's stages, the workspace database and the plugins, from Python.";

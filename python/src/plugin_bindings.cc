@@ -24,13 +24,22 @@ void BindPlugins(py::module_& module) {
   module.def(
       "plugins",
       [](const py::object& manifest) {
+        // A dict is the manifest's JSON, relative paths from the working folder.
+        const std::optional<nlohmann::json> manifest_json =
+            py::isinstance<py::dict>(manifest) ? std::optional(ToJson(manifest)) : std::nullopt;
         const std::optional<std::filesystem::path> manifest_file =
-            manifest.is_none() ? std::nullopt
-                               : std::optional(manifest.cast<std::filesystem::path>());
+            manifest.is_none() || manifest_json
+                ? std::nullopt
+                : std::optional(manifest.cast<std::filesystem::path>());
         // In a child process: a plugin whose factory crashes must not end the interpreter.
         return ToPython(RunInChildProcess("plugins", py::none(), [&](const StageControl&) {
           std::vector<std::filesystem::path> manifest_paths;
           if (manifest_file) manifest_paths = Manifest::Load(*manifest_file).plugin_paths;
+          if (manifest_json) {
+            manifest_paths =
+                Manifest::FromJson(*manifest_json, std::filesystem::current_path(), "manifest")
+                    .plugin_paths;
+          }
           const PluginRegistry registry =
               PluginRegistry::Discover(PluginSearchPath(manifest_paths));
           nlohmann::json json = registry.ToJson();

@@ -7,6 +7,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
+#include <spdlog/spdlog.h>
 
 #include <filesystem>
 #include <optional>
@@ -199,14 +200,20 @@ void BindStages(py::module_& module) {
         if (!options.is_none()) arguments.options = ToJson(options);
         arguments.model_index = model_index;
         arguments.masks = masks.value_or(std::filesystem::path());
-        return ToPython(RunInChildProcess("export", py::none(), [&](const StageControl&) {
-          const ExportSummary summary = ExportModel(arguments);
-          return nlohmann::json{{"exporter", summary.exporter},
-                                {"num_images", summary.num_images},
-                                {"num_points3D", summary.num_points3D},
-                                {"num_observations", summary.num_observations},
-                                {"seconds", summary.seconds}};
-        }));
+        return ToPython(RunInChildProcess(
+            "export", py::none(),
+            [&](const StageControl&) {
+              const ExportSummary summary = ExportModel(arguments);
+              spdlog::info("export: wrote {} images and {} points with '{}' into {}",
+                           summary.num_images, summary.num_points3D, summary.exporter,
+                           arguments.output.string());
+              return nlohmann::json{{"exporter", summary.exporter},
+                                    {"num_images", summary.num_images},
+                                    {"num_points3D", summary.num_points3D},
+                                    {"num_observations", summary.num_observations},
+                                    {"seconds", summary.seconds}};
+            },
+            /*runs_to_the_end=*/true));
       },
       py::arg("model"), py::arg("format"), py::arg("output"), py::arg("images") = py::none(),
       py::arg("options") = py::none(), py::arg("model_index") = 0, py::arg("masks") = py::none(),

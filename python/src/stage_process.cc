@@ -3,6 +3,8 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <spdlog/sinks/base_sink.h>
+#include <spdlog/spdlog.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -72,6 +74,32 @@ std::string JsonLine(const nlohmann::json& json) {
 
 // ---- In the child ----
 
+// One line at a time on the channel: the stage's threads log and report progress at once.
+std::mutex g_channel_mutex;
+
+bool SendLine(int fd, const nlohmann::json& json) {
+  const std::lock_guard<std::mutex> lock(g_channel_mutex);
+  return SendAll(fd, JsonLine(json));
+}
+
+// The child's log lines, {"log": [spdlog level, text]}, for the parent to hand to Python's
+// logging (tessera/_logging.py) instead of the child's stdout.
+class ChannelSink : public spdlog::sinks::base_sink<std::mutex> {
+ public:
+  explicit ChannelSink(int channel) : channel_(channel) {}
+
+ protected:
+  void sink_it_(const spdlog::details::log_msg& message) override {
+    SendLine(channel_, {{"log",
+                         {static_cast<int>(message.level),
+                          std::string(message.payload.data(), message.payload.size())}}});
+  }
+  void flush_() override {}
+
+ private:
+  int channel_;
+};
+
 // Cancelled by SIGINT and SIGTERM in the child (as the CLI's token is), or by the
 // parent's answer to a progress event. Constant-initialised: safe in a signal handler.
 CancellationToken g_child_cancel;
@@ -81,8 +109,9 @@ extern "C" void CancelChildStage(int) { g_child_cancel.Cancel(); }
 // Signals as the CLI has them, not as the interpreter left them: SIGINT and SIGTERM
 // cancel (every time: the parent forwards the Ctrl-C the terminal also sent), fatal
 // signals in a plugin call end the child with exit code 4 and a record on `crash_fd`.
-// `parent`: the interpreter's process, whose end cancels the stage.
-void PrepareChild(int crash_fd, pid_t parent) {
+// `parent`: the interpreter's process, whose end cancels the stage. The log goes to the
+// parent on `channel` from `log_level` (spdlog's) up; nothing to the child's stdout.
+void PrepareChild(int crash_fd, pid_t parent, int channel, int log_level) {
   struct sigaction action {};
   action.sa_handler = CancelChildStage;
   sigemptyset(&action.sa_mask);
@@ -96,6 +125,13 @@ void PrepareChild(int crash_fd, pid_t parent) {
   DieWithParent(parent, SIGTERM);
   InstallPluginCrashHandler(kExitPluginCrash);
   SetPluginCrashReportFd(crash_fd);
+  auto logger = std::make_shared<spdlog::logger>("tessera", std::make_shared<ChannelSink>(channel));
+  logger->set_level(static_cast<spdlog::level::level_enum>(log_level));
+  spdlog::set_default_logger(logger);
+  if (const int null = open("/dev/null", O_WRONLY | O_CLOEXEC); null >= 0) {
+    dup2(null, STDOUT_FILENO);  // what a plugin printed itself would land in the caller's
+    close(null);
+  }
 }
 
 nlohmann::json ErrorLine(const char* type, const std::string& message) {
@@ -104,10 +140,10 @@ nlohmann::json ErrorLine(const char* type, const std::string& message) {
 
 // The stage's result or its error, classed as errors.cc translates it in-process.
 nlohmann::json RunStage(const std::function<nlohmann::json(const StageControl&)>& stage,
-                        const StageControl& control) {
+                        const StageControl& control, bool runs_to_the_end) {
   try {
     nlohmann::json result = stage(control);
-    if (control.Cancelled()) return {{"interrupted", true}};
+    if (control.Cancelled() && !runs_to_the_end) return {{"interrupted", true}};
     return {{"result", std::move(result)}};
   } catch (const InputError& error) {
     return ErrorLine("InputError", error.what());
@@ -128,8 +164,9 @@ nlohmann::json RunStage(const std::function<nlohmann::json(const StageControl&)>
 // done, total]} lines, each answered by one byte ('c': go on, else cancel), then one
 // line of the result, the error or the interruption. Never returns.
 [[noreturn]] void ChildMain(const std::function<nlohmann::json(const StageControl&)>& stage,
-                            bool report_progress, int channel, int crash_fd, pid_t parent) {
-  PrepareChild(crash_fd, parent);
+                            bool report_progress, bool runs_to_the_end, int channel, int crash_fd,
+                            pid_t parent, int log_level) {
+  PrepareChild(crash_fd, parent, channel, log_level);
   std::mutex progress_mutex;  // the stages report one at a time; this makes sure
   StageControl control;
   control.cancel = &g_child_cancel;
@@ -139,15 +176,15 @@ nlohmann::json RunStage(const std::function<nlohmann::json(const StageControl&)>
       if (g_child_cancel.IsCancelled()) return;
       char answer = 0;
       ssize_t n = -1;
-      if (SendAll(channel, JsonLine({{"progress", {name, done, total}}}))) {
+      if (SendLine(channel, {{"progress", {name, done, total}}})) {
         while ((n = recv(channel, &answer, 1, 0)) < 0 && errno == EINTR) {
         }
       }
       if (n != 1 || answer != 'c') g_child_cancel.Cancel();
     };
   }
-  const nlohmann::json outcome = RunStage(stage, control);
-  SendAll(channel, JsonLine(outcome));
+  const nlohmann::json outcome = RunStage(stage, control, runs_to_the_end);
+  SendLine(channel, outcome);
   std::fflush(nullptr);
   _exit(0);  // no interpreter's atexit handlers, no static destructors: the parent's
 }
@@ -158,8 +195,8 @@ nlohmann::json RunStage(const std::function<nlohmann::json(const StageControl&)>
 // child on Ctrl-C or the callback's exception, until the child closes the channel.
 class ChildWatch {
  public:
-  ChildWatch(pid_t pid, int channel, const py::object& progress)
-      : pid_(pid), channel_(channel), progress_(progress) {}
+  ChildWatch(pid_t pid, int channel, const py::object& progress, const py::object& log)
+      : pid_(pid), channel_(channel), progress_(progress), log_(log) {}
 
   // Called with the GIL released.
   void Run() {
@@ -191,6 +228,15 @@ class ChildWatch {
   void HandleLine(const std::string& text) {
     nlohmann::json line = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
     if (!line.is_object()) return;
+    if (line.contains("log")) {
+      const py::gil_scoped_acquire gil;
+      try {
+        log_.attr("emit")(line["log"][0].get<int>(), line["log"][1].get<std::string>());
+      } catch (const py::error_already_set&) {
+        Fail();  // a handler that raised stops the stage, as a progress callback that raised
+      }
+      return;
+    }
     if (!line.contains("progress")) {
       outcome_ = std::move(line);
       return;
@@ -234,6 +280,7 @@ class ChildWatch {
   pid_t pid_;
   int channel_;
   const py::object& progress_;
+  const py::object& log_;  // tessera._logging.StageLog
   bool cancelled_ = false;
   std::optional<nlohmann::json> outcome_;
   std::exception_ptr python_error_;
@@ -283,7 +330,8 @@ std::string ReadCrashRecord(int fd) {
 }  // namespace
 
 nlohmann::json RunInChildProcess(const std::string& verb, const py::object& progress,
-                                 const std::function<nlohmann::json(const StageControl&)>& stage) {
+                                 const std::function<nlohmann::json(const StageControl&)>& stage,
+                                 bool runs_to_the_end) {
   int channel_fds[2];
   if (socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, channel_fds) != 0) {
     ThrowSystemError(verb, "open a socket to the stage's process");
@@ -293,6 +341,9 @@ nlohmann::json RunInChildProcess(const std::string& verb, const py::object& prog
   if (pipe2(crash_fds, O_CLOEXEC) != 0) ThrowSystemError(verb, "open a pipe");
   Fd crash_read(crash_fds[0]), crash_write(crash_fds[1]);
 
+  const py::module_ logging = py::module_::import("tessera._logging");
+  py::object log = logging.attr("StageLog")(verb);
+  const int log_level = logging.attr("child_threshold")(verb).cast<int>();
   std::fflush(nullptr);  // the child must not write our buffered output again
   // Forked with the GIL held: no other thread is inside the interpreter; the child
   // never enters it, and starts its own threads only once it runs the stage.
@@ -302,12 +353,13 @@ nlohmann::json RunInChildProcess(const std::string& verb, const py::object& prog
   if (pid == 0) {
     channel.Close();  // the child sees the parent end the channel when the parent ends
     crash_read.Close();
-    ChildMain(stage, !progress.is_none(), child_channel.get(), crash_write.get(), parent);
+    ChildMain(stage, !progress.is_none(), runs_to_the_end, child_channel.get(), crash_write.get(),
+              parent, log_level);
   }
   child_channel.Close();
   crash_write.Close();
 
-  ChildWatch watch(pid, channel.get(), progress);
+  ChildWatch watch(pid, channel.get(), progress, log);
   int status = 0;
   {
     const py::gil_scoped_release release;
@@ -332,6 +384,12 @@ nlohmann::json RunInChildProcess(const std::string& verb, const py::object& prog
   if (outcome && outcome->contains("error")) ThrowStageError((*outcome)["error"]);
   if (!outcome && WIFEXITED(status) && WEXITSTATUS(status) == kExitPluginCrash) {
     ThrowChildDeath(verb, status, record);
+  }
+  if (watch.python_error() && runs_to_the_end && outcome && outcome->contains("result")) {
+    // The interrupt came too late to stop it: the caller learns it finished, in full.
+    log.attr("emit")(static_cast<int>(spdlog::level::warn),
+                     verb + ": interrupted after it had finished; its output is complete");
+    return (*outcome)["result"];
   }
   if (watch.python_error()) std::rethrow_exception(watch.python_error());
   if (!outcome) ThrowChildDeath(verb, status, record);

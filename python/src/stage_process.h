@@ -31,7 +31,10 @@ namespace tessera::python {
 // (InputError, NoModelError, Error, MemoryError); PluginCrashError naming the plugin
 // when one crashed; the callback's exception, or KeyboardInterrupt, when the stage was
 // cancelled by it. `progress`: None or a callable (stage: str, done: int, total: int).
+// `runs_to_the_end`: the stage cannot stop midway (export); a Ctrl-C that came while it
+// ran then returns its result with a warning that it had finished, not KeyboardInterrupt.
 nlohmann::json RunInChildProcess(const std::string& verb, const pybind11::object& progress,
-                                 const std::function<nlohmann::json(const StageControl&)>& stage);
+                                 const std::function<nlohmann::json(const StageControl&)>& stage,
+                                 bool runs_to_the_end = false);
 
 }  // namespace tessera::python

@@ -17,7 +17,9 @@ def test_the_installed_module_imports_and_finds_its_prefix(sample, tmp_path):
                    check=True, capture_output=True)
     # The same folder below the prefix as below the build folder.
     build_dir = pathlib.Path(os.environ["TESSERA_BUILD_DIR"]).resolve()
-    module_dir = prefix / pathlib.Path(tessera.__file__).resolve().parent.relative_to(build_dir)
+    # tessera/__init__.py: the folder above the package's is the one on the path.
+    module_dir = prefix / pathlib.Path(tessera.__file__).resolve().parent.parent.relative_to(
+        build_dir)
     script = f"""
 import json, tessera
 plugins = tessera.plugins()
@@ -32,7 +34,7 @@ print(json.dumps({{"file": tessera.__file__, "search_paths": plugins["search_pat
                             text=True, cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     found = json.loads(result.stdout)
-    assert pathlib.Path(found["file"]).parent == module_dir
+    assert pathlib.Path(found["file"]).parent.parent == module_dir
     # Only the prefix's bundled folder (lib/ or lib64/ as GNUInstallDirs names it).
     [search_path] = found["search_paths"]
     assert pathlib.Path(search_path).parent.parent.parent == prefix

@@ -30,7 +30,7 @@ def failing_plugins(monkeypatch):
 
 
 def test_a_crashing_detector_raises_and_is_quarantined_as_in_the_cli(
-        sample, tmp_path, failing_plugins, capfd):
+        sample, tmp_path, failing_plugins, caplog):
     images, _, _ = sample
     # 0000.jpg 512 px wide, 0001.jpg 1024 px: the detector crashes on the second only.
     two = tmp_path / "two"
@@ -53,13 +53,17 @@ def test_a_crashing_detector_raises_and_is_quarantined_as_in_the_cli(
     assert isinstance(raised.value, tessera.Error)
     # The third call, as the CLI's third run: the image that crashed the detector twice
     # is skipped, the other was kept from the first call.
-    capfd.readouterr()
-    summary = tessera.extract(images=two, output=output, manifest=manifest, threads=1)
-    assert "extract: skipping 0001.jpg: it crashed detector 'failing_detector' twice" in (
-        capfd.readouterr().out)
+    caplog.clear()
+    with caplog.at_level("INFO", logger="tessera"):
+        summary = tessera.extract(images=two, output=output, manifest=manifest, threads=1)
+    assert ("tessera.extract", 30,
+            "extract: skipping 0001.jpg: it crashed detector 'failing_detector' twice") in (
+        caplog.record_tuples)
     assert summary["num_images"] == 2
     assert summary["num_reused"] == 1
     assert summary["num_detected"] == 0
+    assert summary["num_quarantined"] == 1  # counted, not lost among the 0 failed
+    assert summary["num_failed"] == 0
     history = (output / "plugin_crashes.tsv").read_text().splitlines()
     assert history == ["SIGSEGV\tfailing_detector\tdetect\timage 0001.jpg"] * 2
 

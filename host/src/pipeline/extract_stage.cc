@@ -431,6 +431,7 @@ std::vector<size_t> PlanDetection(const Workspace& workspace, const ExtractSetti
                                        ImageSubject(images[i].name))) {
       spdlog::warn("extract: skipping {}: it crashed detector '{}' twice", images[i].name,
                    detector);
+      ++summary->num_quarantined;
     } else {
       todo.push_back(i);
     }

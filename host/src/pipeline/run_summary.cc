@@ -31,6 +31,7 @@ nlohmann::json RunSummary::ToJson() const {
             {"num_detected", extract.num_detected},
             {"num_reused", extract.num_reused},
             {"num_failed", extract.num_failed},
+            {"num_quarantined", extract.num_quarantined},
             {"num_changed", extract.num_changed},
             {"num_removed", extract.num_removed}}},
           {"match",
@@ -59,6 +60,7 @@ RunSummary RunSummary::FromJson(const nlohmann::json& json) {
   summary.extract.num_detected = extract.at("num_detected").get<size_t>();
   summary.extract.num_reused = extract.at("num_reused").get<size_t>();
   summary.extract.num_failed = extract.at("num_failed").get<size_t>();
+  summary.extract.num_quarantined = extract.value("num_quarantined", size_t{0});  // older files
   summary.extract.num_changed = extract.at("num_changed").get<size_t>();
   summary.extract.num_removed = extract.at("num_removed").get<size_t>();
   const nlohmann::json& match = json.at("match");

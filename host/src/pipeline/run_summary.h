@@ -28,6 +28,7 @@ struct ExtractionSummary {
   size_t num_changed = 0;        // images whose file changed since the workspace had them
   size_t num_removed = 0;        // images the workspace had that are no longer in the folder
   double seconds = 0;
+  size_t num_quarantined = 0;  // images skipped: they crashed the detector twice
 };
 
 // The pairs that one pair selector chose (before the union with the others').

@@ -7,7 +7,7 @@ namespace {
 
 RunSummary Example() {
   RunSummary summary;
-  summary.extract = {StageStatus::kCompleted, 11, 1, 9, 2, 70000, 0, 3, 4, 1.5};
+  summary.extract = {StageStatus::kCompleted, 11, 1, 9, 2, 70000, 0, 3, 4, 1.5, 5};
   summary.match.num_pairs = 55;
   summary.match.pairs_per_selector = {{"spatial", "pipeline.pair_selector[0]", 40},
                                       {"sequential", "pipeline.pair_selector[1]", 20}};
@@ -40,7 +40,8 @@ TEST(RunSummary, JsonHasTheKeysBenchReads) {
   EXPECT_EQ(json.at("plugins").at(5),
             nlohmann::json({{"slot", "exporter"}, {"plugin", "ply"}, {"version", "1.1.0"}}));
   // What the file has is exactly this (status and in-memory figures stay out).
-  EXPECT_EQ(json.at("extract").size(), 7u);
+  EXPECT_EQ(json.at("extract").at("num_quarantined").get<size_t>(), 5u);
+  EXPECT_EQ(json.at("extract").size(), 8u);
   EXPECT_EQ(json.at("match").size(), 6u);
   EXPECT_EQ(json.at("map").size(), 6u);
   EXPECT_EQ(json.size(), 5u);
@@ -52,6 +53,7 @@ TEST(RunSummary, RoundTrip) {
   EXPECT_EQ(back.ToJson(), summary.ToJson());
   EXPECT_EQ(back.extract.num_detected, 9u);
   EXPECT_EQ(back.extract.num_removed, 4u);
+  EXPECT_EQ(back.extract.num_quarantined, 5u);
   ASSERT_EQ(back.match.pairs_per_selector.size(), 2u);
   EXPECT_EQ(back.match.pairs_per_selector[0].json_path, "pipeline.pair_selector[0]");
   EXPECT_EQ(back.match.pairs_per_selector[0].num_pairs, 40u);
@@ -68,8 +70,10 @@ TEST(RunSummary, OlderFilesWithoutPairsPerSelectorOrImagesPerModelRead) {
   json["match"].erase("pairs_per_selector");
   json["map"].erase("images_per_model");
   json["map"].erase("kept");
+  json["extract"].erase("num_quarantined");
   json.erase("plugins");
   const RunSummary back = RunSummary::FromJson(json);
+  EXPECT_EQ(back.extract.num_quarantined, 0u);
   EXPECT_TRUE(back.plugins.empty());
   EXPECT_TRUE(back.match.pairs_per_selector.empty());
   EXPECT_TRUE(back.map.images_per_model.empty());

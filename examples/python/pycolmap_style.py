@@ -1,0 +1,108 @@
+#!/usr/bin/env python3
+"""A pycolmap user's first script, run on Tessera: each call as pycolmap spells it, and
+where Tessera differs, its own call beside, as docs/python.md's table says. Prints each
+call with "same" or "differs" and the counts (python/tests/test_pycolmap_style.py checks
+them against the table).
+
+    PYTHONPATH=build/lib/python3.11/dist-packages python3 examples/python/pycolmap_style.py \
+        --workspace sample-output [--images IMAGES --manifest MANIFEST]
+"""
+
+import argparse
+import copy
+import pathlib
+import pickle
+import tempfile
+from typing import Any, Callable, List, Optional, Tuple
+
+import numpy as np
+
+import tessera
+
+SAME, DIFFERS = "same", "differs"
+
+
+def checked_calls(workspace: pathlib.Path) -> List[Tuple[str, str, Callable[[], Any]]]:
+    """(pycolmap call, SAME or DIFFERS, Tessera's call) for a workspace that has a model."""
+    rec = tessera.Reconstruction(workspace / "sparse" / "0")
+    image = next(iter(rec.images.values()))
+    camera = rec.cameras[image.camera_id]
+    point_id, point = next(iter(rec.points3D.items()))
+    out = pathlib.Path(tempfile.mkdtemp())
+    return [
+        ("pycolmap.Reconstruction(path)", SAME, lambda: tessera.Reconstruction(
+            workspace / "sparse" / "0")),
+        ("pycolmap.Reconstruction()", SAME, lambda: tessera.Reconstruction()),
+        ("rec.summary()", SAME, rec.summary),
+        ("rec.num_reg_images()", SAME, rec.num_reg_images),
+        ("rec.num_points3D()", SAME, rec.num_points3D),
+        ("rec.num_cameras()", SAME, rec.num_cameras),
+        ("rec.num_images()", SAME, rec.num_images),
+        ("rec.compute_mean_reprojection_error()", SAME, rec.compute_mean_reprojection_error),
+        ("rec.find_image_with_name(name)", SAME, lambda: rec.find_image_with_name(image.name)),
+        ("rec.images.items()", SAME, lambda: list(rec.images.items())),
+        ("rec.cameras[camera_id]", SAME, lambda: rec.cameras[image.camera_id]),
+        ("rec.points3D[point3D_id]", SAME, lambda: rec.points3D[point_id]),
+        ("rec.write(path)", SAME, lambda: rec.write(out / "binary")),
+        ("rec.write_text(path)", DIFFERS, lambda: rec.write(out / "text", format="text")),
+        ("pickle.dumps(rec)", SAME, lambda: pickle.loads(pickle.dumps(rec))),
+        ("copy.deepcopy(rec)", SAME, lambda: copy.deepcopy(rec)),
+        ("image.name", SAME, lambda: image.name),
+        ("image.image_id", SAME, lambda: image.image_id),
+        ("image.camera_id", SAME, lambda: image.camera_id),
+        ("image.cam_from_world.rotation.quat", SAME, lambda: image.cam_from_world.rotation.quat),
+        ("image.cam_from_world.rotation.matrix()", SAME,
+         lambda: image.cam_from_world.rotation.matrix()),
+        ("image.cam_from_world.translation", SAME, lambda: image.cam_from_world.translation),
+        ("image.cam_from_world.matrix()", SAME, lambda: image.cam_from_world.matrix()),
+        ("image.projection_center()", SAME, image.projection_center),
+        ("image.num_points3D", DIFFERS, image.num_points3D),
+        ("image.points2D", DIFFERS, lambda: (image.keypoints, image.point3D_ids)),
+        ("camera.model", DIFFERS, lambda: camera.model),
+        ("camera.width, camera.height", SAME, lambda: (camera.width, camera.height)),
+        ("camera.params", SAME, lambda: camera.params),
+        ("camera.calibration_matrix()", SAME, camera.calibration_matrix),
+        ("camera.img_from_cam(points)", DIFFERS,
+         lambda: camera.img_from_cam(np.array([[0.1, 0.2, 1.0]]))),
+        ("point3D.xyz", SAME, lambda: point.xyz),
+        ("point3D.color", SAME, lambda: point.color),
+        ("point3D.error", SAME, lambda: point.error),
+        ("point3D.track", DIFFERS, lambda: point.track),
+    ]
+
+
+def stage_calls(images: pathlib.Path,
+                manifest: Optional[pathlib.Path]) -> List[Tuple[str, str, Callable[[], Any]]]:
+    """pycolmap's pipeline functions take a database path; Tessera's a workspace folder."""
+    workspace = pathlib.Path(tempfile.mkdtemp())
+    return [
+        ("pycolmap.extract_features(database_path, image_path)", DIFFERS,
+         lambda: tessera.extract(images=images, output=workspace, manifest=manifest)),
+        ("pycolmap.match_exhaustive(database_path)", DIFFERS,
+         lambda: tessera.match(output=workspace, manifest=manifest)),
+        ("pycolmap.incremental_mapping(database_path, image_path, output_path)", DIFFERS,
+         lambda: tessera.map(output=workspace, manifest=manifest)),
+    ]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0] if __doc__ else None)
+    parser.add_argument("--workspace", type=pathlib.Path, required=True,
+                        help="a workspace with a model, e.g. `tessera run`'s output")
+    parser.add_argument("--images", type=pathlib.Path,
+                        help="also run the stages on these images, in a new workspace")
+    parser.add_argument("--manifest", type=pathlib.Path, help="the stages' recipe")
+    arguments = parser.parse_args()
+    counts = {SAME: 0, DIFFERS: 0}
+    calls = checked_calls(arguments.workspace)
+    if arguments.images:
+        calls += stage_calls(arguments.images, arguments.manifest)
+    for call, kind, function in calls:
+        function()
+        counts[kind] += 1
+        print(f"{kind:8} {call}")
+    print(f"{counts[SAME]} calls run unchanged, {counts[DIFFERS]} need a documented difference")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,333 @@
+"""Tessera, Structure-from-Motion whose every stage is a plugin: COLMAP models, the
+pipeline's stages, the workspace database and the plugins, from Python.
+
+The C++ extension is ``tessera._tessera``; this layer gives its functions Python
+signatures (``inspect.signature`` and type checkers read them), checks argument types
+(TypeError naming the argument), routes the host's log through ``logging`` (logger
+"tessera", one child per stage, see tessera/_logging.py), phrases the host's hints as
+Python calls, and adds pycolmap's names where the meaning is the same (docs/python.md).
+"""
+
+import numbers
+import os
+import typing
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+from . import _hints, _logging, _tessera
+from ._tessera import (Camera, Database, Error, Image, InputError, NoModelError, Point3D,
+                       PluginCrashError, Reconstruction)
+from ._version import __version__
+
+__all__ = [
+    "Camera", "Database", "Error", "Image", "InputError", "NoModelError", "Point3D",
+    "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "__version__", "bench",
+    "evaluate", "export", "extract", "map", "match", "plugins", "run",
+]
+
+PathLike = Union[str, os.PathLike[str]]
+ManifestLike = Union[str, os.PathLike[str], Mapping[str, Any], None]
+Progress = Optional[Callable[[str, int, int], object]]
+
+
+# ---- Argument checks: TypeError naming the argument, before anything runs ----
+
+def _type_name(value: object) -> str:
+    return type(value).__name__
+
+
+def _path(function: str, name: str, value: object) -> Any:
+    if value is None:
+        raise TypeError(f"{function}(): {name} is required (a path)")
+    if isinstance(value, (str, os.PathLike)):
+        return value
+    raise TypeError(f"{function}(): {name} must be a path (str or os.PathLike), "
+                    f"not {_type_name(value)}")
+
+
+def _optional_path(function: str, name: str, value: object) -> Any:
+    return None if value is None else _path(function, name, value)
+
+
+def _manifest(function: str, value: object) -> Any:
+    if value is None or isinstance(value, (str, os.PathLike)):
+        return value
+    if isinstance(value, Mapping):
+        return dict(value)
+    raise TypeError(f"{function}(): manifest must be a path (str or os.PathLike), a dict or "
+                    f"None, not {_type_name(value)}")
+
+
+def _int(function: str, name: str, value: object) -> int:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{function}(): {name} must be an int, not {_type_name(value)}")
+    return int(value)
+
+
+def _bool(function: str, name: str, value: object) -> bool:
+    if not isinstance(value, bool):
+        raise TypeError(f"{function}(): {name} must be a bool, not {_type_name(value)}")
+    return value
+
+
+def _paths(function: str, name: str, value: object) -> List[Any]:
+    if isinstance(value, (str, bytes, os.PathLike)) or not isinstance(value, Sequence):
+        raise TypeError(f"{function}(): {name} must be a list of paths, not {_type_name(value)}")
+    return [_path(function, f"{name}[{index}]", item) for index, item in enumerate(value)]
+
+
+def _progress(function: str, value: object) -> Any:
+    if value is not None and not callable(value):
+        raise TypeError(f"{function}(): progress must be a callable (stage, done, total) or "
+                        f"None, not {_type_name(value)}")
+    return value
+
+
+def _call(function: Callable[..., Any], *arguments: Any, **keywords: Any) -> Any:
+    """Calls the extension, its errors' hints phrased as Python calls."""
+    try:
+        return function(*arguments, **keywords)
+    except Error as error:
+        if error.args and isinstance(error.args[0], str):
+            error.args = (_hints.for_python(error.args[0]),) + error.args[1:]
+        raise
+
+
+# ---- The stages ----
+
+def run(images: Optional[PathLike] = None, output: Optional[PathLike] = None,
+        manifest: ManifestLike = None, camera_K: Optional[PathLike] = None,
+        masks: Optional[PathLike] = None, videos: Sequence[PathLike] = (), threads: int = 0,
+        progress: Progress = None, camera_per_folder: bool = False) -> Dict[str, Any]:
+    """Every stage, images in, models out (`tessera run`); returns run_summary.json as a
+    dict, NoModelError when no model was built. output is required. manifest: a file or a
+    dict (default: default.json); camera_K: a K.txt file; camera_per_folder: images in
+    different subfolders never share a camera; threads: 0 for the manifest's;
+    progress(stage, done, total): an exception from it (KeyboardInterrupt) cancels the
+    stage, keeping what was finished for the same call to resume. Runs in a child process:
+    a plugin that crashes raises PluginCrashError naming it."""
+    name = "run"
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.run, images=_optional_path(name, "images", images),
+        output=_path(name, "output", output), manifest=_manifest(name, manifest),
+        camera_K=_optional_path(name, "camera_K", camera_K),
+        masks=_optional_path(name, "masks", masks), videos=_paths(name, "videos", videos),
+        threads=_int(name, "threads", threads), progress=_progress(name, progress),
+        camera_per_folder=_bool(name, "camera_per_folder", camera_per_folder)))
+
+
+def extract(images: Optional[PathLike] = None, output: Optional[PathLike] = None,
+            manifest: ManifestLike = None, camera_K: Optional[PathLike] = None,
+            masks: Optional[PathLike] = None, videos: Sequence[PathLike] = (),
+            threads: int = 0, progress: Progress = None,
+            camera_per_folder: bool = False) -> Dict[str, Any]:
+    """Ingests images and detects features (`tessera extract`); returns the summary's
+    'extract' part (num_failed: images skipped as unreadable; num_quarantined: images
+    skipped because they crashed the detector twice). Arguments as run()'s."""
+    name = "extract"
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.extract, images=_optional_path(name, "images", images),
+        output=_path(name, "output", output), manifest=_manifest(name, manifest),
+        camera_K=_optional_path(name, "camera_K", camera_K),
+        masks=_optional_path(name, "masks", masks), videos=_paths(name, "videos", videos),
+        threads=_int(name, "threads", threads), progress=_progress(name, progress),
+        camera_per_folder=_bool(name, "camera_per_folder", camera_per_folder)))
+
+
+def match(output: PathLike, manifest: ManifestLike = None, camera_K: Optional[PathLike] = None,
+          threads: int = 0, progress: Progress = None) -> Dict[str, Any]:
+    """Matches and verifies the workspace's pairs (`tessera match`); returns the summary's
+    'match' part. Arguments as run()'s."""
+    name = "match"
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.match, output=_path(name, "output", output),
+        manifest=_manifest(name, manifest), camera_K=_optional_path(name, "camera_K", camera_K),
+        threads=_int(name, "threads", threads), progress=_progress(name, progress)))
+
+
+def map(output: PathLike, images: Optional[PathLike] = None, manifest: ManifestLike = None,
+        camera_K: Optional[PathLike] = None, threads: int = 0,
+        progress: Progress = None) -> Dict[str, Any]:
+    """Maps a workspace into models (`tessera map`); returns the summary's 'map' part,
+    NoModelError when no model was built. Arguments as run()'s."""
+    name = "map"
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.map, output=_path(name, "output", output),
+        images=_optional_path(name, "images", images), manifest=_manifest(name, manifest),
+        camera_K=_optional_path(name, "camera_K", camera_K),
+        threads=_int(name, "threads", threads), progress=_progress(name, progress)))
+
+
+def export(model: PathLike, format: str, output: PathLike, images: Optional[PathLike] = None,
+           options: Optional[Mapping[str, Any]] = None, model_index: int = 0,
+           masks: Optional[PathLike] = None) -> Dict[str, Any]:
+    """Writes a model with an exporter plugin (`tessera export`), in a child process;
+    options: a dict. An export cannot stop midway: a Ctrl-C during it returns the result
+    once it has finished and logs a warning that says so."""
+    name = "export"
+    if not isinstance(format, str):
+        raise TypeError(f"export(): format must be a str, not {_type_name(format)}")
+    if options is not None and not isinstance(options, Mapping):
+        raise TypeError(f"export(): options must be a dict or None, not {_type_name(options)}")
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.export, model=_path(name, "model", model), format=format,
+        output=_path(name, "output", output), images=_optional_path(name, "images", images),
+        options=None if options is None else dict(options),
+        model_index=_int(name, "model_index", model_index),
+        masks=_optional_path(name, "masks", masks)))
+
+
+def plugins(manifest: ManifestLike = None) -> Dict[str, Any]:
+    """The plugins found on the search path (manifest, a file or a dict: also its
+    plugin_paths), as `tessera plugins --json` lists them, each usable one with its
+    default 'options'."""
+    return typing.cast(Dict[str, Any],
+                       _call(_tessera.plugins, manifest=_manifest("plugins", manifest)))
+
+
+def evaluate(model: PathLike, ground_truth: PathLike) -> Dict[str, Any]:
+    """Scores a model folder's poses against ground truth (*.camera files, a
+    transforms.json or a model folder) as `tessera eval --json` does; InputError when it
+    cannot be aligned."""
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.evaluate, model=_path("evaluate", "model", model),
+        ground_truth=_path("evaluate", "ground_truth", ground_truth)))
+
+
+def bench(images: PathLike, manifests: Sequence[PathLike], output: PathLike = "bench-output",
+          ground_truth: Optional[PathLike] = None, camera_K: Optional[PathLike] = None,
+          with_colmap: bool = False, threads: int = 0) -> List[Dict[str, Any]]:
+    """Runs each manifest file (each a `tessera run` of the installed executable, in
+    OUTPUT/<name>) on the same images and returns the rows `tessera bench --json` writes,
+    one dict per manifest (and COLMAP's): a row that failed keeps its exit_code."""
+    name = "bench"
+    return typing.cast(List[Dict[str, Any]], _call(
+        _tessera.bench, images=_path(name, "images", images),
+        manifests=_paths(name, "manifests", manifests), output=_path(name, "output", output),
+        ground_truth=_optional_path(name, "ground_truth", ground_truth),
+        camera_K=_optional_path(name, "camera_K", camera_K),
+        with_colmap=_bool(name, "with_colmap", with_colmap),
+        threads=_int(name, "threads", threads)))
+
+
+# ---- pycolmap's names, where the meaning is the same ----
+
+class Rotation3d:
+    """A rotation: quat (x, y, z, w), pycolmap's (and Eigen's) order, and matrix()."""
+
+    def __init__(self, quat: Sequence[float]) -> None:
+        self.quat: npt.NDArray[np.float64] = np.array(quat, dtype=np.float64)
+
+    def matrix(self) -> npt.NDArray[np.float64]:
+        """The 3x3 rotation matrix."""
+        x, y, z, w = (float(value) for value in self.quat)
+        return np.array([
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+
+    def __repr__(self) -> str:
+        return f"Rotation3d(quat=[{', '.join(f'{v:.6g}' for v in self.quat)}])"
+
+
+class Rigid3d(Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]):
+    """A pose x_cam = R @ x_world + t. Unpacks as (R, t), as Image.cam_from_world always
+    did; pycolmap's names beside: rotation (a Rotation3d, quat in (x, y, z, w)),
+    translation, matrix() (3x4)."""
+
+    rotation: Rotation3d
+
+    def __new__(cls, matrix: npt.NDArray[np.float64], translation: npt.NDArray[np.float64],
+                quat: Sequence[float]) -> "Rigid3d":
+        pose = tuple.__new__(cls, (matrix, translation))
+        pose.rotation = Rotation3d(quat)
+        return pose
+
+    def __getnewargs__(self) -> Tuple[Any, ...]:  # pickle and copy
+        return (self[0], self[1], tuple(float(value) for value in self.rotation.quat))
+
+    @property
+    def translation(self) -> npt.NDArray[np.float64]:
+        return self[1]
+
+    def matrix(self) -> npt.NDArray[np.float64]:
+        """[R | t], 3x4."""
+        return np.hstack([self[0], self[1].reshape(3, 1)])
+
+    def __repr__(self) -> str:
+        return (f"Rigid3d(rotation={self.rotation!r}, "
+                f"translation=[{', '.join(f'{v:.6g}' for v in self[1])}])")
+
+
+def _cam_from_world(image: Image) -> Rigid3d:
+    matrix, translation = image._cam_from_world_matrix
+    return Rigid3d(matrix, translation, image._cam_from_world_quat)
+
+
+def _compute_mean_reprojection_error(self: Reconstruction) -> float:
+    """COLMAP's (and pycolmap's) mean reprojection error: the mean over points of each
+    point's mean error over its track; 0 for a model without points."""
+    return float(self.statistics()["mean_reprojection_error"])
+
+
+def _find_image_with_name(self: Reconstruction, name: str) -> Optional[Image]:
+    """The image of that name (relative to the image folder), None if there is none."""
+    for image in self.images.values():
+        if image.name == name:
+            return image
+    return None
+
+
+def _num_points3D(self: Reconstruction) -> int:
+    """How many 3D points the model has."""
+    return len(self.points3D)
+
+
+def _num_cameras(self: Reconstruction) -> int:
+    """How many cameras the model has."""
+    return len(self.cameras)
+
+
+def _num_images(self: Reconstruction) -> int:
+    """How many images the model has (registered or not)."""
+    return len(self.images)
+
+
+def _summary(self: Reconstruction) -> str:
+    """A few lines of what the model holds, as pycolmap's summary()."""
+    statistics = self.statistics()
+    return "\n".join([
+        "Reconstruction:",
+        f"\tnum_cameras = {len(self.cameras)}",
+        f"\tnum_images = {len(self.images)}",
+        f"\tnum_reg_images = {self.num_reg_images()}",
+        f"\tnum_points3D = {statistics['num_points3D']}",
+        f"\tnum_observations = {statistics['num_observations']}",
+        f"\tmean_track_length = {statistics['mean_track_length']:.6f}",
+        f"\tmean_reprojection_error = {statistics['mean_reprojection_error']:.6f}",
+    ])
+
+
+def _attach() -> None:
+    # Set on the extension's classes: pycolmap's names beside the C++ ones.
+    image_class: Any = Image
+    image_class._cam_from_world_matrix = image_class.cam_from_world
+    image_class.cam_from_world = property(
+        _cam_from_world, doc="x_cam = R @ x_world + t: a Rigid3d that unpacks as (R, t), with "
+                             "rotation.quat (x, y, z, w) and matrix() as pycolmap's")
+    model_class: Any = Reconstruction
+    model_class.compute_mean_reprojection_error = _compute_mean_reprojection_error
+    model_class.find_image_with_name = _find_image_with_name
+    model_class.num_points3D = _num_points3D
+    model_class.num_cameras = _num_cameras
+    model_class.num_images = _num_images
+    model_class.summary = _summary
+    for function in (_compute_mean_reprojection_error, _find_image_with_name, _num_points3D,
+                     _num_cameras, _num_images, _summary):
+        function.__name__ = function.__qualname__ = function.__name__.lstrip("_")
+        function.__module__ = __name__
+
+
+_attach()
