@@ -2,12 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include "pipeline/run_pipeline.h"
+
 namespace tessera {
 namespace {
 
 RunSummary Example() {
   RunSummary summary;
-  summary.extract = {StageStatus::kCompleted, 11, 1, 9, 2, 70000, 0, 3, 4, 1.5};
+  summary.extract = {StageStatus::kCompleted, 11, 1, 9, 2, 70000, 0, 3, 4, 1.5, 1};
   summary.match.num_pairs = 55;
   summary.match.pairs_per_selector = {{"spatial", "pipeline.pair_selector[0]", 40},
                                       {"sequential", "pipeline.pair_selector[1]", 20}};
@@ -15,14 +17,15 @@ RunSummary Example() {
   summary.match.num_reused = 5;
   summary.match.num_verified = 53;
   summary.match.seconds = 2.25;
+  summary.match.num_quarantined = 2;
   summary.map = {StageStatus::kCompleted, 2, 10, 11, 3.5, {7, 3}};
   summary.total_seconds = 7.75;
-  summary.plugins = {{"detector", "orb", "1.0.0"},
-                     {"pair_selector", "spatial", "1.0.0"},
-                     {"pair_selector", "sequential", "1.0.0"},
-                     {"matcher", "brute_force", "1.0.0"},
-                     {"bundle_adjuster", "ceres", "1.0.0"},
-                     {"exporter", "ply", "1.1.0"}};
+  summary.plugins = {{"detector", "orb", "1.0.0", "/p/libmy_orb.so", "0123456789abcdef"},
+                     {"pair_selector", "spatial", "1.0.0", "", ""},
+                     {"pair_selector", "sequential", "1.0.0", "", ""},
+                     {"matcher", "brute_force", "1.0.0", "", ""},
+                     {"bundle_adjuster", "ceres", "1.0.0", "", ""},
+                     {"exporter", "ply", "1.1.0", "", ""}};
   return summary;
 }
 
@@ -36,11 +39,16 @@ TEST(RunSummary, JsonHasTheKeysBenchReads) {
   EXPECT_EQ(json.at("map").at("num_models").get<size_t>(), 2u);
   EXPECT_EQ(json.at("map").at("images_per_model"), nlohmann::json({7, 3}));
   EXPECT_DOUBLE_EQ(json.at("total_seconds").get<double>(), 7.75);
-  EXPECT_EQ(json.at("plugins").at(5),
-            nlohmann::json({{"slot", "exporter"}, {"plugin", "ply"}, {"version", "1.1.0"}}));
+  EXPECT_EQ(json.at("plugins").at(0), nlohmann::json({{"slot", "detector"},
+                                                      {"plugin", "orb"},
+                                                      {"version", "1.0.0"},
+                                                      {"file", "/p/libmy_orb.so"},
+                                                      {"file_hash", "0123456789abcdef"}}));
+  EXPECT_EQ(json.at("extract").at("num_quarantined").get<size_t>(), 1u);
+  EXPECT_EQ(json.at("match").at("num_quarantined").get<size_t>(), 2u);
   // What the file has is exactly this (status and in-memory figures stay out).
-  EXPECT_EQ(json.at("extract").size(), 7u);
-  EXPECT_EQ(json.at("match").size(), 6u);
+  EXPECT_EQ(json.at("extract").size(), 8u);
+  EXPECT_EQ(json.at("match").size(), 7u);
   EXPECT_EQ(json.at("map").size(), 5u);
   EXPECT_EQ(json.size(), 5u);
 }
@@ -59,6 +67,10 @@ TEST(RunSummary, RoundTrip) {
   ASSERT_EQ(back.plugins.size(), 6u);
   EXPECT_EQ(back.plugins[2].plugin, "sequential");
   EXPECT_EQ(back.plugins[5].version, "1.1.0");
+  EXPECT_EQ(back.plugins[0].file, "/p/libmy_orb.so");
+  EXPECT_EQ(back.plugins[0].file_hash, "0123456789abcdef");
+  EXPECT_EQ(back.extract.num_quarantined, 1u);
+  EXPECT_EQ(back.match.num_quarantined, 2u);
 }
 
 TEST(RunSummary, OlderFilesWithoutPairsPerSelectorOrImagesPerModelRead) {
@@ -66,7 +78,10 @@ TEST(RunSummary, OlderFilesWithoutPairsPerSelectorOrImagesPerModelRead) {
   json["match"].erase("pairs_per_selector");
   json["map"].erase("images_per_model");
   json.erase("plugins");
+  json["extract"].erase("num_quarantined");
+  json["match"].erase("num_quarantined");
   const RunSummary back = RunSummary::FromJson(json);
+  EXPECT_EQ(back.extract.num_quarantined, 0u);
   EXPECT_TRUE(back.plugins.empty());
   EXPECT_TRUE(back.match.pairs_per_selector.empty());
   EXPECT_TRUE(back.map.images_per_model.empty());
@@ -80,6 +95,16 @@ TEST(RunSummary, MissingOrMistypedFieldThrows) {
   json = Example().ToJson();
   json["total_seconds"] = "soon";
   EXPECT_THROW(RunSummary::FromJson(json), nlohmann::json::exception);
+}
+
+// The no-model verdict of `map` and `run` points at the warnings above only when some
+// were logged (issue 50: it did after a run that logged none).
+TEST(NoModelMessage, PointsAtTheWarningsAboveOnlyWhenThereAreSome) {
+  EXPECT_EQ(NoModelMessage("out/database.db", true),
+            "out/database.db: no model could be built: no pair of images initialised a model "
+            "(see the warnings above)");
+  EXPECT_EQ(NoModelMessage("out/database.db", false),
+            "out/database.db: no model could be built: no pair of images initialised a model");
 }
 
 }  // namespace
