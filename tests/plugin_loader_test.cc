@@ -217,6 +217,31 @@ TEST(PluginLoader, APluginThatAsksTheHostForItselfIsRefusedNamingTheChain) {
   EXPECT_EQ(WrappingError({{"wrap", "wrapping_b"}}), "");
 }
 
+// The same loop made during a call (Adjust asks the host for itself): refused, not a
+// stack overflow.
+TEST(PluginLoader, APluginThatAsksForItselfDuringACallIsRefusedNamingTheChain) {
+  const PluginRegistry registry = PluginRegistry::Discover({kRoot / "wrapping"});
+  const auto adjuster =
+      registry.Create<BundleAdjuster>("bundle_adjuster", "wrapping_a",
+                                      {{"wrap", "wrapping_a"},
+                                       {"lazy", true},
+                                       {"options", {{"wrap", "wrapping_a"}, {"lazy", true}}}},
+                                      "pipeline.bundle_adjuster");
+  Reconstruction reconstruction;
+  try {
+    adjuster.Call(PluginStage::kAdjust, "a bundle", [&](const BundleAdjuster& plugin) {
+      return plugin.Adjust(BundleAdjustmentConfig(), &reconstruction);
+    });
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("plugin creation loops: 'wrapping_a' -> 'wrapping_a': "
+                        "plugin 'wrapping_a' asks the host for the bundle_adjuster 'wrapping_a'"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
 TEST(PluginLoader, OptionErrorsOfAWrappedPluginNameTheirPathInTheManifest) {
   const std::string file_b = File("wrapping", "wrapping_b").string();
   EXPECT_EQ(WrappingError({{"wrap", "wrapping_b"}, {"options", {{"levle", 2}}}}),

@@ -317,31 +317,38 @@ TESSERA_PLUGIN(pair_selector, FloatOnlyPairSelector, "float_only", "1.0.0",
 
 #elif defined(TESSERA_TEST_CASE_WRAPPING_A) || defined(TESSERA_TEST_CASE_WRAPPING_B)
 // A bundle adjuster that wraps the one its option `wrap` names (made through the host,
-// with `options`), or none: wrapping_a wrapping itself, or wrapping_b wrapping
-// wrapping_a, is a loop the host must refuse; `level` is an option it can refuse.
+// with `options`, in its constructor, or in each Adjust with `lazy`), or none:
+// wrapping_a wrapping itself, or wrapping_b wrapping wrapping_a, is a loop the host must
+// refuse; `level` is an option it can refuse.
 namespace {
 class WrappingBundleAdjuster : public tessera::BundleAdjuster {
  public:
   explicit WrappingBundleAdjuster(const nlohmann::json& options) {
     tessera::OptionReader reader(options);
-    const std::string wrap = reader.GetString("wrap", "");
-    const nlohmann::json wrapped_options = reader.GetJson("options", nlohmann::json::object());
+    wrap_ = reader.GetString("wrap", "");
+    wrapped_options_ = reader.GetJson("options", nlohmann::json::object());
     reader.Get<int>("level", 0, 0, 10);
+    const bool lazy = reader.GetBool("lazy", false);
     reader.Finish();
     effective_options_ = reader.Effective();
-    if (!wrap.empty()) {
-      wrapped_ = host().Create<tessera::BundleAdjuster>("bundle_adjuster", wrap, wrapped_options);
-    }
+    if (!wrap_.empty() && !lazy) wrapped_ = Make();
   }
   tessera::BundleAdjustmentSummary Adjust(const tessera::BundleAdjustmentConfig& config,
                                           tessera::Reconstruction* reconstruction) const override {
     if (wrapped_) return wrapped_->Adjust(config, reconstruction);
+    if (!wrap_.empty()) return Make()->Adjust(config, reconstruction);
     tessera::BundleAdjustmentSummary summary;
     summary.usable = true;
     return summary;
   }
 
  private:
+  std::unique_ptr<tessera::BundleAdjuster> Make() const {
+    return host().Create<tessera::BundleAdjuster>("bundle_adjuster", wrap_, wrapped_options_);
+  }
+
+  std::string wrap_;
+  nlohmann::json wrapped_options_;
   std::unique_ptr<tessera::BundleAdjuster> wrapped_;
 };
 }  // namespace
