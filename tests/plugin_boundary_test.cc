@@ -114,6 +114,8 @@ TEST(PluginBoundary, EveryExceptionFromEveryKindBecomesOneHostErrorNamingPluginA
   }
 }
 
+// Bad input (InputError, OptionError) is exit code 2; anything else the constructor
+// throws is the plugin's failure, exit code 1, as for a call (the guide says so).
 TEST(PluginBoundary, FactoryFailuresOfEveryKindNameTheFileAndPlugin) {
   const PluginRegistry registry = PluginRegistry::Discover({kFailing});
   for (const std::string kind :
@@ -124,7 +126,15 @@ TEST(PluginBoundary, FactoryFailuresOfEveryKindNameTheFileAndPlugin) {
       try {
         registry.Create<Plugin>(kind, "failing_" + kind, options, "pipeline." + kind);
         ADD_FAILURE() << "no error";
+      } catch (const PluginError& error) {
+        EXPECT_FALSE(failure.input_error);
+        EXPECT_FALSE(error.input_error());
+        EXPECT_EQ(std::string(error.what()),
+                  "plugin 'failing_" + kind + "' failed while starting from " +
+                      (kFailing / ("libtessera_test_failing_" + kind + ".so")).string() + ": " +
+                      failure.message);
       } catch (const InputError& error) {
+        EXPECT_TRUE(failure.input_error);
         const std::string text = error.what();
         EXPECT_NE(text.find("failing_" + kind), std::string::npos) << text;
         if (failure.how == "option_error") {
@@ -442,7 +452,8 @@ TEST(PluginBoundaryCli, APluginThatEndsTheProcessIsExit4NamingPluginAndStage) {
   EXPECT_TRUE(Contains(exits.output, "[1/3] a.png: 16 features")) << exits.output;
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "out" / "sparse")) << exits.output;
 
-  // Recorded as a crash: the rerun reports it, and the second one quarantines b.png.
+  // Recorded as a crash: the rerun reports it, and the second one of a build (the same
+  // file and options) quarantines b.png.
   const auto again = RunTessera(
       run + WriteManifest(dir.path(), {{"fail", "quick_exit"}, {"on_width", 48}}).string());
   EXPECT_EQ(again.exit_code, 4) << again.output;
@@ -454,8 +465,16 @@ TEST(PluginBoundaryCli, APluginThatEndsTheProcessIsExit4NamingPluginAndStage) {
                        "[error] plugin 'failing_detector' ended the process (quick_exit) while "
                        "detecting image b.png\n"))
       << again.output;
-  const auto skipped = RunTessera(
-      Extract(dir.path(), WriteManifest(dir.path(), {{"fail", "exit"}, {"on_width", 48}})));
+  // A crash counts for the options it ran with: the record of the run with "exit" is set
+  // aside while the plugin runs with "quick_exit", and b.png is tried once more.
+  const std::string quick_exit =
+      Extract(dir.path(), WriteManifest(dir.path(), {{"fail", "quick_exit"}, {"on_width", 48}}));
+  const auto other_options = RunTessera(quick_exit);
+  EXPECT_EQ(other_options.exit_code, 4) << other_options.output;
+  EXPECT_TRUE(Contains(other_options.output,
+                       "[info] plugin 'failing_detector': a crash record of an older build"))
+      << other_options.output;
+  const auto skipped = RunTessera(quick_exit);
   EXPECT_EQ(skipped.exit_code, 0) << skipped.output;
   EXPECT_TRUE(Contains(skipped.output,
                        "extract: skipping b.png: it crashed detector 'failing_detector' twice"))

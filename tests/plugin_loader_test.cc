@@ -172,16 +172,82 @@ TEST(PluginLoader, RefusesADuplicateNameAndKeepsTheFirst) {
   EXPECT_EQ(registry.NamesOfKind("pair_selector"), std::vector<std::string>{"twin"});
 }
 
+// A constructor's std::runtime_error is the plugin's failure, not bad input: exit code 1,
+// as for a call that throws it (docs/plugin_authors_guide.md).
 TEST(PluginLoader, ReportsAFactoryThatThrows) {
   const PluginRegistry registry = PluginRegistry::Discover({kRoot / "factory_throws"});
   const auto file = File("factory_throws", "factory_throws");
   try {
     registry.Create<PairSelector>("pair_selector", "throws", {}, "pipeline.pair_selector");
     FAIL() << "expected an error";
-  } catch (const InputError& error) {
-    EXPECT_EQ(std::string(error.what()),
-              file.string() + ": plugin 'throws' failed to start: cannot reach the license server");
+  } catch (const PluginError& error) {
+    EXPECT_EQ(std::string(error.what()), "plugin 'throws' failed while starting from " +
+                                             file.string() + ": cannot reach the license server");
+    EXPECT_FALSE(error.input_error());
   }
+}
+
+// The message of the InputError that Create of the wrapping_a bundle adjuster with
+// `options` throws ("" when none).
+std::string WrappingError(const nlohmann::json& options) {
+  const PluginRegistry registry = PluginRegistry::Discover({kRoot / "wrapping"});
+  try {
+    registry.Create<BundleAdjuster>("bundle_adjuster", "wrapping_a", options,
+                                    "pipeline.bundle_adjuster");
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "";
+}
+
+TEST(PluginLoader, APluginThatAsksTheHostForItselfIsRefusedNamingTheChain) {
+  const std::string file = File("wrapping", "wrapping_a").string();
+  EXPECT_EQ(WrappingError({{"wrap", "wrapping_a"}, {"options", {{"wrap", "wrapping_a"}}}}),
+            "pipeline.bundle_adjuster: plugin creation loops: 'wrapping_a' -> 'wrapping_a': plugin "
+            "'wrapping_a' asks the host for the bundle_adjuster 'wrapping_a', which is already "
+            "being made or called (" +
+                file + "); a plugin cannot wrap itself");
+  // A -> B -> A.
+  EXPECT_EQ(WrappingError({{"wrap", "wrapping_b"}, {"options", {{"wrap", "wrapping_a"}}}}),
+            "pipeline.bundle_adjuster: plugin creation loops: 'wrapping_a' -> 'wrapping_b' -> "
+            "'wrapping_a': plugin 'wrapping_b' asks the host for the bundle_adjuster "
+            "'wrapping_a', which is already being made or called (" +
+                file + "); a plugin cannot wrap itself");
+  // A wraps B, which wraps nothing: no loop.
+  EXPECT_EQ(WrappingError({{"wrap", "wrapping_b"}}), "");
+}
+
+// The same loop made during a call (Adjust asks the host for itself): refused, not a
+// stack overflow.
+TEST(PluginLoader, APluginThatAsksForItselfDuringACallIsRefusedNamingTheChain) {
+  const PluginRegistry registry = PluginRegistry::Discover({kRoot / "wrapping"});
+  const auto adjuster =
+      registry.Create<BundleAdjuster>("bundle_adjuster", "wrapping_a",
+                                      {{"wrap", "wrapping_a"},
+                                       {"lazy", true},
+                                       {"options", {{"wrap", "wrapping_a"}, {"lazy", true}}}},
+                                      "pipeline.bundle_adjuster");
+  Reconstruction reconstruction;
+  try {
+    adjuster.Call(PluginStage::kAdjust, "a bundle", [&](const BundleAdjuster& plugin) {
+      return plugin.Adjust(BundleAdjustmentConfig(), &reconstruction);
+    });
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("plugin creation loops: 'wrapping_a' -> 'wrapping_a': "
+                        "plugin 'wrapping_a' asks the host for the bundle_adjuster 'wrapping_a'"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
+TEST(PluginLoader, OptionErrorsOfAWrappedPluginNameTheirPathInTheManifest) {
+  const std::string file_b = File("wrapping", "wrapping_b").string();
+  EXPECT_EQ(WrappingError({{"wrap", "wrapping_b"}, {"options", {{"levle", 2}}}}),
+            "pipeline.bundle_adjuster.options.options.levle: unknown key; did you mean "
+            "'level'? (plugin 'wrapping_b', " +
+                file_b + ", made by plugin 'wrapping_a')");
 }
 
 TEST(PluginLoader, ReportsInvalidOptionsWithTheirJsonPath) {

@@ -69,7 +69,8 @@ nlohmann::json StageJson(const char* stage, const RunSummary& summary) {
 }
 
 void CheckModels(const MapStageSummary& summary, const std::filesystem::path& output) {
-  if (summary.num_models == 0) throw NoModelError(NoModelMessage(output / "database.db"));
+  if (summary.num_models == 0)
+    throw NoModelError(NoModelMessage(output / "database.db", /*warnings_logged=*/true));
 }
 
 // The keywords the verbs share, in the CLI's terms, and what the docstrings say of them.

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <exception>
+#include <memory>
 #include <stdexcept>
 
 #include "tessera/sdk.h"
@@ -313,6 +314,51 @@ class FloatOnlyPairSelector : public TestPairSelector {
 }  // namespace
 TESSERA_PLUGIN(pair_selector, FloatOnlyPairSelector, "float_only", "1.0.0",
                "Refuses binary descriptors")
+
+#elif defined(TESSERA_TEST_CASE_WRAPPING_A) || defined(TESSERA_TEST_CASE_WRAPPING_B)
+// A bundle adjuster that wraps the one its option `wrap` names (made through the host,
+// with `options`, in its constructor, or in each Adjust with `lazy`), or none:
+// wrapping_a wrapping itself, or wrapping_b wrapping wrapping_a, is a loop the host must
+// refuse; `level` is an option it can refuse.
+namespace {
+class WrappingBundleAdjuster : public tessera::BundleAdjuster {
+ public:
+  explicit WrappingBundleAdjuster(const nlohmann::json& options) {
+    tessera::OptionReader reader(options);
+    wrap_ = reader.GetString("wrap", "");
+    wrapped_options_ = reader.GetJson("options", nlohmann::json::object());
+    reader.Get<int>("level", 0, 0, 10);
+    const bool lazy = reader.GetBool("lazy", false);
+    reader.Finish();
+    effective_options_ = reader.Effective();
+    if (!wrap_.empty() && !lazy) wrapped_ = Make();
+  }
+  tessera::BundleAdjustmentSummary Adjust(const tessera::BundleAdjustmentConfig& config,
+                                          tessera::Reconstruction* reconstruction) const override {
+    if (wrapped_) return wrapped_->Adjust(config, reconstruction);
+    if (!wrap_.empty()) return Make()->Adjust(config, reconstruction);
+    tessera::BundleAdjustmentSummary summary;
+    summary.usable = true;
+    return summary;
+  }
+
+ private:
+  std::unique_ptr<tessera::BundleAdjuster> Make() const {
+    return host().Create<tessera::BundleAdjuster>("bundle_adjuster", wrap_, wrapped_options_);
+  }
+
+  std::string wrap_;
+  nlohmann::json wrapped_options_;
+  std::unique_ptr<tessera::BundleAdjuster> wrapped_;
+};
+}  // namespace
+#if defined(TESSERA_TEST_CASE_WRAPPING_A)
+TESSERA_PLUGIN(bundle_adjuster, WrappingBundleAdjuster, "wrapping_a", "1.0.0",
+               "Wraps the bundle adjuster its options name")
+#else
+TESSERA_PLUGIN(bundle_adjuster, WrappingBundleAdjuster, "wrapping_b", "1.0.0",
+               "Wraps the bundle adjuster its options name")
+#endif
 
 #elif defined(TESSERA_TEST_CASE_GOOD)
 TESSERA_PLUGIN(pair_selector, TestPairSelector, "consecutive", "1.2.3",

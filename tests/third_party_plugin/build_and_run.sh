@@ -26,6 +26,10 @@ for page in plugin_authors_guide.md manifest_reference.md plugins/detector.md pl
     plugins/pair_selector.md plugins/mapper.md plugins/bundle_adjuster.md plugins/exporter.md; do
   [ -s "$docs/$page" ] || { echo "FAIL: $docs/$page is not installed"; exit 1; }
 done
+# The guide states the installed plugin.h's ABI, each bundled plugin's options page is
+# installed, and every link of the installed pages resolves.
+python3 "$source_dir/../../scripts/check_installed_docs.py" "$work/prefix" \
+  --source "$source_dir/../.." || { echo "FAIL: the installed documentation"; exit 1; }
 for example in "$source_dir"/*.cc "$source_dir"/CMakeLists.txt; do
   cmp -s "$example" "$docs/examples/$(basename "$example")" ||
     { echo "FAIL: $docs/examples/$(basename "$example") is not the installed copy of $example"; exit 1; }
@@ -185,7 +189,8 @@ rc=0
   "$work/ba_crash.log" || { cat "$work/ba_crash.log"; echo "the quarantined wrapped adjuster: exit $rc"; exit 1; }
 for case in '{"adjuster": "cerez"}|no bundle_adjuster plugin '"'cerez'"'; did you mean '"'ceres'"'?' \
             '{"adjuster": "akaze"}|is a detector, not a bundle_adjuster' \
-            '{"adjuster": "ceres", "options": {"loss": "l2"}}|bundle_adjuster.options.loss: '; do
+            '{"adjuster": "ceres", "options": {"loss": "l2"}}|pipeline.bundle_adjuster.options.options.loss: ' \
+            '{"adjuster": "pass_through"}|plugin creation loops: '"'pass_through' -> 'pass_through'"; do
   adjuster bad "{\"plugin\": \"pass_through\", \"options\": ${case%%|*}}"
   rc=0
   "$tessera" map --output "$work/ba_crash" --manifest "$work/bad.json" 2> "$work/bad.log" || rc=$?

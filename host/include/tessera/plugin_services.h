@@ -27,7 +27,10 @@ class PluginServices {
   // through the host's guard: what the plugin throws becomes an error naming it, and a
   // crash in it ends the run naming it (exit code 4), as for the host's own plugins.
   // Throws InputError, one line naming the plugin, for an unknown kind or name, a
-  // plugin of another kind, or options it refuses.
+  // plugin of another kind, or options it refuses (named by their manifest path when
+  // `options` is part of the caller's own options). A plugin that asks for itself, or
+  // for one that asks for it again (A -> B -> A), or plugins nested deeper than 8, get
+  // an InputError naming the chain, which the run reports as exit code 2: let it pass.
   virtual std::unique_ptr<Plugin> CreatePlugin(const std::string& kind, const std::string& name,
                                                const nlohmann::json& options) const = 0;
 

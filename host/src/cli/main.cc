@@ -11,6 +11,7 @@
 #include "plugin/plugin_call.h"
 #include "tessera/errors.h"
 #include "util/exit_codes.h"
+#include "util/warning_count.h"
 
 int main(int argc, char** argv) {
   using namespace tessera;
@@ -35,6 +36,7 @@ int main(int argc, char** argv) {
   }
 
   auto logger = spdlog::stderr_color_mt("tessera");
+  logger->sinks().push_back(WarningCountingSink());  // "see the warnings above" only if any
   spdlog::set_default_logger(logger);
   spdlog::set_pattern("%^[%l]%$ %v");
   spdlog::set_level(global.quiet ? spdlog::level::warn

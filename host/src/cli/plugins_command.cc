@@ -1,11 +1,13 @@
 // `tessera plugins [--json] [--manifest FILE]`: every plugin found on the search path,
-// with the ones the host would refuse marked and why.
+// with the ones the host would refuse marked and why. `tessera plugins --forget-crashes
+// OUTPUT`: forgets the workspace's plugin crash records, and so its quarantine.
 
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "cli/commands.h"
 #include "manifest/manifest.h"
+#include "plugin/plugin_crash_log.h"
 #include "plugin/plugin_registry.h"
 #include "util/exit_codes.h"
 #include "util/paths.h"
@@ -16,13 +18,23 @@ CommandRegistration RegisterPluginsCommand(CLI::App& app, const GlobalOptions&) 
   struct Options {
     bool json = false;
     std::string manifest;
+    std::string forget_crashes;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("plugins", "List the plugins found and the ones refused");
   sub->add_flag("--json", options->json, "Print JSON instead of a table");
   sub->add_option("--manifest", options->manifest, "Also search the plugin_paths of this manifest");
+  sub->add_option("--forget-crashes", options->forget_crashes,
+                  "Forget the plugin crashes recorded in this output folder (plugin_crashes.tsv), "
+                  "and so their quarantine, instead of listing plugins");
 
   auto run = [options]() {
+    if (!options->forget_crashes.empty()) {
+      const size_t forgotten = ForgetPluginCrashes(options->forget_crashes);
+      std::cout << "Forgot " << forgotten << " plugin crash record(s) in "
+                << options->forget_crashes << "\n";
+      return static_cast<int>(kExitSuccess);
+    }
     std::vector<std::filesystem::path> manifest_paths;
     if (!options->manifest.empty()) manifest_paths = Manifest::Load(options->manifest).plugin_paths;
     const PluginRegistry registry = PluginRegistry::Discover(PluginSearchPath(manifest_paths));

@@ -21,6 +21,7 @@
 #include "pipeline/stage_arguments.h"
 #include "util/exit_codes.h"
 #include "util/paths.h"
+#include "util/warning_count.h"
 
 namespace tessera {
 namespace {
@@ -95,7 +96,7 @@ StageControl InterruptibleControl() {
 int MappingExitCode(const MapStageSummary& summary, const std::filesystem::path& database) {
   if (summary.status == StageStatus::kCancelled) return ReportInterrupted("map");
   if (summary.num_models > 0) return kExitSuccess;
-  spdlog::error("{}", NoModelMessage(database));
+  spdlog::error("{}", NoModelMessage(database, NumWarningsLogged() > 0));
   return kExitNoModel;
 }
 
@@ -170,8 +171,9 @@ CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
                 // Named by its cluster: the processes of map --hierarchical share one log.
                 spdlog::error(
                     "map --cluster {}: no model could be built from the images of cluster {} "
-                    "of {} (see the warnings above); the merge leaves it out",
-                    options->cluster, options->cluster, options->output);
+                    "of {}{}; the merge leaves it out",
+                    options->cluster, options->cluster, options->output,
+                    NumWarningsLogged() > 0 ? " (see the warnings above)" : "");
                 return static_cast<int>(kExitNoModel);
               }
             } else if (hierarchical->count() > 0) {

@@ -620,9 +620,9 @@ void LogExtraction(const ExtractionSummary& s) {
   spdlog::info(
       "extract: {} images ({} skipped files), {} detected with {} features, {} reused, "
       "{} skipped at decoding or detection, {} changed and {} removed since the last run, "
-      "{:.2f} s",
+      "{} skipped by quarantine, {:.2f} s",
       s.num_images, s.num_skipped_files, s.num_detected, s.num_features, s.num_reused, s.num_failed,
-      s.num_changed, s.num_removed, s.seconds);
+      s.num_changed, s.num_removed, s.num_quarantined, s.seconds);
 }
 
 }  // namespace tessera

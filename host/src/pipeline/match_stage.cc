@@ -258,6 +258,7 @@ MatchPlan PlanMatching(const Workspace& workspace, const MatchSettings& settings
                                        PairSubject(images[i].name, images[j].name))) {
       spdlog::warn("match: skipping {} and {}: they crashed matcher '{}' twice", images[i].name,
                    images[j].name, matcher);
+      ++plan.num_quarantined;
     } else {
       plan.todo.emplace_back(i, j);
     }
@@ -401,6 +402,7 @@ MatchingSummary MatchFeatures(const Workspace& workspace, const MatchSettings& s
   summary.pairs_per_selector = plan.pairs_per_selector;
   summary.num_pairs = plan.num_in_scope;
   summary.num_reused = plan.num_reused;
+  summary.num_quarantined = plan.num_quarantined;
   const std::vector<ImageIndexPair>& todo = plan.todo;
   const std::string& matcher = settings.matcher->name();
   if (scope.name.empty()) {
@@ -454,11 +456,13 @@ void LogMatching(const MatchingSummary& s) {
   const double mean_inliers =
       s.num_matched > 0 ? static_cast<double>(s.num_inlier_matches) / s.num_matched : 0.0;
   spdlog::info(
-      "match: {} pairs, {} matched now ({} reused), {} verified in the workspace; "
+      "match: {} pairs, {} matched now ({} reused, {} skipped by quarantine), {} verified in the "
+      "workspace; "
       "{} putative and {} inlier matches now ({:.0f} inliers per pair); "
       "matching {:.2f} s, verification {:.2f} s (thread time), {:.2f} s wall",
-      s.num_pairs, s.num_matched, s.num_reused, s.num_verified, s.num_putative_matches,
-      s.num_inlier_matches, mean_inliers, s.match_seconds, s.verify_seconds, s.seconds);
+      s.num_pairs, s.num_matched, s.num_reused, s.num_quarantined, s.num_verified,
+      s.num_putative_matches, s.num_inlier_matches, mean_inliers, s.match_seconds, s.verify_seconds,
+      s.seconds);
 }
 
 }  // namespace tessera

@@ -78,8 +78,9 @@ struct MatchPlan {
   std::vector<ImageIndexPair> pairs;  // united over the selectors, each once as (min, max)
   std::vector<ImageIndexPair> todo;   // pairs of the scope neither done already nor quarantined
   std::vector<SelectorPairs> pairs_per_selector;
-  size_t num_in_scope = 0;  // pairs of the scope (all of `pairs` for a whole stage)
-  size_t num_reused = 0;    // pairs of the scope with matches and a geometry already
+  size_t num_in_scope = 0;     // pairs of the scope (all of `pairs` for a whole stage)
+  size_t num_reused = 0;       // pairs of the scope with matches and a geometry already
+  size_t num_quarantined = 0;  // pairs of the scope skipped: they crashed the matcher twice
 };
 
 // Step 2. Selectors get every image in capture order with its camera and stored

@@ -9,6 +9,7 @@
 #include "pipeline/match_stage.h"
 #include "pipeline/workspace.h"
 #include "plugin/plugin_call.h"
+#include "plugin/plugin_crash_log.h"
 #include "tessera/io/file_io.h"
 #include "util/timer.h"
 
@@ -24,20 +25,23 @@ std::filesystem::path InputImages(const PipelineContext& context, const RunOptio
   return IngestVideos(options.videos, options.output_dir, context.video_options);
 }
 
-// Every plugin of the run with its version, in pipeline order.
+// The plugin in `slot`: name, version, and the file that ran with its hash.
+template <typename Interface>
+PluginUsed Used(const std::string& slot, const PluginInstance<Interface>& plugin) {
+  return {slot, plugin.name(), plugin.version(), plugin.file().string(),
+          PluginFileHash(plugin.file())};
+}
+
+// Every plugin of the run with its version and file, in pipeline order.
 std::vector<PluginUsed> PluginsUsed(const PipelineContext& context) {
-  std::vector<PluginUsed> plugins = {
-      {"detector", context.detector.name(), context.detector.version()}};
+  std::vector<PluginUsed> plugins = {Used("detector", context.detector)};
   for (const auto& selector : context.pair_selectors) {
-    plugins.push_back({"pair_selector", selector.name(), selector.version()});
+    plugins.push_back(Used("pair_selector", selector));
   }
-  plugins.push_back({"matcher", context.matcher.name(), context.matcher.version()});
-  plugins.push_back({"mapper", context.mapper.name(), context.mapper.version()});
-  plugins.push_back(
-      {"bundle_adjuster", context.bundle_adjuster.name(), context.bundle_adjuster.version()});
-  for (const auto& exporter : context.exporters) {
-    plugins.push_back({"exporter", exporter.name(), exporter.version()});
-  }
+  plugins.push_back(Used("matcher", context.matcher));
+  plugins.push_back(Used("mapper", context.mapper));
+  plugins.push_back(Used("bundle_adjuster", context.bundle_adjuster));
+  for (const auto& exporter : context.exporters) plugins.push_back(Used("exporter", exporter));
   return plugins;
 }
 
@@ -143,10 +147,9 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
   return run;
 }
 
-std::string NoModelMessage(const std::filesystem::path& database) {
-  return database.string() +
-         ": no model could be built: no pair of images initialised a model (see the warnings "
-         "above)";
+std::string NoModelMessage(const std::filesystem::path& database, bool warnings_logged) {
+  return database.string() + ": no model could be built: no pair of images initialised a model" +
+         (warnings_logged ? " (see the warnings above)" : "");
 }
 
 }  // namespace tessera

@@ -60,7 +60,7 @@ RunResult RunPipeline(const PipelineContext& context, const RunOptions& options,
                       const StageControl& control = {});
 
 // What a `map` or `run` that built no model says, naming the workspace's database
-// (the CLI's exit code 3).
-std::string NoModelMessage(const std::filesystem::path& database);
+// (the CLI's exit code 3); it points at the warnings above only when some were logged.
+std::string NoModelMessage(const std::filesystem::path& database, bool warnings_logged);
 
 }  // namespace tessera

@@ -13,13 +13,19 @@ void from_json(const nlohmann::json& json, SelectorPairs& pairs) {
 }
 
 void to_json(nlohmann::json& json, const PluginUsed& plugin) {
-  json = {{"slot", plugin.slot}, {"plugin", plugin.plugin}, {"version", plugin.version}};
+  json = {{"slot", plugin.slot},
+          {"plugin", plugin.plugin},
+          {"version", plugin.version},
+          {"file", plugin.file},
+          {"file_hash", plugin.file_hash}};
 }
 
 void from_json(const nlohmann::json& json, PluginUsed& plugin) {
   plugin.slot = json.at("slot").get<std::string>();
   plugin.plugin = json.at("plugin").get<std::string>();
   plugin.version = json.at("version").get<std::string>();
+  plugin.file = json.value("file", "");
+  plugin.file_hash = json.value("file_hash", "");
 }
 
 nlohmann::json RunSummary::ToJson() const {
@@ -40,6 +46,7 @@ nlohmann::json RunSummary::ToJson() const {
             {"pairs_per_selector", selectors},
             {"num_matched", match.num_matched},
             {"num_reused", match.num_reused},
+            {"num_quarantined", match.num_quarantined},
             {"num_verified", match.num_verified}}},
           {"map",
            {{"seconds", map.seconds},
@@ -72,6 +79,7 @@ RunSummary RunSummary::FromJson(const nlohmann::json& json) {
   }
   summary.match.num_matched = match.at("num_matched").get<size_t>();
   summary.match.num_reused = match.at("num_reused").get<size_t>();
+  summary.match.num_quarantined = match.value("num_quarantined", size_t{0});
   summary.match.num_verified = match.at("num_verified").get<size_t>();
   const nlohmann::json& map = json.at("map");
   summary.map.seconds = map.at("seconds").get<double>();

@@ -42,13 +42,17 @@ void to_json(nlohmann::json& json, const SelectorPairs& pairs);
 void from_json(const nlohmann::json& json, SelectorPairs& pairs);
 
 // A plugin a run used: its slot ("detector", "pair_selector", "matcher",
-// "bundle_adjuster" or "exporter"), name and version.
+// "bundle_adjuster" or "exporter"), name and version, and the library file that ran, so
+// that a plugin on TESSERA_PLUGIN_PATH that shadows a bundled one is seen.
 struct PluginUsed {
   std::string slot;
   std::string plugin;
   std::string version;
+  std::string file;       // absolute path of its library
+  std::string file_hash;  // XXH3-64 of that file, 16 hex digits (PluginFileHash)
 };
-// {"slot", "plugin", "version"}.
+// {"slot", "plugin", "version", "file", "file_hash"}; files of older versions lack the
+// last two.
 void to_json(nlohmann::json& json, const PluginUsed& plugin);
 void from_json(const nlohmann::json& json, PluginUsed& plugin);
 
@@ -64,6 +68,7 @@ struct MatchingSummary {
   double match_seconds = 0;         // descriptor matching, summed over threads
   double verify_seconds = 0;        // geometric verification, summed over threads
   double seconds = 0;               // wall time of the stage
+  size_t num_quarantined = 0;       // pairs skipped: they crashed this matcher twice
 };
 
 struct MapStageSummary {

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "pipeline/run_pipeline.h"
+
 namespace tessera {
 namespace {
 
@@ -15,14 +17,15 @@ RunSummary Example() {
   summary.match.num_reused = 5;
   summary.match.num_verified = 53;
   summary.match.seconds = 2.25;
+  summary.match.num_quarantined = 2;
   summary.map = {StageStatus::kCompleted, 2, 10, 11, 3.5, {7, 3}, true};
   summary.total_seconds = 7.75;
-  summary.plugins = {{"detector", "orb", "1.0.0"},
-                     {"pair_selector", "spatial", "1.0.0"},
-                     {"pair_selector", "sequential", "1.0.0"},
-                     {"matcher", "brute_force", "1.0.0"},
-                     {"bundle_adjuster", "ceres", "1.0.0"},
-                     {"exporter", "ply", "1.1.0"}};
+  summary.plugins = {{"detector", "orb", "1.0.0", "/p/libmy_orb.so", "0123456789abcdef"},
+                     {"pair_selector", "spatial", "1.0.0", "", ""},
+                     {"pair_selector", "sequential", "1.0.0", "", ""},
+                     {"matcher", "brute_force", "1.0.0", "", ""},
+                     {"bundle_adjuster", "ceres", "1.0.0", "", ""},
+                     {"exporter", "ply", "1.1.0", "", ""}};
   return summary;
 }
 
@@ -37,12 +40,16 @@ TEST(RunSummary, JsonHasTheKeysBenchReads) {
   EXPECT_EQ(json.at("map").at("images_per_model"), nlohmann::json({7, 3}));
   EXPECT_EQ(json.at("map").at("kept"), true);
   EXPECT_DOUBLE_EQ(json.at("total_seconds").get<double>(), 7.75);
-  EXPECT_EQ(json.at("plugins").at(5),
-            nlohmann::json({{"slot", "exporter"}, {"plugin", "ply"}, {"version", "1.1.0"}}));
+  EXPECT_EQ(json.at("plugins").at(0), nlohmann::json({{"slot", "detector"},
+                                                      {"plugin", "orb"},
+                                                      {"version", "1.0.0"},
+                                                      {"file", "/p/libmy_orb.so"},
+                                                      {"file_hash", "0123456789abcdef"}}));
   // What the file has is exactly this (status and in-memory figures stay out).
   EXPECT_EQ(json.at("extract").at("num_quarantined").get<size_t>(), 5u);
+  EXPECT_EQ(json.at("match").at("num_quarantined").get<size_t>(), 2u);
   EXPECT_EQ(json.at("extract").size(), 8u);
-  EXPECT_EQ(json.at("match").size(), 6u);
+  EXPECT_EQ(json.at("match").size(), 7u);
   EXPECT_EQ(json.at("map").size(), 6u);
   EXPECT_EQ(json.size(), 5u);
 }
@@ -63,6 +70,9 @@ TEST(RunSummary, RoundTrip) {
   ASSERT_EQ(back.plugins.size(), 6u);
   EXPECT_EQ(back.plugins[2].plugin, "sequential");
   EXPECT_EQ(back.plugins[5].version, "1.1.0");
+  EXPECT_EQ(back.plugins[0].file, "/p/libmy_orb.so");
+  EXPECT_EQ(back.plugins[0].file_hash, "0123456789abcdef");
+  EXPECT_EQ(back.match.num_quarantined, 2u);
 }
 
 TEST(RunSummary, OlderFilesWithoutPairsPerSelectorOrImagesPerModelRead) {
@@ -71,6 +81,7 @@ TEST(RunSummary, OlderFilesWithoutPairsPerSelectorOrImagesPerModelRead) {
   json["map"].erase("images_per_model");
   json["map"].erase("kept");
   json["extract"].erase("num_quarantined");
+  json["match"].erase("num_quarantined");
   json.erase("plugins");
   const RunSummary back = RunSummary::FromJson(json);
   EXPECT_EQ(back.extract.num_quarantined, 0u);
@@ -88,6 +99,16 @@ TEST(RunSummary, MissingOrMistypedFieldThrows) {
   json = Example().ToJson();
   json["total_seconds"] = "soon";
   EXPECT_THROW(RunSummary::FromJson(json), nlohmann::json::exception);
+}
+
+// The no-model verdict of `map` and `run` points at the warnings above only when some
+// were logged (issue 50: it did after a run that logged none).
+TEST(NoModelMessage, PointsAtTheWarningsAboveOnlyWhenThereAreSome) {
+  EXPECT_EQ(NoModelMessage("out/database.db", true),
+            "out/database.db: no model could be built: no pair of images initialised a model "
+            "(see the warnings above)");
+  EXPECT_EQ(NoModelMessage("out/database.db", false),
+            "out/database.db: no model could be built: no pair of images initialised a model");
 }
 
 }  // namespace

@@ -11,6 +11,8 @@
 #include <cstring>
 #include <vector>
 
+#include "plugin/plugin_crash_log.h"
+
 namespace tessera {
 namespace {
 
@@ -23,6 +25,7 @@ struct CallRecord {
   char stage[32];
   char activity[32];
   char subject[1024];
+  char build[192];  // "version\tfile hash\toptions digest" (CurrentPluginBuild), or empty
 };
 
 // initial-exec: the handler may read it from any thread without allocating.
@@ -109,7 +112,8 @@ CallRecord* ActiveRecord() {
   return last != nullptr && last->active ? last : nullptr;
 }
 
-// Writes "CAUSE\tplugin\tstage\tsubject\n" to `fd`. Async-signal-safe.
+// Writes "CAUSE\tplugin\tstage\tsubject\tversion\tfile hash\toptions digest\n" to `fd`
+// (without the build's fields when it is unknown). Async-signal-safe.
 void WriteCrashRecord(int fd, const CallRecord* record, const char* cause) {
   WriteAll(fd, cause);
   WriteAll(fd, "\t");
@@ -118,6 +122,10 @@ void WriteCrashRecord(int fd, const CallRecord* record, const char* cause) {
   WriteAll(fd, record->stage);
   WriteAll(fd, "\t");
   WriteAll(fd, record->subject);
+  if (record->build[0] != '\0') {
+    WriteAll(fd, "\t");
+    WriteAll(fd, record->build);
+  }
   WriteAll(fd, "\n");
 }
 
@@ -294,6 +302,7 @@ PluginCallScope::PluginCallScope(const std::string& plugin, PluginStage stage,
   CopyField(PluginStageName(stage), record.stage, sizeof(record.stage));
   CopyField(PluginStageActivity(stage), record.activity, sizeof(record.activity));
   CopyField(subject, record.subject, sizeof(record.subject));
+  CopyCurrentPluginBuildFields(plugin, record.build, sizeof(record.build));
   std::atomic_signal_fence(std::memory_order_seq_cst);
   record.active = 1;
   g_last_started.store(&record);
@@ -302,6 +311,13 @@ PluginCallScope::PluginCallScope(const std::string& plugin, PluginStage stage,
 std::string CurrentPluginSubject() {
   const CallRecord& record = t_record;
   return record.active ? std::string(record.subject) : std::string();
+}
+
+std::vector<std::string> ActivePluginCalls() {
+  std::vector<std::string> plugins;
+  for (const CallRecord& outer : t_outer_records) plugins.emplace_back(outer.plugin);
+  if (t_record.active) plugins.emplace_back(t_record.plugin);
+  return plugins;
 }
 
 LogSink PluginLogSink(const std::string& plugin) {
@@ -325,6 +341,7 @@ PluginCallScope::~PluginCallScope() {
     std::memcpy(t_record.stage, outer.stage, sizeof(outer.stage));
     std::memcpy(t_record.activity, outer.activity, sizeof(outer.activity));
     std::memcpy(t_record.subject, outer.subject, sizeof(outer.subject));
+    std::memcpy(t_record.build, outer.build, sizeof(outer.build));
     std::atomic_signal_fence(std::memory_order_seq_cst);
     t_record.active = 1;
     t_outer_records.pop_back();

@@ -11,6 +11,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "tessera/errors.h"
 #include "tessera/log.h"
@@ -106,6 +107,10 @@ class PluginCallScope {
 // The subject of the plugin call the current thread is in ("image a.jpg"), empty
 // outside one.
 std::string CurrentPluginSubject();
+// The plugins the current thread is in calls of, outermost first (a mapper, then the
+// bundle adjuster it called; a wrapper being made, then the plugin its constructor asks
+// the host for); empty outside plugin calls.
+std::vector<std::string> ActivePluginCalls();
 // Where the Logger of the plugin `plugin` writes (Plugin::SetLogSink): the host's log,
 // as "PLUGIN: text", or "PLUGIN (image a.jpg): text" during a call about an image or
 // pair; -v and -q apply as to the host's own lines.

@@ -1,11 +1,15 @@
 #include "plugin/plugin_registry.h"
 
 #include <dlfcn.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <mutex>
+#include <optional>
 #include <set>
 
 #include "plugin/host_plugin_services.h"
+#include "plugin/plugin_crash_log.h"
 #include "plugin/plugin_probe.h"
 
 namespace tessera {
@@ -241,10 +245,122 @@ nlohmann::json PluginRegistry::DefaultOptions(const PluginRecord& record) const 
   return plugin->EffectiveOptions();
 }
 
+namespace {
+
+// Deeper than this, a chain of plugins made for plugins is taken for a loop that the
+// names alone do not show (a plugin that asks for others with changing options).
+constexpr size_t kMaxPluginNesting = 8;
+
+// A chain of plugins that makes itself: passed through every level unchanged (it is a
+// HostInputError), so that the user reads the chain, not a wrapper's failure to start.
+class PluginChainError : public HostInputError {
+ public:
+  using HostInputError::HostInputError;
+};
+
+// Options refused by a plugin made for another plugin: `path` below the `options` it was
+// given. Each maker on the way out finds those options among its own and lengthens the
+// path, so that the outermost names the manifest's path
+// (pipeline.bundle_adjuster.options.primary_options.loss).
+class NestedOptionError : public HostInputError {
+ public:
+  NestedOptionError(const std::string& fallback, std::string path, nlohmann::json options,
+                    std::string message, std::string who)
+      : HostInputError(fallback),
+        path(std::move(path)),
+        options(std::move(options)),
+        message(std::move(message)),
+        who(std::move(who)) {}
+  std::string path;
+  nlohmann::json options;
+  std::string message;
+  std::string who;  // "plugin 'ceres', FILE, made by plugin 'wrapper'"
+};
+
+// The JSON path of `needle` in `haystack` ("" for the whole, "a.b", "list[2]"), or
+// nullopt when it is not there.
+std::optional<std::string> FindJsonPath(const nlohmann::json& haystack,
+                                        const nlohmann::json& needle) {
+  if (haystack == needle) return std::string();
+  if (haystack.is_object()) {
+    for (const auto& [key, value] : haystack.items()) {
+      if (const auto below = FindJsonPath(value, needle)) {
+        return key + (below->empty() || (*below)[0] == '[' ? "" : ".") + *below;
+      }
+    }
+  }
+  if (haystack.is_array()) {
+    for (size_t i = 0; i < haystack.size(); ++i) {
+      if (const auto below = FindJsonPath(haystack[i], needle)) {
+        return "[" + std::to_string(i) + "]" + (below->empty() || (*below)[0] == '[' ? "" : ".") +
+               *below;
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+std::string JoinPath(const std::string& head, const std::string& tail) {
+  if (tail.empty()) return head;
+  return head + (head.empty() || tail[0] == '[' ? "" : ".") + tail;
+}
+
+// Refuses to make `name` when the thread is already inside it (a plugin asking the host
+// for itself, or A -> B -> A), or when plugins made for plugins nest too deep.
+void CheckPluginChain(const std::string& kind, const std::string& name,
+                      const std::filesystem::path& file) {
+  const std::vector<std::string> active = ActivePluginCalls();
+  std::string chain;
+  for (const std::string& plugin : active) chain += "'" + plugin + "' -> ";
+  chain += "'" + name + "'";
+  if (std::find(active.begin(), active.end(), name) != active.end()) {
+    throw PluginChainError("plugin creation loops: " + chain + ": plugin '" + active.back() +
+                           "' asks the host for the " + kind + " '" + name +
+                           "', which is already being made or called (" + file.string() +
+                           "); a plugin cannot wrap itself");
+  }
+  if (active.size() >= kMaxPluginNesting) {
+    throw PluginChainError("plugins made for plugins nest deeper than " +
+                           std::to_string(kMaxPluginNesting) + ": " + chain);
+  }
+}
+
+// Says, once per plugin name in a process, which file runs when files found later on
+// the search path (a bundled plugin) carry the same name: "pipeline.detector: plugin
+// 'orb' runs from A (version 2.0); it shadows B (version 1.0), found later on the
+// plugin path".
+void AnnounceShadowing(const PluginRecord& record, const std::vector<PluginRecord>& records,
+                       const std::string& json_path) {
+  std::string shadowed;
+  for (const PluginRecord& other : records) {
+    if (other.usable() || other.name != record.name || other.file == record.file) continue;
+    if (other.refusal.find(": duplicate plugin name ") == std::string::npos) continue;
+    shadowed +=
+        (shadowed.empty() ? "" : ", ") + other.file.string() + " (version " + other.version + ")";
+  }
+  if (shadowed.empty()) return;
+  static std::mutex mutex;
+  static std::set<std::string> announced;
+  {
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (!announced.insert(record.name).second) return;
+  }
+  spdlog::warn(
+      "{}: plugin '{}' runs from {} (version {}); it shadows {}, found later on the "
+      "plugin path (the manifest's plugin_paths, then TESSERA_PLUGIN_PATH, then the "
+      "bundled plugins; in a folder, by file name)",
+      json_path, record.name, record.file.string(), record.version, shadowed);
+}
+
+}  // namespace
+
 std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
                                                      const nlohmann::json& options,
                                                      const std::string& json_path,
                                                      const std::string& options_path) const {
+  // Made for another plugin (Plugin::host()) while that one is being made or called.
+  const bool nested = !ActivePluginCalls().empty();
+  if (nested) CheckPluginChain(record.kind, record.name, record.file);
   if (!record.library) {
     // Inspected in a child process only: open it here now.
     PluginRecord loaded = InspectPluginFile(record.file);
@@ -254,27 +370,59 @@ std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
     }
     record.library = std::move(loaded.library);
   }
+  // Its crash records carry this build: a rebuilt plugin, or other options, run again.
+  SetCurrentPluginBuild(record.name, MakePluginBuild(record.version, record.file, options.dump()));
+  AnnounceShadowing(record, records_, json_path);
   const auto& factory = record.library->get_alias<PluginFactory>(kFactorySymbol);
+  const std::string options_base = options_path.empty() ? json_path + ".options" : options_path;
+  const std::string who = "plugin " + Quote(record.name) + ", " + record.file.string();
   std::unique_ptr<Plugin> plugin;
   try {
     const PluginCallScope scope(record.name, PluginStage::kCreate, "from " + record.file.string());
     plugin = factory(options, services_.lock());
   } catch (const OptionError& error) {
     // Plugins report paths relative to their options; anchor them in the manifest.
-    const std::string path = (options_path.empty() ? json_path + ".options" : options_path) +
-                             (error.path().empty() ? "" : "." + error.path());
-    throw InputError(path + ": " + error.message() + " (plugin " + Quote(record.name) + ", " +
-                     record.file.string() + ")");
-  } catch (const std::exception& error) {
+    const std::string fallback =
+        JoinPath(options_base, error.path()) + ": " + error.message() + " (" + who + ")";
+    if (nested) throw NestedOptionError(fallback, error.path(), options, error.message(), who);
+    throw InputError(fallback);
+  } catch (const NestedOptionError& error) {
+    // A plugin this one made refused its options: find them among this one's.
+    const std::optional<std::string> at = FindJsonPath(options, error.options);
+    const std::string made_by = error.who + ", made by plugin " + Quote(record.name);
+    if (!at) {
+      throw InputError(options_base + ": plugin " + Quote(record.name) +
+                       " made a plugin with options it refuses, " +
+                       JoinPath("options", error.path) + ": " + error.message + " (" + made_by +
+                       ")");
+    }
+    const std::string path = JoinPath(*at, error.path);
+    const std::string fallback =
+        JoinPath(options_base, path) + ": " + error.message + " (" + made_by + ")";
+    if (nested) throw NestedOptionError(fallback, path, options, error.message, made_by);
+    throw InputError(fallback);
+  } catch (const PluginChainError& error) {
+    if (nested) throw;
+    throw InputError(json_path + ": " + error.what());
+  } catch (const PluginError&) {
+    throw;  // a plugin this one made failed: it is named
+  } catch (const HostInputError&) {
+    throw;  // the host refused what this plugin asked of it: the host's words
+  } catch (const InputError& error) {
     throw InputError(record.file.string() + ": plugin " + Quote(record.name) +
                      " failed to start: " + error.what());
+  } catch (const std::exception& error) {
+    // Not the user's input: the plugin's failure, exit code 1, as for any call.
+    throw PluginError(record.name, PluginStage::kCreate, "from " + record.file.string(),
+                      error.what(), /*input_error=*/false);
   } catch (...) {
-    throw InputError(record.file.string() + ": plugin " + Quote(record.name) +
-                     " failed to start: it threw an exception that is not a std::exception");
+    throw PluginError(record.name, PluginStage::kCreate, "from " + record.file.string(),
+                      "it threw an exception that is not a std::exception",
+                      /*input_error=*/false);
   }
   if (plugin == nullptr) {
-    throw InputError(record.file.string() + ": plugin " + Quote(record.name) +
-                     " failed to start: its factory returned nothing");
+    throw PluginError(record.name, PluginStage::kCreate, "from " + record.file.string(),
+                      "its factory returned nothing", /*input_error=*/false);
   }
   plugin->SetLogSink(PluginLogSink(record.name));
   return plugin;

@@ -15,6 +15,7 @@
 #include "util/paths.h"
 #include "util/random.h"
 #include "util/strings.h"
+#include "util/warning_count.h"
 
 namespace tessera {
 namespace {
@@ -50,6 +51,19 @@ TEST(PluginSearchPath, WarnsOnceNamingEachPluginPathFolderThatIsNone) {
                            "' does not exist; no plugins are loaded from it\n"
                            "warning TESSERA_PLUGIN_PATH: '" +
                            file + "' is not a folder; no plugins are loaded from it\n");
+}
+
+// The verdict "(see the warnings above)" is said only where a warning was logged.
+TEST(WarningCount, CountsWarningsAndErrorsOnly) {
+  auto logger = std::make_shared<spdlog::logger>("counted", WarningCountingSink());
+  logger->set_level(spdlog::level::debug);
+  const size_t before = NumWarningsLogged();
+  logger->debug("d");
+  logger->info("i");
+  EXPECT_EQ(NumWarningsLogged(), before);
+  logger->warn("w");
+  logger->error("e");
+  EXPECT_EQ(NumWarningsLogged(), before + 2);
 }
 
 TEST(NaturalLess, OrdersDigitRunsByValue) {
