@@ -12,7 +12,8 @@
 #include <cerrno>
 #include <cstring>
 
-#include "database/database.h"
+#include "database/sqlite_connection.h"
+#include "database/sqlite_statement.h"
 #include "eval/evaluation.h"
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
@@ -68,19 +69,20 @@ ChildResult RunChild(const std::vector<std::string>& argv, const fs::path& log) 
 
 // Pairs matched, pairs verified and their mean number of inliers, from a workspace.
 void ReadMatchingFigures(const fs::path& database_file, BenchRow* row) {
-  const Database database(database_file, Database::Mode::kReadOnly);
-  row->num_images = database.NumImages();
-  row->num_pairs = database.NumMatchedPairs();
-  size_t num_inliers = 0;
-  row->num_verified = 0;
-  for (const auto& [pair_id, geometry] : database.ReadAllTwoViewGeometries()) {
-    if (geometry.config == TwoViewGeometry::UNDEFINED ||
-        geometry.config == TwoViewGeometry::DEGENERATE) {
-      continue;
-    }
-    ++row->num_verified;
-    num_inliers += geometry.inlier_matches.size();
-  }
+  // Plain SQL on COLMAP's own tables, read-only: the database may be COLMAP's (3.8 or 4,
+  // without Tessera's tables), which Database would refuse read-only.
+  const SqliteConnection connection(database_file, /*read_only=*/true);
+  const auto count = [&](const std::string& sql, const std::string& what) {
+    return SqliteStatement(connection, sql, false).QueryInt64(what);
+  };
+  row->num_images = static_cast<size_t>(count("SELECT COUNT(*) FROM images;", "count the images"));
+  row->num_pairs =
+      static_cast<size_t>(count("SELECT COUNT(*) FROM matches;", "count the matched pairs"));
+  // Verified: a configuration other than UNDEFINED (0) and DEGENERATE (1).
+  const std::string verified = " FROM two_view_geometries WHERE config NOT IN (0, 1);";
+  row->num_verified =
+      static_cast<size_t>(count("SELECT COUNT(*)" + verified, "count the verified pairs"));
+  const int64_t num_inliers = count("SELECT COALESCE(SUM(rows), 0)" + verified, "sum the inliers");
   row->mean_inliers =
       row->num_verified > 0 ? static_cast<double>(num_inliers) / row->num_verified : kBenchNaN;
 }
