@@ -8,7 +8,9 @@
 #     and after COLMAP's runs, and keeps its 3.8 schema, while COLMAP 4's copy was
 #     upgraded (so mapping the original would have changed it);
 #  3. a COLMAP binary that is missing, not executable, crashing, not COLMAP or too old is
-#     exit 2 with one error line naming it, before any row runs.
+#     exit 2 with one error line naming it, before any row runs;
+#  4. COLMAP 4's whole pipeline (--colmap, at 320 px): extraction and matching once, both
+#     mappers' rows with those seconds and their figures read from COLMAP's own database.
 # Without a COLMAP 4 that runs (scripts/install_dependencies.sh installs its libraries)
 # it skips, and fails under CI=true.
 # usage: colmap4_bench_test.sh TESSERA DOWNSCALE SOURCE_DIR SHARED_DIR
@@ -110,4 +112,28 @@ check_refused "$work/not_executable" "not executable"
 check_refused "$work/not_colmap" "does not say it is COLMAP"
 check_refused "$work/crashing" "crashed (signal 11)"
 check_refused "$work/old_colmap" "is COLMAP 3.6; tessera bench needs COLMAP 3.8 or later"
+
+# 4. The whole pipeline.
+"$downscale" "$source_dir/examples/fountain-P11-small/images" "$work/small" 320 90 > /dev/null ||
+  fail "downscale to 320 px"
+"$tessera" bench --images "$work/small" --gt "$gt" --output "$work/out4" --threads 2 \
+  --json "$work/4.json" --colmap "$colmap4" "$source_dir/manifests/fast.json" \
+  > "$work/4.md" 2> "$work/4.log"
+code=$?
+[ "$code" -eq 0 ] || { cat "$work/4.md" "$work/4.log"; fail "the whole pipeline: exit $code"; }
+python3 - "$work/4.json" <<'PY' || { cat "$work/4.md"; fail "COLMAP 4's whole pipeline"; }
+import json, sys
+rows = json.load(open(sys.argv[1]))["rows"]
+assert [r["manifest"].split("-")[-1] for r in rows] == ["fast", "global", "incremental"], rows
+glob, incr = rows[1], rows[2]
+for r in (glob, incr):
+    assert r["exit_code"] == 0 and r["matches_of"] == "", r
+    assert r["plugins"].startswith("COLMAP 4.") and "sift / exhaustive" in r["plugins"], r
+    assert r["num_pairs"] == 55 and r["num_verified_pairs"] > 0 and r["num_registered"] >= 9, r
+    assert r["total_seconds"] >= r["extract_seconds"] + r["match_seconds"] > 0, r
+assert (glob["extract_seconds"], glob["match_seconds"]) == (incr["extract_seconds"], incr["match_seconds"])
+assert glob["num_verified_pairs"] == incr["num_verified_pairs"]
+print("whole pipeline: %d/%d and %d/%d registered" % (
+    glob["num_registered"], glob["num_images"], incr["num_registered"], incr["num_images"]))
+PY
 echo "PASS"
