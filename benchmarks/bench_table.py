@@ -7,7 +7,8 @@ Each BENCH.json may have a BENCH.command beside it (benchmarks/shared_sets_vs_co
 writes one): its first line the UTC date the bench started, the rest the command. One
 table row per bench row: set (the images folder's parent), row, mapper, seconds per
 stage, registered images, mean position and rotation errors, and the row's total time
-(map time where COLMAP mapped a Tessera row's matches, --colmap-mapper-only) and
+(map time where COLMAP mapped a Tessera row's matches, --colmap-mapper-only; a row that
+started from another's features is charged that row's extraction seconds) and
 position error as a share of the same bench's COLMAP 4 global row (COLMAP's rows
 are named colmap-<version>-global / -incremental). Under the table, each bench's date
 and command, numbered as the rows' `run` column.
@@ -50,18 +51,26 @@ def main(files):
                           and r["manifest"].endswith("-global") and r["exit_code"] == 0), None)
         # Map time alone where COLMAP mapped a Tessera row's matches (--colmap-mapper-only).
         key = "map_seconds" if reference and reference.get("matches_of") else "total_seconds"
+        by_name = {r["manifest"]: r for r in bench["rows"]}
         for row in bench["rows"]:
+            extract = fmt(row["extract_seconds"], 1)
+            seconds = row[key]
+            shared = row.get("extract_shared_with") or ""
+            if shared and key == "total_seconds" and seconds is not None:
+                # Charged the extraction it started from, as if it had run alone.
+                extract += " (features of %s)" % shared
+                seconds += by_name[shared]["extract_seconds"] or 0
             registered = "%d/%d" % (row["num_registered"], row["num_images"])
             if row["exit_code"] != 0:
                 registered += " (exit %d)" % row["exit_code"]
             lines.append("| " + " | ".join([
-                name, row["manifest"], mapper_of(row), fmt(row["extract_seconds"], 1),
+                name, row["manifest"], mapper_of(row), extract,
                 fmt(row["match_seconds"], 1), fmt(row["map_seconds"], 1),
                 fmt(row["total_seconds"], 1), registered, fmt(row["position_error_mean"], 5),
                 fmt(None if row["position_error_mean_relative"] is None
                     else 100 * row["position_error_mean_relative"], 3),
                 fmt(row["rotation_error_mean_deg"], 3),
-                share(row[key], reference and reference[key]),
+                share(seconds, reference and reference[key]),
                 share(row["position_error_mean"], reference and reference["position_error_mean"]),
                 "(%d)" % number]) + " |")
         command_file = os.path.splitext(path)[0] + ".command"
