@@ -32,7 +32,8 @@ CommandRegistration RegisterBenchCommand(CLI::App& app, const GlobalOptions&) {
                 "COLMAP 3.8's (colmap on the PATH)");
   sub->add_option("--colmap", options->colmap_binaries,
                   "A COLMAP binary to run instead of those --with-colmap finds (repeat for "
-                  "several; implies --with-colmap)");
+                  "several; implies --with-colmap)")
+      ->allow_extra_args(false);  // one path per --colmap: the manifests follow
   sub->add_flag("--colmap-mapper-only", options->colmap_mapper_only,
                 "COLMAP's mappers alone, on a copy of the first manifest's database (the "
                 "same matches), instead of COLMAP's whole pipeline (implies --with-colmap)");
