@@ -18,6 +18,11 @@ packages=(
   # `pip install .` offline (pyproject.toml, setup.py: --no-build-isolation) and the
   # typing test (mypy --strict on examples/python).
   python3-venv python3-setuptools python3-wheel mypy
+  # What COLMAP 4 (../shared/anchors/colmap-4/bin/colmap, the reference of `tessera bench
+  # --with-colmap` and of colmap4_bench_end_to_end) links at run time: the list of its
+  # README.
+  libopenimageio2.4 libgoogle-glog0v6 libcholmod3 libspqr2 libcxsparse3 libmetis5
+  libboost-program-options1.74.0 libsqlite3-0 libgomp1 libblas3 liblapack3
 )
 # The reference system, for the interoperability tests and benchmarks, and Open3D, an
 # independent PLY reader for the ply exporter's test; optional.

@@ -5,7 +5,8 @@
 #     of two selectors, window 40 united with sequential 19 that it contains, shown per
 #     selector), every image registered, scored against the ground truth; the same rows in
 #     --json and --csv, and an SVG chart of them; with colmap installed (a failure under
-#     CI=true without it), a COLMAP row that registers every image;
+#     CI=true without it), a COLMAP 3.8 row (--colmap colmap: that binary alone, labelled
+#     with its version) that registers every image;
 #  2. the same command again gives the same pairs, registered counts and errors;
 #  3. a manifest naming an unknown plugin gives its row an exit code of 2 and the bench
 #     exit code 2, after the other rows are printed; a missing manifest file fails
@@ -36,7 +37,7 @@ json.dump(m, open(sys.argv[2] + "/broken.json", "w"))
 PY
 
 colmap_flag=()
-if have_colmap; then colmap_flag=(--with-colmap); else
+if have_colmap; then colmap_flag=(--colmap colmap); else
   skip_part_or_fail "colmap is not installed: the COLMAP row is not tested"; fi
 
 # 1. Two manifests, shared features, every output.
@@ -49,11 +50,12 @@ grep -q "^| orb_window | orb 1.0.0 / window 1.0.0+sequential 1.0.0 / flann 1.0.0
   "$work/1.md" || fail "orb_window's row does not say it reused orb_exhaustive's features"
 grep -q "^| orb_window |.*| 40 | window 40 + sequential 19 = 40 |" "$work/1.md" ||
   fail "orb_window's row does not show the pairs of each selector"
-python3 - "$work/1.json" "$work/1.csv" "${#colmap_flag[@]}" <<'PY' || fail "bench JSON/CSV"
+python3 - "$work/1.json" "$work/1.csv" "${#colmap_flag[@]}" "$(colmap -h 2>/dev/null | head -1)" <<'PY' || fail "bench JSON/CSV"
 import csv, json, sys
 rows = json.load(open(sys.argv[1]))["rows"]
-with_colmap = sys.argv[3] == "1"
-assert [r["manifest"] for r in rows] == ["orb_exhaustive", "orb_window"] + (["colmap"] if with_colmap else []), rows
+with_colmap = sys.argv[3] != "0"
+colmap_row = "colmap-%s-incremental" % sys.argv[4].split()[1] if with_colmap else None
+assert [r["manifest"] for r in rows] == ["orb_exhaustive", "orb_window"] + ([colmap_row] if with_colmap else []), rows
 assert [r["num_pairs"] for r in rows[:2]] == [55, 40], [r["num_pairs"] for r in rows]
 assert rows[1]["extract_shared_with"] == "orb_exhaustive"
 assert rows[0]["pairs_per_selector"] == [
@@ -61,7 +63,8 @@ assert rows[0]["pairs_per_selector"] == [
 assert [(s["plugin"], s["json_path"], s["num_pairs"]) for s in rows[1]["pairs_per_selector"]] == [
     ("window", "pipeline.pair_selector[0]", 40), ("sequential", "pipeline.pair_selector[1]", 19)], rows[1]
 for r in rows:
-    if r["manifest"] == "colmap":
+    if r["manifest"] == colmap_row:
+        assert r["plugins"].startswith("COLMAP %s: sift / exhaustive" % sys.argv[4].split()[1]), r
         continue
     # Every plugin with its version, exporters included (fast.json's colmap_binary and ply).
     used = [(p["slot"], p["plugin"]) for p in r["plugins_used"]]

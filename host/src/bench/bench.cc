@@ -1,35 +1,29 @@
 // `tessera bench --images DIR [--gt GT] MANIFEST...`: every manifest run on the same
 // images, each as its own `tessera run` child process (so that one plugin's crash loses
-// no other row, and each row's peak memory is its own), and optionally COLMAP 3.8 on the
-// CPU, in the same command on the same machine. Detection is shared: a manifest whose
-// detector and camera settings equal an earlier one's starts from a copy of that
+// no other row, and each row's peak memory is its own), and optionally COLMAP (4 and
+// 3.8, colmap_rows.h) on the CPU, in the same command on the same machine. Detection is shared: a
+// manifest whose detector and camera settings equal an earlier one's starts from a copy of that
 // workspace's features (not its matches), and its row says so. Prints a Markdown
 // table; --json and --csv write the same rows to files, --chart draws them (gnuplot).
 
 #include "bench/bench.h"
 
-#include <fcntl.h>
-#include <spawn.h>
 #include <spdlog/spdlog.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
 #include <filesystem>
 #include <iostream>
-#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 #include <thread>
 
+#include "bench/bench_rows.h"
+#include "bench/colmap_rows.h"
 #include "database/database.h"
-#include "eval/evaluation.h"
 #include "eval/ground_truth.h"
 #include "pipeline/mapping_summary.h"
 #include "pipeline/run_summary.h"
@@ -37,133 +31,20 @@
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
-#include "tessera/io/model_statistics.h"
 #include "util/exit_codes.h"
 #include "util/paths.h"
-#include "util/timer.h"
-
-extern char** environ;
 
 namespace tessera {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// One system on the images: a manifest, or COLMAP.
-struct BenchRow {
-  std::string name;  // the manifest's file stem, or "colmap"
-  // detector / pair_selector / matcher / bundle_adjuster / exporters, each with its
-  // version once the run has said it (plugins_used)
-  std::string plugins;
-  std::vector<PluginUsed> plugins_used;  // from run_summary.json
-  std::string workspace;
-  int exit_code = 0;
-  std::string extract_shared_with;  // the row whose features this one started from
-  double extract_seconds = kNaN;
-  double match_seconds = kNaN;
-  double map_seconds = kNaN;
-  double total_seconds = kNaN;
-  double peak_memory_mb = kNaN;
-  size_t num_pairs = 0;
-  // The pairs each pair selector chose, from run_summary.json; their union is the
-  // run's pair count.
-  std::vector<SelectorPairs> pairs_per_selector;
-  size_t num_selected_pairs = 0;
-  size_t num_verified = 0;
-  double mean_inliers = kNaN;
-  size_t num_images = 0;
-  size_t num_registered = 0;  // in model 0
-  size_t num_models = 0;
-  size_t num_points = 0;
-  double mean_track_length = kNaN;
-  double mean_reprojection_error = kNaN;
-  // With --gt, model 0 against it.
-  double position_error_mean = kNaN;
-  double position_error_relative = kNaN;  // of the scene extent
-  double rotation_error_mean_deg = kNaN;
-  // Registered images more than kWrongRegistrationDeg off; -1 without ground truth.
-  int num_wrongly_registered = -1;
-};
-
-struct ChildResult {
-  int exit_code = 0;  // 127: could not be started; 128 + n: killed by signal n
-  double peak_memory_mb = kNaN;
-  double seconds = 0;
-};
-
-// Runs `argv` with stdout and stderr appended to `log`; waits for it.
-ChildResult RunChild(const std::vector<std::string>& argv, const fs::path& log) {
-  std::vector<char*> args;
-  for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
-  args.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
-                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  const Timer timer;
-  pid_t pid = 0;
-  const int error = posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  ChildResult result;
-  if (error != 0) {
-    result.exit_code = 127;
-    return result;
-  }
-  int status = 0;
-  struct rusage usage {};
-  while (wait4(pid, &status, 0, &usage) < 0) {
-    if (errno != EINTR) {
-      throw InputError(argv[0] + ": cannot wait for the row's process " + std::to_string(pid) +
-                       ": " + std::strerror(errno));
-    }
-  }
-  result.seconds = timer.ElapsedSeconds();
-  result.peak_memory_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss: KiB
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  return result;
-}
 
 nlohmann::json ReadJsonFile(const fs::path& file) {
   return nlohmann::json::parse(ReadFileContents(file), nullptr, /*allow_exceptions=*/true,
                                /*ignore_comments=*/true);
 }
 
-// Pairs matched, pairs verified and their mean number of inliers, from a workspace.
-void ReadMatchingFigures(const fs::path& database_file, BenchRow* row) {
-  const Database database(database_file, Database::Mode::kReadOnly);
-  row->num_images = database.NumImages();
-  row->num_pairs = database.NumMatchedPairs();
-  size_t num_inliers = 0;
-  row->num_verified = 0;
-  for (const auto& [pair_id, geometry] : database.ReadAllTwoViewGeometries()) {
-    if (geometry.config == TwoViewGeometry::UNDEFINED ||
-        geometry.config == TwoViewGeometry::DEGENERATE) {
-      continue;
-    }
-    ++row->num_verified;
-    num_inliers += geometry.inlier_matches.size();
-  }
-  row->mean_inliers =
-      row->num_verified > 0 ? static_cast<double>(num_inliers) / row->num_verified : kNaN;
-}
-
-using GroundTruth = std::map<std::string, GroundTruthPose>;
-
-// A model scored against the ground truth, when there is one (nullptr: none).
-void ScoreModel(const Reconstruction& model, const GroundTruth* ground_truth, BenchRow* row) {
-  if (ground_truth == nullptr) return;
-  const EvaluationResult result = EvaluateReconstruction(model, *ground_truth);
-  if (!result.aligned) {
-    spdlog::warn("bench: {}: model 0 cannot be scored: {}", row->name, result.error);
-    return;
-  }
-  row->position_error_mean = result.position_error_mean;
-  row->position_error_relative = result.position_error_mean / result.scene_extent;
-  row->rotation_error_mean_deg = result.rotation_error_mean_deg;
-  row->num_wrongly_registered = static_cast<int>(result.num_wrongly_registered);
-}
+using GroundTruth = BenchGroundTruth;
 
 std::string SlotPlugin(const nlohmann::json& manifest, const std::string& slot) {
   const auto pipeline = manifest.find("pipeline");
@@ -206,35 +87,6 @@ std::string PairsBySelector(const BenchRow& row) {
   return text;
 }
 
-// A row's workspace is bench's own scratch folder, marked with this file when made: a
-// rerun replaces it whole. A folder without the mark is never deleted.
-constexpr const char* kBenchMark = ".tessera_bench";
-
-// Throws InputError naming `folder` when it exists and bench did not make it (a link,
-// a file, or a folder without the mark that is not empty).
-void CheckBenchWorkspace(const fs::path& folder) {
-  std::error_code error;
-  const fs::file_status status = fs::symlink_status(folder, error);
-  if (status.type() == fs::file_type::not_found) return;
-  const bool made_by_bench =
-      status.type() == fs::file_type::directory &&
-      fs::symlink_status(folder / kBenchMark, error).type() == fs::file_type::regular;
-  if (made_by_bench) return;
-  if (status.type() == fs::file_type::directory && fs::is_empty(folder, error)) return;
-  throw InputError(folder.string() + ": exists and was not made by tessera bench (no " +
-                   kBenchMark +
-                   "), so it is not replaced; choose another --output or move it away");
-}
-
-// Empties a row's workspace (CheckBenchWorkspace passed) and marks it as bench's.
-void ResetBenchWorkspace(const fs::path& folder) {
-  CheckBenchWorkspace(folder);
-  std::error_code error;
-  fs::remove_all(folder, error);
-  CreateFolder(folder);
-  WriteFileAtomically(folder / kBenchMark, "made by tessera bench; replaced by each bench run\n");
-}
-
 BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_truth,
                      const std::string& manifest_file, const nlohmann::json& manifest,
                      const std::string& name, const std::string& shared_from,
@@ -261,6 +113,7 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
   if (options.threads > 0) argv.insert(argv.end(), {"--threads", std::to_string(options.threads)});
   if (!options.camera_K.empty()) argv.insert(argv.end(), {"--camera-K", options.camera_K});
   if (options.camera_per_folder) argv.push_back("--camera-per-folder");
+  row.log = (workspace / "run.log").string();
   spdlog::info("bench: {} ({}) ...", name, row.plugins);
   const ChildResult child = RunChild(argv, workspace / "run.log");
   row.exit_code = child.exit_code;
@@ -291,55 +144,6 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
     if (ground_truth != nullptr && fs::exists(model_dir / "images.bin")) {
       ScoreModel(ReadColmapModel(model_dir), ground_truth, &row);
     }
-  }
-  return row;
-}
-
-// COLMAP 3.8 with its CPU defaults, one shared camera and exhaustive matching.
-BenchRow RunColmap(const BenchOptions& options, const GroundTruth* ground_truth,
-                   const fs::path& workspace) {
-  BenchRow row;
-  row.name = "colmap";
-  row.plugins = "COLMAP 3.8: sift / exhaustive / sift_matcher / mapper";
-  row.workspace = workspace.string();
-  ResetBenchWorkspace(workspace);
-  CreateFolder(workspace / "sparse");
-  setenv("QT_QPA_PLATFORM", "offscreen", 1);
-  const std::string database = (workspace / "database.db").string();
-  const std::string threads = std::to_string(options.threads > 0 ? options.threads : -1);
-  const std::vector<std::vector<std::string>> steps = {
-      {"colmap", "feature_extractor", "--database_path", database, "--image_path", options.images,
-       options.camera_per_folder ? "--ImageReader.single_camera_per_folder"
-                                 : "--ImageReader.single_camera",
-       "1", "--SiftExtraction.use_gpu", "0", "--SiftExtraction.num_threads", threads},
-      {"colmap", "exhaustive_matcher", "--database_path", database, "--SiftMatching.use_gpu", "0",
-       "--SiftMatching.num_threads", threads},
-      {"colmap", "mapper", "--database_path", database, "--image_path", options.images,
-       "--output_path", (workspace / "sparse").string(), "--Mapper.num_threads", threads}};
-  spdlog::info("bench: colmap ...");
-  double* const seconds[] = {&row.extract_seconds, &row.match_seconds, &row.map_seconds};
-  row.peak_memory_mb = 0;
-  row.total_seconds = 0;
-  for (size_t i = 0; i < steps.size(); ++i) {
-    const ChildResult child = RunChild(steps[i], workspace / "colmap.log");
-    *seconds[i] = child.seconds;
-    row.total_seconds += child.seconds;
-    row.peak_memory_mb = std::max(row.peak_memory_mb, child.peak_memory_mb);
-    row.exit_code = child.exit_code;
-    if (child.exit_code != 0) return row;
-  }
-  ReadMatchingFigures(database, &row);
-  const fs::path model_dir = workspace / "sparse" / "0";
-  if (fs::exists(model_dir / "images.bin")) {
-    const Reconstruction model = ReadColmapModel(model_dir);
-    row.num_models = 1;
-    row.num_registered = model.images.size();
-    row.num_points = model.points3D.size();
-    // The same figures, computed the same way, as Tessera's rows (mapping_summary.json).
-    const ModelStatistics statistics = ComputeModelStatistics(model);
-    row.mean_track_length = statistics.mean_track_length;
-    row.mean_reprojection_error = statistics.mean_reprojection_error;
-    ScoreModel(model, ground_truth, &row);
   }
   return row;
 }
@@ -381,6 +185,7 @@ const std::vector<std::string>& Columns() {
 std::vector<std::string> Cells(const BenchRow& row) {
   std::string extract = Format(row.extract_seconds, 1);
   if (!row.extract_shared_with.empty()) extract += " (features of " + row.extract_shared_with + ")";
+  if (!row.matches_of.empty()) extract += " (matches of " + row.matches_of + ")";
   return {row.name,
           row.plugins,
           extract,
@@ -415,6 +220,7 @@ nlohmann::json ToJson(const BenchRow& row) {
           {"workspace", row.workspace},
           {"exit_code", row.exit_code},
           {"extract_shared_with", row.extract_shared_with},
+          {"matches_of", row.matches_of},
           {"extract_seconds", number(row.extract_seconds)},
           {"match_seconds", number(row.match_seconds)},
           {"map_seconds", number(row.map_seconds)},
@@ -536,9 +342,8 @@ std::string ExtractionKey(const nlohmann::json& manifest) {
 int ExitCodeOfRows(const std::vector<BenchRow>& rows) {
   for (const BenchRow& row : rows) {
     if (row.exit_code != 0) {
-      spdlog::error(
-          "bench: {} ended with exit code {}; its log: {}", row.name, row.exit_code,
-          (fs::path(row.workspace) / (row.name == "colmap" ? "colmap.log" : "run.log")).string());
+      spdlog::error("bench: {} ended with exit code {}; its log: {}", row.name, row.exit_code,
+                    row.log);
       // A documented exit code stays what it is; a signal or failure to start is 1.
       const bool documented = row.exit_code == kExitBadInput || row.exit_code == kExitNoModel ||
                               row.exit_code == kExitPluginCrash;
@@ -546,6 +351,61 @@ int ExitCodeOfRows(const std::vector<BenchRow>& rows) {
     }
   }
   return kExitSuccess;
+}
+
+// COLMAP's rows: its whole pipeline, or (--colmap-mapper-only) its mappers on the
+// database of the first Tessera row that ended with 0.
+std::vector<BenchRow> RunColmapRows(const BenchOptions& options,
+                                    const std::vector<ColmapBinary>& colmaps,
+                                    const GroundTruth* ground_truth,
+                                    const std::vector<BenchRow>& tessera_rows) {
+  std::vector<BenchRow> rows;
+  const BenchRow* source = nullptr;
+  if (options.colmap_mapper_only && !colmaps.empty()) {
+    const auto ok = std::find_if(tessera_rows.begin(), tessera_rows.end(),
+                                 [](const BenchRow& row) { return row.exit_code == 0; });
+    if (ok == tessera_rows.end()) {
+      spdlog::warn(
+          "bench: --colmap-mapper-only: no manifest's run ended with exit code 0, so "
+          "COLMAP has no database to map: no COLMAP rows");
+      return rows;
+    }
+    source = &*ok;
+  }
+  for (const ColmapBinary& colmap : colmaps) {
+    for (BenchRow& row : source != nullptr
+                             ? RunColmapMappers(options, colmap, ground_truth, *source)
+                             : RunColmapPipeline(options, colmap, ground_truth)) {
+      rows.push_back(std::move(row));
+    }
+  }
+  return rows;
+}
+
+// Each Tessera row's time as a share of each COLMAP row's that ended with 0: end to end
+// and extract + match, or map time alone where COLMAP mapped a Tessera row's matches.
+void PrintShares(const std::vector<BenchRow>& rows, size_t num_tessera_rows) {
+  for (size_t c = num_tessera_rows; c < rows.size(); ++c) {
+    const BenchRow& colmap = rows[c];
+    if (colmap.exit_code != 0) continue;
+    const bool mapper_only = !colmap.matches_of.empty();
+    std::cout << "\n"
+              << (mapper_only ? "Map time as a share of " + colmap.name + "'s:\n"
+                              : "Time as a share of " + colmap.name +
+                                    "'s (end to end; extract + match):\n");
+    for (size_t i = 0; i < num_tessera_rows; ++i) {
+      std::cout << "- " << rows[i].name << ": ";
+      if (mapper_only) {
+        std::cout << Format(rows[i].map_seconds / colmap.map_seconds, 2) << "\n";
+        continue;
+      }
+      std::cout << Format(rows[i].total_seconds / colmap.total_seconds, 2) << "; "
+                << Format((rows[i].extract_seconds + rows[i].match_seconds) /
+                              (colmap.extract_seconds + colmap.match_seconds),
+                          2)
+                << "\n";
+    }
+  }
 }
 
 }  // namespace
@@ -587,7 +447,23 @@ BenchReport RunBenchReport(const BenchOptions& options) {
   CreateFolder(options.output);
   // Every row's folder is checked before the first row runs.
   for (const std::string& name : names) CheckBenchWorkspace(fs::path(options.output) / name);
-  if (options.with_colmap) CheckBenchWorkspace(fs::path(options.output) / "colmap");
+  // COLMAP's binaries are asked their versions before the first row runs too.
+  const bool with_colmap =
+      options.with_colmap || !options.colmap_binaries.empty() || options.colmap_mapper_only;
+  std::vector<ColmapBinary> colmaps;
+  if (with_colmap) colmaps = FindColmapBinaries(options, options.output);
+  if (with_colmap && colmaps.empty()) {
+    spdlog::warn(
+        "bench: no COLMAP found (no --colmap, TESSERA_COLMAP, {} or colmap on the "
+        "PATH): no COLMAP rows",
+        kColmap4Anchor);
+  }
+  for (const ColmapBinary& colmap : colmaps) {
+    CheckBenchWorkspace(fs::path(options.output) / ("colmap-" + colmap.version));
+    for (const std::string& name : ColmapRowNames(colmap)) {
+      CheckBenchWorkspace(fs::path(options.output) / name);
+    }
+  }
 
   std::vector<BenchRow> rows;
   for (size_t i = 0; i < options.manifests.size(); ++i) {
@@ -601,27 +477,11 @@ BenchReport RunBenchReport(const BenchOptions& options) {
     rows.push_back(RunManifest(options, gt, options.manifests[i], manifests[i], names[i],
                                shared_from, fs::path(options.output) / names[i]));
   }
-  if (options.with_colmap) {
-    if (std::system("command -v colmap > /dev/null 2>&1") != 0) {
-      spdlog::warn("bench: colmap is not installed: no COLMAP row");
-    } else {
-      rows.push_back(RunColmap(options, gt, fs::path(options.output) / "colmap"));
-    }
-  }
+  const size_t num_tessera_rows = rows.size();
+  for (BenchRow& row : RunColmapRows(options, colmaps, gt, rows)) rows.push_back(std::move(row));
 
   std::cout << MarkdownTable(rows);
-  if (options.with_colmap && rows.back().name == "colmap" && rows.back().exit_code == 0) {
-    const BenchRow& colmap = rows.back();
-    std::cout << "\nTime as a share of COLMAP's (end to end; extract + match):\n";
-    for (size_t i = 0; i + 1 < rows.size(); ++i) {
-      std::cout << "- " << rows[i].name << ": "
-                << Format(rows[i].total_seconds / colmap.total_seconds, 2) << "; "
-                << Format((rows[i].extract_seconds + rows[i].match_seconds) /
-                              (colmap.extract_seconds + colmap.match_seconds),
-                          2)
-                << "\n";
-    }
-  }
+  PrintShares(rows, num_tessera_rows);
   nlohmann::json json = {{"images", options.images},
                          {"ground_truth", options.ground_truth},
                          {"hardware_threads", std::thread::hardware_concurrency()},

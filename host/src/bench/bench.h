@@ -18,6 +18,13 @@ struct BenchOptions {
   std::string camera_K;
   bool camera_per_folder = false;  // every run with --camera-per-folder, COLMAP's per folder
   bool with_colmap = false;
+  // --colmap: the COLMAP binaries to run, in order (each implies with_colmap); empty:
+  // TESSERA_COLMAP or ../shared/anchors/colmap-4/bin/colmap, then colmap on the PATH
+  // (FindColmapBinaries in colmap_rows.h).
+  std::vector<std::string> colmap_binaries;
+  // COLMAP's mappers alone, on a copy of the first successful row's database (implies
+  // with_colmap), instead of COLMAP's whole pipeline.
+  bool colmap_mapper_only = false;
   int threads = 0;
   std::vector<std::string> manifests;
 };

@@ -27,7 +27,16 @@ CommandRegistration RegisterBenchCommand(CLI::App& app, const GlobalOptions&) {
   sub->add_option("--threads", options->threads, "Worker threads of every run (default: all)")
       ->check(CLI::Range(0, 1024));
   sub->add_flag("--with-colmap", options->with_colmap,
-                "Add a row for COLMAP 3.8 (CPU, exhaustive) on the same images");
+                "Add COLMAP's rows (CPU, exhaustive): COLMAP 4's global and incremental "
+                "mappers (TESSERA_COLMAP, else ../shared/anchors/colmap-4/bin/colmap) and "
+                "COLMAP 3.8's (colmap on the PATH)");
+  sub->add_option("--colmap", options->colmap_binaries,
+                  "A COLMAP binary to run instead of those --with-colmap finds (repeat for "
+                  "several; implies --with-colmap)")
+      ->allow_extra_args(false);  // one path per --colmap: the manifests follow
+  sub->add_flag("--colmap-mapper-only", options->colmap_mapper_only,
+                "COLMAP's mappers alone, on a copy of the first manifest's database (the "
+                "same matches), instead of COLMAP's whole pipeline (implies --with-colmap)");
   sub->add_option("MANIFEST", options->manifests, "Manifests to compare")->required();
   return {sub, [options]() { return RunBench(*options); }};
 }

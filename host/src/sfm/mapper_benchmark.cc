@@ -9,8 +9,11 @@
 // `peak_rss_mb` is the process's peak resident memory after the run (getrusage): run one
 // size alone (a filter) for the peak of that size.
 //
-//   mapper_benchmark                                      # both, n = 100 ... 3000 (long)
+//   mapper_benchmark                                      # both, n = 100 ... 3000 (long),
+//                                                         # and global at 10,000
 //   mapper_benchmark --benchmark_filter='/(100|300|1000)/'  # both, the smaller sizes
+//   mapper_benchmark --benchmark_filter='Global.*/(1000|3000|10000)/'  # global's exponent
+//                                                         # to 10,000 and its peak there
 //   mapper_benchmark --benchmark_filter='Global/3000/'    # its peak memory alone
 //   SPDLOG_LEVEL=info mapper_benchmark ...                # the mappers' logs
 
@@ -94,14 +97,20 @@ void BM_GlobalMapperPath(benchmark::State& state) {
   state.counters["s_ba"] = result.step_seconds.bundle_adjustment;
 }
 
-// Both mappers on paths of 100 to 3000 images, one run each.
+// Both mappers on paths of 100 to 3000 images, one run each; the global mapper also on
+// 10,000 (the incremental mapper would take hours there).
 void PathSizes(benchmark::internal::Benchmark* benchmark) {
   for (const int num_images : {100, 300, 1000, 3000}) benchmark->Arg(num_images);
   benchmark->Iterations(1)->Unit(benchmark::kSecond);
 }
 
+void GlobalPathSizes(benchmark::internal::Benchmark* benchmark) {
+  PathSizes(benchmark);
+  benchmark->Arg(10000);
+}
+
 BENCHMARK(BM_IncrementalMapperPath)->Apply(PathSizes);
-BENCHMARK(BM_GlobalMapperPath)->Apply(PathSizes);
+BENCHMARK(BM_GlobalMapperPath)->Apply(GlobalPathSizes);
 
 // The console output, plus for each mapper the fit of log(CPU time) against log(n)
 // over its runs, and global's time as a share of incremental's at each size.

@@ -1,0 +1,141 @@
+// The helpers that Tessera's rows and COLMAP's rows of `tessera bench` share.
+
+#include "bench/bench_rows.h"
+
+#include <fcntl.h>
+#include <spawn.h>
+#include <spdlog/spdlog.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+
+#include "database/sqlite_connection.h"
+#include "database/sqlite_statement.h"
+#include "eval/evaluation.h"
+#include "tessera/errors.h"
+#include "tessera/io/file_io.h"
+#include "tessera/io/model_statistics.h"
+#include "util/timer.h"
+
+extern char** environ;
+
+namespace tessera {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A row's workspace is bench's own scratch folder, marked with this file when made: a
+// rerun replaces it whole. A folder without the mark is never deleted.
+constexpr const char* kBenchMark = ".tessera_bench";
+
+}  // namespace
+
+// Runs `argv` with stdout and stderr appended to `log`; waits for it.
+ChildResult RunChild(const std::vector<std::string>& argv, const fs::path& log) {
+  std::vector<char*> args;
+  for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
+  args.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
+                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  const Timer timer;
+  pid_t pid = 0;
+  const int error = posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ChildResult result;
+  if (error != 0) {
+    result.exit_code = 127;
+    return result;
+  }
+  int status = 0;
+  struct rusage usage {};
+  while (wait4(pid, &status, 0, &usage) < 0) {
+    if (errno != EINTR) {
+      throw InputError(argv[0] + ": cannot wait for the row's process " + std::to_string(pid) +
+                       ": " + std::strerror(errno));
+    }
+  }
+  result.seconds = timer.ElapsedSeconds();
+  result.peak_memory_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss: KiB
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  return result;
+}
+
+// Pairs matched, pairs verified and their mean number of inliers, from a workspace.
+void ReadMatchingFigures(const fs::path& database_file, BenchRow* row) {
+  // Plain SQL on COLMAP's own tables, read-only: the database may be COLMAP's (3.8 or 4,
+  // without Tessera's tables), which Database would refuse read-only.
+  const SqliteConnection connection(database_file, SqliteConnection::Access::kReadOnly);
+  const auto count = [&](const std::string& sql, const std::string& what) {
+    return SqliteStatement(connection, sql, false).QueryInt64(what);
+  };
+  row->num_images = static_cast<size_t>(count("SELECT COUNT(*) FROM images;", "count the images"));
+  row->num_pairs =
+      static_cast<size_t>(count("SELECT COUNT(*) FROM matches;", "count the matched pairs"));
+  // Verified: a configuration other than UNDEFINED (0) and DEGENERATE (1).
+  const std::string verified = " FROM two_view_geometries WHERE config NOT IN (0, 1);";
+  row->num_verified =
+      static_cast<size_t>(count("SELECT COUNT(*)" + verified, "count the verified pairs"));
+  const int64_t num_inliers = count("SELECT COALESCE(SUM(rows), 0)" + verified, "sum the inliers");
+  row->mean_inliers =
+      row->num_verified > 0 ? static_cast<double>(num_inliers) / row->num_verified : kBenchNaN;
+}
+
+// A model scored against the ground truth, when there is one (nullptr: none).
+void ScoreModel(const Reconstruction& model, const BenchGroundTruth* ground_truth, BenchRow* row) {
+  if (ground_truth == nullptr) return;
+  const EvaluationResult result = EvaluateReconstruction(model, *ground_truth);
+  if (!result.aligned) {
+    spdlog::warn("bench: {}: model 0 cannot be scored: {}", row->name, result.error);
+    return;
+  }
+  row->position_error_mean = result.position_error_mean;
+  row->position_error_relative = result.position_error_mean / result.scene_extent;
+  row->rotation_error_mean_deg = result.rotation_error_mean_deg;
+  row->num_wrongly_registered = static_cast<int>(result.num_wrongly_registered);
+}
+
+void ReadModelFigures(const Reconstruction& model, const BenchGroundTruth* ground_truth,
+                      BenchRow* row) {
+  row->num_models = std::max<size_t>(row->num_models, 1);
+  row->num_registered = model.images.size();
+  row->num_points = model.points3D.size();
+  // The same figures, computed the same way, as Tessera's rows (mapping_summary.json).
+  const ModelStatistics statistics = ComputeModelStatistics(model);
+  row->mean_track_length = statistics.mean_track_length;
+  row->mean_reprojection_error = statistics.mean_reprojection_error;
+  ScoreModel(model, ground_truth, row);
+}
+
+// Throws InputError naming `folder` when it exists and bench did not make it (a link,
+// a file, or a folder without the mark that is not empty).
+void CheckBenchWorkspace(const fs::path& folder) {
+  std::error_code error;
+  const fs::file_status status = fs::symlink_status(folder, error);
+  if (status.type() == fs::file_type::not_found) return;
+  const bool made_by_bench =
+      status.type() == fs::file_type::directory &&
+      fs::symlink_status(folder / kBenchMark, error).type() == fs::file_type::regular;
+  if (made_by_bench) return;
+  if (status.type() == fs::file_type::directory && fs::is_empty(folder, error)) return;
+  throw InputError(folder.string() + ": exists and was not made by tessera bench (no " +
+                   kBenchMark +
+                   "), so it is not replaced; choose another --output or move it away");
+}
+
+// Empties a row's workspace (CheckBenchWorkspace passed) and marks it as bench's.
+void ResetBenchWorkspace(const fs::path& folder) {
+  CheckBenchWorkspace(folder);
+  std::error_code error;
+  fs::remove_all(folder, error);
+  CreateFolder(folder);
+  WriteFileAtomically(folder / kBenchMark, "made by tessera bench; replaced by each bench run\n");
+}
+
+}  // namespace tessera
