@@ -15,7 +15,6 @@
 #include "pipeline/workspace.h"
 #include "plugin/bundle_adjuster_guard.h"
 #include "plugin/plugin_call.h"
-#include "sfm/mapper_threads.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
 #include "tessera/io/georeference_io.h"
@@ -401,8 +400,6 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
   }
   MapperResult result;
   try {
-    // The building blocks the mapper calls (Tessera::sfm) use the stage's threads too.
-    const ScopedMapperThreads threads(context.num_threads);
     result = mapper.Call(PluginStage::kMap, subject,
                          [&](const Mapper& plugin) { return plugin.Map(input, context); });
   } catch (const PluginError& error) {

@@ -11,6 +11,7 @@
 #include "estimators/ransac.h"
 #include "geometry/similarity_estimator.h"
 #include "geometry/similarity_transform.h"
+#include "sfm/option_ranges.h"
 #include "util/random.h"
 
 namespace tessera {
@@ -225,6 +226,7 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
                                     const BundleAdjuster& bundle_adjuster,
                                     const GpsAnchoringOptions& options, uint64_t seed,
                                     Reconstruction* model) {
+  options.Check();
   GpsAnchoringReport report;
   std::vector<image_t> tagged;
   for (const auto& [image_id, image] : model->images) {
@@ -307,6 +309,21 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
   *model = std::move(anchored);
   report.anchored = true;
   return report;
+}
+
+void GpsAnchoringOptions::Check() const {
+  const option_ranges::Checker check("GpsAnchoringOptions");
+  check("horizontal_sigma_m", horizontal_sigma_m, 1e-3, 1e6);
+  check("vertical_sigma_m", vertical_sigma_m, 1e-3, 1e6);
+  check("min_num_images", min_num_images, 3, 1000000);
+  check("max_error_sigmas", max_error_sigmas, 1e-3, 1e3);
+  check("min_inlier_ratio", min_inlier_ratio, 0.0, 1.0);
+  check("ransac_num_trials", ransac_num_trials, 1, 100000000);
+  check("ba_max_num_iterations", ba_max_num_iterations, 1, 10000);
+  check("min_altitude_m", min_altitude_m, -1e6, max_altitude_m);
+  check("max_altitude_m", max_altitude_m, min_altitude_m, 1e9);
+  check("far_tag_mads", far_tag_mads, 0.0, 1e6);
+  check("far_tag_floor_m", far_tag_floor_m, 0.0, 1e9);
 }
 
 }  // namespace tessera

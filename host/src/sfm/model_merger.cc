@@ -7,6 +7,7 @@
 
 #include "estimators/ransac.h"
 #include "geometry/similarity_estimator.h"
+#include "sfm/option_ranges.h"
 
 namespace tessera {
 namespace {
@@ -43,6 +44,7 @@ double SquaredReprojectionError(const Reconstruction& model, const Point3D& poin
 
 ModelMergeReport MergeModels(const FeatureTracks& tracks, const ModelMergeOptions& options,
                              uint64_t seed, const Reconstruction& source, Reconstruction* target) {
+  options.Check();
   ModelMergeReport report;
   const std::map<track_t, point3D_t> source_points = PointOfTrack(tracks, source);
   const std::map<track_t, point3D_t> target_points = PointOfTrack(tracks, *target);
@@ -136,6 +138,14 @@ ModelMergeReport MergeModels(const FeatureTracks& tracks, const ModelMergeOption
   }
   report.merged = true;
   return report;
+}
+
+void ModelMergeOptions::Check() const {
+  const option_ranges::Checker check("ModelMergeOptions");
+  check("min_num_shared_points", min_num_shared_points, 3, 100000000);
+  check("min_inlier_ratio", min_inlier_ratio, 0.0, 1.0);
+  check("max_reproj_error", max_reproj_error, 1e-3, 1000.0);
+  check("max_num_trials", max_num_trials, 1, 100000000);
 }
 
 }  // namespace tessera
