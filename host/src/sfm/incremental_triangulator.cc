@@ -187,7 +187,7 @@ size_t IncrementalTriangulator::Retriangulate() {
 void IncrementalTriangulatorOptions::Check() const {
   const option_ranges::Checker check("IncrementalTriangulatorOptions");
   check("max_error", max_error, 1e-3, 1000.0);
-  check("min_angle", min_angle, 0.0, 90.0);
+  check("min_angle", min_angle, 0.0, 180.0);
   check("max_num_pairs", max_num_pairs, 0, 100000000);
 }
 

@@ -170,7 +170,7 @@ TEST(OptionsCheck, TriangulationChecksItsOptions) {
   options.min_angle_deg = -1;
   Reconstruction model;
   EXPECT_EQ(ErrorOf([&] { TriangulateTracks({}, options, &model); }),
-            "TrackTriangulationOptions: min_angle_deg = -1 is out of range [0, 90]");
+            "TrackTriangulationOptions: min_angle_deg = -1 is out of range [0, 180]");
   IncrementalTriangulatorOptions incremental;
   incremental.max_error = 0;
   FeatureTracks tracks;

@@ -135,7 +135,7 @@ size_t TriangulateTracks(const std::vector<Track>& tracks, const TrackTriangulat
 void TrackTriangulationOptions::Check() const {
   const option_ranges::Checker check("TrackTriangulationOptions");
   check("max_error_px", max_error_px, 1e-3, 1000.0);
-  check("min_angle_deg", min_angle_deg, 0.0, 90.0);
+  check("min_angle_deg", min_angle_deg, 0.0, 180.0);
   check("max_num_pairs", max_num_pairs, 0, 100000000);
 }
 
