@@ -263,8 +263,8 @@ std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
     // Plugins report paths relative to their options; anchor them in the manifest.
     const std::string path = (options_path.empty() ? json_path + ".options" : options_path) +
                              (error.path().empty() ? "" : "." + error.path());
-    throw InputError(path + ": " + error.message() + " (plugin " + Quote(record.name) + ", " +
-                     record.file.string() + ")");
+    throw InputError(OptionError::Join(path, error.message()) + " (plugin " + Quote(record.name) +
+                     ", " + record.file.string() + ")");
   } catch (const std::exception& error) {
     throw InputError(record.file.string() + ": plugin " + Quote(record.name) +
                      " failed to start: " + error.what());
