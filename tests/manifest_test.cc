@@ -103,7 +103,7 @@ TEST(Manifest, UnknownKeysNameTheirPathAndTheClosestKey) {
             "'SIMPLE_RADIAL', 'RADIAL', 'OPENCV', 'OPENCV_FISHEYE', 'SIMPLE_RADIAL_FISHEYE'; did "
             "you mean 'PINHOLE'?");
   EXPECT_EQ(ErrorOf({{"verification", {{"max_error_px", -1}}}}),
-            "m.json: verification.max_error_px: = -1 is out of range; must be in [0.1, 100]");
+            "m.json: verification.max_error_px = -1 is out of range [0.1, 100]");
   EXPECT_EQ(ErrorOf({{"threads", "many"}}), "m.json: threads: expected an integer, got a string");
   EXPECT_EQ(ErrorOf({{"camera", {{"K", {1, 2, 3}}}}}),
             "m.json: camera.K: expected [fx, fy, cx, cy] in pixels");

@@ -263,7 +263,7 @@ TEST(PluginLoader, ReportsInvalidOptionsWithTheirJsonPath) {
     }
   };
   expect_error({{"overlap", 0}},
-               "pipeline.pair_selector.options.overlap: = 0 is out of range; must be in [1, 100] "
+               "pipeline.pair_selector.options.overlap = 0 is out of range [1, 100] "
                "(plugin 'consecutive', " +
                    file.string() + ")");
   expect_error({{"overlpa", 2}},
@@ -311,7 +311,7 @@ TEST(PluginLoader, OptionErrorsNameTheOptionsPathTheSlotGives) {
                                   "pipeline.pair_selector", "legacy");
     FAIL() << "expected an error";
   } catch (const InputError& error) {
-    EXPECT_EQ(std::string(error.what()).rfind("legacy.overlap: = 0 is out of range", 0), 0u)
+    EXPECT_EQ(std::string(error.what()).rfind("legacy.overlap = 0 is out of range", 0), 0u)
         << error.what();
   }
 }

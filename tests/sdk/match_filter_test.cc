@@ -122,13 +122,12 @@ TEST(ReadMatchFilterOptions, ReadsDefaultsValuesAndRefusesOutOfRange) {
     }
     return "no error";
   };
-  EXPECT_EQ(message({{"ratio", 0}}),
-            "pipeline.matcher.options.ratio: = 0.0 is out of range; must be in (0, 1]");
+  EXPECT_EQ(message({{"ratio", 0}}), "pipeline.matcher.options.ratio = 0.0 is out of range (0, 1]");
   EXPECT_EQ(message({{"ratio", 1.5}}),
-            "pipeline.matcher.options.ratio: = 1.5 is out of range; must be in (0, 1]");
+            "pipeline.matcher.options.ratio = 1.5 is out of range (0, 1]");
   EXPECT_EQ(message({{"ratio", 1}}), "no error");
   EXPECT_EQ(message({{"max_distance", -1}}),
-            "pipeline.matcher.options.max_distance: = -1 is out of range; must be in [0, 1e+09]");
+            "pipeline.matcher.options.max_distance = -1 is out of range [0, 1e+09]");
   EXPECT_EQ(message({{"cross_check", 1}}),
             "pipeline.matcher.options.cross_check: expected true or false, got a number");
 }

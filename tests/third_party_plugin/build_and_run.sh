@@ -106,9 +106,9 @@ refuse() {  # refuse SLOT JSON EXPECTED
     echo "expected exit code 2 and '$3', got $rc:"; cat "$work/bad.log"; exit 1; }
 }
 refuse pair_selector '{"plugin": "window_stride", "options": {"window": 3, "stride": 2}}' \
-  "pipeline.pair_selector.options.stride: = 2 must be 0 or greater than window = 3"
+  "pipeline.pair_selector.options.stride = 2 must be 0 or greater than window = 3"
 refuse matcher '{"plugin": "symmetric_ratio", "options": {"cross_check": false}}' \
-  "pipeline.matcher.options.cross_check: = false contradicts symmetric = true"
+  "pipeline.matcher.options.cross_check = false contradicts symmetric = true"
 # The mapper slot: options checked (the incremental options nested in the strict ones),
 # and a plugin of another kind refused naming its kind.
 cat > "$work/mapper_bad.json" <<JSON

@@ -19,11 +19,16 @@ class TESSERA_API InputError : public std::runtime_error {
 class TESSERA_API OptionError : public InputError {
  public:
   OptionError(const std::string& path, const std::string& message)
-      : InputError(path.empty() ? message : path + ": " + message),
-        path_(path),
-        message_(message) {}
+      : InputError(Join(path, message)), path_(path), message_(message) {}
   const std::string& path() const { return path_; }
   const std::string& message() const { return message_; }
+
+  // "path: message", or "path = value ..." when the message states the value ("= 300 is
+  // out of range [1, 100]"), so that it reads as the manifest line it names.
+  static std::string Join(const std::string& path, const std::string& message) {
+    if (path.empty()) return message;
+    return path + (message.rfind("= ", 0) == 0 ? " " : ": ") + message;
+  }
 
  private:
   std::string path_;

@@ -43,8 +43,8 @@ inline MatchFilterOptions ReadMatchFilterOptions(OptionReader& reader,
   MatchFilterOptions options;
   options.ratio = reader.Get<double>("ratio", defaults.ratio);
   if (!(options.ratio > 0 && options.ratio <= 1)) {
-    throw OptionError(reader.KeyPath("ratio"), "= " + nlohmann::json(options.ratio).dump() +
-                                                   " is out of range; must be in (0, 1]");
+    throw OptionError(reader.KeyPath("ratio"),
+                      "= " + nlohmann::json(options.ratio).dump() + " is out of range (0, 1]");
   }
   options.cross_check = reader.GetBool("cross_check", defaults.cross_check);
   options.max_distance = reader.Get<double>("max_distance", defaults.max_distance, 0.0, 1e9);

@@ -90,8 +90,8 @@ class OptionReader {
       if (as_double < static_cast<double>(min_value) ||
           as_double > static_cast<double>(max_value)) {
         std::ostringstream message;
-        message << "= " << item.dump() << " is out of range; must be in [" << min_value << ", "
-                << max_value << "]";
+        message << "= " << item.dump() << " is out of range [" << min_value << ", " << max_value
+                << "]";
         throw OptionError(KeyPath(key), message.str());
       }
       value = item.get<T>();

@@ -15,6 +15,9 @@
 //                           const M_t& model, std::vector<double>* residuals);
 //   };
 //
+// Estimate and Residuals may instead be const members of an estimator that carries its
+// options (SimilarityEstimator's residual): pass the instances to the constructor.
+//
 // Samples are drawn from a seeded engine, so a given seed always yields the same
 // report, whichever thread runs it.
 
@@ -136,7 +139,8 @@ class RANSAC {
   using M_t = typename Estimator::M_t;
   using Report = RANSACReport<M_t>;
 
-  RANSAC(const RANSACOptions& options, uint64_t seed) : options_(options), seed_(seed) {
+  RANSAC(const RANSACOptions& options, uint64_t seed, Estimator estimator = {})
+      : options_(options), seed_(seed), estimator_(std::move(estimator)) {
     options_.Check();
   }
 
@@ -145,6 +149,7 @@ class RANSAC {
  private:
   RANSACOptions options_;
   uint64_t seed_;
+  Estimator estimator_;
 };
 
 // LO-RANSAC: whenever a minimal sample gives a new best model, LocalEstimator is
@@ -158,7 +163,12 @@ class LORANSAC {
   using M_t = typename Estimator::M_t;
   using Report = RANSACReport<M_t>;
 
-  LORANSAC(const RANSACOptions& options, uint64_t seed) : options_(options), seed_(seed) {
+  LORANSAC(const RANSACOptions& options, uint64_t seed, Estimator estimator = {},
+           LocalEstimator local_estimator = {})
+      : options_(options),
+        seed_(seed),
+        estimator_(std::move(estimator)),
+        local_estimator_(std::move(local_estimator)) {
     options_.Check();
   }
 
@@ -167,6 +177,8 @@ class LORANSAC {
  private:
   RANSACOptions options_;
   uint64_t seed_;
+  Estimator estimator_;
+  LocalEstimator local_estimator_;
 };
 
 ////////////////////////////////////////////////////////////////////////////////
@@ -195,7 +207,8 @@ struct RunState {
 // Re-estimates the new best model (whose residuals are in state->residuals) on its
 // inliers while that keeps enlarging the inlier set.
 template <typename Estimator, typename LocalEstimator>
-void OptimizeLocally(const std::vector<typename Estimator::X_t>& X,
+void OptimizeLocally(const LocalEstimator& local_estimator,
+                     const std::vector<typename Estimator::X_t>& X,
                      const std::vector<typename Estimator::Y_t>& Y, double max_residual,
                      RunState<Estimator, LocalEstimator>* state) {
   using M_t = typename Estimator::M_t;
@@ -210,8 +223,8 @@ void OptimizeLocally(const std::vector<typename Estimator::X_t>& X,
       }
     }
     const size_t prev_best_num_inliers = state->best_support.num_inliers;
-    for (const M_t& local_model : LocalEstimator::Estimate(state->X_inlier, state->Y_inlier)) {
-      LocalEstimator::Residuals(X, Y, local_model, &state->residuals);
+    for (const M_t& local_model : local_estimator.Estimate(state->X_inlier, state->Y_inlier)) {
+      local_estimator.Residuals(X, Y, local_model, &state->residuals);
       const RANSACSupport local_support = EvaluateSupport(state->residuals, max_residual);
       if (local_support.IsBetterThan(state->best_support)) {
         state->best_support = local_support;
@@ -228,7 +241,8 @@ void OptimizeLocally(const std::vector<typename Estimator::X_t>& X,
 
 // Fills the report from the run's best model, if it has enough inliers.
 template <typename Estimator, typename LocalEstimator>
-void FinishReport(const std::vector<typename Estimator::X_t>& X,
+void FinishReport(const Estimator& estimator, const LocalEstimator& local_estimator,
+                  const std::vector<typename Estimator::X_t>& X,
                   const std::vector<typename Estimator::Y_t>& Y, double max_residual,
                   RunState<Estimator, LocalEstimator>* state,
                   RANSACReport<typename Estimator::M_t>* report) {
@@ -242,9 +256,9 @@ void FinishReport(const std::vector<typename Estimator::X_t>& X,
 
   // Recomputing the winner's residuals once is cheaper than keeping a mask per model.
   if (state->best_model_is_local) {
-    LocalEstimator::Residuals(X, Y, report->model, &state->residuals);
+    local_estimator.Residuals(X, Y, report->model, &state->residuals);
   } else {
-    Estimator::Residuals(X, Y, report->model, &state->residuals);
+    estimator.Residuals(X, Y, report->model, &state->residuals);
   }
   report->inlier_mask.resize(X.size());
   for (size_t i = 0; i < X.size(); ++i) {
@@ -255,6 +269,8 @@ void FinishReport(const std::vector<typename Estimator::X_t>& X,
 // The RANSAC loop; with kLocalOptimization, a new best model is refined on its inliers.
 template <typename Estimator, typename LocalEstimator, bool kLocalOptimization>
 RANSACReport<typename Estimator::M_t> Run(const RANSACOptions& options, uint64_t seed,
+                                          const Estimator& estimator,
+                                          const LocalEstimator& local_estimator,
                                           const std::vector<typename Estimator::X_t>& X,
                                           const std::vector<typename Estimator::Y_t>& Y) {
   static_assert(std::is_same_v<typename Estimator::M_t, typename LocalEstimator::M_t>,
@@ -288,8 +304,8 @@ RANSACReport<typename Estimator::M_t> Run(const RANSACOptions& options, uint64_t
     Gather(X, sample, &state.X_sample);
     Gather(Y, sample, &state.Y_sample);
 
-    for (const M_t& sample_model : Estimator::Estimate(state.X_sample, state.Y_sample)) {
-      Estimator::Residuals(X, Y, sample_model, &state.residuals);
+    for (const M_t& sample_model : estimator.Estimate(state.X_sample, state.Y_sample)) {
+      estimator.Residuals(X, Y, sample_model, &state.residuals);
       const RANSACSupport support = EvaluateSupport(state.residuals, max_residual);
       if (support.IsBetterThan(state.best_support)) {
         state.best_support = support;
@@ -298,7 +314,7 @@ RANSACReport<typename Estimator::M_t> Run(const RANSACOptions& options, uint64_t
         if constexpr (kLocalOptimization) {
           if (support.num_inliers > static_cast<size_t>(Estimator::kMinNumSamples) &&
               support.num_inliers >= static_cast<size_t>(LocalEstimator::kMinNumSamples)) {
-            OptimizeLocally(X, Y, max_residual, &state);
+            OptimizeLocally(local_estimator, X, Y, max_residual, &state);
           }
         }
         dyn_max_num_trials =
@@ -325,7 +341,7 @@ RANSACReport<typename Estimator::M_t> Run(const RANSACOptions& options, uint64_t
       break;
     }
   }
-  FinishReport(X, Y, max_residual, &state, &report);
+  FinishReport(estimator, local_estimator, X, Y, max_residual, &state, &report);
   return report;
 }
 
@@ -334,13 +350,15 @@ RANSACReport<typename Estimator::M_t> Run(const RANSACOptions& options, uint64_t
 template <typename Estimator>
 typename RANSAC<Estimator>::Report RANSAC<Estimator>::Estimate(const std::vector<X_t>& X,
                                                                const std::vector<Y_t>& Y) const {
-  return ransac_internal::Run<Estimator, Estimator, false>(options_, seed_, X, Y);
+  return ransac_internal::Run<Estimator, Estimator, false>(options_, seed_, estimator_, estimator_,
+                                                           X, Y);
 }
 
 template <typename Estimator, typename LocalEstimator>
 typename LORANSAC<Estimator, LocalEstimator>::Report LORANSAC<Estimator, LocalEstimator>::Estimate(
     const std::vector<X_t>& X, const std::vector<Y_t>& Y) const {
-  return ransac_internal::Run<Estimator, LocalEstimator, true>(options_, seed_, X, Y);
+  return ransac_internal::Run<Estimator, LocalEstimator, true>(options_, seed_, estimator_,
+                                                               local_estimator_, X, Y);
 }
 
 }  // namespace tessera

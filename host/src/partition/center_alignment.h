@@ -1,12 +1,12 @@
 #pragma once
 
 // The similarity between the frames of two models of overlapping clusters, from the
-// images both registered: a RANSAC over pairs of shared images (the rotation from one
-// image's two orientations, scale and translation from the two centres), inliers whose
-// centre lands within a tolerance relative to the scene's size and whose orientation
-// agrees, refined on the inliers (Umeyama on the centres when they are spread out).
-// Deterministic: every pair is tried when there are few shared images, else a seeded
-// sample.
+// images both registered: LO-RANSAC (geometry/similarity_estimator.h, residual
+// kPositionAndOrientation) over triples of shared images, whose rotation comes from the
+// images' own orientations; inliers are the images whose centre lands within a
+// tolerance relative to the scene's size and whose orientation agrees, and the model is
+// refined on them (Umeyama on the centres when they are spread out). Deterministic: the
+// samples are drawn from `seed`.
 
 #include <cstdint>
 #include <string>
@@ -24,7 +24,7 @@ struct CenterAlignmentOptions {
   double max_center_error = 0.05;
   // ... and its orientations differ by at most this many degrees.
   double max_rotation_error_deg = 5;
-  size_t max_num_hypotheses = 5000;  // pairs of shared images tried at most
+  size_t max_num_hypotheses = 5000;  // samples of shared images tried at most
   // Fewer of the shared images agreeing: no alignment (one of the models is likely
   // wrong, folded or drifted, and a merge would bend the other).
   double min_inlier_ratio = 0.7;

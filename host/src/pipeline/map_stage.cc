@@ -16,7 +16,6 @@
 #include "pipeline/workspace.h"
 #include "plugin/bundle_adjuster_guard.h"
 #include "plugin/plugin_call.h"
-#include "sfm/mapper_threads.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
 #include "tessera/io/georeference_io.h"
@@ -311,8 +310,6 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
 MapperResult CallMapper(const PluginInstance<Mapper>& mapper, const std::string& subject,
                         const MapperInput& input, const MapperContext& context) {
   try {
-    // The building blocks the mapper calls (Tessera::sfm) use the stage's threads too.
-    const ScopedMapperThreads threads(context.num_threads);
     return mapper.Call(PluginStage::kMap, subject,
                        [&](const Mapper& plugin) { return plugin.Map(input, context); });
   } catch (const PluginError& error) {

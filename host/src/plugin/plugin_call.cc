@@ -275,8 +275,10 @@ PluginError PluginError::Reworded(const std::string& message) const {
 
 InputError PluginError::AsSlotError(const std::string& json_path, const std::string& what) const {
   if (option_error_) {
-    return InputError(json_path + ".options" + (option_path_.empty() ? "" : "." + option_path_) +
-                      ": " + option_message_ + " (" + what + ")");
+    return InputError(
+        OptionError::Join(json_path + ".options" + (option_path_.empty() ? "" : "." + option_path_),
+                          option_message_) +
+        " (" + what + ")");
   }
   return InputError(json_path + ": " + what + ": " + message_);
 }

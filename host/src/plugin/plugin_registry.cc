@@ -383,7 +383,7 @@ std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
   } catch (const OptionError& error) {
     // Plugins report paths relative to their options; anchor them in the manifest.
     const std::string fallback =
-        JoinPath(options_base, error.path()) + ": " + error.message() + " (" + who + ")";
+        OptionError::Join(JoinPath(options_base, error.path()), error.message()) + " (" + who + ")";
     if (nested) throw NestedOptionError(fallback, error.path(), options, error.message(), who);
     throw InputError(fallback);
   } catch (const NestedOptionError& error) {
@@ -393,12 +393,12 @@ std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
     if (!at) {
       throw InputError(options_base + ": plugin " + Quote(record.name) +
                        " made a plugin with options it refuses, " +
-                       JoinPath("options", error.path) + ": " + error.message + " (" + made_by +
-                       ")");
+                       OptionError::Join(JoinPath("options", error.path), error.message) + " (" +
+                       made_by + ")");
     }
     const std::string path = JoinPath(*at, error.path);
     const std::string fallback =
-        JoinPath(options_base, path) + ": " + error.message + " (" + made_by + ")";
+        OptionError::Join(JoinPath(options_base, path), error.message) + " (" + made_by + ")";
     if (nested) throw NestedOptionError(fallback, path, options, error.message, made_by);
     throw InputError(fallback);
   } catch (const PluginChainError& error) {

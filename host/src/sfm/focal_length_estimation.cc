@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sfm/option_ranges.h"
+
 namespace tessera {
 namespace {
 
@@ -43,6 +45,7 @@ double PairCost(const FundamentalPair& pair, const Eigen::Matrix3d& K1, const Ei
 std::map<camera_t, FocalLengthEstimate> EstimateFocalLengths(
     const MapperInput& input, const std::vector<const MapperInput::Pair*>& pairs,
     const FocalLengthEstimationOptions& options) {
+  options.Check();
   std::map<camera_t, double> focal;
   std::map<camera_t, FocalLengthEstimate> estimates;
   for (const auto& [camera_id, camera] : input.cameras) {
@@ -133,6 +136,14 @@ std::map<camera_t, FocalLengthEstimate> EstimateFocalLengths(
     }
   }
   return estimates;
+}
+
+void FocalLengthEstimationOptions::Check() const {
+  const option_ranges::Checker check("FocalLengthEstimationOptions");
+  check("min_num_inliers", min_num_inliers, 0, 100000000);
+  check("min_num_pairs", min_num_pairs, 1, 100000000);
+  check("min_factor", min_factor, 1e-3, max_factor);
+  check("max_factor", max_factor, min_factor, 100.0);
 }
 
 }  // namespace tessera

@@ -216,9 +216,8 @@ PartOutcome PositionPart(const PartRun& run, size_t part_index, const std::set<i
   GlobalPositioningOptions positioning_options;
   positioning_options.max_num_iterations = options.gp_max_num_iterations;
   positioning_options.huber_threshold = options.gp_huber_threshold;
-  positioning_options.num_threads = options.gp_num_threads;
-  positioning_options.seed =
-      DeriveSeed(static_cast<uint64_t>(options.seed), kPositioningStream + part_index);
+  positioning_options.num_threads = options.num_threads;
+  positioning_options.seed = DeriveSeed(options.seed, kPositioningStream + part_index);
   const GlobalPositioningResult positions = PositionGlobally(
       cameras, input.images, part_rotations, positioning_tracks, positioning_options, should_stop);
   if (positions.cancelled || stop()) return PartOutcome::kCancelled;
@@ -532,6 +531,7 @@ GlobalMapperResult GlobalMapper::Reconstruct(
     const MapperInput& input, const BundleAdjuster& bundle_adjuster,
     const GlobalMapperOptions& options, std::function<bool()> should_stop,
     const std::function<void(const std::string&, size_t, size_t)>& on_progress) {
+  options.Check();
   const auto start_time = std::chrono::steady_clock::now();
   GlobalMapperResult result;
   const auto seconds = [&start_time] {
@@ -549,7 +549,6 @@ GlobalMapperResult GlobalMapper::Reconstruct(
   const auto stop = [&should_stop] { return should_stop && should_stop(); };
   const auto cancelled = [&] { return CancelledResult(seconds()); };
   if (stop()) return cancelled();
-
   // 1. The pairs that map.
   std::set<image_t> in_verified_pair;
   const std::vector<const MapperInput::Pair*> pairs =
@@ -561,8 +560,8 @@ GlobalMapperResult GlobalMapper::Reconstruct(
   if (stop()) return cancelled();
 
   // 3. The view graph and its rotation-cycle filtering.
-  ViewGraph view_graph =
-      ViewGraph::Build(input, cameras, pairs, DeriveSeed(options.seed, kViewGraphStream));
+  ViewGraph view_graph = ViewGraph::Build(
+      input, cameras, pairs, DeriveSeed(options.seed, kViewGraphStream), options.num_threads);
   if (options.filter_view_graph) {
     result.num_pairs_dropped_by_cycles =
         view_graph.FilterByRotationCycles(options.view_graph_max_cycle_error, 3);

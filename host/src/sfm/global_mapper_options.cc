@@ -2,61 +2,64 @@
 
 #include <limits>
 
+#include "sfm/option_ranges.h"
 #include "tessera/options.h"
 
 namespace tessera {
 
-GlobalMapperOptions GlobalMapperOptions::FromJson(const nlohmann::json& json) {
+namespace {
+
+// Every field, with its range for the numbers (option_ranges.h): FromJson and Check()
+// read the same list.
+template <typename Options, typename Visitor>
+void VisitGlobalMapperOptions(Options& o, const Visitor& visit) {
+  visit("min_num_matches", o.min_num_matches, 5, 100000);
+  visit("min_relative_pair_strength", o.min_relative_pair_strength, 0.0, 1.0);
+  visit("estimate_focal_length", o.estimate_focal_length);
+  visit("filter_view_graph", o.filter_view_graph);
+  visit("view_graph_max_cycle_error", o.view_graph_max_cycle_error, 0.01, 180.0);
+  visit("ra_num_l1_iterations", o.ra_num_l1_iterations, 0, 10000);
+  visit("ra_max_num_iterations", o.ra_max_num_iterations, 1, 10000);
+  visit("ra_robust_sigma", o.ra_robust_sigma, 0.01, 180.0);
+  visit("ra_max_residual", o.ra_max_residual, 0.01, 180.0);
+  visit("tracks_min_length", o.tracks_min_length, 2, 100000);
+  visit("tracks_max_per_image", o.tracks_max_per_image, 1, 100000000);
+  visit("gp_max_num_iterations", o.gp_max_num_iterations, 1, 10000);
+  visit("gp_huber_threshold", o.gp_huber_threshold, 1e-4, 10.0);
+  visit("filter_max_angle_error", o.filter_max_angle_error, 1e-3, 180.0);
+  visit("filter_max_reproj_error", o.filter_max_reproj_error, 1e-3, 1000.0);
+  visit("filter_min_tri_angle", o.filter_min_tri_angle, 0.0, 90.0);
+  visit("min_num_observations_per_image", o.min_num_observations_per_image, 0, 100000000);
+  visit("ba_num_rounds", o.ba_num_rounds, 1, 100);
+  visit("ba_max_num_iterations", o.ba_max_num_iterations, 1, 10000);
+  visit("ba_function_tolerance", o.ba_function_tolerance, 1e-12, 1.0);
+  visit("ba_refine_focal_length", o.ba_refine_focal_length);
+  visit("ba_refine_principal_point", o.ba_refine_principal_point);
+  visit("ba_refine_extra_params", o.ba_refine_extra_params);
+  visit("retriangulate", o.retriangulate);
+  visit("tri_max_error", o.tri_max_error, 1e-3, 1000.0);
+  visit("tri_min_angle", o.tri_min_angle, 0.0, 90.0);
+  visit("final_ba_max_num_iterations", o.final_ba_max_num_iterations, 1, 10000);
+  visit("final_ba_function_tolerance", o.final_ba_function_tolerance, 1e-12, 1.0);
+  visit("min_model_size", o.min_model_size, 2, 1000000);
+  visit("seed", o.seed, 0, std::numeric_limits<uint64_t>::max());
+}
+
+}  // namespace
+
+GlobalMapperOptions GlobalMapperOptions::FromJson(const nlohmann::json& json,
+                                                  const std::string& path) {
   GlobalMapperOptions o;
-  OptionReader reader(json);
-  o.min_num_matches = reader.Get<int>("min_num_matches", o.min_num_matches, 5, 100000);
-  o.min_relative_pair_strength =
-      reader.Get<double>("min_relative_pair_strength", o.min_relative_pair_strength, 0.0, 1.0);
-  o.estimate_focal_length = reader.GetBool("estimate_focal_length", o.estimate_focal_length);
-  o.filter_view_graph = reader.GetBool("filter_view_graph", o.filter_view_graph);
-  o.view_graph_max_cycle_error =
-      reader.Get<double>("view_graph_max_cycle_error", o.view_graph_max_cycle_error, 0.01, 180.0);
-  o.ra_num_l1_iterations =
-      reader.Get<int>("ra_num_l1_iterations", o.ra_num_l1_iterations, 0, 10000);
-  o.ra_max_num_iterations =
-      reader.Get<int>("ra_max_num_iterations", o.ra_max_num_iterations, 1, 10000);
-  o.ra_robust_sigma = reader.Get<double>("ra_robust_sigma", o.ra_robust_sigma, 0.01, 180.0);
-  o.ra_max_residual = reader.Get<double>("ra_max_residual", o.ra_max_residual, 0.01, 180.0);
-  o.tracks_min_length = reader.Get<int>("tracks_min_length", o.tracks_min_length, 2, 100000);
-  o.tracks_max_per_image =
-      reader.Get<int>("tracks_max_per_image", o.tracks_max_per_image, 1, 100000000);
-  o.gp_max_num_iterations =
-      reader.Get<int>("gp_max_num_iterations", o.gp_max_num_iterations, 1, 10000);
-  o.gp_huber_threshold = reader.Get<double>("gp_huber_threshold", o.gp_huber_threshold, 1e-4, 10.0);
-  o.gp_num_threads = reader.Get<int>("gp_num_threads", o.gp_num_threads, 1, 1024);
-  o.filter_max_angle_error =
-      reader.Get<double>("filter_max_angle_error", o.filter_max_angle_error, 1e-3, 180.0);
-  o.filter_max_reproj_error =
-      reader.Get<double>("filter_max_reproj_error", o.filter_max_reproj_error, 1e-3, 1000.0);
-  o.filter_min_tri_angle =
-      reader.Get<double>("filter_min_tri_angle", o.filter_min_tri_angle, 0.0, 90.0);
-  o.min_num_observations_per_image = reader.Get<int>(
-      "min_num_observations_per_image", o.min_num_observations_per_image, 0, 100000000);
-  o.ba_num_rounds = reader.Get<int>("ba_num_rounds", o.ba_num_rounds, 1, 100);
-  o.ba_max_num_iterations =
-      reader.Get<int>("ba_max_num_iterations", o.ba_max_num_iterations, 1, 10000);
-  o.ba_function_tolerance =
-      reader.Get<double>("ba_function_tolerance", o.ba_function_tolerance, 1e-12, 1.0);
-  o.ba_refine_focal_length = reader.GetBool("ba_refine_focal_length", o.ba_refine_focal_length);
-  o.ba_refine_principal_point =
-      reader.GetBool("ba_refine_principal_point", o.ba_refine_principal_point);
-  o.ba_refine_extra_params = reader.GetBool("ba_refine_extra_params", o.ba_refine_extra_params);
-  o.retriangulate = reader.GetBool("retriangulate", o.retriangulate);
-  o.tri_max_error = reader.Get<double>("tri_max_error", o.tri_max_error, 1e-3, 1000.0);
-  o.tri_min_angle = reader.Get<double>("tri_min_angle", o.tri_min_angle, 0.0, 90.0);
-  o.final_ba_max_num_iterations =
-      reader.Get<int>("final_ba_max_num_iterations", o.final_ba_max_num_iterations, 1, 10000);
-  o.final_ba_function_tolerance =
-      reader.Get<double>("final_ba_function_tolerance", o.final_ba_function_tolerance, 1e-12, 1.0);
-  o.min_model_size = reader.Get<int>("min_model_size", o.min_model_size, 2, 1000000);
-  o.seed = reader.Get<int>("seed", o.seed, 0, std::numeric_limits<int>::max());
+  OptionReader reader(json, path);
+  VisitGlobalMapperOptions(o, option_ranges::Reader(&reader));
   reader.Finish();
   return o;
+}
+
+void GlobalMapperOptions::Check() const {
+  const option_ranges::Checker check("GlobalMapperOptions");
+  VisitGlobalMapperOptions(*this, check);
+  check("num_threads", num_threads, 1, 1024);
 }
 
 nlohmann::json GlobalMapperOptions::ToJson() const {
@@ -73,7 +76,6 @@ nlohmann::json GlobalMapperOptions::ToJson() const {
           {"tracks_max_per_image", tracks_max_per_image},
           {"gp_max_num_iterations", gp_max_num_iterations},
           {"gp_huber_threshold", gp_huber_threshold},
-          {"gp_num_threads", gp_num_threads},
           {"filter_max_angle_error", filter_max_angle_error},
           {"filter_max_reproj_error", filter_max_reproj_error},
           {"filter_min_tri_angle", filter_min_tri_angle},

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdint>
+#include <type_traits>
+
 #include "tessera/errors.h"
 
 namespace tessera {
@@ -51,6 +54,28 @@ TEST(GlobalMapperOptions, RangeErrorsNameTheKey) {
   EXPECT_EQ(ErrorPath({{"ba_num_rounds", 1.5}}), "ba_num_rounds");
   EXPECT_EQ(ErrorPath({{"min_relative_pair_strength", -0.1}}), "min_relative_pair_strength");
   EXPECT_EQ(ErrorPath({{"min_relative_pair_strength", 1.5}}), "min_relative_pair_strength");
+}
+
+// The same shape as IncrementalMapperOptions::FromJson: a path prefixes every key, and
+// the range is printed after the value.
+TEST(GlobalMapperOptions, FromJsonTakesThePathItNames) {
+  try {
+    GlobalMapperOptions::FromJson({{"ba_num_rounds", 300}}, "pipeline.mapper.options");
+    FAIL() << "expected an OptionError";
+  } catch (const OptionError& error) {
+    EXPECT_EQ(error.path(), "pipeline.mapper.options.ba_num_rounds");
+    EXPECT_STREQ(error.what(),
+                 "pipeline.mapper.options.ba_num_rounds = 300 is out of range [1, 100]");
+  }
+}
+
+// One seed type with MapperContext::seed: a 64-bit seed is kept whole.
+TEST(GlobalMapperOptions, TheSeedIsSixtyFourBits) {
+  const uint64_t seed = (uint64_t{1} << 40) + 7;
+  static_assert(std::is_same_v<decltype(GlobalMapperOptions::seed), uint64_t>);
+  const GlobalMapperOptions read = GlobalMapperOptions::FromJson({{"seed", seed}});
+  EXPECT_EQ(read.seed, seed);
+  EXPECT_EQ(read.ToJson().at("seed").get<uint64_t>(), seed);
 }
 
 TEST(GlobalMapperOptions, UnknownKeysAreRefused) {

@@ -6,6 +6,7 @@
 #include <memory>
 #include <random>
 
+#include "sfm/option_ranges.h"
 #include "util/random.h"
 
 namespace tessera {
@@ -115,6 +116,7 @@ GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& camer
                                          const std::vector<Track>& tracks,
                                          const GlobalPositioningOptions& options,
                                          const std::function<bool()>& should_stop) {
+  options.Check();
   GlobalPositioningResult result;
   RandomEngine engine(options.seed);
   std::uniform_real_distribution<double> uniform(-options.init_extent, options.init_extent);
@@ -214,6 +216,15 @@ GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& camer
     for (Eigen::Vector3d& point : result.points) point /= median;
   }
   return result;
+}
+
+void GlobalPositioningOptions::Check() const {
+  const option_ranges::Checker check("GlobalPositioningOptions");
+  check("max_num_iterations", max_num_iterations, 1, 10000);
+  check("huber_threshold", huber_threshold, 1e-4, 10.0);
+  check("function_tolerance", function_tolerance, 0.0, 1.0);
+  check("init_extent", init_extent, 1e-6, 1e9);
+  check("num_threads", num_threads, 1, 1024);
 }
 
 }  // namespace tessera

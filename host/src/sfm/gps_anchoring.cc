@@ -8,7 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "estimators/ransac.h"
+#include "geometry/similarity_estimator.h"
 #include "geometry/similarity_transform.h"
+#include "sfm/option_ranges.h"
 #include "util/random.h"
 
 namespace tessera {
@@ -198,36 +201,23 @@ std::string DegenerateSpread(const std::vector<Eigen::Vector3d>& enu, double sig
 std::vector<size_t> AgreeingTags(const std::vector<Eigen::Vector3d>& centres,
                                  const std::vector<Eigen::Vector3d>& enu, double threshold,
                                  const GpsAnchoringOptions& options, uint64_t seed) {
-  RandomEngine random(DeriveSeed(seed, 0x6a5));
-  std::uniform_int_distribution<size_t> pick(0, centres.size() - 1);
-  std::vector<size_t> best_inliers;
-  const auto inliers_of = [&](const Similarity3d& sim) {
-    std::vector<size_t> inliers;
-    for (size_t i = 0; i < centres.size(); ++i) {
-      if ((sim * centres[i] - enu[i]).norm() <= threshold) inliers.push_back(i);
-    }
-    return inliers;
-  };
-  for (int trial = 0; trial < options.ransac_num_trials; ++trial) {
-    const size_t a = pick(random), b = pick(random), c = pick(random);
-    if (a == b || b == c || a == c) continue;
-    Similarity3d sim =
-        EstimateSimilarity({centres[a], centres[b], centres[c]}, {enu[a], enu[b], enu[c]});
-    if (!(sim.scale > 0) || !sim.rotation.allFinite()) continue;
-    std::vector<size_t> inliers = inliers_of(sim);
-    // Local optimisation: refit on the inliers once.
-    if (inliers.size() >= 3) {
-      std::vector<Eigen::Vector3d> src, dst;
-      for (const size_t i : inliers) src.push_back(centres[i]), dst.push_back(enu[i]);
-      const Similarity3d refit = EstimateSimilarity(src, dst);
-      if (refit.scale > 0 && refit.rotation.allFinite()) {
-        std::vector<size_t> refit_inliers = inliers_of(refit);
-        if (refit_inliers.size() >= inliers.size()) inliers = std::move(refit_inliers);
-      }
-    }
-    if (inliers.size() > best_inliers.size()) best_inliers = std::move(inliers);
+  std::vector<SimilaritySample> source(centres.size()), target(enu.size());
+  for (size_t i = 0; i < centres.size(); ++i) {
+    source[i].position = centres[i];
+    target[i].position = enu[i];
   }
-  return best_inliers;
+  RANSACOptions ransac_options;
+  ransac_options.max_error = threshold;
+  ransac_options.min_inlier_ratio = std::clamp(options.min_inlier_ratio, 1e-3, 1.0);
+  ransac_options.max_num_trials = options.ransac_num_trials;
+  const auto report =
+      LORANSAC<SimilarityEstimator, SimilarityEstimator>(ransac_options, DeriveSeed(seed, 0x6a5))
+          .Estimate(source, target);
+  std::vector<size_t> inliers;
+  for (size_t i = 0; i < report.inlier_mask.size(); ++i) {
+    if (report.inlier_mask[i]) inliers.push_back(i);
+  }
+  return inliers;
 }
 
 }  // namespace
@@ -236,6 +226,7 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
                                     const BundleAdjuster& bundle_adjuster,
                                     const GpsAnchoringOptions& options, uint64_t seed,
                                     Reconstruction* model) {
+  options.Check();
   GpsAnchoringReport report;
   std::vector<image_t> tagged;
   for (const auto& [image_id, image] : model->images) {
@@ -318,6 +309,21 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
   *model = std::move(anchored);
   report.anchored = true;
   return report;
+}
+
+void GpsAnchoringOptions::Check() const {
+  const option_ranges::Checker check("GpsAnchoringOptions");
+  check("horizontal_sigma_m", horizontal_sigma_m, 1e-3, 1e6);
+  check("vertical_sigma_m", vertical_sigma_m, 1e-3, 1e6);
+  check("min_num_images", min_num_images, 3, 1000000);
+  check("max_error_sigmas", max_error_sigmas, 1e-3, 1e3);
+  check("min_inlier_ratio", min_inlier_ratio, 0.0, 1.0);
+  check("ransac_num_trials", ransac_num_trials, 1, 100000000);
+  check("ba_max_num_iterations", ba_max_num_iterations, 1, 10000);
+  check("min_altitude_m", min_altitude_m, -1e6, max_altitude_m);
+  check("max_altitude_m", max_altitude_m, min_altitude_m, 1e9);
+  check("far_tag_mads", far_tag_mads, 0.0, 1e6);
+  check("far_tag_floor_m", far_tag_floor_m, 0.0, 1e9);
 }
 
 }  // namespace tessera

@@ -13,6 +13,7 @@
 #include "estimators/ransac.h"
 #include "geometry/essential_matrix.h"
 #include "geometry/triangulation.h"
+#include "sfm/option_ranges.h"
 #include "sfm/rig_poses.h"
 #include "tessera/io/model_statistics.h"
 #include "tessera/sfm/camera_plausibility.h"
@@ -22,6 +23,21 @@ namespace tessera {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
+
+// The options, once checked: before any member is built from them.
+const IncrementalMapperOptions& Checked(const IncrementalMapperOptions& options) {
+  options.Check();
+  return options;
+}
+MapperRunState& Checked(MapperRunState* run) {
+  run->ransac.Check();
+  return *run;
+}
+
+// The level of a run's step messages.
+spdlog::level::level_enum StepLevel(MapperLogging logging) {
+  return logging == MapperLogging::kQuiet ? spdlog::level::debug : spdlog::level::info;
+}
 // The view graph's seed stream (see MapperRansacOptions for the estimators').
 constexpr uint64_t kViewGraphStream = 4;
 // See IncrementalMapper::NextImages. The penalty puts weakly connected images after
@@ -62,7 +78,8 @@ IncrementalTriangulatorOptions TriangulatorOptions(const IncrementalMapperOption
 // `min_num_inliers` of its 2D-3D correspondences reproject within `max_error_px`;
 // returns whether it did, and logs it.
 bool RegisterByRigFrame(const std::vector<CameraRig>& rigs, image_t image_id, int min_num_inliers,
-                        double max_error_px, ObservationManager* obs) {
+                        double max_error_px, spdlog::level::level_enum step_level,
+                        ObservationManager* obs) {
   image_t source = kInvalidImageId;
   const std::optional<Rigid3d> cam_from_world =
       RigPoseOfImage(rigs, obs->model(), image_id, &source);
@@ -89,11 +106,11 @@ bool RegisterByRigFrame(const std::vector<CameraRig>& rigs, image_t image_id, in
       obs->AddObservation(point3D_id, {image_id, idx});
     }
   }
-  spdlog::info(
-      "map: registered {} ({} images): posed by its rig frame with {}, {} of {} 2D-3D "
-      "correspondences agree",
-      image.name, obs->registered_images().size(), rec.images.at(source).name, consistent.size(),
-      num_correspondences);
+  spdlog::log(step_level,
+              "map: registered {} ({} images): posed by its rig frame with {}, {} of {} 2D-3D "
+              "correspondences agree",
+              image.name, obs->registered_images().size(), rec.images.at(source).name,
+              consistent.size(), num_correspondences);
   return true;
 }
 
@@ -121,13 +138,15 @@ const char* StatusName(IncrementalMapper::Status status) {
 
 size_t MapperRunState::Prepare(const IncrementalMapperOptions& options,
                                const std::vector<const MapperInput::Pair*>& pairs) {
-  view_graph = ViewGraph::Build(input, cameras, pairs, DeriveSeed(seed, kViewGraphStream));
+  view_graph = ViewGraph::Build(input, cameras, pairs, DeriveSeed(seed, kViewGraphStream),
+                                options.num_threads);
   size_t num_dropped = 0;
   if (options.filter_view_graph) {
     constexpr size_t kMinNumCycles = 3;
     num_dropped =
         view_graph.FilterByRotationCycles(options.view_graph_max_cycle_error, kMinNumCycles);
-    spdlog::info(
+    spdlog::log(
+        StepLevel(logging),
         "map: view graph: {} of {} verified pairs dropped: their relative rotations close none "
         "of the {} or more rotation cycles (triangles of pairs) through them within {:g} deg",
         num_dropped, pairs.size(), kMinNumCycles, options.view_graph_max_cycle_error);
@@ -149,8 +168,8 @@ size_t MapperRunState::Prepare(const IncrementalMapperOptions& options,
 }
 
 IncrementalMapper::IncrementalMapper(const IncrementalMapperOptions& options, MapperRunState* run)
-    : options_(options),
-      run_(*run),
+    : options_(Checked(options)),
+      run_(Checked(run)),
       obs_(run->cameras, run->input.images, run->tracks),
       triangulator_(TriangulatorOptions(options, run->ransac), &obs_) {}
 
@@ -286,9 +305,10 @@ IncrementalMapper::Status IncrementalMapper::Initialize() {
   for (const InitialPair::Point& point : best.points) {
     obs_.AddPoint(point.track_id, point.xyz, {{image_id1, point.idx1}, {image_id2, point.idx2}});
   }
-  spdlog::info("map: initial pair {} and {}: {} points, median triangulation angle {:.1f} deg",
-               obs_.model().images.at(image_id1).name, obs_.model().images.at(image_id2).name,
-               best.points.size(), best.median_angle / kDegToRad);
+  spdlog::log(StepLevel(run_.logging),
+              "map: initial pair {} and {}: {} points, median triangulation angle {:.1f} deg",
+              obs_.model().images.at(image_id1).name, obs_.model().images.at(image_id2).name,
+              best.points.size(), best.median_angle / kDegToRad);
   GlobalBundleAdjustment();
   return Status::kSuccess;
 }
@@ -401,7 +421,7 @@ IncrementalMapper::Status IncrementalMapper::RegisterImage(image_t image_id) {
   // A frame's image follows its rig, where the rig's pose agrees with what it sees.
   if (run_.used_images.count(image_id) == 0 &&
       RegisterByRigFrame(run_.input.rigs, image_id, options_.abs_pose_min_num_inliers,
-                         options_.abs_pose_max_error, &obs_)) {
+                         options_.abs_pose_max_error, StepLevel(run_.logging), &obs_)) {
     run_.failure_reasons.erase(image_id);
     changed_since_global_ba_ = true;
     return Status::kSuccess;
@@ -468,7 +488,7 @@ IncrementalMapper::Status IncrementalMapper::RegisterImage(image_t image_id) {
     std::string disagreement;
     if (!AgreesWithViewGraph(image_id, rotation, &disagreement)) {
       ++run_.num_registrations_refused;
-      spdlog::info("map: refused {}: {}", image.name, disagreement);
+      spdlog::log(StepLevel(run_.logging), "map: refused {}: {}", image.name, disagreement);
       // Pairs whose two-view rotation is wrong are common where the scene barely
       // constrains it: first wait for more of the image's neighbours (its strongest
       // pairs may be to images not registered yet); only when none will come, trust the
@@ -493,8 +513,8 @@ IncrementalMapper::Status IncrementalMapper::RegisterImage(image_t image_id) {
   }
   run_.failure_reasons.erase(image_id);
   changed_since_global_ba_ = true;
-  spdlog::info("map: registered {} ({} images): PnP kept {}", image.name,
-               obs_.registered_images().size(), counts);
+  spdlog::log(StepLevel(run_.logging), "map: registered {} ({} images): PnP kept {}", image.name,
+              obs_.registered_images().size(), counts);
   return Status::kSuccess;
 }
 
@@ -849,6 +869,17 @@ void IncrementalMapper::BeginFinalRounds() {
   refused_with_neighbours_.clear();
   final_rounds_ = true;
   changed_since_global_ba_ = false;
+}
+
+void MapperRansacOptions::Check() const {
+  const option_ranges::Checker check("MapperRansacOptions");
+  check("init_confidence", init_confidence, 0.01, 1 - 1e-12);
+  check("init_min_inlier_ratio", init_min_inlier_ratio, 1e-6, 1.0);
+  check("init_max_num_trials", init_max_num_trials, 1, 100000000);
+  check("abs_pose_confidence", abs_pose_confidence, 0.01, 1 - 1e-12);
+  check("abs_pose_min_inlier_ratio_floor", abs_pose_min_inlier_ratio_floor, 1e-6, 1.0);
+  check("abs_pose_max_num_trials", abs_pose_max_num_trials, 1, 100000000);
+  check("tri_max_num_pairs", tri_max_num_pairs, 0, 100000000);
 }
 
 }  // namespace tessera

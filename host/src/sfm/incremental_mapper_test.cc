@@ -181,13 +181,10 @@ TEST(IncrementalMapper, RansacOptionsReachTheEstimators) {
   setup.run.ransac.init_max_num_trials = 0;
   expect_refused([&] { IncrementalMapper(setup.options, &setup.run).Initialize(); });
 
+  // MapperRansacOptions::Check() refuses it as the mapper is built, before any step.
   setup.run.ransac = MapperRansacOptions();
   setup.run.ransac.abs_pose_max_num_trials = 0;
-  IncrementalMapper mapper(setup.options, &setup.run);
-  ASSERT_EQ(mapper.Initialize(), IncrementalMapper::Status::kSuccess);
-  const std::vector<image_t> next = mapper.NextImages();
-  ASSERT_FALSE(next.empty());
-  expect_refused([&] { mapper.RegisterImage(next[0]); });
+  expect_refused([&] { IncrementalMapper(setup.options, &setup.run); });
 }
 
 // Local BA: the new image and its local_ba_num_images - 1 best-connected neighbours are
@@ -290,13 +287,14 @@ TEST(IncrementalMapper, FilterPointsRemovesWhatReprojectsTooFar) {
   for (const auto& [point3D_id, point3D] : setup.mapper->model().points3D) all.insert(point3D_id);
   EXPECT_EQ(setup.mapper->FilterPoints(all), 0u) << "the pair's points all fit";
   IncrementalMapperOptions strict = setup.options;
-  strict.filter_max_reproj_error = 1e-9;
+  strict.filter_max_reproj_error = 1e-3;  // the smallest Check() allows
   IncrementalMapper strict_mapper(strict, &setup.run);
   setup.run.used_images.clear();
   setup.run.tried_initial_pairs.clear();
   ASSERT_EQ(strict_mapper.Initialize(), IncrementalMapper::Status::kSuccess);
-  EXPECT_TRUE(strict_mapper.model().points3D.empty())
-      << "noisy keypoints: none fits within 1e-9 px";
+  // Noisy keypoints: all but a handful of points are off by more than 1e-3 px.
+  EXPECT_LT(strict_mapper.model().points3D.size(), setup.mapper->model().points3D.size() / 100)
+      << "of " << setup.mapper->model().points3D.size();
 }
 
 }  // namespace

@@ -162,6 +162,7 @@ ModelFinishingOptions FinishingOptions(const IncrementalMapperOptions& options) 
   finishing.gps.horizontal_sigma_m = options.gps_horizontal_sigma;
   finishing.gps.vertical_sigma_m = options.gps_vertical_sigma;
   finishing.gps.min_num_images = options.gps_min_images;
+  finishing.num_threads = options.num_threads;
   finishing.gps.ba_max_num_iterations = options.ba_global_max_num_iterations;
   return finishing;
 }
@@ -264,8 +265,8 @@ Reconstruction MapFirstModel(const IncrementalMapperOptions& options, const Mapp
   MapperRunState calibration(run.input, run.bundle_adjuster, run.seed);
   calibration.ransac = run.ransac;
   calibration.cameras = run.cameras;
-  const spdlog::level::level_enum level = spdlog::get_level();
-  if (level > spdlog::level::debug) spdlog::set_level(spdlog::level::warn);
+  // Its steps are no model of the user's: logged at debug.
+  calibration.logging = MapperLogging::kQuiet;
   calibration.Prepare(options, pairs);
   IncrementalMapper mapper(options, &calibration);
   Reconstruction model;
@@ -290,7 +291,6 @@ Reconstruction MapFirstModel(const IncrementalMapperOptions& options, const Mapp
     }
     model = mapper.TakeModel();
   }
-  spdlog::set_level(level);
   return model;
 }
 
@@ -468,7 +468,10 @@ IncrementalPipeline::IncrementalPipeline(const IncrementalMapperOptions& options
     : options_(options),
       bundle_adjuster_(bundle_adjuster),
       seed_(seed),
-      ransac_options_(ransac_options) {}
+      ransac_options_(ransac_options) {
+  options_.Check();
+  ransac_options_.Check();
+}
 
 MapperResult IncrementalPipeline::Reconstruct(const MapperInput& input,
                                               const MapperControl& observer) const {

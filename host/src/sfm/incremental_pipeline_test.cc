@@ -4,6 +4,8 @@
 #include <spdlog/sinks/ostream_sink.h>
 #include <spdlog/spdlog.h>
 
+#include <memory>
+#include <set>
 #include <sstream>
 
 #include "eval/evaluation.h"
@@ -601,6 +603,53 @@ TEST(IncrementalPipeline, SameSeedSameModel) {
   for (const auto& [point3D_id, point3D] : model_a.points3D) {
     EXPECT_EQ(point3D.xyz, model_b.points3D.at(point3D_id).xyz);
   }
+}
+
+// The adjuster the pipeline calls, recording spdlog's global level at each call.
+class LevelRecordingAdjuster : public BundleAdjuster {
+ public:
+  BundleAdjustmentSummary Adjust(const BundleAdjustmentConfig& config,
+                                 Reconstruction* model) const override {
+    levels.insert(spdlog::get_level());
+    return testing::CeresAdjusterOnOneThread().Adjust(config, model);
+  }
+  mutable std::set<spdlog::level::level_enum> levels;
+};
+
+// The first model mapped for the focal lengths logs its steps at debug, without
+// touching the global level (the GUI logs beside a pipeline on a worker thread).
+TEST(IncrementalPipeline, TheFirstModelLogsAtDebugWithoutChangingTheGlobalLevel) {
+  SyntheticSceneOptions scene_options;
+  scene_options.focal_prior = false;
+  scene_options.num_images = 8;
+  scene_options.seed = 11;
+  const SyntheticScene scene = MakeSyntheticScene(scene_options);
+  IncrementalMapperOptions options;
+  options.min_view_graph_focal_pairs = 0;  // every camera gets a first model
+  std::ostringstream log;
+  const auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(log);
+  sink->set_pattern("%l %v");
+  const auto logger = spdlog::default_logger();
+  const spdlog::level::level_enum previous = spdlog::get_level();
+  logger->sinks().push_back(sink);
+  spdlog::set_level(spdlog::level::info);
+  const LevelRecordingAdjuster adjuster;
+  const MapperResult result = IncrementalPipeline(options, adjuster, 0).Reconstruct(scene.input);
+  logger->sinks().pop_back();
+  const spdlog::level::level_enum after = spdlog::get_level();
+  spdlog::set_level(previous);
+  ASSERT_EQ(result.focal_lengths.size(), 1u);
+  EXPECT_NE(result.focal_lengths[0].method.find("first model"), std::string::npos);
+  EXPECT_EQ(adjuster.levels, std::set<spdlog::level::level_enum>{spdlog::level::info});
+  EXPECT_EQ(after, spdlog::level::info);
+  // The real pass's registrations are at info, each image once.
+  const std::string text = log.str();
+  size_t registered = 0;
+  for (size_t at = text.find("info map: registered"); at != std::string::npos;
+       at = text.find("info map: registered", at + 1)) {
+    ++registered;
+  }
+  EXPECT_GT(registered, 0u) << text;
 }
 
 TEST(IncrementalMapperOptions, UnknownKeysAndBadValuesNameTheField) {

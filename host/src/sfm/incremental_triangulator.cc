@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "geometry/triangulation.h"
+#include "sfm/option_ranges.h"
 
 namespace tessera {
 namespace {
@@ -16,7 +17,9 @@ constexpr double kDegToRad = M_PI / 180.0;
 
 IncrementalTriangulator::IncrementalTriangulator(const IncrementalTriangulatorOptions& options,
                                                  ObservationManager* observations)
-    : options_(options), obs_(*observations) {}
+    : options_(options), obs_(*observations) {
+  options_.Check();
+}
 
 bool IncrementalTriangulator::TriangulateTrack(track_t track_id) {
   const Reconstruction& rec = obs_.model();
@@ -179,6 +182,13 @@ size_t IncrementalTriangulator::Retriangulate() {
     if (num_registered >= 2 && TriangulateTrack(track_id)) ++num_created;
   }
   return num_created;
+}
+
+void IncrementalTriangulatorOptions::Check() const {
+  const option_ranges::Checker check("IncrementalTriangulatorOptions");
+  check("max_error", max_error, 1e-3, 1000.0);
+  check("min_angle", min_angle, 0.0, 180.0);
+  check("max_num_pairs", max_num_pairs, 0, 100000000);
 }
 
 }  // namespace tessera

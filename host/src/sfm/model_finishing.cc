@@ -9,6 +9,7 @@
 #include <set>
 #include <utility>
 
+#include "sfm/option_ranges.h"
 #include "tessera/options.h"
 #include "util/random.h"
 
@@ -79,21 +80,36 @@ std::optional<Georeference> Anchor(const MapperInput& input, const BundleAdjuste
 
 }  // namespace
 
+namespace {
+
+// Every field, with its range for the numbers (option_ranges.h): FromJson and Check()
+// read the same list.
+template <typename Options, typename Visitor>
+void VisitModelFinishingOptions(Options& o, const Visitor& visit) {
+  visit("reg_max_rotation_error", "max_rotation_error_deg", o.max_rotation_error_deg, 0.01, 180.0);
+  visit("min_model_agreement", o.min_model_agreement, 0.0, 1.0);
+  visit("use_gps_prior", o.use_gps_prior);
+  visit("gps_horizontal_sigma", "gps.horizontal_sigma_m", o.gps.horizontal_sigma_m, 1e-3, 1e6);
+  visit("gps_vertical_sigma", "gps.vertical_sigma_m", o.gps.vertical_sigma_m, 1e-3, 1e6);
+  visit("gps_min_images", "gps.min_num_images", o.gps.min_num_images, 3, 1000000);
+}
+
+}  // namespace
+
 ModelFinishingOptions ModelFinishingOptions::FromJson(const nlohmann::json& json,
                                                       const std::string& path) {
   ModelFinishingOptions o;
   OptionReader reader(json, path);
-  o.max_rotation_error_deg =
-      reader.Get<double>("reg_max_rotation_error", o.max_rotation_error_deg, 0.01, 180.0);
-  o.min_model_agreement =
-      reader.Get<double>("min_model_agreement", o.min_model_agreement, 0.0, 1.0);
-  o.use_gps_prior = reader.GetBool("use_gps_prior", o.use_gps_prior);
-  o.gps.horizontal_sigma_m =
-      reader.Get<double>("gps_horizontal_sigma", o.gps.horizontal_sigma_m, 1e-3, 1e6);
-  o.gps.vertical_sigma_m =
-      reader.Get<double>("gps_vertical_sigma", o.gps.vertical_sigma_m, 1e-3, 1e6);
-  o.gps.min_num_images = reader.Get<int>("gps_min_images", o.gps.min_num_images, 3, 1000000);
+  VisitModelFinishingOptions(o, option_ranges::Reader(&reader));
   return o;
+}
+
+void ModelFinishingOptions::Check() const {
+  const option_ranges::Checker check("ModelFinishingOptions");
+  VisitModelFinishingOptions(*this, check);
+  check("num_threads", num_threads, 1, 1024);
+  check("min_num_matches", min_num_matches, 1, 100000000);
+  gps.Check();
 }
 
 const std::vector<std::string>& ModelFinishingOptions::JsonKeys() {
@@ -130,7 +146,7 @@ void SortModelsLargestFirst(std::vector<Reconstruction>* models) {
 }
 
 ViewGraph ModelViewGraph(const MapperInput& input, const Reconstruction& model, int min_num_matches,
-                         uint64_t seed) {
+                         int num_threads, uint64_t seed) {
   std::map<camera_t, Camera> cameras = input.cameras;
   for (const auto& [camera_id, camera] : model.cameras) cameras[camera_id] = camera;
   std::vector<const MapperInput::Pair*> pairs;
@@ -141,7 +157,7 @@ ViewGraph ModelViewGraph(const MapperInput& input, const Reconstruction& model, 
       pairs.push_back(&pair);
     }
   }
-  return ViewGraph::Build(input, cameras, pairs, seed);
+  return ViewGraph::Build(input, cameras, pairs, seed, num_threads);
 }
 
 ModelSelfCheck SelfCheckModel(const ViewGraph& view_graph, const Reconstruction& model,
@@ -162,15 +178,16 @@ ModelSelfCheck SelfCheckModel(const ViewGraph& view_graph, const Reconstruction&
 void FinishModels(const MapperInput& input, const BundleAdjuster& bundle_adjuster,
                   const ModelFinishingOptions& options, uint64_t seed, MapperResult* result,
                   const ViewGraph* view_graph) {
+  options.Check();
   SortModelsLargestFirst(&result->models);
   result->self_checks.clear();
   for (size_t index = 0; index < result->models.size(); ++index) {
     const Reconstruction& model = result->models[index];
     const ModelSelfCheck check =
-        view_graph != nullptr
-            ? SelfCheckModel(*view_graph, model, options)
-            : SelfCheckModel(ModelViewGraph(input, model, options.min_num_matches, seed), model,
-                             options);
+        view_graph != nullptr ? SelfCheckModel(*view_graph, model, options)
+                              : SelfCheckModel(ModelViewGraph(input, model, options.min_num_matches,
+                                                              options.num_threads, seed),
+                                               model, options);
     LogSelfCheck(options, index, model, check);
     result->self_checks.push_back(check);
   }

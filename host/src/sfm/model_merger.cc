@@ -1,12 +1,13 @@
 #include "tessera/sfm/model_merger.h"
 
 #include <algorithm>
+#include <limits>
 #include <map>
-#include <random>
 #include <vector>
 
-#include "geometry/similarity_transform.h"
-#include "util/random.h"
+#include "estimators/ransac.h"
+#include "geometry/similarity_estimator.h"
+#include "sfm/option_ranges.h"
 
 namespace tessera {
 namespace {
@@ -24,25 +25,26 @@ std::map<track_t, point3D_t> PointOfTrack(const FeatureTracks& tracks,
   return point_of_track;
 }
 
-bool ProjectsWithin(const Reconstruction& model, const Point3D& point3D, const Eigen::Vector3d& xyz,
-                    double max_error) {
+// The largest squared distance, in pixels, between the projection of `xyz` and an
+// observation of `point3D` in `model`; infinite when it lies behind one of the cameras.
+double SquaredReprojectionError(const Reconstruction& model, const Point3D& point3D,
+                                const Eigen::Vector3d& xyz) {
+  double largest = 0;
   for (const TrackElement& element : point3D.track) {
     const Image& image = model.images.at(element.image_id);
     const Eigen::Vector3d point_in_cam = image.cam_from_world * xyz;
-    if (point_in_cam.z() <= 0) return false;
+    if (point_in_cam.z() <= 0) return std::numeric_limits<double>::infinity();
     const Eigen::Vector2d projected = model.cameras.at(image.camera_id).ImgFromCam(point_in_cam);
-    if ((projected - image.points2D[element.point2D_idx].xy).squaredNorm() >
-        max_error * max_error) {
-      return false;
-    }
+    largest = std::max(largest, (projected - image.points2D[element.point2D_idx].xy).squaredNorm());
   }
-  return true;
+  return largest;
 }
 
 }  // namespace
 
 ModelMergeReport MergeModels(const FeatureTracks& tracks, const ModelMergeOptions& options,
                              uint64_t seed, const Reconstruction& source, Reconstruction* target) {
+  options.Check();
   ModelMergeReport report;
   const std::map<track_t, point3D_t> source_points = PointOfTrack(tracks, source);
   const std::map<track_t, point3D_t> target_points = PointOfTrack(tracks, *target);
@@ -60,54 +62,34 @@ ModelMergeReport MergeModels(const FeatureTracks& tracks, const ModelMergeOption
     return report;
   }
 
-  const auto inliers_of = [&](const Similarity3d& target_from_source) {
-    std::vector<size_t> inliers;
-    for (size_t k = 0; k < shared.size(); ++k) {
-      const Eigen::Vector3d xyz = target_from_source * source.points3D.at(shared[k].first).xyz;
-      if (ProjectsWithin(*target, target->points3D.at(shared[k].second), xyz,
-                         options.max_reproj_error)) {
-        inliers.push_back(k);
-      }
-    }
-    return inliers;
+  // A shared point agrees when the source's point, moved, reprojects into every target
+  // image of the point: its residual is the largest squared reprojection error.
+  SimilarityEstimatorOptions estimator_options;
+  estimator_options.residual = SimilarityEstimatorOptions::Residual::kCustom;
+  estimator_options.custom_residual = [&](const SimilaritySample& target_point,
+                                          const Eigen::Vector3d& moved) {
+    return SquaredReprojectionError(*target, target->points3D.at(shared[target_point.id].second),
+                                    moved);
   };
-  const auto fit = [&](const std::vector<size_t>& indices) {
-    std::vector<Eigen::Vector3d> src, dst;
-    for (const size_t k : indices) {
-      src.push_back(source.points3D.at(shared[k].first).xyz);
-      dst.push_back(target->points3D.at(shared[k].second).xyz);
-    }
-    return EstimateSimilarity(src, dst);
-  };
-
-  RandomEngine engine(seed);
-  std::uniform_int_distribution<size_t> pick(0, shared.size() - 1);
-  std::vector<size_t> best_inliers;
-  Similarity3d best;
-  for (int trial = 0; trial < options.max_num_trials; ++trial) {
-    std::vector<size_t> sample;
-    while (sample.size() < 3) {
-      const size_t k = pick(engine);
-      if (std::find(sample.begin(), sample.end(), k) == sample.end()) sample.push_back(k);
-    }
-    const Similarity3d candidate = fit(sample);
-    if (!(candidate.scale > 0) || !candidate.rotation.allFinite()) continue;
-    std::vector<size_t> inliers = inliers_of(candidate);
-    if (inliers.size() > best_inliers.size()) {
-      // Local optimisation: refit on the inliers while that finds more.
-      Similarity3d refined = candidate;
-      while (inliers.size() >= 3) {
-        const Similarity3d refit = fit(inliers);
-        std::vector<size_t> refit_inliers = inliers_of(refit);
-        if (refit_inliers.size() <= inliers.size()) break;
-        refined = refit;
-        inliers = std::move(refit_inliers);
-      }
-      best = refined;
-      best_inliers = std::move(inliers);
-      if (best_inliers.size() == shared.size()) break;
-    }
+  std::vector<SimilaritySample> source_xyz(shared.size()), target_xyz(shared.size());
+  for (size_t k = 0; k < shared.size(); ++k) {
+    source_xyz[k].position = source.points3D.at(shared[k].first).xyz;
+    target_xyz[k].position = target->points3D.at(shared[k].second).xyz;
+    target_xyz[k].id = k;
   }
+  RANSACOptions ransac_options;
+  ransac_options.max_error = options.max_reproj_error;
+  ransac_options.min_inlier_ratio = std::clamp(options.min_inlier_ratio, 1e-3, 1.0);
+  ransac_options.max_num_trials = options.max_num_trials;
+  const auto ransac = LORANSAC<SimilarityEstimator, SimilarityEstimator>(
+                          ransac_options, seed, SimilarityEstimator(estimator_options),
+                          SimilarityEstimator(estimator_options))
+                          .Estimate(source_xyz, target_xyz);
+  std::vector<size_t> best_inliers;
+  for (size_t k = 0; k < ransac.inlier_mask.size(); ++k) {
+    if (ransac.inlier_mask[k]) best_inliers.push_back(k);
+  }
+  const Similarity3d& best = ransac.model;
   report.num_inliers = best_inliers.size();
   if (best_inliers.size() < options.min_num_shared_points ||
       static_cast<double>(best_inliers.size()) <
@@ -156,6 +138,14 @@ ModelMergeReport MergeModels(const FeatureTracks& tracks, const ModelMergeOption
   }
   report.merged = true;
   return report;
+}
+
+void ModelMergeOptions::Check() const {
+  const option_ranges::Checker check("ModelMergeOptions");
+  check("min_num_shared_points", min_num_shared_points, 3, 100000000);
+  check("min_inlier_ratio", min_inlier_ratio, 0.0, 1.0);
+  check("max_reproj_error", max_reproj_error, 1e-3, 1000.0);
+  check("max_num_trials", max_num_trials, 1, 100000000);
 }
 
 }  // namespace tessera

@@ -8,6 +8,8 @@
 #include <numeric>
 #include <queue>
 
+#include "sfm/option_ranges.h"
+
 namespace tessera {
 namespace {
 
@@ -162,6 +164,7 @@ void MarkDroppedPairs(const std::vector<RotationEdge>& edges, const std::vector<
 RotationAveragingResult AverageRotations(const std::vector<RelativeRotation>& pairs,
                                          const RotationAveragingOptions& options,
                                          const std::function<bool()>& should_stop) {
+  options.Check();
   RotationAveragingResult result;
   result.residuals_deg.assign(pairs.size(), 0.0);
   result.dropped.assign(pairs.size(), false);
@@ -274,6 +277,15 @@ RotationAveragingResult AverageRotations(const std::vector<RelativeRotation>& pa
     result.component[image_ids[i]] = component_of[i];
   }
   return result;
+}
+
+void RotationAveragingOptions::Check() const {
+  const option_ranges::Checker check("RotationAveragingOptions");
+  check("num_l1_iterations", num_l1_iterations, 0, 10000);
+  check("max_num_irls_iterations", max_num_irls_iterations, 0, 10000);
+  check("robust_sigma_deg", robust_sigma_deg, 0.01, 180.0);
+  check("convergence_deg", convergence_deg, 1e-12, 180.0);
+  check("max_residual_deg", max_residual_deg, 0.01, 180.0);
 }
 
 }  // namespace tessera

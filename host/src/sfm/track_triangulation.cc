@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "geometry/triangulation.h"
+#include "sfm/option_ranges.h"
 
 namespace tessera {
 namespace {
@@ -61,6 +62,7 @@ bool WideEnough(const std::vector<View>& views, const std::vector<size_t>& subse
 
 size_t TriangulateTracks(const std::vector<Track>& tracks, const TrackTriangulationOptions& options,
                          Reconstruction* model) {
+  options.Check();
   for (auto& [image_id, image] : model->images) {
     for (Point2D& point2D : image.points2D) point2D.point3D_id = kInvalidPoint3DId;
   }
@@ -128,6 +130,13 @@ size_t TriangulateTracks(const std::vector<Track>& tracks, const TrackTriangulat
     model->points3D.emplace(point3D_id, std::move(point3D));
   }
   return model->points3D.size();
+}
+
+void TrackTriangulationOptions::Check() const {
+  const option_ranges::Checker check("TrackTriangulationOptions");
+  check("max_error_px", max_error_px, 1e-3, 1000.0);
+  check("min_angle_deg", min_angle_deg, 0.0, 180.0);
+  check("max_num_pairs", max_num_pairs, 0, 100000000);
 }
 
 }  // namespace tessera

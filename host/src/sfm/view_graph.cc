@@ -9,7 +9,6 @@
 #include "estimators/essential_matrix.h"
 #include "estimators/ransac.h"
 #include "geometry/essential_matrix.h"
-#include "sfm/mapper_threads.h"
 #include "util/parallel.h"
 #include "util/random.h"
 
@@ -100,10 +99,11 @@ bool RelativeRotation(const MapperInput& input, const std::map<camera_t, Camera>
 }  // namespace
 
 ViewGraph ViewGraph::Build(const MapperInput& input, const std::map<camera_t, Camera>& cameras,
-                           const std::vector<const MapperInput::Pair*>& pairs, uint64_t seed) {
+                           const std::vector<const MapperInput::Pair*>& pairs, uint64_t seed,
+                           int num_threads) {
   // Each pair alone, with its own seed: any number of threads gives the same edges.
   std::vector<ViewGraphEdge> edges(pairs.size());
-  ParallelFor(pairs.size(), MapperThreads(), [&](size_t k) {
+  ParallelFor(pairs.size(), std::max(1, num_threads), [&](size_t k) {
     const MapperInput::Pair& pair = *pairs[k];
     ViewGraphEdge& edge = edges[k];
     edge.image_id1 = pair.image_id1;

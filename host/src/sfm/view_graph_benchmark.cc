@@ -16,7 +16,6 @@
 
 #include <vector>
 
-#include "sfm/mapper_threads.h"
 #include "synthetic_scene.h"
 #include "tessera/sfm/view_graph.h"
 
@@ -37,9 +36,10 @@ void BM_ViewGraphBuildUncalibrated(benchmark::State& state) {
     num_inliers += pair.geometry.inlier_matches.size();
   }
   size_t num_with_rotation = 0;
-  const ScopedMapperThreads threads(static_cast<int>(state.range(2)));
+  const int num_threads = static_cast<int>(state.range(2));
   for (auto _ : state) {
-    const ViewGraph graph = ViewGraph::Build(scene.input, scene.input.cameras, pairs, 0);
+    const ViewGraph graph =
+        ViewGraph::Build(scene.input, scene.input.cameras, pairs, 0, num_threads);
     num_with_rotation = 0;
     for (const ViewGraphEdge& edge : graph.edges()) num_with_rotation += edge.has_rotation;
   }

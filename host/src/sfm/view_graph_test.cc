@@ -4,7 +4,6 @@
 
 #include <thread>
 
-#include "sfm/mapper_threads.h"
 #include "synthetic_scene.h"
 #include "tessera/sfm/focal_length_estimation.h"
 
@@ -49,24 +48,9 @@ TEST(ViewGraph, GivesTheSameEdgesOnAnyNumberOfThreads) {
   options.focal_prior = false;  // every rotation from seeded five-point RANSAC
   options.num_images = 8;
   const SyntheticScene scene = MakeSyntheticScene(options);
-  EXPECT_EQ(MapperThreads(), 1);
   const ViewGraph one = ViewGraph::Build(scene.input, scene.input.cameras, AllPairs(scene), 7);
-  ViewGraph three;
-  {
-    const ScopedMapperThreads threads(3);
-    EXPECT_EQ(MapperThreads(), 3);
-    {
-      const ScopedMapperThreads inner(0);
-      EXPECT_EQ(MapperThreads(), 1);
-    }
-    EXPECT_EQ(MapperThreads(), 3);
-    // Another thread is not in this thread's scope.
-    int elsewhere = 0;
-    std::thread([&elsewhere] { elsewhere = MapperThreads(); }).join();
-    EXPECT_EQ(elsewhere, 1);
-    three = ViewGraph::Build(scene.input, scene.input.cameras, AllPairs(scene), 7);
-  }
-  EXPECT_EQ(MapperThreads(), 1);
+  const ViewGraph three =
+      ViewGraph::Build(scene.input, scene.input.cameras, AllPairs(scene), 7, /*num_threads=*/3);
   ASSERT_EQ(three.edges().size(), one.edges().size());
   for (size_t k = 0; k < one.edges().size(); ++k) {
     const ViewGraphEdge& a = one.edges()[k];

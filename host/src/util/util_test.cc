@@ -123,7 +123,7 @@ TEST(OptionReader, ChecksTypesAndRangesAndRecordsEffectiveOptions) {
     out_of_range.Get<double>("x", 1, 0, 10);
     FAIL();
   } catch (const OptionError& error) {
-    EXPECT_EQ(std::string(error.what()), "o.x: = 11.0 is out of range; must be in [0, 10]");
+    EXPECT_EQ(std::string(error.what()), "o.x = 11.0 is out of range [0, 10]");
   }
   EXPECT_THROW(OptionReader(nlohmann::json::array()), OptionError);
 }

@@ -279,16 +279,16 @@ bool StartsWith(const std::string& text, const std::string& prefix) {
 TEST(SiftDetector, RejectsInvalidOptions) {
   std::string text = OptionErrorText({{"max_num_features", 0}});
   EXPECT_TRUE(StartsWith(text,
-                         "pipeline.test.options.max_num_features: = 0 is out of range; must be "
-                         "in [1, 1000000] (plugin 'sift', "))
+                         "pipeline.test.options.max_num_features = 0 is out of range "
+                         "[1, 1000000] (plugin 'sift', "))
       << text;
   text = OptionErrorText({{"max_image_size", 8}});
-  EXPECT_TRUE(StartsWith(
-      text, "pipeline.test.options.max_image_size: = 8 is out of range; must be in [16, 100000]"))
+  EXPECT_TRUE(
+      StartsWith(text, "pipeline.test.options.max_image_size = 8 is out of range [16, 100000]"))
       << text;
   text = OptionErrorText({{"contrast_threshold", -0.5}});
-  EXPECT_TRUE(StartsWith(
-      text, "pipeline.test.options.contrast_threshold: = -0.5 is out of range; must be in [0, 1]"))
+  EXPECT_TRUE(
+      StartsWith(text, "pipeline.test.options.contrast_threshold = -0.5 is out of range [0, 1]"))
       << text;
   text = OptionErrorText({{"root_sift", 1}});
   EXPECT_TRUE(

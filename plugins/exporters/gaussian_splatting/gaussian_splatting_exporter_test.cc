@@ -364,9 +364,9 @@ TEST(GaussianSplattingExporter, FullFieldOptionsAreCheckedNamingTheOption) {
   const std::vector<std::pair<nlohmann::json, std::string>> bad = {
       {{{"field_of_view", "wide"}}, "pipeline.test.options.field_of_view: 'wide' is not one of"},
       {{{"field_of_view", "full"}, {"max_scale", 0.5}},
-       "pipeline.test.options.max_scale: = 0.5 is out of range; must be in [1, 10]"},
+       "pipeline.test.options.max_scale = 0.5 is out of range [1, 10]"},
       {{{"field_of_view", "full"}, {"max_ray_angle", 90}},
-       "pipeline.test.options.max_ray_angle: = 90 is out of range; must be in [1, 89]"},
+       "pipeline.test.options.max_ray_angle = 90 is out of range [1, 89]"},
       {{{"max_scale", 3}},
        "pipeline.test.options.max_scale: is used only with field_of_view \"full\""},
   };

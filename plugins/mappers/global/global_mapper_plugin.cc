@@ -74,7 +74,10 @@ class GlobalMapperPlugin : public Mapper {
                  "incremental mapper keeps them");
     }
     GlobalMapperOptions options = options_;
-    options.seed = static_cast<int>(context.seed & 0x7fffffff);
+    options.seed = context.seed;
+    options.num_threads = context.num_threads;
+    ModelFinishingOptions finishing = finishing_;
+    finishing.num_threads = context.num_threads;
     MapperResult result;
     const std::optional<MapperInput> calibrated =
         WithFirstModelFocalLengths(input, context, &result.focal_lengths);
@@ -114,7 +117,7 @@ class GlobalMapperPlugin : public Mapper {
     result.num_tracks = mapped.num_tracks;
     result.num_global_ba = mapped.num_bundle_adjustments;
     result.seconds = mapped.seconds;
-    FinishModels(input, *context.bundle_adjuster, finishing_, context.seed, &result);
+    FinishModels(input, *context.bundle_adjuster, finishing, context.seed, &result);
     result.details = {
         {"num_verified_pairs", mapped.num_verified_pairs},
         {"num_weak_pairs_set_aside", mapped.num_weak_pairs_set_aside},

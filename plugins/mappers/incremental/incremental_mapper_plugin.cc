@@ -18,7 +18,9 @@ class IncrementalMapperPlugin : public Mapper {
     if (context.bundle_adjuster == nullptr) {
       throw InputError("the incremental mapper needs a bundle adjuster (pipeline.bundle_adjuster)");
     }
-    const IncrementalPipeline pipeline(options_, *context.bundle_adjuster, context.seed);
+    IncrementalMapperOptions options = options_;
+    options.num_threads = context.num_threads;
+    const IncrementalPipeline pipeline(options, *context.bundle_adjuster, context.seed);
     MapperResult result = pipeline.Reconstruct(input, context.control);
     // Added to the pipeline's own (each model's rigs).
     result.details["num_tracks"] = result.num_tracks;

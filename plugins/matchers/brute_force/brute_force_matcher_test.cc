@@ -156,7 +156,7 @@ TEST(BruteForceMatcher, ValidatesOptions) {
     FAIL() << "expected an error";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what())
-                  .find("pipeline.matcher.options.ratio: = 0.0 is out of range; must be in (0, 1]"),
+                  .find("pipeline.matcher.options.ratio = 0.0 is out of range (0, 1]"),
               std::string::npos)
         << error.what();
   }
@@ -165,7 +165,7 @@ TEST(BruteForceMatcher, ValidatesOptions) {
     FAIL() << "expected an error";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what())
-                  .find("pipeline.matcher.options.ratio: = 1.5 is out of range; must be in (0, 1]"),
+                  .find("pipeline.matcher.options.ratio = 1.5 is out of range (0, 1]"),
               std::string::npos)
         << error.what();
   }

@@ -443,10 +443,9 @@ TEST(FlannMatcher, ValidatesOptions) {
     Load({{"ratio", -0.5}});
     FAIL() << "expected an error";
   } catch (const InputError& error) {
-    EXPECT_NE(
-        std::string(error.what())
-            .find("pipeline.matcher.options.ratio: = -0.5 is out of range; must be in (0, 1]"),
-        std::string::npos)
+    EXPECT_NE(std::string(error.what())
+                  .find("pipeline.matcher.options.ratio = -0.5 is out of range (0, 1]"),
+              std::string::npos)
         << error.what();
   }
   const nlohmann::json effective = testing::Unguarded(Load()).EffectiveOptions();

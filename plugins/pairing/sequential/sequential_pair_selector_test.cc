@@ -116,7 +116,7 @@ TEST(SequentialPairSelector, RejectsBadOptions) {
     FAIL() << "expected an error";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what())
-                  .find("pipeline.pair_selector.options.overlap: = 0 is out of range; must be in "
+                  .find("pipeline.pair_selector.options.overlap = 0 is out of range "
                         "[1, 1000000]"),
               std::string::npos)
         << error.what();

@@ -211,7 +211,7 @@ TEST(SpatialPairSelector, OptionsAndErrors) {
     FAIL() << "expected an error";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what())
-                  .find("pipeline.pair_selector[1].options.max_distance: = -1 is out of range"),
+                  .find("pipeline.pair_selector[1].options.max_distance = -1 is out of range"),
               std::string::npos)
         << error.what();
   }

@@ -104,7 +104,7 @@ TEST(WindowPairSelector, RejectsBadOptions) {
     FAIL() << "expected an error";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what())
-                  .find("pipeline.pair_selector.options.window: = 0 is out of range; must be in "
+                  .find("pipeline.pair_selector.options.window = 0 is out of range "
                         "[1, 1000000]"),
               std::string::npos)
         << error.what();

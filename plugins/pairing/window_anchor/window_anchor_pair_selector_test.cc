@@ -119,8 +119,8 @@ TEST(WindowAnchorPairSelector, RejectsBadOptions) {
     FAIL() << "expected an error";
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what())
-                  .find("pipeline.pair_selector.options.anchor_every: = 0 is out of range; must "
-                        "be in [1, 1000000]"),
+                  .find("pipeline.pair_selector.options.anchor_every = 0 is out of range "
+                        "[1, 1000000]"),
               std::string::npos)
         << error.what();
   }

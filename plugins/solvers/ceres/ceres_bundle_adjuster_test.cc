@@ -521,7 +521,7 @@ TEST(CeresBundleAdjuster, RejectsInvalidOptions) {
                "pipeline.bundle_adjuster.options.max_iterations: unknown key; did you mean "
                "'max_num_iterations'?");
   expect_error({{"loss_scale", -1.0}},
-               "pipeline.bundle_adjuster.options.loss_scale: = -1.0 is out of range");
+               "pipeline.bundle_adjuster.options.loss_scale = -1.0 is out of range");
   expect_error({{"num_threads", 2.5}},
                "pipeline.bundle_adjuster.options.num_threads: expected an integer, got a number");
   expect_error({{"linear_solver", "sparse"}},

@@ -36,6 +36,10 @@ struct FocalLengthEstimationOptions {
   // The search range, as factors of the larger image side.
   double min_factor = 0.25;
   double max_factor = 5.0;
+
+  // Throws InputError naming the first field out of its range (e.g. "FocalLengthEstimationOptions:
+  // min_factor = 0 is out of range [0.001, 100]"); EstimateFocalLengths calls it.
+  TESSERA_SFM_EXPORT void Check() const;
 };
 
 // Estimates the focal length of every camera of `input` that has no prior focal length,

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <cstdint>
 #include <nlohmann/json.hpp>
+#include <string>
 
 #include "tessera/sfm/export.h"
 
@@ -45,7 +47,6 @@ struct TESSERA_SFM_EXPORT GlobalMapperOptions {
   // residual; its seed is derived from `seed`.
   int gp_max_num_iterations = 100;
   double gp_huber_threshold = 0.1;
-  int gp_num_threads = 1;
 
   // After positioning: observations whose ray is off the point's direction by more.
   double filter_max_angle_error = 2.0;
@@ -85,12 +86,22 @@ struct TESSERA_SFM_EXPORT GlobalMapperOptions {
 
   // Connected parts of the view graph with fewer images make no model.
   int min_model_size = 3;
-  int seed = 0;
+  // Every random choice derives from it (MapperContext::seed in the bundled plugin).
+  uint64_t seed = 0;
+  // Threads of the view graph's relative poses and of global positioning (the bundled
+  // plugin passes MapperContext::num_threads; not read from JSON).
+  int num_threads = 1;
 
-  // Reads the JSON object `json` (unknown keys and values out of range throw
-  // OptionError naming "<key>", which the host anchors at pipeline.mapper.options).
-  static GlobalMapperOptions FromJson(const nlohmann::json& json);
+  // Reads the global mapper's options; unknown keys and out-of-range values throw
+  // OptionError naming "<path>.<key>" ("<key>" when `path` is empty, as a plugin's
+  // factory reads them: the host anchors it at pipeline.mapper.options).
+  static GlobalMapperOptions FromJson(const nlohmann::json& json, const std::string& path = "");
   nlohmann::json ToJson() const;
+
+  // Throws InputError naming the first field out of its range, the same ranges FromJson
+  // reads with (e.g. "GlobalMapperOptions: ba_num_rounds = 0 is out of range [1, 100]");
+  // GlobalMapper::Reconstruct calls it.
+  void Check() const;
 };
 
 }  // namespace tessera

@@ -39,6 +39,10 @@ struct GlobalPositioningOptions {
   // solver creeps: on the benchmark's path of 1000 images it took 78 iterations, this
   // 14, to a minimum no worse.
   bool use_nonmonotonic_steps = true;
+
+  // Throws InputError naming the first field out of its range (e.g. "GlobalPositioningOptions:
+  // huber_threshold = 0 is out of range [0.0001, 10]"); PositionGlobally calls it.
+  TESSERA_SFM_EXPORT void Check() const;
 };
 
 struct GlobalPositioningResult {

@@ -50,6 +50,10 @@ struct GpsAnchoringOptions {
   // deviation) is set aside (with 3 tags or more).
   double far_tag_mads = 10;
   double far_tag_floor_m = 3000;
+
+  // Throws InputError naming the first field out of its range (e.g. "GpsAnchoringOptions:
+  // horizontal_sigma_m = 0 is out of range [0.001, 1e+06]"); AnchorModelToGps calls it.
+  TESSERA_SFM_EXPORT void Check() const;
 };
 
 // A tag set aside before anchoring, and why.

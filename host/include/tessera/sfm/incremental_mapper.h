@@ -56,7 +56,17 @@ struct MapperRansacOptions {
   // the pair or image (and trial) it serves.
   uint64_t init_seed_stream = 1;
   uint64_t abs_pose_seed_stream = 2;
+
+  // Throws InputError naming the first field out of its range (e.g. "MapperRansacOptions:
+  // init_confidence = 1 is out of range [0.01, 0.999999]"); IncrementalMapper's constructor calls
+  // it.
+  TESSERA_SFM_EXPORT void Check() const;
 };
+
+// How a run logs its steps (registrations, initial pairs, the view graph's filter):
+// kSteps at info, kQuiet at debug (a first model mapped only for its focal lengths).
+// Warnings stay warnings. The level is the run's own: nothing changes spdlog's.
+enum class MapperLogging { kSteps, kQuiet };
 
 // What the models of one run share: the verified pairs the view graph kept and their
 // tracks, which images a model took, why images failed, and counters.
@@ -74,6 +84,7 @@ struct TESSERA_SFM_EXPORT MapperRunState {
   const BundleAdjuster& bundle_adjuster;  // must outlive the state
   uint64_t seed = 0;
   MapperRansacOptions ransac;
+  MapperLogging logging = MapperLogging::kSteps;
   // The cameras every model starts from: the input's, with estimated focal lengths.
   std::map<camera_t, Camera> cameras;
   ViewGraph view_graph;

@@ -122,6 +122,10 @@ struct TESSERA_SFM_EXPORT IncrementalMapperOptions {
   double gps_vertical_sigma = GpsAnchoringOptions().vertical_sigma_m;
   int gps_min_images = GpsAnchoringOptions().min_num_images;
 
+  // Threads of the view graph's relative poses (the bundled plugin passes
+  // MapperContext::num_threads; not read from JSON). Any count gives the same models.
+  int num_threads = 1;
+
   // Reads the `incremental` mapper's options; unknown keys and out-of-range values throw
   // OptionError naming "<path>.<key>" ("<key>" when `path` is empty, as a plugin's
   // factory reads them).
@@ -129,6 +133,11 @@ struct TESSERA_SFM_EXPORT IncrementalMapperOptions {
                                            const std::string& path = "");
   // Every option with its value, for provenance and logs.
   nlohmann::json ToJson() const;
+
+  // Throws InputError naming the first field out of its range, the same ranges FromJson
+  // reads with (e.g. "IncrementalMapperOptions: min_num_matches = 2 is out of range [5, 100000]");
+  // IncrementalPipeline and IncrementalMapper call it.
+  void Check() const;
 };
 
 }  // namespace tessera

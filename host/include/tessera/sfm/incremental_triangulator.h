@@ -21,6 +21,11 @@ struct IncrementalTriangulatorOptions {
   // Pairs of observations tried when a track's observations disagree with their
   // all-view solution.
   size_t max_num_pairs = 200;
+
+  // Throws InputError naming the first field out of its range (e.g.
+  // "IncrementalTriangulatorOptions: max_error = 0 is out of range [0.001, 1000]"); the
+  // triangulator's constructor calls it.
+  TESSERA_SFM_EXPORT void Check() const;
 };
 
 class TESSERA_SFM_EXPORT IncrementalTriangulator {

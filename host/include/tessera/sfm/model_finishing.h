@@ -46,6 +46,8 @@ struct TESSERA_SFM_EXPORT ModelFinishingOptions {
   GpsAnchoringOptions gps;
   // Starts every log line ("map", "merge").
   std::string log_prefix = "map";
+  // Threads of the view graphs it builds (a mapper passes MapperContext::num_threads).
+  int num_threads = 1;
 
   // The options every mapper shares, as both bundled mappers name them in
   // pipeline.mapper.options: reg_max_rotation_error, min_model_agreement, use_gps_prior,
@@ -55,6 +57,11 @@ struct TESSERA_SFM_EXPORT ModelFinishingOptions {
   // The keys FromJson reads.
   static const std::vector<std::string>& JsonKeys();
   nlohmann::json ToJson() const;
+
+  // Throws InputError naming the first field out of its range, the same ranges FromJson
+  // reads with (e.g. "ModelFinishingOptions: min_model_agreement = 2 is out of range [0, 1]");
+  // FinishModels calls it.
+  void Check() const;
 };
 
 // True when `a` is larger than `b`: more registered images, then more points.
@@ -65,9 +72,10 @@ TESSERA_SFM_EXPORT void SortModelsLargestFirst(std::vector<Reconstruction>* mode
 
 // The view graph of `input`'s pairs with min_num_matches inliers or more between two
 // images of `model`, their relative rotations from the model's cameras (the input's
-// for cameras the model lacks), five-point RANSAC seeded from `seed`.
+// for cameras the model lacks), five-point RANSAC seeded from `seed`, on `num_threads`
+// threads (any count gives the same graph).
 TESSERA_SFM_EXPORT ViewGraph ModelViewGraph(const MapperInput& input, const Reconstruction& model,
-                                            int min_num_matches, uint64_t seed);
+                                            int min_num_matches, int num_threads, uint64_t seed);
 
 // The self-check of `model` against `view_graph` (the edges between its images).
 TESSERA_SFM_EXPORT ModelSelfCheck SelfCheckModel(const ViewGraph& view_graph,

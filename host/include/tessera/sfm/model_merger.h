@@ -23,6 +23,10 @@ struct ModelMergeOptions {
   // within this many pixels of every target observation of that track.
   double max_reproj_error = 4.0;
   int max_num_trials = 1000;
+
+  // Throws InputError naming the first field out of its range (e.g. "ModelMergeOptions:
+  // max_reproj_error = 0 is out of range [0.001, 1000]"); MergeModels calls it.
+  TESSERA_SFM_EXPORT void Check() const;
 };
 
 struct ModelMergeReport {

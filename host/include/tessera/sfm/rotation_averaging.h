@@ -40,6 +40,10 @@ struct RotationAveragingOptions {
   double robust_sigma_deg = 5.0;   // Geman-McClure scale
   double convergence_deg = 1e-3;   // stop once no rotation moves by more
   double max_residual_deg = 10.0;  // pairs further off at the end are dropped
+
+  // Throws InputError naming the first field out of its range (e.g. "RotationAveragingOptions:
+  // robust_sigma_deg = 0 is out of range [0.01, 180]"); AverageRotations calls it.
+  TESSERA_SFM_EXPORT void Check() const;
 };
 
 struct RotationAveragingResult {

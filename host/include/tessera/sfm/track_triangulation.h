@@ -18,6 +18,10 @@ struct TrackTriangulationOptions {
   double max_error_px = 4.0;   // every kept observation reprojects within this
   double min_angle_deg = 1.5;  // largest angle between two of the kept rays
   size_t max_num_pairs = 100;  // pairs of observations tried when they disagree
+
+  // Throws InputError naming the first field out of its range (e.g. "TrackTriangulationOptions:
+  // max_error_px = 0 is out of range [0.001, 1000]"); TriangulateTracks calls it.
+  TESSERA_SFM_EXPORT void Check() const;
 };
 
 // Replaces the model's points by one per track of `tracks` that triangulates (at least

@@ -36,11 +36,11 @@ class TESSERA_SFM_EXPORT ViewGraph {
   // Relative rotations of `pairs` (each a verified pair of `input`) with the intrinsics
   // in `cameras`: from the stored E for calibrated pairs, else from E estimated on the
   // pair's inliers (five-point LO-RANSAC seeded from `seed` and the pair), each
-  // decomposed by cheirality on the inliers. The pairs are spread over the threads the
-  // host gave the running mapper (MapperContext::num_threads; one outside a map stage);
-  // any count gives the same edges.
+  // decomposed by cheirality on the inliers. The pairs are spread over `num_threads`
+  // threads (a mapper passes MapperContext::num_threads); any count gives the same edges.
   static ViewGraph Build(const MapperInput& input, const std::map<camera_t, Camera>& cameras,
-                         const std::vector<const MapperInput::Pair*>& pairs, uint64_t seed);
+                         const std::vector<const MapperInput::Pair*>& pairs, uint64_t seed,
+                         int num_threads = 1);
 
   const std::vector<ViewGraphEdge>& edges() const { return edges_; }
   // Marks an edge removed: the mapper found it contradicts a stronger group of pairs.
