@@ -98,9 +98,8 @@ void SolveRobustly(ceres::Solver::Options solver_options, const GlobalPositionin
   solver_options.function_tolerance = options.function_tolerance;
   solver_options.use_nonmonotonic_steps = options.use_nonmonotonic_steps;
   // Sparse Cholesky of the whole normal equations. The Schur complement over the scales
-  // (Ceres 2.1 has no specialised eliminator for their 1-dimensional blocks) took about
-  // twice as long on mapper_benchmark's path of 1,000 images (18.5 s against 8.7 to 9.4 s
-  // of positioning, separate runs), and 0.08 s against 0.015 s per iteration on fox.
+  // is slower here (Ceres 2.1 has no specialised eliminator for their 1-dimensional
+  // blocks); mapper_benchmark shows the difference.
   solver_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
   solver_options.sparse_linear_algebra_library_type = kSparseLibrary;
   UseIterativeSchurWithoutSparseLibrary(&solver_options);

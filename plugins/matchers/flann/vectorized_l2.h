@@ -10,11 +10,9 @@
 // scalar reference (`ScalarL2ToCentre`, no fused multiply-add) in the same order, so
 // every CPU gives the same value on every run.
 //
-// Together with the shorter backward search of the matcher, the lanes took the matching
-// of fountain-P11 (55 pairs, 12,000 SIFT features per image) from 38.8 s to 15.2 s of
-// thread time. The explicit kernels then took the matching of 20 fox images (190 pairs,
-// 5,750 features per image) from 31.6 s to 16.7 s, with the same matches: distances to
-// centres are most of a search and of a tree's build.
+// Distances to centres are most of a search and of a tree's build, so these kernels set
+// the matcher's speed; the matching benchmarks (docs/benchmarks.md, `flann` rows)
+// measure it, with the same matches as the scalar reference.
 
 #include <cstddef>
 #include <cstdint>

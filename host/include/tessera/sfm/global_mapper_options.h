@@ -37,9 +37,8 @@ struct TESSERA_SFM_EXPORT GlobalMapperOptions {
   // Tracks for global positioning: at least tracks_min_length images, the longest
   // first, each taken while one of its images has fewer than tracks_max_per_image.
   // Positioning's time grows with its observations (and its iterations with the scene);
-  // bundle adjustment and retriangulation take every track afterwards. On the
-  // benchmark's path of 1000 images (about 500 keypoints per image) 200 instead of 1000
-  // took positioning from 155 s to 56 s, with centres no worse.
+  // bundle adjustment and retriangulation take every track afterwards, so a bound here
+  // saves time without costing accuracy (docs/benchmarks.md measures it).
   int tracks_min_length = 2;
   int tracks_max_per_image = 200;
 
@@ -63,9 +62,9 @@ struct TESSERA_SFM_EXPORT GlobalMapperOptions {
   int ba_num_rounds = 3;
   int ba_max_num_iterations = 100;
   // A round's adjustment also stops once an iteration lowers the cost by less than this
-  // fraction (as the incremental mapper's global BA does). On lego-100 with retrieval
-  // pairs the three rounds took 31 iterations in 2.3 s instead of 130 in 9.8 s at the
-  // adjuster's 1e-6, with the same cameras (0.13% of the extent, 0.14 degrees).
+  // fraction (as the incremental mapper's global BA does): the rounds converge in a
+  // fraction of the adjuster's iterations at its 1e-6, with the same cameras
+  // (docs/benchmarks.md).
   double ba_function_tolerance = 1e-4;
   bool ba_refine_focal_length = true;
   bool ba_refine_principal_point = false;
