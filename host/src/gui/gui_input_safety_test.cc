@@ -16,23 +16,6 @@ namespace tessera::gui {
 namespace {
 namespace fs = std::filesystem;
 
-// Ctrl+A in the focused field, then `text` typed over the selection.
-void ReplaceFieldText(GuiApp* app, const std::string& text) {
-  SyntheticInput select_all;
-  select_all.x = select_all.y = -1;
-  select_all.keys = {ImGuiKey_A};
-  select_all.ctrl = true;
-  app->Frame(&select_all);
-  SyntheticInput typed;
-  typed.x = typed.y = -1;
-  typed.text = text;
-  app->Frame(&typed);
-}
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
 TEST_F(GuiWindowTest, SlashTypedIntoTheManifestFieldWithTheEditorOpenIsAMessage) {
   GuiApp app(GuiOptions{});
   app.Frame();
@@ -84,11 +67,7 @@ TEST_F(GuiWindowTest, FolderOrPipeInTheManifestFieldBeforeTheEditorOpensIsAMessa
 }
 
 TEST_F(GuiWindowTest, FolderTypedIntoTheManifestFieldDuringARunKeepsTheEditorsText) {
-  MakeSample();
-  GuiOptions options;
-  options.images = dir_.path() / "images";
-  options.output = dir_.path() / "out";
-  options.manifest = manifest_;
+  GuiOptions options = SampleOptions();
   GuiApp app(options);
   app.Frame();
   app.Frame();
@@ -99,7 +78,7 @@ TEST_F(GuiWindowTest, FolderTypedIntoTheManifestFieldDuringARunKeepsTheEditorsTe
   app.SetEditorText(edited);
   ASSERT_TRUE(app.Run()) << app.SetupError();
   Click(&app, "manifest");
-  ReplaceFieldText(&app, "/");
+  ReplaceFocusedText(&app, "/");
   app.Frame();
   EXPECT_EQ(app.ManifestField(), "/");
   EXPECT_EQ(app.EditorError(), "/: the manifest is a folder, not a file");

@@ -18,11 +18,7 @@ namespace tessera::gui {
 namespace {
 
 TEST_F(GuiWindowTest, WidgetsBelowTheProgressBarsStayWhileTheBarsAppear) {
-  MakeSample();
-  GuiOptions options;
-  options.images = dir_.path() / "images";
-  options.output = dir_.path() / "out";
-  options.manifest = manifest_;
+  GuiOptions options = SampleOptions();
   GuiApp app(options);
   app.Frame();
   app.Frame();
@@ -61,11 +57,7 @@ TEST_F(GuiWindowTest, WidgetsBelowTheProgressBarsStayWhileTheBarsAppear) {
 }
 
 TEST_F(GuiWindowTest, RatesAreClearedWhenARunIsCancelled) {
-  MakeSample();
-  GuiOptions options;
-  options.images = dir_.path() / "images";
-  options.output = dir_.path() / "out";
-  options.manifest = manifest_;
+  GuiOptions options = SampleOptions();
   GuiApp app(options);
   app.Frame();
   ASSERT_TRUE(app.Run()) << app.SetupError();

@@ -90,11 +90,7 @@ TEST_F(GuiWindowTest, GlobalMapperReportsItsStepsAndTheImagesItRegistered) {
 }
 
 TEST_F(GuiWindowTest, MapBarMovesWithEachRegistrationAndAResumedRunSaysReused) {
-  MakeSample();
-  GuiOptions options;
-  options.images = dir_.path() / "images";
-  options.output = dir_.path() / "out";
-  options.manifest = manifest_;
+  GuiOptions options = SampleOptions();
   // A small window with a larger font: the map bar's text is wider than the bar.
   options.width = 1024;
   options.height = 640;

@@ -19,22 +19,6 @@ namespace tessera::gui {
 namespace {
 namespace fs = std::filesystem;
 
-void ReplaceFocusedText(GuiApp* app, const std::string& text) {
-  SyntheticInput select_all;
-  select_all.x = select_all.y = -1;
-  select_all.keys = {ImGuiKey_A};
-  select_all.ctrl = true;
-  app->Frame(&select_all);
-  SyntheticInput typed;
-  typed.x = typed.y = -1;
-  typed.text = text;
-  app->Frame(&typed);
-}
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
 TEST_F(GuiWindowTest, UnsavedEditorTextIsReplacedOnlyWhenTheUserSaysSo) {
   GuiOptions options;
   options.width = 1600;

@@ -82,11 +82,7 @@ TEST_F(GuiWindowTest, ClickThroughRunOnTheSampleShowsTheReconstruction) {
 }
 
 TEST_F(GuiWindowTest, CancelDuringMatchingThenRunReusesFeaturesAndPairs) {
-  MakeSample();
-  GuiOptions options;
-  options.images = dir_.path() / "images";
-  options.output = dir_.path() / "out";
-  options.manifest = manifest_;
+  GuiOptions options = SampleOptions();
   GuiApp app(options);
   app.Frame();
   app.Frame();

@@ -5,6 +5,7 @@
 // cheap manifest, and the 3D view's pixels counted.
 
 #include <gtest/gtest.h>
+#include <imgui.h>
 
 #include <chrono>
 #include <filesystem>
@@ -83,13 +84,36 @@ class GuiWindowTest : public ::testing::Test {
     })";
   }
 
-  // Runs the sample (MakeSample) into out/ through the window; returns the workspace.
-  std::filesystem::path FinishedWorkspace() {
+  // The window's options for the sample (MakeSample): its images, out/ and its manifest.
+  GuiOptions SampleOptions() {
     MakeSample();
     GuiOptions options;
     options.images = dir_.path() / "images";
     options.output = dir_.path() / "out";
     options.manifest = manifest_;
+    return options;
+  }
+
+  // Ctrl+A in the focused field, then `text` typed over the selection.
+  static void ReplaceFocusedText(GuiApp* app, const std::string& text) {
+    SyntheticInput select_all;
+    select_all.x = select_all.y = -1;
+    select_all.keys = {ImGuiKey_A};
+    select_all.ctrl = true;
+    app->Frame(&select_all);
+    SyntheticInput typed;
+    typed.x = typed.y = -1;
+    typed.text = text;
+    app->Frame(&typed);
+  }
+
+  static bool Contains(const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+  }
+
+  // Runs the sample (MakeSample) into out/ through the window; returns the workspace.
+  std::filesystem::path FinishedWorkspace() {
+    const GuiOptions options = SampleOptions();
     GuiApp app(options);
     app.Frame();
     EXPECT_TRUE(app.Run());
