@@ -19,12 +19,15 @@ namespace {
 // What the current thread is doing in a plugin. Plain characters only, so that the
 // signal handler can read it; tabs and newlines are replaced when it is filled.
 // Trivial, so that the thread-local copy needs no dynamic initialisation (zeroed).
+// Small: initial-exec TLS of a library loaded with dlopen (the Python module) comes out
+// of glibc's small static TLS surplus, which a larger record exhausts ("cannot allocate
+// memory in static TLS block" at import).
 struct CallRecord {
   volatile sig_atomic_t active;
   char plugin[256];
   char stage[32];
   char activity[32];
-  char subject[1024];
+  char subject[768];
   char build[192];  // "version\tfile hash\toptions digest" (CurrentPluginBuild), or empty
 };
 
