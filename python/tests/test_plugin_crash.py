@@ -65,7 +65,11 @@ def test_a_crashing_detector_raises_and_is_quarantined_as_in_the_cli(
     assert summary["num_quarantined"] == 1  # counted, not lost among the 0 failed
     assert summary["num_failed"] == 0
     history = (output / "plugin_crashes.tsv").read_text().splitlines()
-    assert history == ["SIGSEGV\tfailing_detector\tdetect\timage 0001.jpg"] * 2
+    # Each record: signal, plugin, stage, subject, then the plugin's build (version, file
+    # hash, options digest), which keys the quarantine.
+    assert [line.split("\t")[:4] for line in history] == \
+        [["SIGSEGV", "failing_detector", "detect", "image 0001.jpg"]] * 2
+    assert all(len(line.split("\t")) == 7 for line in history), history
 
 
 def test_the_interpreter_runs_normal_stages_after_a_crash(sample, tmp_path, failing_plugins):

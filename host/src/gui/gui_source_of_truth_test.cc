@@ -82,6 +82,7 @@ TEST_F(GuiWindowTest, SaveAsOverAnExistingFileAsksFirst) {
   app.SetEditorText(R"({"pipeline": {"detector": {"plugin": "orb"},
       "pair_selector": {"plugin": "exhaustive"}, "matcher": {"plugin": "brute_force"}}})");
   app.Frame();
+  app.Frame();  // the new text laid out: the save path's place is where it will be clicked
   Click(&app, "save path");
   ReplaceFocusedText(&app, existing.string());
   Click(&app, "save as");
