@@ -37,7 +37,8 @@ def share(value, reference):
     return "%.2f" % (value / reference)
 
 
-def main(files):
+def table(files):
+    """The table's lines, then a blank line and one line per bench (its date and command)."""
     lines = ["| set | row | mapper | extract s | match s | map s | total s | registered | "
              "position error | % of extent | rotation deg | time / COLMAP 4 global | "
              "position error / COLMAP 4 global | run |",
@@ -79,9 +80,11 @@ def main(files):
             notes.append("(%d) %s: `%s`" % (number, date, command.strip()))
         else:
             notes.append("(%d) %s (no command recorded)" % (number, path))
-    print("\n".join(lines))
-    print()
-    print("\n".join("- " + note for note in notes))
+    return lines + [""] + ["- " + note for note in notes]
+
+
+def main(files):
+    print("\n".join(table(files)))
 
 
 if __name__ == "__main__":

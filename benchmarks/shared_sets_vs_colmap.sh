@@ -8,6 +8,8 @@
 # usage: benchmarks/shared_sets_vs_colmap.sh OUT [SET...]   (default: all three)
 # COLMAP 4 is found as `tessera bench` finds it (TESSERA_COLMAP, else
 # ../shared/anchors/colmap-4/bin/colmap); COLMAP 3.8 is `colmap` on the PATH.
+# To put a run in docs/benchmarks.md: copy OUT/SET.json and OUT/SET.command into
+# benchmarks/results/shared_sets/ and run `python3 benchmarks/benchmarks_doc.py`.
 set -uo pipefail
 out=$1
 shift
