@@ -64,3 +64,20 @@ import json, sys
 e = json.load(sys.stdin)
 print(e["registered"], e["pos_mean_rel"], e["mean_reprojection_error_px"])'
 }
+
+# The start of a test on geotagged copies of fountain-P11 (georeference, spatial,
+# gps_outlier): takes the scripts' arguments TESSERA DOWNSCALE GEOTAG SHARED_DIR
+# SOURCE_DIR and sets tessera, downscale, geotag, shared, source_dir, dataset (skipping
+# without it or its ground truth) and work, a folder removed on exit.
+start_fountain_gps_test() {
+  tessera=$1
+  downscale=$2
+  geotag=$3
+  shared=${TESSERA_SHARED_DIR:-$4}
+  source_dir=$5
+  dataset="$shared/datasets/fountain-P11"
+  require_dataset "$dataset"
+  [ -d "$dataset/gt" ] || skip_or_fail "$dataset/gt not found"
+  work=$(mktemp -d)
+  trap 'rm -rf "$work"' EXIT
+}

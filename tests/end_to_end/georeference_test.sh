@@ -16,17 +16,8 @@
 #  without a frame.
 # usage: georeference_test.sh TESSERA DOWNSCALE GEOTAG SHARED_DIR SOURCE_DIR
 set -uo pipefail
-tessera=$1
-downscale=$2
-geotag=$3
-shared=${TESSERA_SHARED_DIR:-$4}
-source_dir=$5
-dataset="$shared/datasets/fountain-P11"
 source "$(dirname "$0")/common.sh"
-require_dataset "$dataset"
-[ -d "$dataset/gt" ] || skip_or_fail "$dataset/gt not found"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+start_fountain_gps_test "$@"
 
 "$downscale" "$dataset/images" "$work/clean" 768 95 > /dev/null || fail "downscale"
 cp -r "$work/clean" "$work/images"

@@ -12,17 +12,8 @@
 # Prints the figures (gps_figures.py: origin to the good tags' median, centres to tags).
 # usage: gps_outlier_test.sh TESSERA DOWNSCALE GEOTAG SHARED_DIR SOURCE_DIR
 set -uo pipefail
-tessera=$1
-downscale=$2
-geotag=$3
-shared=${TESSERA_SHARED_DIR:-$4}
-source_dir=$5
-dataset="$shared/datasets/fountain-P11"
 source "$(dirname "$0")/common.sh"
-require_dataset "$dataset"
-[ -d "$dataset/gt" ] || skip_or_fail "$dataset/gt not found"
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
+start_fountain_gps_test "$@"
 figures="$(dirname "$0")/gps_figures.py"
 
 "$downscale" "$dataset/images" "$work/images" 512 90 > /dev/null || fail "downscale"

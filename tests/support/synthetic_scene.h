@@ -28,6 +28,7 @@
 #include "eval/ground_truth.h"
 #include "geometry/essential_matrix.h"
 #include "tessera/rigid3.h"
+#include "tessera/sfm/feature_tracks.h"
 #include "tessera/sfm/incremental_mapper.h"
 #include "util/random.h"
 
@@ -431,6 +432,19 @@ inline SyntheticTwoViewScene MakeSyntheticTwoViewScene(const SyntheticTwoViewOpt
 }
 
 // Angle in degrees between two rotations.
+// The feature tracks of a scene's verified pairs (its images' keypoint counts given).
+inline FeatureTracks SceneFeatureTracks(const SyntheticScene& scene) {
+  std::vector<ImagePairMatches> matches;
+  for (const MapperInput::Pair& pair : scene.input.pairs) {
+    matches.push_back({pair.image_id1, pair.image_id2, pair.geometry.inlier_matches});
+  }
+  std::map<image_t, size_t> num_points2D;
+  for (const auto& [image_id, image] : scene.input.images) {
+    num_points2D[image_id] = image.points2D.size();
+  }
+  return BuildFeatureTracks(matches, num_points2D);
+}
+
 inline double RotationErrorDeg(const Eigen::Quaterniond& a, const Eigen::Quaterniond& b) {
   return a.angularDistance(b) * 180 / M_PI;
 }

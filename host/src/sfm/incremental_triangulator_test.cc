@@ -8,20 +8,9 @@ namespace tessera {
 namespace {
 
 using testing::MakeSyntheticScene;
+using testing::SceneFeatureTracks;
 using testing::SyntheticScene;
 using testing::SyntheticSceneOptions;
-
-FeatureTracks TracksOf(const SyntheticScene& scene) {
-  std::vector<ImagePairMatches> matches;
-  for (const MapperInput::Pair& pair : scene.input.pairs) {
-    matches.push_back({pair.image_id1, pair.image_id2, pair.geometry.inlier_matches});
-  }
-  std::map<image_t, size_t> num_points2D;
-  for (const auto& [image_id, image] : scene.input.images) {
-    num_points2D[image_id] = image.points2D.size();
-  }
-  return BuildFeatureTracks(matches, num_points2D);
-}
 
 SyntheticScene ExactScene() {
   SyntheticSceneOptions options;
@@ -52,7 +41,7 @@ size_t NumObservations(const Reconstruction& model) {
 // points, observed by every registered image of their track.
 TEST(IncrementalTriangulator, TriangulatesAnImagesTracksAtTheTruePoints) {
   const SyntheticScene scene = ExactScene();
-  const FeatureTracks tracks = TracksOf(scene);
+  const FeatureTracks tracks = SceneFeatureTracks(scene);
   ObservationManager obs(scene.input.cameras, scene.input.images, tracks);
   for (const image_t image_id : {1, 2, 3}) {
     obs.RegisterImage(image_id, scene.true_cam_from_world.at(image_id));
@@ -79,7 +68,7 @@ TEST(IncrementalTriangulator, TriangulatesAnImagesTracksAtTheTruePoints) {
 // A keypoint moved 50 px off its point is left out of the point; the others agree.
 TEST(IncrementalTriangulator, LeavesOutAnObservationThatDisagrees) {
   SyntheticScene scene = ExactScene();
-  const FeatureTracks tracks = TracksOf(scene);
+  const FeatureTracks tracks = SceneFeatureTracks(scene);
   track_t t = 0;
   while (tracks.tracks[t].size() < 5) ++t;
   const TrackElement wrong = tracks.tracks[t][1];
@@ -109,7 +98,7 @@ TEST(IncrementalTriangulator, LeavesOutAnObservationThatDisagrees) {
 // retriangulation.
 TEST(IncrementalTriangulator, CompletesTracksAndRetriangulates) {
   const SyntheticScene scene = ExactScene();
-  const FeatureTracks tracks = TracksOf(scene);
+  const FeatureTracks tracks = SceneFeatureTracks(scene);
   ObservationManager obs(scene.input.cameras, scene.input.images, tracks);
   obs.RegisterImage(1, scene.true_cam_from_world.at(1));
   obs.RegisterImage(2, scene.true_cam_from_world.at(2));
@@ -143,7 +132,7 @@ TEST(IncrementalTriangulator, CompletesTracksAndRetriangulates) {
 // they are merged into one point with every observation.
 TEST(IncrementalTriangulator, MergesTracksThatARefusedMatchLinks) {
   const SyntheticScene scene = ExactScene();
-  FeatureTracks tracks = TracksOf(scene);
+  FeatureTracks tracks = SceneFeatureTracks(scene);
   track_t t1 = 0;
   while (tracks.tracks[t1].size() < 6) ++t1;
   const Track whole = tracks.tracks[t1];

@@ -8,20 +8,9 @@ namespace tessera {
 namespace {
 
 using testing::MakeSyntheticScene;
+using testing::SceneFeatureTracks;
 using testing::SyntheticScene;
 using testing::SyntheticSceneOptions;
-
-FeatureTracks TracksOf(const SyntheticScene& scene) {
-  std::vector<ImagePairMatches> matches;
-  for (const MapperInput::Pair& pair : scene.input.pairs) {
-    matches.push_back({pair.image_id1, pair.image_id2, pair.geometry.inlier_matches});
-  }
-  std::map<image_t, size_t> num_points2D;
-  for (const auto& [image_id, image] : scene.input.images) {
-    num_points2D[image_id] = image.points2D.size();
-  }
-  return BuildFeatureTracks(matches, num_points2D);
-}
 
 // A track with at least `min_size` features.
 track_t LongTrack(const FeatureTracks& tracks, size_t min_size) {
@@ -37,7 +26,7 @@ TEST(ObservationManager, KeepsPointsObservationsAndTracksInStep) {
   SyntheticSceneOptions options;
   options.noise_px = 0;
   const SyntheticScene scene = MakeSyntheticScene(options);
-  const FeatureTracks tracks = TracksOf(scene);
+  const FeatureTracks tracks = SceneFeatureTracks(scene);
   ObservationManager obs(scene.input.cameras, scene.input.images, tracks);
   EXPECT_TRUE(obs.model().points3D.empty());
   EXPECT_TRUE(obs.images_seeing_points().empty());
@@ -84,7 +73,7 @@ TEST(ObservationManager, KeepsPointsObservationsAndTracksInStep) {
 // merged track leads to it.
 TEST(ObservationManager, MergesThePointsOfTwoTracks) {
   const SyntheticScene scene = MakeSyntheticScene(SyntheticSceneOptions{});
-  const FeatureTracks tracks = TracksOf(scene);
+  const FeatureTracks tracks = SceneFeatureTracks(scene);
   ObservationManager obs(scene.input.cameras, scene.input.images, tracks);
   const track_t t1 = LongTrack(tracks, 2);
   track_t t2 = t1 + 1;
@@ -112,7 +101,7 @@ TEST(ObservationManager, JudgesObservationsAndTakesTheRegisteredModel) {
   SyntheticSceneOptions options;
   options.noise_px = 0;
   const SyntheticScene scene = MakeSyntheticScene(options);
-  const FeatureTracks tracks = TracksOf(scene);
+  const FeatureTracks tracks = SceneFeatureTracks(scene);
   ObservationManager obs(scene.input.cameras, scene.input.images, tracks);
   const track_t t = LongTrack(tracks, 3);
   const Track& track = tracks.tracks[t];
