@@ -5,9 +5,9 @@
 #include <optional>
 
 #include "database/database.h"
-#include "distributed/merge.h"
 #include "distributed/shard_database.h"
-#include "image/image_io.h"
+#include "distributed/shard_merge.h"
+#include "image/image_folder_scan.h"
 #include "pipeline/extract_stage.h"
 #include "pipeline/match_stage.h"
 #include "pipeline/workspace.h"

@@ -17,7 +17,7 @@
 #include <string>
 
 #include "database/database.h"
-#include "image/image_io.h"
+#include "image/image_folder_scan.h"
 #include "plugin/plugin_crash_log.h"
 #include "util/workspace_lock.h"
 

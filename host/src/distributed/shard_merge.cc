@@ -1,4 +1,4 @@
-#include "distributed/merge.h"
+#include "distributed/shard_merge.h"
 
 #include <spdlog/spdlog.h>
 
@@ -100,9 +100,9 @@ void CopyDatabase(const std::filesystem::path& from, const std::filesystem::path
   if (std::filesystem::exists(wal)) std::filesystem::copy_file(wal, to.string() + "-wal");
 }
 
-MergeSummary MergeExtraction(Workspace& workspace, int count) {
+ShardMergeSummary MergeExtraction(Workspace& workspace, int count) {
   const std::filesystem::path& output_dir = workspace.folder();
-  MergeSummary summary;
+  ShardMergeSummary summary;
   summary.num_shards = count;
   std::vector<OpenShard> shards = OpenShards(output_dir, kExtractStage, count);
   const nlohmann::json merged_record = MergedExtractionRecord(shards);
@@ -172,9 +172,9 @@ MergeSummary MergeExtraction(Workspace& workspace, int count) {
   return summary;
 }
 
-MergeSummary MergeMatching(Workspace& workspace, int count) {
+ShardMergeSummary MergeMatching(Workspace& workspace, int count) {
   const std::filesystem::path& output_dir = workspace.folder();
-  MergeSummary summary;
+  ShardMergeSummary summary;
   summary.num_shards = count;
   const std::vector<OpenShard> shards = OpenShards(output_dir, kMatchStage, count);
   const std::filesystem::path database_file = workspace.DatabaseFile();
@@ -256,7 +256,7 @@ std::optional<int> FindShardCount(const std::filesystem::path& output_dir,
   return *counts.begin();
 }
 
-MergeSummary MergeShards(Workspace& workspace, const MergeOptions& options) {
+ShardMergeSummary MergeShards(Workspace& workspace, const ShardMergeOptions& options) {
   std::optional<int> count = options.num_shards;
   if (!count) count = FindShardCount(workspace.folder(), options.stage);
   if (!count) {
