@@ -22,6 +22,7 @@
 #include "pipeline/stage_arguments.h"
 #include "stage_process.h"
 #include "tessera/errors.h"
+#include "util/workspace_layout.h"
 
 namespace py = pybind11;
 using OptionalPath = std::optional<std::filesystem::path>;
@@ -70,7 +71,8 @@ nlohmann::json StageJson(const char* stage, const RunSummary& summary) {
 
 void CheckModels(const MapStageSummary& summary, const std::filesystem::path& output) {
   if (summary.num_models == 0)
-    throw NoModelError(NoModelMessage(output / "database.db", /*warnings_logged=*/true));
+    throw NoModelError(
+        NoModelMessage(output / workspace_layout::kDatabase, /*warnings_logged=*/true));
 }
 
 // The keywords the verbs share, in the CLI's terms, and what the docstrings say of them.

@@ -9,7 +9,7 @@
 
 #include "fuzz_support.h"
 #include "image/camera_assignment.h"
-#include "image/image_io.h"
+#include "image/image_folder_scan.h"
 
 namespace {
 

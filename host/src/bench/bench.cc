@@ -33,6 +33,7 @@
 #include "tessera/io/file_io.h"
 #include "util/exit_codes.h"
 #include "util/paths.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
@@ -100,8 +101,8 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
                 SlotPlugin(manifest, "exporters");
   ResetBenchWorkspace(workspace);
   if (!shared_from.empty()) {
-    fs::copy_file(fs::path(options.output) / shared_from / "database.db",
-                  workspace / "database.db");
+    fs::copy_file(fs::path(options.output) / shared_from / workspace_layout::kDatabase,
+                  workspace / workspace_layout::kDatabase);
     // Only the features are shared: a workspace keeps pairs matched under another pair
     // selector, and those would make this row map pairs its own selector never chose.
     Workspace::Open(workspace)->database().ClearMatches();
@@ -118,8 +119,9 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
   const ChildResult child = RunChild(argv, workspace / "run.log");
   row.exit_code = child.exit_code;
   row.peak_memory_mb = child.peak_memory_mb;
-  if (!fs::exists(workspace / "run_summary.json")) return row;  // failed before the end
-  const RunSummary run = RunSummary::FromJson(ReadJsonFile(workspace / "run_summary.json"));
+  if (!fs::exists(workspace / workspace_layout::kRunSummary)) return row;  // failed before the end
+  const RunSummary run =
+      RunSummary::FromJson(ReadJsonFile(workspace / workspace_layout::kRunSummary));
   row.extract_seconds = run.extract.seconds;
   row.match_seconds = run.match.seconds;
   row.map_seconds = run.map.seconds;
@@ -131,16 +133,16 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
     row.plugins_used = run.plugins;
     row.plugins = DescribePlugins(run.plugins);
   }
-  ReadMatchingFigures(workspace / "database.db", &row);
+  ReadMatchingFigures(workspace / workspace_layout::kDatabase, &row);
   const MappingSummary mapping =
-      MappingSummary::FromJson(ReadJsonFile(workspace / "mapping_summary.json"));
+      MappingSummary::FromJson(ReadJsonFile(workspace / workspace_layout::kMappingSummary));
   if (!mapping.models.empty()) {
     const MappingSummary::Model& model = mapping.models.front();
     row.num_registered = model.num_images;
     row.num_points = model.num_points3D;
     row.mean_track_length = model.mean_track_length;
     row.mean_reprojection_error = model.mean_reprojection_error;
-    const fs::path model_dir = workspace / "sparse" / "0";
+    const fs::path model_dir = workspace / workspace_layout::kModelsFolder / "0";
     if (ground_truth != nullptr && fs::exists(model_dir / "images.bin")) {
       ScoreModel(ReadColmapModel(model_dir), ground_truth, &row);
     }

@@ -19,6 +19,7 @@
 #include "tessera/io/file_io.h"
 #include "tessera/io/model_statistics.h"
 #include "util/timer.h"
+#include "util/workspace_layout.h"
 
 extern char** environ;
 
@@ -30,7 +31,7 @@ namespace {
 
 // A row's workspace is bench's own scratch folder, marked with this file when made: a
 // rerun replaces it whole. A folder without the mark is never deleted.
-constexpr const char* kBenchMark = ".tessera_bench";
+constexpr const char* kBenchMark = workspace_layout::kBenchMark;
 
 }  // namespace
 

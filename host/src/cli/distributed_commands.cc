@@ -7,8 +7,8 @@
 #include <memory>
 
 #include "cli/commands.h"
-#include "distributed/merge.h"
 #include "distributed/shard_database.h"
+#include "distributed/shard_merge.h"
 #include "distributed/sharded_stages.h"
 #include "distributed/slurm.h"
 #include "partition/merge_map_stage.h"
@@ -93,10 +93,10 @@ CommandRegistration RegisterMergeCommand(CLI::App& app, const GlobalOptions&) {
             open.open_database = false;  // opened by the merge, only when it exists
             const auto workspace = Workspace::Open(options->output, open);
             for (const std::string& stage : stages) {
-              MergeOptions merge;
+              ShardMergeOptions merge;
               merge.stage = stage;
               if (options->shards != 0) merge.num_shards = options->shards;
-              const MergeSummary summary = MergeShards(*workspace, merge);
+              const ShardMergeSummary summary = MergeShards(*workspace, merge);
               if (summary.already_merged) {
                 spdlog::info("merge: the {} {} shards are already in {}/database.db",
                              summary.num_shards, stage, options->output);

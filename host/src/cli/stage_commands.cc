@@ -22,6 +22,7 @@
 #include "util/exit_codes.h"
 #include "util/paths.h"
 #include "util/warning_count.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
@@ -190,7 +191,8 @@ CommandRegistration RegisterMapCommand(CLI::App& app, const GlobalOptions&) {
             } else {
               summary = RunMap(context, run, InterruptibleControl());
             }
-            return MappingExitCode(summary, std::filesystem::path(options->output) / "database.db");
+            return MappingExitCode(
+                summary, std::filesystem::path(options->output) / workspace_layout::kDatabase);
           }};
 }
 
@@ -260,8 +262,8 @@ CommandRegistration RegisterRunCommand(CLI::App& app, const GlobalOptions&) {
             run_options.force_map = options->force_map;
             const RunResult run = RunPipeline(context, run_options, InterruptibleControl());
             if (run.status == StageStatus::kCancelled) return ReportInterrupted("run");
-            return MappingExitCode(run.summary.map,
-                                   std::filesystem::path(options->output) / "database.db");
+            return MappingExitCode(run.summary.map, std::filesystem::path(options->output) /
+                                                        workspace_layout::kDatabase);
           }};
 }
 

@@ -11,6 +11,7 @@
 
 #include "io/names.h"
 #include "tessera/errors.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
@@ -52,7 +53,7 @@ bool ShardRecord::SameInputs(const ShardRecord& other) const {
 
 std::filesystem::path ShardDatabasePath(const std::filesystem::path& output_dir,
                                         const std::string& stage, const Shard& shard) {
-  return output_dir / "shards" /
+  return output_dir / workspace_layout::kShardsFolder /
          (stage + "-" + std::to_string(shard.index) + "-of-" + std::to_string(shard.count) + ".db");
 }
 

@@ -5,13 +5,14 @@
 #include <optional>
 
 #include "database/database.h"
-#include "distributed/merge.h"
 #include "distributed/shard_database.h"
-#include "image/image_io.h"
+#include "distributed/shard_merge.h"
+#include "image/image_folder_scan.h"
 #include "pipeline/extract_stage.h"
 #include "pipeline/match_stage.h"
 #include "pipeline/workspace.h"
 #include "tessera/errors.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
@@ -30,7 +31,7 @@ std::string ExtractContent(const Database& database) {
 std::optional<ShardRecord> TryReadShardRecord(const std::filesystem::path& path) {
   if (!std::filesystem::exists(path)) return std::nullopt;
   try {
-    return ReadShardRecord(Database(path));
+    return ReadShardRecord(Database(path, Database::Mode::kReadOnly));
   } catch (const InputError&) {
     return std::nullopt;
   }
@@ -57,9 +58,9 @@ std::vector<int> UnfinishedShards(const PipelineContext& context, const RunOptio
     images = ImageListFingerprint(files);
     shard_options = ExtractShardOptions(options.image_dir);
   } else {
-    const std::filesystem::path database_file = options.output_dir / "database.db";
+    const std::filesystem::path database_file = options.output_dir / workspace_layout::kDatabase;
     if (extraction_pending || !std::filesystem::exists(database_file)) return all;
-    const Database database(database_file);
+    const Database database(database_file, Database::Mode::kReadOnly);
     // database.db must be the merge of the extraction shards there are now.
     nlohmann::json contents = nlohmann::json::array();
     for (int k = 0; k < count; ++k) {
@@ -123,7 +124,7 @@ MatchingSummary RunMatchShard(const PipelineContext& context, const RunOptions& 
                               const Shard& shard, const StageControl& control) {
   context.Require("pair_selector", "match");
   context.Require("matcher", "match");
-  const std::filesystem::path source_file = options.output_dir / "database.db";
+  const std::filesystem::path source_file = options.output_dir / workspace_layout::kDatabase;
   if (!std::filesystem::exists(source_file)) {
     throw InputError(source_file.string() +
                      ": no workspace database; merge the extraction shards first "

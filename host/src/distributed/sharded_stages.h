@@ -3,7 +3,7 @@
 // `tessera extract --shard K/N` and `tessera match --shard K/N`: one shard of a stage,
 // written to its own database under OUTPUT/shards/ (never to database.db), for Slurm
 // job arrays or any other way of running the shards side by side. `tessera merge`
-// (merge.h) folds the finished shards into database.db.
+// (shard_merge.h) folds the finished shards into database.db.
 
 #include <string>
 #include <vector>

@@ -14,6 +14,7 @@
 #include "io/names.h"
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
@@ -26,7 +27,7 @@ std::string PercentEscaped(const std::string& path) {
 }
 
 std::string Header(const SlurmOptions& options, const std::string& name, bool array) {
-  const std::filesystem::path logs = options.output_dir / "slurm" / "logs";
+  const std::filesystem::path logs = options.output_dir / workspace_layout::kSlurmFolder / "logs";
   std::string text = "#!/bin/bash\n";
   text += "#SBATCH --job-name=tessera-" + name + "\n";
   text +=
@@ -117,7 +118,8 @@ std::vector<SlurmScript> MakeSlurmScripts(const SlurmOptions& options, const Slu
     if (array)
       text.insert(text.find("#SBATCH --output"), "#SBATCH --array=" + ArraySpec(indices) + "\n");
     text += "exec " + tessera + " " + command + "\n";
-    scripts.push_back({name, options.output_dir / "slurm" / (name + ".sh"), text});
+    scripts.push_back(
+        {name, options.output_dir / workspace_layout::kSlurmFolder / (name + ".sh"), text});
   };
   if (!plan.extract_shards.empty()) {
     add("extract", true, plan.extract_shards,

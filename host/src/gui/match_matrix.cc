@@ -4,6 +4,7 @@
 
 #include "database/database.h"
 #include "tessera/errors.h"
+#include "util/workspace_layout.h"
 
 namespace tessera::gui {
 namespace fs = std::filesystem;
@@ -11,7 +12,7 @@ namespace {
 
 fs::path DatabaseFile(const fs::path& path) {
   std::error_code error;
-  const fs::path file = fs::is_directory(path, error) ? path / "database.db" : path;
+  const fs::path file = fs::is_directory(path, error) ? path / workspace_layout::kDatabase : path;
   if (!fs::is_regular_file(file, error)) {
     throw InputError(file.string() + ": no workspace database (run the pipeline first)");
   }

@@ -7,6 +7,7 @@
 
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
+#include "util/workspace_layout.h"
 
 namespace tessera::gui {
 namespace fs = std::filesystem;
@@ -16,11 +17,11 @@ std::vector<fs::path> FindModelFolders(const fs::path& path) {
   if (!fs::exists(path, error)) throw InputError(path.string() + ": no such file or folder");
   if (fs::is_directory(path, error) && ExistsColmapModel(path)) return {path};
   const fs::path workspace = fs::is_directory(path, error) ? path : path.parent_path();
-  if (!fs::is_directory(path, error) && path.filename() != "database.db") {
+  if (!fs::is_directory(path, error) && path.filename() != workspace_layout::kDatabase) {
     throw InputError(path.string() + ": not a model folder or a workspace database.db");
   }
   std::vector<std::pair<int, fs::path>> models;
-  const fs::path sparse = workspace / "sparse";
+  const fs::path sparse = workspace / workspace_layout::kModelsFolder;
   if (fs::is_directory(sparse, error)) {
     for (const auto& entry : fs::directory_iterator(sparse, error)) {
       const std::string name = entry.path().filename().string();

@@ -10,6 +10,7 @@
 #include "gui/model_loader.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
+#include "util/workspace_layout.h"
 
 namespace tessera::gui {
 namespace fs = std::filesystem;
@@ -75,8 +76,8 @@ void ModelPanel::CheckStale(const fs::path& folder) {
   // that replaced them was cancelled before it mapped): the model is not the database's.
   const fs::path workspace = folder.parent_path().parent_path();
   std::error_code error;
-  if (folder.parent_path().filename() != "sparse" ||
-      !fs::is_regular_file(workspace / "database.db", error)) {
+  if (folder.parent_path().filename() != workspace_layout::kModelsFolder ||
+      !fs::is_regular_file(workspace / workspace_layout::kDatabase, error)) {
     return;
   }
   std::optional<MatchMatrix> matrix;
@@ -84,7 +85,7 @@ void ModelPanel::CheckStale(const fs::path& folder) {
   if (CheckedRead(
           workspace, [&] { matrix = ReadMatchMatrix(workspace); }, &problem) &&
       matrix->max_inliers == 0) {
-    stale_ = "stale: " + (workspace / "database.db").string() +
+    stale_ = "stale: " + (workspace / workspace_layout::kDatabase).string() +
              " holds no verified pairs now (its matches were discarded after this model was "
              "written); Run again to match and map anew";
     spdlog::warn("gui: {}", stale_);

@@ -17,6 +17,7 @@
 #include "tessera/errors.h"
 #include "util/exit_codes.h"
 #include "util/paths.h"
+#include "util/workspace_layout.h"
 
 namespace tessera::gui {
 namespace {
@@ -249,7 +250,7 @@ void RunController::Work(RunRequest request) {
       spdlog::info("run cancelled: the finished work is kept in {}; Run again resumes it",
                    request.output_dir.string());
     } else if (num_models == 0) {
-      error = (request.output_dir / "database.db").string() +
+      error = (request.output_dir / workspace_layout::kDatabase).string() +
               ": no model could be built: no pair of images initialised a model";
       spdlog::error("{}", error);
       exit_code = kExitNoModel;

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "image/image_io.h"
+#include "image/image_folder_scan.h"
 #include "image/sensor_database.h"
 #include "manifest/manifest.h"
 #include "tessera/errors.h"

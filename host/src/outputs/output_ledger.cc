@@ -51,28 +51,17 @@ std::string EntryProblem(const std::string& path) {
 
 }  // namespace
 
-bool IsWorkspaceFile(const std::string& name) {
-  static const std::set<std::string> kFolders = {"cache", "clusters", "shards", "slurm",
-                                                 "video_frames"};
-  static const std::set<std::string> kFiles = {"clusters.json", "frames.json"};
-  return kFolders.count(name) != 0 || kFiles.count(name) != 0 ||
-         name.rfind("database.db", 0) == 0 || name.rfind(".tessera", 0) == 0 ||
-         name.rfind("plugin_crashes", 0) == 0;
-}
-
-bool IsHostSummaryFile(const std::string& name) {
-  return name == "run_summary.json" || name == "mapping_summary.json";
-}
-
 std::vector<std::string> ForeignModelFolderWarnings(const fs::path& output_folder,
                                                     const OutputLedger& ledger) {
   std::vector<std::string> warnings;
   std::error_code error;
-  for (const fs::directory_entry& entry : fs::directory_iterator(output_folder / "sparse", error)) {
-    const std::string relative = "sparse/" + entry.path().filename().string();
+  const fs::path models = output_folder / workspace_layout::kModelsFolder;
+  for (const fs::directory_entry& entry : fs::directory_iterator(models, error)) {
+    const std::string relative =
+        std::string(workspace_layout::kModelsFolder) + "/" + entry.path().filename().string();
     if (!ledger.HasFolder(relative)) {
       warnings.push_back(entry.path().string() + " was not written by Tessera; readers of " +
-                         (output_folder / "sparse").string() + " will take it for a model");
+                         models.string() + " will take it for a model");
     }
   }
   return warnings;

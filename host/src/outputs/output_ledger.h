@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "util/workspace_layout.h"  // IsWorkspaceFile: what no ledger names
+
 namespace tessera {
 
 struct FileDigest {
@@ -24,23 +26,13 @@ struct FileDigest {
   }
 };
 
-// Whether `name`, a top-level entry of a workspace, is one of the workspace's own files
-// (database.db and its journals, the lock, the ledger, the staging folder, caches,
-// shards, clusters, Slurm scripts, video frames, frames.json, clusters.json, crash
-// records), which no exporter may write and no ledger may name.
-bool IsWorkspaceFile(const std::string& name);
-// Whether `name`, a top-level entry of an output folder, is a summary the host writes of
-// its own outputs (run_summary.json, mapping_summary.json): an output in the ledger like
-// the others, placed and removed with every set, which only the writer "tessera" writes.
-bool IsHostSummaryFile(const std::string& name);
-
 // The digest of the regular file `path` (not followed when a link). Throws InputError
 // naming the file when it cannot be read.
 FileDigest DigestFile(const std::filesystem::path& path);
 
 class OutputLedger {
  public:
-  static constexpr const char* kFileName = ".tessera_outputs.json";
+  static constexpr const char* kFileName = workspace_layout::kOutputLedger;
 
   // The ledger of `output_folder`; empty when it has none. Throws InputError naming the
   // file when it is unreadable or not a ledger, and naming the file and the entry when an
@@ -74,8 +66,8 @@ class OutputLedger {
   std::set<std::string> folders_;                         // relative paths
 };
 
-// One warning for each entry of OUTPUT/sparse that `ledger` does not record as a folder
-// Tessera made: readers of OUTPUT/sparse take it for one of the models.
+// One warning for each entry of OUTPUT/sparse (workspace_layout::kModelsFolder) that `ledger` does
+// not record as a folder Tessera made: readers of OUTPUT/sparse take it for one of the models.
 std::vector<std::string> ForeignModelFolderWarnings(const std::filesystem::path& output_folder,
                                                     const OutputLedger& ledger);
 

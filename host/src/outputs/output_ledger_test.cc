@@ -14,6 +14,7 @@
 #include "outputs/output_transaction.h"
 #include "tessera/errors.h"
 #include "test_support.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
@@ -118,6 +119,28 @@ TEST(ForgedLedger, TheWorkspacesOwnFilesAreRefused) {
        {"database.db", "database.db-wal", "cache/matcher/x.idx", "shards/extract-0-of-2.db",
         "video_frames/clip/frame_000000_0.000s.jpg", "frames.json", "clusters.json",
         ".tessera.lock", ".tessera_staging/1/x", "plugin_crashes.log"}) {
+    Workspace workspace;
+    WriteText(workspace.output / entry, "workspace");
+    Forge(workspace.output, entry, workspace.output / entry);
+    const std::string error = CommitError(workspace.output);
+    EXPECT_TRUE(Has(error, "the entry '" + entry + "'")) << error;
+    EXPECT_TRUE(Has(error, "the workspace's own")) << error;
+    workspace.ExpectNothingDone();
+    EXPECT_EQ(ReadText(workspace.output / entry), "workspace") << entry;
+  }
+}
+
+// Every entry of the workspace layout that is the workspace's own state, so that a new
+// one is refused without a word here.
+TEST(ForgedLedger, EveryStateEntryOfTheWorkspaceLayoutIsRefused) {
+  for (const WorkspaceEntry& layout_entry : WorkspaceEntries()) {
+    // The ledger itself is the file the forger writes.
+    if (layout_entry.role != WorkspaceEntry::Role::kWorkspaceState ||
+        layout_entry.name == workspace_layout::kOutputLedger) {
+      continue;
+    }
+    const std::string entry = std::string(layout_entry.name) +
+                              (layout_entry.kind == WorkspaceEntry::Kind::kFolder ? "/x" : "");
     Workspace workspace;
     WriteText(workspace.output / entry, "workspace");
     Forge(workspace.output, entry, workspace.output / entry);

@@ -14,6 +14,7 @@
 
 #include "io/names.h"
 #include "tessera/errors.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace fs = std::filesystem;
@@ -273,7 +274,8 @@ void OutputTransaction::Plan(const fs::path& set, const fs::path& relative,
                           "; give it another file or folder");
     } else if (type == fs::file_type::not_found) {
       placements->push_back({key, false});
-    } else if (!(mode_ == Mode::kAddToSet && key == "sparse") && ledger_.Owns(output_, child)) {
+    } else if (!(mode_ == Mode::kAddToSet && key == workspace_layout::kModelsFolder) &&
+               ledger_.Owns(output_, child)) {
       placements->push_back({key, true});
     } else if (type == fs::file_type::directory &&
                TypeOf(set / child) == fs::file_type::directory) {
@@ -364,7 +366,9 @@ OutputTransaction::Result OutputTransaction::Commit() {
     const fs::path path(relative);
     auto part = path.begin();
     fs::path entry = *part;
-    if (entry == "sparse" && ++part != path.end() && std::next(part) != path.end()) entry /= *part;
+    if (entry == workspace_layout::kModelsFolder && ++part != path.end() &&
+        std::next(part) != path.end())
+      entry /= *part;
     result.entries_by_writer[writer].insert((output_ / entry).string());
   }
   OutputLedger final_ledger = placed;
@@ -433,7 +437,8 @@ std::vector<std::string> OutputTransaction::ShadowWarnings(const OutputLedger& p
   std::vector<std::string> warnings;
   std::error_code error;
   // A model folder in sparse/ that is not Tessera's is read as one of its models.
-  if (placed.HasFolder("sparse") || TypeOf(output_ / "sparse") == fs::file_type::directory) {
+  if (placed.HasFolder(workspace_layout::kModelsFolder) ||
+      TypeOf(output_ / workspace_layout::kModelsFolder) == fs::file_type::directory) {
     warnings = ForeignModelFolderWarnings(output_, ledger_);
   }
   // images.bin beside a new images.txt (or the reverse): readers take the .bin first.

@@ -26,12 +26,13 @@
 #include <vector>
 
 #include "outputs/output_ledger.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 
 class OutputTransaction {
  public:
-  static constexpr const char* kStagingFolderName = ".tessera_staging";
+  static constexpr const char* kStagingFolderName = workspace_layout::kStagingFolder;
 
   struct Result {
     size_t files_placed = 0;

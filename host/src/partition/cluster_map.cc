@@ -13,6 +13,7 @@
 #include "pipeline/workspace.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
@@ -20,7 +21,7 @@ namespace {
 // The database every cluster job reads at once: read only, without a lock. Immutable
 // reads do not see a write-ahead log, which only a killed writer leaves behind.
 std::filesystem::path CheckedDatabaseFile(const std::filesystem::path& workspace) {
-  const std::filesystem::path file = workspace / "database.db";
+  const std::filesystem::path file = workspace / workspace_layout::kDatabase;
   std::error_code error;
   if (!std::filesystem::exists(file, error)) {
     throw InputError(file.string() +
@@ -61,14 +62,14 @@ void SetCorruptClusterAside(const std::filesystem::path& folder, const std::stri
 }  // namespace
 
 std::filesystem::path ClusterFolder(const std::filesystem::path& workspace, int cluster) {
-  return workspace / "clusters" / std::to_string(cluster);
+  return workspace / workspace_layout::kClustersFolder / std::to_string(cluster);
 }
 
 ClusterOutput ReadClusterOutput(const std::filesystem::path& workspace, int cluster,
                                 const std::string& clusters_fingerprint) {
   using State = ClusterOutput::State;
   const std::filesystem::path folder = ClusterFolder(workspace, cluster);
-  const std::filesystem::path summary_file = folder / "mapping_summary.json";
+  const std::filesystem::path summary_file = folder / workspace_layout::kMappingSummary;
   ClusterOutput output;
   std::error_code error;
   if (!std::filesystem::exists(summary_file, error)) {
@@ -95,7 +96,8 @@ ClusterOutput ReadClusterOutput(const std::filesystem::path& workspace, int clus
   }
   try {
     for (const MappingSummary::Model& entry : summary.models) {
-      const std::filesystem::path dir = folder / "sparse" / std::to_string(entry.index);
+      const std::filesystem::path dir =
+          folder / workspace_layout::kModelsFolder / std::to_string(entry.index);
       Reconstruction model = ReadColmapModel(dir);
       if (model.images.size() != entry.num_images || model.points3D.size() != entry.num_points3D) {
         return corrupt(dir.string() + ": holds " + std::to_string(model.images.size()) +

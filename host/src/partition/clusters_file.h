@@ -12,6 +12,7 @@
 #include "partition/view_graph_partitioner.h"
 #include "tessera/errors.h"
 #include "tessera/mapper.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 
@@ -83,7 +84,7 @@ class StaleClustersError : public InputError {
 
 // The clusters file of a workspace.
 inline std::filesystem::path ClustersFilePath(const std::filesystem::path& workspace) {
-  return workspace / "clusters.json";
+  return workspace / workspace_layout::kClustersFile;
 }
 
 }  // namespace tessera

@@ -10,7 +10,7 @@
 #include <optional>
 
 #include "image/camera_assignment.h"
-#include "image/image_io.h"
+#include "image/image_folder_scan.h"
 #include "image/image_masks.h"
 #include "plugin/plugin_crash_log.h"
 #include "tessera/io/exif.h"

@@ -13,6 +13,7 @@
 #include "outputs/output_ledger.h"
 #include "pipeline/run_summary.h"
 #include "tessera/errors.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
@@ -268,8 +269,8 @@ std::string ChangedOutputs(const fs::path& output_dir) {
   } catch (const InputError& error) {
     return error.what();
   }
-  if (!ledger.HasFile("mapping_summary.json")) {
-    return (output_dir / "mapping_summary.json").string() + " is not one Tessera placed";
+  if (!ledger.HasFile(workspace_layout::kMappingSummary)) {
+    return (output_dir / workspace_layout::kMappingSummary).string() + " is not one Tessera placed";
   }
   std::error_code error;
   for (const auto& [relative, digests] : ledger.files()) {
@@ -299,7 +300,7 @@ std::string ChangedOutputs(const fs::path& output_dir) {
 
 std::optional<MappingSummary> FindUnchangedModels(const fs::path& output_dir,
                                                   const MapInputs& inputs) {
-  const fs::path file = output_dir / "mapping_summary.json";
+  const fs::path file = output_dir / workspace_layout::kMappingSummary;
   std::error_code error;
   if (fs::symlink_status(file, error).type() != fs::file_type::regular) return std::nullopt;
   MappingSummary recorded;

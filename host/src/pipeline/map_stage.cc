@@ -22,6 +22,7 @@
 #include "tessera/io/model_statistics.h"
 #include "tessera/io/point_colors.h"
 #include "util/timer.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 
@@ -164,7 +165,7 @@ void ExportModel(const Reconstruction& model, size_t index,
                  std::vector<std::string>* quarantined) {
   if (settings.exporters == nullptr || settings.exporters->empty()) {
     const std::filesystem::path dir =
-        outputs->StageFor("tessera") / "sparse" / std::to_string(index);
+        outputs->StageFor("tessera") / workspace_layout::kModelsFolder / std::to_string(index);
     WriteColmapModel(model, dir, ColmapModelFormat::kBinary);
     if (georeference) WriteGeoreference(*georeference, dir);
     return;
@@ -224,7 +225,7 @@ void ColorModels(const std::filesystem::path& image_dir, int num_threads,
 }
 
 // Removes OUTPUT/run_summary.json, a file of the workspace that only Tessera writes
-// (outputs/output_transaction.h: IsWorkspaceFile), when it is a file; logs that it did.
+// (util/workspace_layout.h: IsWorkspaceFile), when it is a file; logs that it did.
 void RemoveRunSummary(const std::filesystem::path& output_dir) {
   const std::filesystem::path file = output_dir / kRunSummaryFileName;
   std::error_code error;
@@ -251,7 +252,7 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
   const std::filesystem::path output_dir =
       target.output_dir.empty() ? workspace.folder() : target.output_dir;
   MappingSummary mapping = SummarizeMapping(
-      result, input, output_dir / "sparse",
+      result, input, output_dir / workspace_layout::kModelsFolder,
       settings.mapper != nullptr ? settings.mapper->name() : "",
       settings.mapper != nullptr ? settings.mapper->EffectiveOptions() : nlohmann::json::object(),
       settings.seed);
@@ -291,7 +292,7 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
     spdlog::warn("map: {} is in no model: {}", image.image, image.reason);
   }
   mapping.seconds = summary->seconds;
-  mapping.Write(outputs.StageFor("tessera") / "mapping_summary.json");
+  mapping.Write(outputs.StageFor("tessera") / workspace_layout::kMappingSummary);
   // run_summary.json describes the set this one replaces (its mapper, its models): it
   // goes before the set is placed, so that it never names models that are not there,
   // and `run` writes its own once its set is in place.

@@ -9,13 +9,14 @@
 #include <vector>
 
 #include "pipeline/stage_control.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 
 // OUTPUT/run_summary.json: written by `run` once its models are placed; every placed
 // model set (map, run, merge) removes the earlier one first, so that it never describes
 // models that are not there.
-constexpr const char* kRunSummaryFileName = "run_summary.json";
+constexpr const char* kRunSummaryFileName = workspace_layout::kRunSummary;
 
 struct ExtractionSummary {
   StageStatus status = StageStatus::kCompleted;

@@ -9,6 +9,7 @@
 #include <stdexcept>
 
 #include "plugin/plugin_call.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
@@ -67,7 +68,7 @@ std::unique_ptr<Workspace> Workspace::OpenShard(
     const std::filesystem::path& folder, const std::string& shard_name,
     const std::function<std::unique_ptr<Database>()>& open_database) {
   std::unique_ptr<Workspace> workspace(new Workspace(folder));
-  const std::filesystem::path shards = folder / "shards";
+  const std::filesystem::path shards = folder / workspace_layout::kShardsFolder;
   CreateWorkspaceFolder(shards);
   workspace->crash_log_ = PluginCrashLog::Open(shards, shard_name + ".plugin_crashes");
   ReportNewCrashes(workspace->crash_log_);
@@ -90,7 +91,7 @@ void Workspace::OpenDatabase() {
 
 std::filesystem::path Workspace::CacheFolder(const std::string& kind,
                                              const std::string& name) const {
-  return std::filesystem::absolute(folder_ / "cache" / kind / name);
+  return std::filesystem::absolute(folder_ / workspace_layout::kCacheFolder / kind / name);
 }
 
 ImageScanOptions WorkspaceScanOptions(const std::filesystem::path& folder,
@@ -167,7 +168,7 @@ void CheckImageFolderApart(const std::filesystem::path& image_dir,
                      ": the image folder is the output folder of this run; choose another "
                      "output folder (a sub-folder of the image folder is fine)");
   }
-  const std::filesystem::path sparse = output / "sparse";
+  const std::filesystem::path sparse = output / workspace_layout::kModelsFolder;
   // images starts with every element of OUTPUT/sparse: it is that folder or below it.
   if (std::mismatch(sparse.begin(), sparse.end(), images.begin(), images.end()).first ==
       sparse.end()) {

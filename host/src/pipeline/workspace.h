@@ -17,8 +17,9 @@
 #include <string>
 
 #include "database/database.h"
-#include "image/image_io.h"
+#include "image/image_folder_scan.h"
 #include "plugin/plugin_crash_log.h"
+#include "util/workspace_layout.h"
 #include "util/workspace_lock.h"
 
 namespace tessera {
@@ -64,7 +65,7 @@ class Workspace {
 
   const std::filesystem::path& folder() const { return folder_; }
   // OUTPUT/database.db, whether or not this process opened it.
-  std::filesystem::path DatabaseFile() const { return folder_ / "database.db"; }
+  std::filesystem::path DatabaseFile() const { return folder_ / workspace_layout::kDatabase; }
   // The database this process writes (a shard's own for a shard). Throws
   // std::logic_error when it is not open.
   Database& database() const;

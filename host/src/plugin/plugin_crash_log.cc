@@ -14,6 +14,7 @@
 
 #include "tessera/io/file_io.h"
 #include "util/strings.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
@@ -264,7 +265,7 @@ size_t ForgetPluginCrashes(const std::filesystem::path& folder) {
   }
   std::vector<std::filesystem::path> files = {PluginCrashLog::HistoryFile(folder),
                                               PluginCrashLog::PendingFile(folder)};
-  const std::filesystem::path shards = folder / "shards";
+  const std::filesystem::path shards = folder / workspace_layout::kShardsFolder;
   if (std::filesystem::is_directory(shards, error)) {
     for (const auto& entry : std::filesystem::directory_iterator(shards, error)) {
       const std::string name = entry.path().filename().string();

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "plugin/plugin_call.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 
@@ -112,7 +113,7 @@ class PluginCrashLog {
     return NumCrashes(plugin, stage, subject) >= kQuarantineCrashes;
   }
 
-  static constexpr const char* kWorkspaceStem = "plugin_crashes";
+  static constexpr const char* kWorkspaceStem = workspace_layout::kPluginCrashesStem;
   static std::filesystem::path HistoryFile(const std::filesystem::path& folder,
                                            const std::string& stem = kWorkspaceStem);
   static std::filesystem::path PendingFile(const std::filesystem::path& folder,

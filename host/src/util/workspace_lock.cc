@@ -11,6 +11,7 @@
 
 #include "tessera/errors.h"
 #include "util/test_pause.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
@@ -52,7 +53,7 @@ std::string UtcNow() {
 }  // namespace
 
 std::filesystem::path WorkspaceLock::LockFile(const std::filesystem::path& workspace) {
-  return workspace / ".tessera.lock";
+  return workspace / workspace_layout::kLock;
 }
 
 WorkspaceLock::WorkspaceLock(const std::filesystem::path& workspace, std::string* stale_holder)

@@ -20,6 +20,7 @@
 #include "tessera/io/file_io.h"
 #include "tessera/options.h"
 #include "util/timer.h"
+#include "util/workspace_layout.h"
 #include "video/video_decoder.h"
 
 namespace tessera {
@@ -123,7 +124,7 @@ nlohmann::json Record(const VideoFrames& result, const VideoFrameOptions& option
 // in its video's folder. The frame is read as an image of the run.
 void CheckRecordedFrame(const std::string& image, const std::string& folder,
                         const fs::path& frames_dir) {
-  const std::string where = (frames_dir.parent_path() / "frames.json").string();
+  const std::string where = (frames_dir.parent_path() / workspace_layout::kFramesFile).string();
   CheckPathBelow(frames_dir, image, where);
   const std::string prefix = folder + "/";
   if (image.compare(0, prefix.size(), prefix) != 0 ||
@@ -342,8 +343,8 @@ std::vector<std::string> VideoFolders(const std::vector<fs::path>& videos) {
 
 fs::path IngestVideos(const std::vector<fs::path>& videos, const fs::path& output_dir,
                       const VideoFrameOptions& options, std::vector<VideoFrames>* results) {
-  const fs::path frames_dir = output_dir / "video_frames";
-  const fs::path record_file = output_dir / "frames.json";
+  const fs::path frames_dir = output_dir / workspace_layout::kVideoFramesFolder;
+  const fs::path record_file = output_dir / workspace_layout::kFramesFile;
   nlohmann::json recorded = nlohmann::json::object();
   std::error_code error;
   if (fs::exists(record_file, error)) {

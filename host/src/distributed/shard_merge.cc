@@ -1,4 +1,4 @@
-#include "distributed/merge.h"
+#include "distributed/shard_merge.h"
 
 #include <spdlog/spdlog.h>
 
@@ -12,6 +12,7 @@
 #include "distributed/shard_database.h"
 #include "pipeline/workspace.h"
 #include "tessera/errors.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
@@ -40,10 +41,10 @@ std::vector<OpenShard> OpenShards(const std::filesystem::path& output_dir, const
   if (!missing.empty()) {
     std::string list;
     for (const int k : missing) list += (list.empty() ? "" : ", ") + std::to_string(k);
-    throw InputError((output_dir / "shards").string() + ": " + stage + " shard" +
-                     (missing.size() > 1 ? "s " : " ") + list + " of " + std::to_string(count) +
-                     " missing; run them (tessera " + stage + " --shard K/" +
-                     std::to_string(count) + ") or submit again");
+    throw InputError((output_dir / workspace_layout::kShardsFolder).string() + ": " + stage +
+                     " shard" + (missing.size() > 1 ? "s " : " ") + list + " of " +
+                     std::to_string(count) + " missing; run them (tessera " + stage +
+                     " --shard K/" + std::to_string(count) + ") or submit again");
   }
   std::vector<OpenShard> shards;
   for (int k = 0; k < count; ++k) {
@@ -52,7 +53,7 @@ std::vector<OpenShard> OpenShards(const std::filesystem::path& output_dir, const
     const std::string name = Describe(stage, k, count, shard.path);
     std::optional<ShardRecord> record;
     try {
-      shard.database = std::make_unique<Database>(shard.path);
+      shard.database = std::make_unique<Database>(shard.path, Database::Mode::kReadOnly);
       record = ReadShardRecord(*shard.database);
     } catch (const std::exception& error) {
       throw InputError(name + " is corrupt or truncated: " + error.what() +
@@ -100,9 +101,9 @@ void CopyDatabase(const std::filesystem::path& from, const std::filesystem::path
   if (std::filesystem::exists(wal)) std::filesystem::copy_file(wal, to.string() + "-wal");
 }
 
-MergeSummary MergeExtraction(Workspace& workspace, int count) {
+ShardMergeSummary MergeExtraction(Workspace& workspace, int count) {
   const std::filesystem::path& output_dir = workspace.folder();
-  MergeSummary summary;
+  ShardMergeSummary summary;
   summary.num_shards = count;
   std::vector<OpenShard> shards = OpenShards(output_dir, kExtractStage, count);
   const nlohmann::json merged_record = MergedExtractionRecord(shards);
@@ -134,7 +135,7 @@ MergeSummary MergeExtraction(Workspace& workspace, int count) {
     for (size_t k = 1; k < shards.size(); ++k) {
       const std::string name = Describe(kExtractStage, static_cast<int>(k), count, shards[k].path);
       try {
-        const Database shard(shards[k].path);
+        const Database shard(shards[k].path, Database::Mode::kReadOnly);
         std::map<image_t, std::string> names;
         for (const Image& image : shard.ReadAllImages()) names[image.image_id] = image.name;
         for (const auto& [image_id, num_keypoints] : shard.ReadNumKeypointsPerImage()) {
@@ -172,9 +173,9 @@ MergeSummary MergeExtraction(Workspace& workspace, int count) {
   return summary;
 }
 
-MergeSummary MergeMatching(Workspace& workspace, int count) {
+ShardMergeSummary MergeMatching(Workspace& workspace, int count) {
   const std::filesystem::path& output_dir = workspace.folder();
-  MergeSummary summary;
+  ShardMergeSummary summary;
   summary.num_shards = count;
   const std::vector<OpenShard> shards = OpenShards(output_dir, kMatchStage, count);
   const std::filesystem::path database_file = workspace.DatabaseFile();
@@ -236,7 +237,7 @@ MergeSummary MergeMatching(Workspace& workspace, int count) {
 
 std::optional<int> FindShardCount(const std::filesystem::path& output_dir,
                                   const std::string& stage) {
-  const std::filesystem::path folder = output_dir / "shards";
+  const std::filesystem::path folder = output_dir / workspace_layout::kShardsFolder;
   std::error_code error;
   if (!std::filesystem::is_directory(folder, error)) return std::nullopt;
   const std::regex pattern(stage + "-([0-9]+)-of-([0-9]+)\\.db");
@@ -256,12 +257,12 @@ std::optional<int> FindShardCount(const std::filesystem::path& output_dir,
   return *counts.begin();
 }
 
-MergeSummary MergeShards(Workspace& workspace, const MergeOptions& options) {
+ShardMergeSummary MergeShards(Workspace& workspace, const ShardMergeOptions& options) {
   std::optional<int> count = options.num_shards;
   if (!count) count = FindShardCount(workspace.folder(), options.stage);
   if (!count) {
-    throw InputError((workspace.folder() / "shards").string() + ": no " + options.stage +
-                     " shards to merge");
+    throw InputError((workspace.folder() / workspace_layout::kShardsFolder).string() + ": no " +
+                     options.stage + " shards to merge");
   }
   if (*count < 1) throw InputError("--shards " + std::to_string(*count) + ": must be at least 1");
   return options.stage == kExtractStage ? MergeExtraction(workspace, *count)

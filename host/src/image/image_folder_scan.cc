@@ -1,4 +1,4 @@
-#include "image/image_io.h"
+#include "image/image_folder_scan.h"
 
 #include <dirent.h>
 #include <fcntl.h>
@@ -18,6 +18,7 @@
 #include "tessera/errors.h"
 #include "tessera/io/image_io.h"
 #include "util/strings.h"
+#include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
@@ -132,8 +133,8 @@ std::string WhyFolderCannotBeListed(const fs::path& path) {
 
 bool IsTesseraWorkspace(const fs::path& dir) {
   std::error_code error;
-  return fs::is_regular_file(dir / "database.db", error) ||
-         fs::is_regular_file(dir / ".tessera.lock", error);
+  return fs::is_regular_file(dir / workspace_layout::kDatabase, error) ||
+         fs::is_regular_file(dir / workspace_layout::kLock, error);
 }
 
 namespace {

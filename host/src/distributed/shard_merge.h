@@ -23,12 +23,12 @@ namespace tessera {
 // {"count": N, "contents": [each shard's content hash]}.
 inline constexpr const char* kMergedExtractionKey = "tessera_merged_extraction";
 
-struct MergeOptions {
+struct ShardMergeOptions {
   std::string stage;              // kExtractStage or kMatchStage
   std::optional<int> num_shards;  // N; nullopt: the N of the shard files found
 };
 
-struct MergeSummary {
+struct ShardMergeSummary {
   int num_shards = 0;
   bool already_merged = false;  // extraction: database.db already held these shards
   size_t num_images = 0;        // extraction: images with features in database.db
@@ -39,7 +39,7 @@ struct MergeSummary {
 // closed: extraction opens it only when it exists, then swaps the merged one in).
 // Throws InputError (nothing changed) for missing, unfinished, corrupt or mismatched
 // shards.
-MergeSummary MergeShards(Workspace& workspace, const MergeOptions& options);
+ShardMergeSummary MergeShards(Workspace& workspace, const ShardMergeOptions& options);
 
 // The N of the STAGE-K-of-N.db files in OUTPUT/shards (nullopt: none). Throws
 // InputError when files of several N are there and `num_shards` does not choose.

@@ -1,4 +1,4 @@
-#include "image/image_io.h"
+#include "image/image_folder_scan.h"
 
 #include <gtest/gtest.h>
 #include <sys/socket.h>

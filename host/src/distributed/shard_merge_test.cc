@@ -1,4 +1,4 @@
-#include "distributed/merge.h"
+#include "distributed/shard_merge.h"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>
@@ -66,7 +66,7 @@ std::string FileBytes(const std::filesystem::path& path) {
 }
 
 // `tessera merge --stage STAGE` on `output`.
-MergeSummary Merge(const std::filesystem::path& output, const std::string& stage) {
+ShardMergeSummary Merge(const std::filesystem::path& output, const std::string& stage) {
   Workspace::Options open;
   open.open_database = false;
   const auto workspace = Workspace::Open(output, open);
@@ -122,7 +122,7 @@ class MergeTest : public ::testing::Test {
 TEST_F(MergeTest, ShardsMergeIntoWhatOneProcessMakes) {
   Single();
   ExtractShards(3);
-  const MergeSummary extraction = Merge(output(), kExtractStage);
+  const ShardMergeSummary extraction = Merge(output(), kExtractStage);
   EXPECT_EQ(extraction.num_shards, 3);
   EXPECT_EQ(extraction.num_images, 4u);
   EXPECT_FALSE(extraction.already_merged);
@@ -132,7 +132,7 @@ TEST_F(MergeTest, ShardsMergeIntoWhatOneProcessMakes) {
     EXPECT_FALSE(ReadShardRecord(database)) << "shard 0's record came along";
   }
   MatchShards(2);
-  const MergeSummary matching = Merge(output(), kMatchStage);
+  const ShardMergeSummary matching = Merge(output(), kMatchStage);
   EXPECT_EQ(matching.num_pairs, 6u);
   const Database database(output() / "database.db");
   EXPECT_EQ(Rows(database, "matches"), matches_);
