@@ -308,10 +308,11 @@ void GuiApp::DrawWindows(const RunStatus& status) {
     match_matrix_->Draw(matrix_room, images, &widgets_);
   }
   picking_->HandleMouse(view);
-  if (view_->scene() == nullptr && !options_.view_only && OverwriteQuestion().empty()) {
+  if (view_->scene() == nullptr && !options_.view_only && OverwriteQuestion().empty() &&
+      EditorQuestion().empty()) {
     // An empty view says what fills it: the run's model (until the mapper registers its
-    // first images), or what to do first; not while the window asks before a run (its
-    // question would cover it half).
+    // first images), or what to do first; not while the window asks a question (it
+    // would cover the hint half).
     const bool running = status.state == RunState::kRunning && setup_->follow_run();
     const char* hint = running ? "the run's model appears here as its images register"
                                : "choose a folder of images and press Run, or open a model";

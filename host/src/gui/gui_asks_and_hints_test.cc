@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 // ba_local_max_num_iterations (it has no local bundle adjustment) but takes
 // ba_refine_principal_point (which vanished without a word, the issue says, when the
 // whole JSON was written anew). The editor asks; "Keep incremental" leaves the text as it was;
-// "Change and drop them" drops that one option in place, the rest of the text unchanged. A change
+// "Change and drop it" drops that one option in place, the rest of the text unchanged. A change
 // that drops nothing (ORB's max_num_features to SIFT, which takes it) asks nothing.
 TEST_F(GuiWindowTest, APluginChangeAsksBeforeItDropsOptionsTheNewPluginDoesNotTake) {
   const std::string text = R"({
@@ -49,7 +49,8 @@ TEST_F(GuiWindowTest, APluginChangeAsksBeforeItDropsOptionsTheNewPluginDoesNotTa
   const std::string question = app.EditorQuestion();
   EXPECT_TRUE(Contains(question, "ba_local_max_num_iterations")) << question;
   EXPECT_FALSE(Contains(question, "ba_refine_principal_point")) << question;  // global takes it
-  EXPECT_EQ(app.EditorText(), text);  // nothing changed before the answer
+  EXPECT_EQ(app.EditorText(), text);                  // nothing changed before the answer
+  EXPECT_FALSE(app.Widget("view hint").has_value());  // not half under the question
   if (const char* keep = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(keep);
   Click(&app, "keep answer");
   app.Frame();

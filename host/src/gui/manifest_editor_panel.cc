@@ -181,7 +181,10 @@ void ManifestEditorPanel::DrawQuestion(WidgetRects* widgets) {
   const std::string keep = pending_ == Pending::kLoad     ? "Keep my text"
                            : pending_ == Pending::kPlugin ? "Keep " + pending_kept_
                                                           : "Keep the file";
-  if (ImGui::Button(pending_ == Pending::kPlugin ? "Change and drop them" : "Replace")) answer = 1;
+  const char* replace = pending_ != Pending::kPlugin ? "Replace"
+                        : pending_drop_.size() == 1  ? "Change and drop it"
+                                                     : "Change and drop them";
+  if (ImGui::Button(replace)) answer = 1;
   widgets->RecordLastItem("replace answer");
   ImGui::SameLine();
   if (ImGui::Button(keep.c_str())) answer = 0;

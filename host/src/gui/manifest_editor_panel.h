@@ -53,7 +53,7 @@ class ManifestEditorPanel {
   // As a slot's dropdown: SetPlugin, unless the slot's options hold some the new plugin
   // does not take (those not among its options with defaults filled in), or the plugin
   // is a mapper and an older manifest's top-level "mapper" options would go with the
-  // rewrite: then the editor asks first (Question()). "Change and drop them" sets the
+  // rewrite: then the editor asks first (Question()). "Change and drop them" ("... it") sets the
   // plugin and removes those options in place (RemoveOptionsInText); "Keep PLUGIN"
   // leaves the text as it was.
   void RequestSetPlugin(const std::string& slot, const std::string& plugin);
