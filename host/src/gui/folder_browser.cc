@@ -33,6 +33,16 @@ void FolderBrowser::Draw(const std::string& name, PathField* path, WidgetRects* 
   } else {
     ImGui::TextDisabled("choose a %s file", file_extension.c_str());
   }
+  // A new folder (a workspace to be): named, made here and gone into.
+  ImGui::SetNextItemWidth(ImGui::GetFontSize() * 14);
+  const bool entered =
+      ImGui::InputTextWithHint("##new folder", "new folder name", new_folder_.data(),
+                               new_folder_.size(), ImGuiInputTextFlags_EnterReturnsTrue);
+  widgets->RecordLastItem("new folder name");
+  ImGui::SameLine();
+  if (ImGui::Button("New folder") || entered) CreateFolder();
+  widgets->RecordLastItem("create folder");
+  ErrorText(create_error_, widgets);
   ImGui::Separator();
   if (ImGui::Selectable("..", false, ImGuiSelectableFlags_DontClosePopups)) {
     browse_dir_ = browse_dir_.parent_path();
@@ -46,6 +56,26 @@ void FolderBrowser::Draw(const std::string& name, PathField* path, WidgetRects* 
     ImGui::CloseCurrentPopup();
   }
   ImGui::EndPopup();
+}
+
+bool FolderBrowser::CreateFolder() {
+  const std::string name = new_folder_.data();
+  create_error_.clear();
+  const fs::path folder = browse_dir_ / name;
+  std::error_code error;
+  if (name.empty()) {
+    create_error_ = "type the new folder's name";
+  } else if (name.find('/') != std::string::npos || name == "." || name == "..") {
+    create_error_ = "'" + name + "': a folder's name, not a path";
+  } else if (fs::exists(folder, error)) {
+    create_error_ = folder.string() + " is there already";
+  } else if (!fs::create_directory(folder, error) || error) {
+    create_error_ = "cannot create the folder " + folder.string() + ": " + error.message();
+  }
+  if (!create_error_.empty()) return false;
+  browse_dir_ = folder;
+  new_folder_[0] = '\0';
+  return true;
 }
 
 fs::path FolderBrowser::DrawFolderList(const std::string& file_extension, WidgetRects* widgets) {

@@ -36,6 +36,10 @@ std::string& GlfwError() {
 
 void OnGlfwError(int /*code*/, const char* description) { GlfwError() = description; }
 
+// Under the model when the Images field is empty, as the camera window says it too.
+constexpr const char* kSetImagesHint =
+    "Set the Images field (above) to the model's image folder to see its photographs";
+
 GuiApp* AppOf(GLFWwindow* window) { return static_cast<GuiApp*>(glfwGetWindowUserPointer(window)); }
 
 }  // namespace
@@ -87,18 +91,12 @@ GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
   ImGui::GetIO().IniFilename = nullptr;
-  ImGui::StyleColorsDark();
-  // Opaque windows: a window's text never shows through another over it.
-  ImGui::GetStyle().Colors[ImGuiCol_WindowBg].w = 1.0f;
-  ImGui::GetStyle().Colors[ImGuiCol_PopupBg].w = 1.0f;
   float scale = options.ui_scale;
   if (scale <= 0) {
     float y_scale = 1;
     glfwGetWindowContentScale(window_, &scale, &y_scale);
   }
-  scale = std::clamp(scale, 0.5f, 4.0f);
-  ImGui::GetIO().FontGlobalScale = scale;
-  ImGui::GetStyle().ScaleAllSizes(scale);
+  asked_scale_ = std::clamp(scale, 0.5f, 4.0f);
   ImGui_ImplGlfw_InitForOpenGL(window_, true);
   ImGui_ImplOpenGL3_Init("#version 330 core");
   renderer_ = std::make_unique<Renderer>();
@@ -110,6 +108,7 @@ GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
   log_sink_ = std::make_shared<LogSink>();
   log_sink_->SetOnLine(wake);
   spdlog::default_logger()->sinks().push_back(log_sink_);
+  FitUiScale();  // after the log pane's sink: a smaller scale is said there
   controller_ = std::make_unique<RunController>(wake);
 
   view_ = std::make_unique<SceneView>(renderer_.get(), [this]() { changed_.store(true); });
@@ -124,6 +123,14 @@ GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
                                      model_panel_->RunStarted(setup_->OutputField());
                                      view_->Show(nullptr, false);
                                    });
+  // "Keep it" (a run that would replace the output folder's model, not run): the model
+  // kept is what the view shows, rather than an empty view.
+  setup_->OnKeepModel([this]() {
+    const fs::path output(setup_->OutputField());
+    if (model_panel_->ModelField() == output.string() && view_->scene() != nullptr) return;
+    if (OpenModel(output))
+      spdlog::info("gui: kept the model of {}; the view shows it", output.string());
+  });
   picking_ = std::make_unique<Picking>(view_.get());
   match_matrix_ = std::make_unique<MatchMatrixPanel>();
   log_pane_ = std::make_unique<LogPane>(log_sink_);
@@ -176,6 +183,36 @@ void GuiApp::MarkChangedFromInput() { changed_.store(true); }
 
 float GuiApp::UiScale() const { return ImGui::GetIO().FontGlobalScale; }
 
+float FittingUiScale(float asked, int width) {
+  // The set-up window takes at most half the window and needs 30 lines of text's width
+  // (PanelAutoWidth): beyond that its fields and buttons spilled past its edge.
+  const float fits = std::floor(100 * static_cast<float>(width) / (2 * 30 * 13)) / 100;
+  return std::max(std::min(asked, fits), 0.5f);
+}
+
+void GuiApp::FitUiScale() {
+  int width = 0, height = 0;
+  glfwGetWindowSize(window_, &width, &height);
+  const float scale = FittingUiScale(asked_scale_, width);
+  if (scale == applied_scale_) return;
+  applied_scale_ = scale;
+  // The style anew at this scale (ScaleAllSizes multiplies what is there).
+  ImGuiStyle style;
+  ImGui::StyleColorsDark(&style);
+  // Opaque windows: a window's text never shows through another over it.
+  style.Colors[ImGuiCol_WindowBg].w = 1.0f;
+  style.Colors[ImGuiCol_PopupBg].w = 1.0f;
+  style.ScaleAllSizes(scale);
+  ImGui::GetStyle() = style;
+  ImGui::GetIO().FontGlobalScale = scale;
+  if (scale < asked_scale_) {
+    spdlog::info(
+        "gui: text at scale {:.2f}, not {:.2f}: the window ({}x{}) is too narrow for the "
+        "set-up panel at {:.2f}; widen it for larger text",
+        scale, asked_scale_, width, height, asked_scale_);
+  }
+}
+
 float GuiApp::PanelWidth() const {
   int width = 0, height = 0;
   glfwGetWindowSize(window_, &width, &height);
@@ -218,6 +255,7 @@ RunStatus GuiApp::FollowRun() {
 
 void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
   const RunStatus status = FollowRun();
+  FitUiScale();  // the window may have been resized
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGuiIO& io = ImGui::GetIO();
@@ -257,13 +295,24 @@ void GuiApp::DrawWindows(const RunStatus& status) {
     CheckImageFolderOfModel(images);
     DrawSetupWindow(status);
     picking_->DrawDetails(view, images, MaskDir(), &widgets_);
-    match_matrix_->Draw(view, images, &widgets_);
+    // The match matrix beside the camera window (top right) when the view has room for
+    // both: opened after it, the matrix hid it whole at 1600x1000. Else below the camera
+    // window's title bar, which stays in sight to be clicked to the front.
+    WidgetRect matrix_room = view;
+    const std::optional<WidgetRect> camera = widgets_.Find("camera window");
+    if (camera && camera->min_x - view.min_x >= 0.5f * (view.max_x - view.min_x)) {
+      matrix_room.max_x = camera->min_x;
+    } else if (camera) {
+      matrix_room.min_y = camera->min_y + ImGui::GetFrameHeight();
+    }
+    match_matrix_->Draw(matrix_room, images, &widgets_);
   }
   picking_->HandleMouse(view);
-  if (view_->scene() == nullptr && !options_.view_only && OverwriteQuestion().empty()) {
+  if (view_->scene() == nullptr && !options_.view_only && OverwriteQuestion().empty() &&
+      EditorQuestion().empty()) {
     // An empty view says what fills it: the run's model (until the mapper registers its
-    // first images), or what to do first; not while the window asks before a run (its
-    // question would cover it half).
+    // first images), or what to do first; not while the window asks a question (it
+    // would cover the hint half).
     const bool running = status.state == RunState::kRunning && setup_->follow_run();
     const char* hint = running ? "the run's model appears here as its images register"
                                : "choose a folder of images and press Run, or open a model";
@@ -290,6 +339,13 @@ void GuiApp::DrawSetupWindow(const RunStatus& status) {
   setup_->Draw(status, &widgets_);
   ImGui::Separator();
   model_panel_->Draw(&widgets_);
+  if (view_->scene() != nullptr && setup_->ImagesField().empty()) {
+    // A model opened without its photographs (the camera window says "image not found").
+    ImGui::PushTextWrapPos(0);
+    ImGui::TextColored(ImVec4(1, 0.75f, 0.3f, 1), "%s", kSetImagesHint);
+    ImGui::PopTextWrapPos();
+    widgets_.RecordLastItem("images hint");
+  }
   if (!folder_check_.warning.empty()) {
     ImGui::PushTextWrapPos(0);
     ImGui::TextColored(ImVec4(1, 0.75f, 0.3f, 1), "%s", folder_check_.warning.c_str());

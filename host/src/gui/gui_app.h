@@ -47,7 +47,8 @@ struct GuiOptions {
   int width = 1280;  // window size in screen pixels
   int height = 800;
   // The size of text and widgets: 1 is ImGui's 13-pixel font; 0: the monitor's content
-  // scale (its DPI against 96).
+  // scale (its DPI against 96). Drawn smaller in a window too narrow for it
+  // (FittingUiScale).
   float ui_scale = 0;
   bool view_only = false;  // no panels: the 3D view fills the window
   bool follow_run = true;  // show the model of a run as it grows (a check box)
@@ -217,6 +218,9 @@ class GuiApp {
   // Clears the window and draws the 3D view and ImGui's windows; reads the pixels back
   // into `capture` when given.
   void Render(RgbImage* capture);
+  // Sets ImGui's font scale and style to FittingUiScale of the scale asked and the
+  // window's width, when that changed (the window resized), logging when it is less.
+  void FitUiScale();
   // Checks the Images field's folder against the model shown when either changed.
   void CheckImageFolderOfModel(const std::filesystem::path& images);
 
@@ -233,6 +237,8 @@ class GuiApp {
   float panel_width_ = 0;      // set when the user resized the set-up window; 0: automatic
   float panel_set_width_ = 0;  // the width the last frame asked for
   float panel_overflow_ = 0;
+  float asked_scale_ = 1;    // GuiOptions::ui_scale, or the monitor's
+  float applied_scale_ = 0;  // FitUiScale's last (0: none yet)
   std::string frame_error_;
 
   // The panels (destroyed before the OpenGL context: they hold textures).
@@ -268,5 +274,10 @@ bool StartCommandLineRun(const GuiOptions& options, GuiApp* app);
 // The set-up window's width before the user resizes it: about a third of the window,
 // at least 30 and at most 48 lines of text high, and never more than half the window.
 float PanelAutoWidth(float window_width, float font_size);
+
+// The UI scale a window `width` pixels wide draws at: `asked`, unless the set-up window's
+// least width (30 lines of text) would not fit in half the window: then the largest
+// scale that fits (at 1024 pixels, 1.31), at least 0.5. Text stays inside every panel.
+float FittingUiScale(float asked, int width);
 
 }  // namespace tessera::gui

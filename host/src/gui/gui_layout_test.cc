@@ -4,7 +4,10 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cmath>
+#include <regex>
 #include <string>
+#include <utility>
 
 #include "gui/gui_window_test_fixture.h"
 
@@ -36,11 +39,11 @@ class GuiLayoutTest : public GuiWindowTest {
     Click(&app, "manifest editor");
     app.Frame();
     app.Frame();
-    const float font = 13 * ui_scale;
+    const float font = 13 * app.UiScale();  // less than asked where the window is narrow
     const float panel = app.PanelWidth();
     std::printf("%dx%d, scale %.1f: the set-up window is %.0f px wide, %zu texts elided\n", width,
                 height, ui_scale, panel, app.ElidedTexts().size());
-    EXPECT_GE(panel, std::min(30 * font, 0.5f * width));
+    EXPECT_GE(panel, std::floor(std::min(30 * font, 0.5f * width)));
     EXPECT_LE(panel, 0.5f * width);
     EXPECT_EQ(app.ViewRect().min_x, panel);
     EXPECT_EQ(app.Widget("setup window")->max_x, panel);
@@ -68,11 +71,30 @@ class GuiLayoutTest : public GuiWindowTest {
   static inline int tooltips_checked_ = 0;
 };
 
-TEST_F(GuiLayoutTest, SetUpWindowFitsAt1024And1920PixelsAndTwiceTheFont) {
-  CheckLayout(1024, 640, 1);
-  CheckLayout(1920, 1080, 1);
-  CheckLayout(1920, 1080, 2);
+// Issue 52: 1024x640, 1600x1000 and 1920x1080, each at scales 1, 1.5 and 2 (at 1024x640
+// and 1.5 and 2 the set-up window spilled past its edge).
+TEST_F(GuiLayoutTest, SetUpWindowFitsAtEverySizeAndScale) {
+  for (const auto& [width, height] : {std::pair{1024, 640}, {1600, 1000}, {1920, 1080}}) {
+    for (const float scale : {1.0f, 1.5f, 2.0f}) CheckLayout(width, height, scale);
+  }
   EXPECT_GT(tooltips_checked_, 0);  // at 1024 pixels, something is cut short
+}
+
+// A window too narrow for the scale asked draws its text at the largest that fits, and
+// says so in the log; as it is widened, the scale asked comes back.
+TEST_F(GuiLayoutTest, ANarrowWindowDrawsSmallerTextAndSaysSo) {
+  EXPECT_EQ(FittingUiScale(2, 1920), 2.0f);
+  EXPECT_EQ(FittingUiScale(1, 1024), 1.0f);
+  EXPECT_NEAR(FittingUiScale(2, 1024), 1.31f, 0.005f);
+  EXPECT_EQ(FittingUiScale(2, 100), 0.5f);
+  GuiOptions options;
+  options.width = 1024;
+  options.height = 640;
+  options.ui_scale = 2;
+  GuiApp app(options);
+  app.Frame();
+  EXPECT_NEAR(app.UiScale(), 1.31f, 0.005f);
+  EXPECT_TRUE(LogHas(app, std::regex("text at scale 1.31, not 2.00")));
 }
 
 // An empty 3D view says what to do first; a model replaces the hint.

@@ -91,13 +91,30 @@ TEST_F(GuiWindowTest, GlobalMapperReportsItsStepsAndTheImagesItRegistered) {
 
 TEST_F(GuiWindowTest, MapBarMovesWithEachRegistrationAndAResumedRunSaysReused) {
   GuiOptions options = SampleOptions();
-  // A small window with a larger font: the map bar's text is wider than the bar.
+  // A small window with a larger font, the set-up window dragged narrower (its least
+  // width, 30 lines of text, leaves room for the whole text): the map bar's text is
+  // wider than the bar.
   options.width = 1024;
   options.height = 640;
   options.ui_scale = 1.5f;
   GuiApp app(options);
   app.Frame();
   app.Frame();
+  SyntheticInput drag;
+  drag.x = app.PanelWidth() - 1;
+  drag.y = 300;
+  app.Frame(&drag);
+  app.Frame(&drag);
+  drag.left_down = true;
+  app.Frame(&drag);
+  for (int step = 0; step < 4; ++step) {
+    drag.x -= 40;
+    app.Frame(&drag);
+  }
+  drag.left_down = false;
+  app.Frame(&drag);
+  app.Frame();
+  ASSERT_LT(app.PanelWidth(), 30 * 13 * app.UiScale());
   Click(&app, "run");
   // Frames as the event loop draws them; the map bar's readings while mapping.
   std::set<size_t> map_done;

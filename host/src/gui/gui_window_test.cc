@@ -547,7 +547,7 @@ TEST_F(GuiWindowTest, PluginDropdownsShowTheEditorsPlugins) {
 // pipeline.mapper shows the default, "incremental", with its description; "global"
 // picked with the mouse is what the text names and the description follows. An older
 // manifest's top-level "mapper" options go when a mapper is picked (it would be refused
-// beside pipeline.mapper).
+// beside pipeline.mapper), once the user says so.
 TEST_F(GuiWindowTest, MapperDropdownShowsAndSetsTheMapper) {
   const std::string slots = R"("detector": {"plugin": "orb"},
       "pair_selector": {"plugin": "exhaustive"}, "matcher": {"plugin": "brute_force"},
@@ -584,6 +584,10 @@ TEST_F(GuiWindowTest, MapperDropdownShowsAndSetsTheMapper) {
   app.Frame();
   EXPECT_EQ(app.EditorPlugin("mapper"), "incremental");
   pick_global();
+  // Asked first (issue 52 item 9): those options go with the rewrite.
+  EXPECT_NE(app.EditorQuestion().find("init_min_num_inliers"), std::string::npos);
+  Click(&app, "replace answer");
+  app.Frame();
   EXPECT_EQ(app.EditorPlugin("mapper"), "global");
   EXPECT_FALSE(nlohmann::json::parse(app.EditorText()).contains("mapper"));
   EXPECT_TRUE(app.CheckEditedManifest()) << app.EditorError();

@@ -1,7 +1,9 @@
 #include "gui/json_text_edit.h"
 
+#include <algorithm>
 #include <cctype>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 namespace tessera::gui {
 namespace {
@@ -52,23 +54,47 @@ size_t ValueEnd(const std::string& text, size_t at) {
   return i;
 }
 
+// A member of an object: where its key starts (its '"'), where its value starts and
+// ends (one past), and its name.
+struct Member {
+  size_t key = kNone;
+  size_t value = kNone;
+  size_t end = kNone;
+  std::string name;
+};
+
+// The members of the object whose '{' is at `open`, as far as they read as JSON;
+// *complete: whether the object's '}' was reached.
+std::vector<Member> Members(const std::string& text, size_t open, bool* complete) {
+  std::vector<Member> members;
+  *complete = false;
+  size_t at = SkipSpace(text, open + 1);
+  while (at < text.size() && text[at] == '"') {
+    Member member;
+    member.key = at;
+    const size_t key_end = StringEnd(text, at);
+    if (key_end == kNone) return members;
+    member.name = text.substr(at + 1, key_end - at - 2);
+    size_t value = SkipSpace(text, key_end);
+    if (value >= text.size() || text[value] != ':') return members;
+    member.value = SkipSpace(text, value + 1);
+    member.end = ValueEnd(text, member.value);
+    members.push_back(member);
+    if (member.end == kNone) return members;
+    at = SkipSpace(text, member.end);
+    if (at >= text.size() || text[at] != ',') break;
+    at = SkipSpace(text, at + 1);
+  }
+  *complete = at < text.size() && text[at] == '}';
+  return members;
+}
+
 // In the object whose '{' is at `open`, where the value of `key` starts; kNone when the
 // object has no such key.
 size_t FindMember(const std::string& text, size_t open, const std::string& key) {
-  size_t at = SkipSpace(text, open + 1);
-  while (at < text.size() && text[at] == '"') {
-    const size_t key_end = StringEnd(text, at);
-    if (key_end == kNone) return kNone;
-    const std::string name = text.substr(at + 1, key_end - at - 2);
-    size_t value = SkipSpace(text, key_end);
-    if (value >= text.size() || text[value] != ':') return kNone;
-    value = SkipSpace(text, value + 1);
-    if (name == key) return value;
-    at = ValueEnd(text, value);
-    if (at == kNone) return kNone;
-    at = SkipSpace(text, at);
-    if (at >= text.size() || text[at] != ',') return kNone;
-    at = SkipSpace(text, at + 1);
+  bool complete = false;
+  for (const Member& member : Members(text, open, &complete)) {
+    if (member.name == key) return member.value;
   }
   return kNone;
 }
@@ -103,6 +129,39 @@ std::optional<std::string> SetPluginInText(const std::string& text, const std::s
   const size_t current_end = ValueEnd(text, current);
   if (current_end == kNone) return std::nullopt;
   return text.substr(0, current) + name + text.substr(current_end);
+}
+
+std::optional<std::string> RemoveOptionsInText(const std::string& text, const std::string& slot,
+                                               const std::vector<std::string>& keys) {
+  std::string edited = text;
+  for (const std::string& key : keys) {
+    // Found anew for each key: the text before it has changed.
+    const size_t root = SkipSpace(edited, 0);
+    if (root >= edited.size() || edited[root] != '{') return std::nullopt;
+    const size_t pipeline = FindMember(edited, root, "pipeline");
+    if (pipeline == kNone || edited[pipeline] != '{') return std::nullopt;
+    const size_t value = FindMember(edited, pipeline, slot);
+    if (value == kNone || edited[value] != '{') return std::nullopt;
+    const size_t options = FindMember(edited, value, "options");
+    if (options == kNone || edited[options] != '{') return std::nullopt;
+    bool complete = false;
+    const std::vector<Member> members = Members(edited, options, &complete);
+    if (!complete) return std::nullopt;
+    const auto found = std::find_if(members.begin(), members.end(),
+                                    [&](const Member& member) { return member.name == key; });
+    if (found == members.end()) continue;
+    const size_t index = static_cast<size_t>(found - members.begin());
+    if (index + 1 < members.size()) {
+      // Up to the next key: the next member takes this one's place and indentation.
+      edited = edited.substr(0, found->key) + edited.substr(members[index + 1].key);
+    } else if (index > 0) {
+      // The last: from the end of the member before it (its comma goes too).
+      edited = edited.substr(0, members[index - 1].end) + edited.substr(found->end);
+    } else {
+      edited = edited.substr(0, options + 1) + edited.substr(found->end);
+    }
+  }
+  return edited;
 }
 
 }  // namespace tessera::gui

@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace tessera::gui {
 
@@ -16,5 +17,11 @@ namespace tessera::gui {
 // far as the edit reads it): the caller then rewrites the JSON.
 std::optional<std::string> SetPluginInText(const std::string& text, const std::string& slot,
                                            const std::string& plugin);
+
+// `text` without the members `keys` of pipeline.SLOT.options, every other character kept
+// (a member's comma goes with it; a key not there is skipped). Nothing when the text has
+// no such options object to edit (or is not JSON as far as the edit reads it).
+std::optional<std::string> RemoveOptionsInText(const std::string& text, const std::string& slot,
+                                               const std::vector<std::string>& keys);
 
 }  // namespace tessera::gui

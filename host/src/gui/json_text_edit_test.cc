@@ -47,5 +47,45 @@ TEST(SetPluginInText, AddsAnAbsentSlotOrPluginAndReplacesAList) {
   EXPECT_EQ(SetPluginInText("[1, 2]", "mapper", "global"), std::nullopt);
 }
 
+// Issue 52 item 9: the options a new plugin does not take are dropped in place, each
+// with its comma; the rest of the text is as it was.
+TEST(RemoveOptionsInText, DropsOnlyTheKeysNamed) {
+  const std::string text = R"({
+  "pipeline": {
+    "mapper": {"plugin": "incremental", "options": {
+      "ba_refine_principal_point": true,
+      "use_gps_prior": false,
+      "init_min_num_inliers": 50
+    }},
+    "detector": {"plugin": "orb", "options": {"max_num_features": 500}}
+  }
+})";
+  const std::string first_and_last = R"({
+  "pipeline": {
+    "mapper": {"plugin": "incremental", "options": {
+      "use_gps_prior": false
+    }},
+    "detector": {"plugin": "orb", "options": {"max_num_features": 500}}
+  }
+})";
+  EXPECT_EQ(
+      RemoveOptionsInText(text, "mapper", {"ba_refine_principal_point", "init_min_num_inliers"}),
+      first_and_last);
+  const std::optional<std::string> none =
+      RemoveOptionsInText(text, "detector", {"max_num_features"});
+  ASSERT_TRUE(none.has_value());
+  EXPECT_NE(none->find(R"("detector": {"plugin": "orb", "options": {}})"), std::string::npos)
+      << *none;
+  const size_t detector = text.find("\"detector\"");
+  EXPECT_EQ(none->substr(0, detector), text.substr(0, detector));  // the mapper as it was
+  // A key not there: the text unchanged; no options object: nothing to edit.
+  EXPECT_EQ(RemoveOptionsInText(text, "mapper", {"absent"}), text);
+  EXPECT_EQ(
+      RemoveOptionsInText(R"({"pipeline": {"mapper": {"plugin": "global"}}})", "mapper", {"a"}),
+      std::nullopt);
+  EXPECT_EQ(RemoveOptionsInText(R"({"pipeline": {"mapper": {"options": {"a": 1,)", "mapper", {"a"}),
+            std::nullopt);
+}
+
 }  // namespace
 }  // namespace tessera::gui

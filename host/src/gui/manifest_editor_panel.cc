@@ -1,6 +1,7 @@
 #include "gui/manifest_editor_panel.h"
 
 #include <imgui.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <cctype>
@@ -142,12 +143,30 @@ void ManifestEditorPanel::Answer(bool replace) {
     }
   } else if (pending == Pending::kSave && replace) {
     Save(pending_save_);
+  } else if (pending == Pending::kPlugin) {
+    if (!replace) {
+      status_ = "kept " + pending_kept_ + " and its options";
+      return;
+    }
+    if (!SetPlugin(pending_slot_, pending_plugin_)) return;
+    // In place (the rewrite of an older manifest's mapper has dropped them already).
+    if (const std::optional<std::string> edited =
+            RemoveOptionsInText(text_.data(), pending_slot_, pending_drop_)) {
+      SetText(*edited);
+    }
+    status_ = "dropped " + std::to_string(pending_drop_.size()) + " option" +
+              (pending_drop_.size() == 1 ? "" : "s") + " that " + pending_plugin_ +
+              " does not take";
   }
 }
 
 void ManifestEditorPanel::DrawQuestion(WidgetRects* widgets) {
   if (question_.empty()) return;
-  constexpr const char* kTitle = "Replace?##manifest editor";
+  // One popup (its id after "###"), titled by what it asks.
+  const std::string title =
+      std::string(pending_ == Pending::kPlugin ? "Drop options?" : "Replace?") +
+      "###manifest editor";
+  const char* kTitle = title.c_str();
   if (!question_open_) {
     ImGui::OpenPopup(kTitle);
     question_open_ = true;
@@ -159,10 +178,16 @@ void ManifestEditorPanel::DrawQuestion(WidgetRects* widgets) {
   ImGui::TextUnformatted(question_.c_str());
   ImGui::PopTextWrapPos();
   int answer = -1;
-  if (ImGui::Button("Replace")) answer = 1;
+  const std::string keep = pending_ == Pending::kLoad     ? "Keep my text"
+                           : pending_ == Pending::kPlugin ? "Keep " + pending_kept_
+                                                          : "Keep the file";
+  const char* replace = pending_ != Pending::kPlugin ? "Replace"
+                        : pending_drop_.size() == 1  ? "Change and drop it"
+                                                     : "Change and drop them";
+  if (ImGui::Button(replace)) answer = 1;
   widgets->RecordLastItem("replace answer");
   ImGui::SameLine();
-  if (ImGui::Button(pending_ == Pending::kLoad ? "Keep my text" : "Keep the file")) answer = 0;
+  if (ImGui::Button(keep.c_str())) answer = 0;
   widgets->RecordLastItem("keep answer");
   if (answer >= 0) {
     ImGui::CloseCurrentPopup();
@@ -240,6 +265,81 @@ bool ManifestEditorPanel::SetPlugin(const std::string& slot, const std::string& 
   }
 }
 
+void ManifestEditorPanel::RequestSetPlugin(const std::string& slot, const std::string& plugin) {
+  if (pending_ != Pending::kNone) return;  // asking already
+  bool legacy = false;
+  const std::vector<std::string> dropped = OptionsDropped(slot, plugin, &legacy);
+  if (dropped.empty()) {
+    SetPlugin(slot, plugin);
+    return;
+  }
+  std::string names;
+  for (const std::string& name : dropped) names += (names.empty() ? "" : ", ") + name;
+  pending_ = Pending::kPlugin;
+  pending_slot_ = slot;
+  pending_plugin_ = plugin;
+  pending_kept_ = PluginOf(slot);
+  pending_drop_ = dropped;
+  question_ = legacy ? "Setting the mapper removes the older top-level \"mapper\" options (" +
+                           names + "). Change the mapper to " + plugin + " and drop them?"
+                     : "The " + slot + " " + plugin + " does not take the option" +
+                           (dropped.size() == 1 ? " " : "s ") + names + " of pipeline." + slot +
+                           ".options. Change to " + plugin + " and drop " +
+                           (dropped.size() == 1 ? "it?" : "them?");
+}
+
+std::vector<std::string> ManifestEditorPanel::OptionsDropped(const std::string& slot,
+                                                             const std::string& plugin,
+                                                             bool* legacy) {
+  *legacy = false;
+  const nlohmann::json json = nlohmann::json::parse(text_.data(), nullptr, false);
+  if (!json.is_object()) return {};
+  std::vector<std::string> dropped;
+  if (slot == "mapper" && json.contains("mapper") && json["mapper"].is_object()) {
+    // SetPlugin writes the JSON anew without them, whichever mapper is picked.
+    *legacy = true;
+    for (const auto& [key, value] : json["mapper"].items()) dropped.push_back(key);
+    return dropped;
+  }
+  if (!json.contains("pipeline") || !json["pipeline"].is_object()) return {};
+  const nlohmann::json& pipeline = json["pipeline"];
+  if (!pipeline.contains(slot) || !pipeline[slot].is_object()) return {};
+  const nlohmann::json& value = pipeline[slot];
+  if (PluginNamed(value) == plugin || !value.contains("options") || !value["options"].is_object()) {
+    return {};
+  }
+  const std::optional<std::set<std::string>> taken = OptionsTaken(slot, plugin);
+  if (!taken) return {};
+  for (const auto& [key, option] : value["options"].items()) {
+    if (taken->count(key) == 0) dropped.push_back(key);
+  }
+  return dropped;
+}
+
+std::optional<std::set<std::string>> ManifestEditorPanel::OptionsTaken(const std::string& kind,
+                                                                       const std::string& plugin) {
+  const std::string id = kind + " " + plugin;
+  if (const auto found = options_taken_.find(id); found != options_taken_.end()) {
+    return found->second;
+  }
+  std::optional<std::set<std::string>> taken;
+  const std::vector<PluginRecord> none;
+  for (const PluginRecord& record : registry_ ? registry_->records() : none) {
+    if (!record.usable() || record.kind != kind || record.name != plugin) continue;
+    try {
+      const nlohmann::json defaults = registry_->DefaultOptions(record);
+      taken.emplace();
+      for (const auto& [key, value] : defaults.items()) taken->insert(key);
+    } catch (const std::exception& error) {
+      // A plugin with a required option: nothing is dropped; Check names what it refuses.
+      spdlog::debug("gui: the options of {} {}: {}", kind, plugin, error.what());
+    }
+    break;  // the first usable record of the name is the one a run loads
+  }
+  options_taken_[id] = taken;
+  return taken;
+}
+
 std::string ManifestEditorPanel::PluginOf(const std::string& slot) const {
   bool is_default = false;
   return PluginOf(slot, &is_default);
@@ -266,7 +366,9 @@ std::string ManifestEditorPanel::PluginOf(const std::string& slot, bool* is_defa
 
 void ManifestEditorPanel::FindPlugins() {
   try {
-    const PluginRegistry registry = PluginRegistry::Discover(PluginSearchPath({}));
+    registry_ =
+        std::make_shared<const PluginRegistry>(PluginRegistry::Discover(PluginSearchPath({})));
+    const PluginRegistry& registry = *registry_;
     for (const char* kind : kSlots) {
       auto& plugins = plugins_by_kind_[kind];
       for (const std::string& name : registry.NamesOfKind(kind)) {
@@ -294,7 +396,7 @@ void ManifestEditorPanel::DrawSlot(const std::string& kind, WidgetRects* widgets
   widgets->RecordLastItem("slot " + kind);
   if (open) {
     for (const auto& [name, description] : plugins) {
-      if (ImGui::Selectable(name.c_str(), name == current)) SetPlugin(kind, name);
+      if (ImGui::Selectable(name.c_str(), name == current)) RequestSetPlugin(kind, name);
       widgets->RecordLastItem("plugin " + kind + " " + name);
       if (ImGui::IsItemHovered() && !description.empty()) {
         WrappedTooltip(description, widgets);

@@ -9,14 +9,20 @@
 
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "gui/panel_widgets.h"
 #include "gui/widget_rects.h"
+
+namespace tessera {
+class PluginRegistry;
+}
 
 namespace tessera::gui {
 
@@ -44,6 +50,13 @@ class ManifestEditorPanel {
   // take). For the mapper, a top-level "mapper" object of an older manifest is removed
   // (it would be refused beside it): that JSON is written anew, the slot without options.
   bool SetPlugin(const std::string& slot, const std::string& plugin);
+  // As a slot's dropdown: SetPlugin, unless the slot's options hold some the new plugin
+  // does not take (those not among its options with defaults filled in), or the plugin
+  // is a mapper and an older manifest's top-level "mapper" options would go with the
+  // rewrite: then the editor asks first (Question()). "Change and drop them" ("... it") sets the
+  // plugin and removes those options in place (RemoveOptionsInText); "Keep PLUGIN"
+  // leaves the text as it was.
+  void RequestSetPlugin(const std::string& slot, const std::string& plugin);
   // The plugin the editor's JSON names for a slot, as its dropdown shows it: when the
   // slot is absent, the plugin a run uses then (the mapper: "incremental", its dropdown
   // reading "incremental (default)") or "(none)" (a run has no such stage);
@@ -108,11 +121,25 @@ class ManifestEditorPanel {
   std::string error_, status_;
   std::string loaded_from_;  // the manifest field's value when last loaded or saved
   std::string clean_text_;   // the text as loaded or saved (Edited compares with it)
+  // The options of a slot's text that `plugin` would not take (*legacy: the top-level
+  // "mapper" options, all of which a mapper's rewrite drops); empty when none would go.
+  std::vector<std::string> OptionsDropped(const std::string& slot, const std::string& plugin,
+                                          bool* legacy);
+  // The option names a plugin takes (its options with defaults filled in, found once);
+  // nothing when it cannot be made with none (Check then names what it refuses).
+  std::optional<std::set<std::string>> OptionsTaken(const std::string& kind,
+                                                    const std::string& plugin);
+
   // The question asked, and what a "replace" answer does.
   std::string question_;
   std::string load_error_;
-  enum class Pending { kNone, kLoad, kSave } pending_ = Pending::kNone;
+  enum class Pending { kNone, kLoad, kSave, kPlugin } pending_ = Pending::kNone;
   std::filesystem::path pending_save_;
+  // kPlugin: the slot, the plugin picked, the one kept on "Keep", the options dropped.
+  std::string pending_slot_, pending_plugin_, pending_kept_;
+  std::vector<std::string> pending_drop_;
+  std::shared_ptr<const PluginRegistry> registry_;  // found with the plugins
+  std::map<std::string, std::optional<std::set<std::string>>> options_taken_;
   bool question_open_ = false;
   bool open_ = false;
   // Per kind: each plugin's name and description.

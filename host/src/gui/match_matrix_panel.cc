@@ -62,21 +62,35 @@ void MatchMatrixPanel::DrawOpenButton(const fs::path& workspace, WidgetRects* wi
 void MatchMatrixPanel::Draw(const WidgetRect& view_rect, const fs::path& image_dir,
                             WidgetRects* widgets) {
   if (!show_ || !matrix_) return;
-  ImGui::SetNextWindowPos(ImVec2(view_rect.min_x + 10, 10), ImGuiCond_Appearing);
+  // Inside the 3D view, 10 pixels in from its edges: at 1024x640 and twice the text the
+  // window reached past the screen's right edge.
+  constexpr float kMargin = 10;
+  const ImVec2 room(view_rect.max_x - view_rect.min_x - 2 * kMargin,
+                    view_rect.max_y - view_rect.min_y - 2 * kMargin);
+  ImGui::SetNextWindowPos(ImVec2(view_rect.min_x + kMargin, view_rect.min_y + kMargin),
+                          ImGuiCond_Appearing);
+  ImGui::SetNextWindowSizeConstraints(ImVec2(0, 0),
+                                      ImVec2(std::max(room.x, 1.0f), std::max(room.y, 1.0f)));
   ImGui::Begin("Match matrix", &show_, ImGuiWindowFlags_AlwaysAutoResize);
   const size_t n = matrix_->size();
+  ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + room.x - 2 * ImGui::GetStyle().WindowPadding.x);
   ImGui::Text("%zu images; colour: verified inliers. Click a cell.", n);
-  // The cells grow with the UI scale (13 px text: 1), so that each row keeps its label.
+  ImGui::PopTextWrapPos();
+  // The cells grow with the UI scale (13 px text: 1), so that each row keeps its label,
+  // within the window's room: its width, and half the view's height (the pair view
+  // takes the rest).
   const float ui_scale = ImGui::GetFontSize() / 13.0f;
   const float cell = std::clamp(360.0f * ui_scale / static_cast<float>(std::max<size_t>(n, 1)),
                                 2.0f, 24.0f * ui_scale);
-  DrawCells(cell, image_dir, widgets);
+  DrawCells(cell, ImVec2(room.x - 2 * ImGui::GetStyle().WindowPadding.x, 0.5f * room.y), image_dir,
+            widgets);
   DrawLegend(widgets);
   if (pair_row_ >= 0) {
     // The photographs fit in the 3D view's rectangle, 10 pixels in from its edges.
     const ImVec2 padding = ImGui::GetStyle().WindowPadding;
     const ImVec2 at = ImGui::GetCursorScreenPos();
-    pair_view_.Draw(view_rect.max_x - 10 - padding.x - at.x,
+    // (Less a scroll bar's width: one appears where the room is short of height.)
+    pair_view_.Draw(view_rect.max_x - 10 - padding.x - at.x - ImGui::GetStyle().ScrollbarSize,
                     view_rect.max_y - 10 - padding.y - at.y - ImGui::GetFrameHeightWithSpacing() -
                         ImGui::GetTextLineHeightWithSpacing(),
                     widgets);
@@ -87,24 +101,30 @@ void MatchMatrixPanel::Draw(const WidgetRect& view_rect, const fs::path& image_d
   ImGui::End();
 }
 
-void MatchMatrixPanel::DrawCells(float cell, const fs::path& image_dir, WidgetRects* widgets) {
+void MatchMatrixPanel::DrawCells(float cell, const ImVec2& room, const fs::path& image_dir,
+                                 WidgetRects* widgets) {
   const MatchMatrix& matrix = *matrix_;
   const size_t n = matrix.size();
   // The axes: each row's number and image name on the left (at most 14 text heights
-  // wide), the column numbers on top; every k-th when the cells are smaller than a line.
+  // wide, and a third of the room), the column numbers on top; every k-th when the cells
+  // are smaller than a line.
   const float line = ImGui::GetTextLineHeight();
+  const float names_room = std::min(14 * line, room.x / 3);
+  float names_width = 0;
+  std::vector<std::string> row_names(n);
+  for (size_t i = 0; i < n; ++i) {
+    row_names[i] = ElideToWidth(std::to_string(i + 1) + " " + matrix.names[i], names_room);
+    names_width = std::max(names_width, ImGui::CalcTextSize(row_names[i].c_str()).x);
+  }
+  names_width += ImGui::GetStyle().ItemSpacing.x;
+  // The cells within the room left of the names and below the column numbers.
+  const float count = static_cast<float>(std::max<size_t>(n, 1));
+  cell = std::max(2.0f, std::min({cell, (room.x - names_width) / count, (room.y - line) / count}));
   // Rows need a line's height per label; columns the widest number's width and a gap
   // (two-digit numbers on 7-pixel cells ran together: "111315...").
   const size_t row_every = MatrixLabelStep(cell, line);
   const float widest = ImGui::CalcTextSize(std::to_string(n).c_str()).x;
   const size_t column_every = MatrixLabelStep(cell, widest + 0.5f * line);
-  float names_width = 0;
-  std::vector<std::string> row_names(n);
-  for (size_t i = 0; i < n; ++i) {
-    row_names[i] = ElideToWidth(std::to_string(i + 1) + " " + matrix.names[i], 14 * line);
-    names_width = std::max(names_width, ImGui::CalcTextSize(row_names[i].c_str()).x);
-  }
-  names_width += ImGui::GetStyle().ItemSpacing.x;
   const ImVec2 corner = ImGui::GetCursorScreenPos();
   const ImVec2 origin(corner.x + names_width, corner.y + line);
   const float side = cell * static_cast<float>(n);

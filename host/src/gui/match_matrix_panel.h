@@ -4,6 +4,8 @@
 // pair's verified inliers (dark blue: none, to yellow: the most); a click on a cell shows
 // the pair's two photographs side by side with their inlier matches drawn between them.
 
+#include <imgui.h>
+
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -48,7 +50,10 @@ class MatchMatrixPanel {
   std::vector<WidgetRect> column_labels_;
   // The cells, `cell` pixels square, as one item recorded as "match cells"; hovering
   // shows a pair's count, a click selects it.
-  void DrawCells(float cell, const std::filesystem::path& image_dir, WidgetRects* widgets);
+  // The cells at `cell` pixels, less where the names and the cells would not fit in
+  // `room` (the width and height they may take).
+  void DrawCells(float cell, const ImVec2& room, const std::filesystem::path& image_dir,
+                 WidgetRects* widgets);
   // Reads the inlier matches of (row, column) and loads its photographs.
   void SelectPair(int row, int column, const std::filesystem::path& image_dir);
   // The colour scale under the cells, recorded as "matrix legend".

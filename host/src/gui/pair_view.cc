@@ -36,8 +36,12 @@ void PairView::Show(PairInliers pair, const std::filesystem::path& image_dir) {
 
 void PairView::Draw(float max_width, float max_height, WidgetRects* widgets) {
   lines_drawn_ = 0;
-  ImGui::Text("%s - %s: %zu inlier matches of %zu putative", pair_.name1.c_str(),
-              pair_.name2.c_str(), pair_.xy1.size(), pair_.putative_xy1.size());
+  // Wrapped within the room (with a scroll bar's width to spare): at 1024x640 its end was
+  // cut off at the window's edge.
+  ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + max_width - ImGui::GetStyle().ScrollbarSize);
+  ImGui::TextWrapped("%s - %s: %zu inlier matches of %zu putative", pair_.name1.c_str(),
+                     pair_.name2.c_str(), pair_.xy1.size(), pair_.putative_xy1.size());
+  ImGui::PopTextWrapPos();
   if (ImGui::RadioButton("verified inliers", !show_putatives)) show_putatives = false;
   widgets->RecordLastItem("show inliers");
   ImGui::SameLine();

@@ -187,6 +187,10 @@ void Picking::LoadPhoto(const Reconstruction& model, const Image& image, const f
       camera == model.cameras.end()
           ? (found ? "" : "image not found")
           : PhotoProblem(found, photo_.source_width(), photo_.source_height(), camera->second);
+  // A model opened without an image folder: what to do, not only what is missing.
+  if (image_dir.empty() && !found) {
+    photo_problem_ = "image not found: set the Images field to the model's image folder";
+  }
 }
 
 void Picking::DrawPointDetails(const WidgetRect& view_rect, WidgetRects* widgets) {

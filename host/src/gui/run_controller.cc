@@ -8,13 +8,16 @@
 #include <algorithm>
 #include <cerrno>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "gui/match_matrix.h"
 #include "manifest/manifest.h"
+#include "partition/hierarchical_map.h"
 #include "pipeline/pipeline_context.h"
 #include "pipeline/run_pipeline.h"
 #include "plugin/plugin_call.h"
 #include "tessera/errors.h"
+#include "tessera/io/file_io.h"
 #include "util/exit_codes.h"
 #include "util/paths.h"
 #include "util/workspace_layout.h"
@@ -24,6 +27,19 @@ namespace {
 
 // The request's manifest: the editor's JSON when given, else the manifest file.
 PipelineContext CreateContext(const RunRequest& request) {
+  if (request.hierarchical) {
+    // The cluster processes read the manifest's file, and clusters.json records which
+    // manifest cut them: this run's is that file, the editor's text being the same.
+    const std::filesystem::path file =
+        request.manifest_file.empty() ? DefaultManifestFile() : request.manifest_file;
+    if (!request.manifest_json.empty() && ReadFileContents(file) != request.manifest_json) {
+      throw InputError(
+          "map in clusters: each cluster's `tessera map --cluster K` process reads the "
+          "manifest from its file, and the editor's text differs from " +
+          file.string() + ": save it (Save as) first");
+    }
+    return PipelineContext::Create(file);
+  }
   if (request.manifest_json.empty()) return PipelineContext::Create(request.manifest_file);
   const std::filesystem::path file =
       request.manifest_file.empty() ? DefaultManifestFile() : request.manifest_file;
@@ -35,6 +51,40 @@ PipelineContext CreateContext(const RunRequest& request) {
   }
   return PipelineContext::Create(
       Manifest::FromJson(json, file.parent_path(), "the manifest editor"));
+}
+
+// Extract and match here, then map as `tessera map --hierarchical` (the CLI's entry
+// point, MapHierarchically): partition, a pool of `tessera map --cluster K` processes
+// (the executable beside this one: `tessera gui` is it), the merge. Each process gets
+// the cores' share of its job, the manifest file (`context` was made from it:
+// CreateContext) and the image folder.
+RunResult RunHierarchically(const PipelineContext& context, const RunRequest& request,
+                            const StageControl& control) {
+  const std::filesystem::path manifest =
+      request.manifest_file.empty() ? DefaultManifestFile() : request.manifest_file;
+  const RunOptions options(request.image_dir, request.output_dir);
+  RunResult run;
+  run.summary.extract = RunExtract(context, options, control);
+  if (run.summary.extract.status != StageStatus::kCancelled) {
+    run.summary.match = RunMatch(context, options, control);
+  }
+  if (run.summary.extract.status == StageStatus::kCancelled ||
+      run.summary.match.status == StageStatus::kCancelled) {
+    run.status = StageStatus::kCancelled;
+    return run;
+  }
+  HierarchicalMapOptions hierarchical;
+  hierarchical.tessera = (ExecutableDir() / "tessera").string();
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  hierarchical.jobs = request.jobs > 0 ? request.jobs : std::max(1, cores / 2);
+  const int threads = context.manifest.num_threads > 0 ? context.manifest.num_threads
+                                                       : std::max(1, cores / hierarchical.jobs);
+  hierarchical.cluster_arguments = {
+      "--output",   request.output_dir.string(), "--threads", std::to_string(threads),
+      "--manifest", manifest.string(),           "--images",  request.image_dir.string()};
+  run.summary.map = MapHierarchically(context, options, hierarchical, control);
+  if (run.summary.map.status == StageStatus::kCancelled) run.status = StageStatus::kCancelled;
+  return run;
 }
 
 }  // namespace
@@ -242,7 +292,10 @@ void RunController::Work(RunRequest request) {
   try {
     const PipelineContext context = CreateContext(request);
     context.LimitLibraryThreads();
-    const RunResult result = RunPipeline(context, {request.image_dir, request.output_dir}, control);
+    const RunResult result =
+        request.hierarchical
+            ? RunHierarchically(context, request, control)
+            : RunPipeline(context, {request.image_dir, request.output_dir}, control);
     num_models = result.summary.map.num_models;
     if (result.status == StageStatus::kCancelled) {
       state = RunState::kCancelled;

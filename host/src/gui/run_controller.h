@@ -27,6 +27,13 @@ struct RunRequest {
   // Not empty: the manifest editor's JSON, run in place of manifest_file's contents
   // (whose folder still resolves the manifest's relative paths).
   std::string manifest_json;
+  // Map as `tessera map --hierarchical` does (partition/hierarchical_map.h): the view
+  // graph cut into clusters (the manifest's distributed settings), each mapped by a
+  // `tessera map --cluster K` process beside this executable, `jobs` at once (0: half
+  // the cores), then merged. The processes read manifest_file (or the default), so an
+  // editor's text that differs from it is refused (save it first).
+  bool hierarchical = false;
+  int jobs = 0;
 };
 
 struct StageProgress {

@@ -35,6 +35,12 @@ bool HasImageFile(const fs::path& dir) {
   return false;
 }
 
+// Mapping in clusters runs `tessera map --cluster K` processes, which read the manifest
+// from its file.
+constexpr const char* kClustersNeedAFile =
+    "map in clusters: each cluster's process reads the manifest from its file; save the "
+    "editor's text (Save as) first";
+
 }  // namespace
 
 SetupPanel::SetupPanel(const RunRequest& fields, bool follow_run, RunController* controller,
@@ -73,6 +79,8 @@ bool SetupPanel::CheckFields() {
     manifest_error_ = editor_.LoadError();
   } else if (!editor_.Question().empty()) {
     manifest_error_ = "answer the manifest editor's question first";
+  } else if (hierarchical_ && editor_.Edited()) {
+    manifest_error_ = kClustersNeedAFile;
   } else if (editor_.Loaded()) {
     // The editor's text is the run's manifest: checked as `tessera run` would.
     if (!editor_.Check()) manifest_error_ = editor_.Error();
@@ -104,6 +112,7 @@ bool SetupPanel::Run() {
   RunRequest request{
       fs::path(images_.data()), fs::path(output_.data()), fs::path(manifest_.data()), {}};
   if (editor_.Loaded()) request.manifest_json = editor_.Text();
+  request.hierarchical = hierarchical_;
   if (!controller_->Start(request)) {
     error_ = "a run is going on";
     error_field_ = ErrorField::kNone;
@@ -151,7 +160,10 @@ void SetupPanel::DrawOverwriteQuestion(WidgetRects* widgets) {
   }
   widgets->RecordLastItem("replace model");
   ImGui::SameLine();
-  if (ImGui::Button("Keep it")) close = true;
+  if (ImGui::Button("Keep it")) {
+    close = true;
+    if (keep_model_) keep_model_();
+  }
   widgets->RecordLastItem("keep model");
   if (close) {
     overwrite_question_.clear();
@@ -267,6 +279,20 @@ void SetupPanel::DrawRunButtons(const RunStatus& status, bool running, WidgetRec
   ImGui::SameLine();
   ImGui::Text("%s", RunStateName(status.state));
   ImGui::Checkbox("show the model growing", &follow_run_);
+  ImGui::SameLine();
+  ImGui::BeginDisabled(running);
+  ImGui::Checkbox("map in clusters", &hierarchical_);
+  ImGui::EndDisabled();
+  widgets->RecordLastItem("hierarchical");
+  if (ImGui::IsItemHovered(ImGuiHoveredFlags_AllowWhenDisabled)) {
+    WrappedTooltip(
+        "Hierarchical mapping, as `tessera map --hierarchical`: the view graph is cut into "
+        "overlapping clusters (the manifest's distributed.cluster_max_images and "
+        "cluster_overlap), each cluster is mapped by its own process, half the cores' worth "
+        "at once, and the clusters' models are merged. For thousands of images; the model "
+        "appears once merged.",
+        widgets);
+  }
   // A field's message is beside its field (the output folder's has none): not again here.
   const bool beside_field =
       error_field_ == ErrorField::kImages || error_field_ == ErrorField::kManifest;

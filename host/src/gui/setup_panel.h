@@ -35,6 +35,8 @@ class SetupPanel {
   // (its sparse/N): then the window asks first ("Run and replace" or "Keep it"). False
   // with the message in Error() when a field is wrong.
   bool RequestRun();
+  // Called when the user answers "Keep it": the window shows the model kept.
+  void OnKeepModel(std::function<void()> keep_model) { keep_model_ = std::move(keep_model); }
   // The models the run asked about would replace; empty when it is not asking.
   const std::string& OverwriteQuestion() const { return overwrite_question_; }
   // Makes the recipe `name` (manifests/<name>.json) the manifest field's file and loads
@@ -61,6 +63,9 @@ class SetupPanel {
   std::string OutputField() const { return output_.data(); }
   std::string ManifestField() const { return manifest_.data(); }
   bool follow_run() const { return follow_run_; }
+  // Whether Run maps in clusters (RunRequest::hierarchical; the "map in clusters" box).
+  bool hierarchical() const { return hierarchical_; }
+  void set_hierarchical(bool hierarchical) { hierarchical_ = hierarchical; }
   ManifestEditorPanel& editor() { return editor_; }
   // The Recipe box's text in the last frame (RecipeList::preview).
   const std::string& RecipeShown() const { return recipes_.preview(); }
@@ -80,6 +85,7 @@ class SetupPanel {
 
   RunController* controller_;
   std::function<void()> before_start_;
+  std::function<void()> keep_model_;
   PathField images_{}, output_{}, manifest_{};
   std::string error_, images_error_, manifest_error_;
   // The field error_ was taken from; kNone: not a field's (a failed run's, say).
@@ -89,6 +95,7 @@ class SetupPanel {
   std::string overwrite_question_;
   bool overwrite_popup_open_ = false;
   bool follow_run_ = true;
+  bool hierarchical_ = false;
   bool images_active_ = false;
   FolderBrowser browser_;
   RecipeList recipes_;

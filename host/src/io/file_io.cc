@@ -16,9 +16,22 @@ namespace tessera {
 namespace fs = std::filesystem;
 
 std::string ReadFileContents(const fs::path& path) {
+  // A folder opens as a stream on Linux and fails at the first read, inside the library
+  // ("basic_filebuf::underflow error reading the file: Is a directory"): refused here,
+  // named, before it is opened.
+  std::error_code status_error;
+  if (fs::is_directory(path, status_error)) {
+    throw InputError(path.string() + " is a folder, not a file.");
+  }
   std::ifstream file(path, std::ios::binary);
   if (!file) throw InputError("Cannot open " + path.string() + ".");
-  std::string contents((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  std::string contents;
+  try {
+    contents.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+  } catch (const std::ios_base::failure& error) {
+    // The library's own words ("... Is a directory", an I/O error) after the file's name.
+    throw InputError("Cannot read " + path.string() + ": " + error.what() + ".");
+  }
   if (file.bad()) throw InputError("Cannot read " + path.string() + ".");
   return contents;
 }

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "tessera/errors.h"
+#include "tessera/io/image_io.h"
 #include "test_support.h"
 
 namespace tessera {
@@ -50,6 +51,23 @@ TEST(ReadFileContents, ReadsBytesAndNamesAFileItCannotOpen) {
   } catch (const InputError& error) {
     EXPECT_EQ(std::string(error.what()), "Cannot open " + (dir.path() / "b").string() + ".");
   }
+}
+
+// Issue 52 item 1: a folder where a file was expected (a path typed into the GUI's
+// Manifest field) was the library's "basic_filebuf::underflow error reading the file:
+// Is a directory", which closed the window; it is an InputError naming the folder.
+TEST(ReadFileContents, AFolderIsAnInputErrorNamingIt) {
+  testing::TemporaryDir dir;
+  try {
+    ReadFileContents(dir.path());
+    FAIL() << "expected InputError";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()), dir.path().string() + " is a folder, not a file.");
+  }
+  EXPECT_FALSE(ReadFileBytes(dir.path()).has_value());
+  WriteFileAtomically(dir.path() / "a", "abc");
+  ASSERT_TRUE(ReadFileBytes(dir.path() / "a").has_value());
+  EXPECT_EQ(ReadFileBytes(dir.path() / "a")->size(), 3u);
 }
 
 TEST(CreateFolder, CreatesParentsAndNamesAFolderItCannotCreate) {

@@ -130,6 +130,10 @@ constexpr int kDecodeFlags =
 }  // namespace
 
 std::optional<std::vector<unsigned char>> ReadFileBytes(const fs::path& path) {
+  // A folder opens as a stream, and its size reads as a huge number (an allocation that
+  // fails): not a file to read.
+  std::error_code status_error;
+  if (fs::is_directory(path, status_error)) return std::nullopt;
   std::ifstream stream(path, std::ios::binary | std::ios::ate);
   if (!stream) return std::nullopt;
   const std::streamoff size = stream.tellg();
