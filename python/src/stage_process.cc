@@ -346,7 +346,10 @@ nlohmann::json RunInChildProcess(const std::string& verb, const py::object& prog
   const int log_level = logging.attr("child_threshold")(verb).cast<int>();
   std::fflush(nullptr);  // the child must not write our buffered output again
   // Forked with the GIL held: no other thread is inside the interpreter; the child
-  // never enters it, and starts its own threads only once it runs the stage.
+  // never enters it, and starts its own threads only once it runs the stage. A fork
+  // without exec, so not util/child_process's ChildProcesses or RunChild (which run a
+  // program): the child runs `stage`, this process's own code and plugins, and dies with
+  // it (DieWithParent in ChildMain).
   const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid < 0) ThrowSystemError(verb, "start the stage's process");

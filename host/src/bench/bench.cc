@@ -31,6 +31,7 @@
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
+#include "util/child_process.h"
 #include "util/exit_codes.h"
 #include "util/paths.h"
 #include "util/workspace_layout.h"
@@ -116,7 +117,7 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
   if (options.camera_per_folder) argv.push_back("--camera-per-folder");
   row.log = (workspace / "run.log").string();
   spdlog::info("bench: {} ({}) ...", name, row.plugins);
-  const ChildResult child = RunChild(argv, workspace / "run.log");
+  const ChildRun child = RunChild(argv, workspace / "run.log");
   row.exit_code = child.exit_code;
   row.peak_memory_mb = child.peak_memory_mb;
   if (!fs::exists(workspace / workspace_layout::kRunSummary)) return row;  // failed before the end
@@ -324,7 +325,8 @@ void WriteChart(const BenchOptions& options, const std::vector<BenchRow>& rows) 
            << "unset multiplot\n";
   }
   WriteFileAtomically(dir / "chart.gp", script.str());
-  const ChildResult gnuplot = RunChild({"gnuplot", (dir / "chart.gp").string()}, dir / "chart.log");
+  const ChildRun gnuplot =
+      RunChild({FindOnPath("gnuplot").string(), (dir / "chart.gp").string()}, dir / "chart.log");
   if (gnuplot.exit_code != 0) {
     throw InputError(options.chart_file + ": gnuplot failed (exit code " +
                      std::to_string(gnuplot.exit_code) + "), see " + (dir / "chart.log").string());
@@ -419,7 +421,7 @@ BenchReport RunBenchReport(const BenchOptions& options) {
   if (!options.ground_truth.empty() && !fs::exists(options.ground_truth)) {
     throw InputError(options.ground_truth + ": --gt does not exist");
   }
-  if (!options.chart_file.empty() && std::system("command -v gnuplot > /dev/null 2>&1") != 0) {
+  if (!options.chart_file.empty() && FindOnPath("gnuplot").empty()) {
     throw InputError("--chart " + options.chart_file +
                      ": needs gnuplot, which is not installed (Debian package gnuplot-nox)");
   }

@@ -2,15 +2,9 @@
 
 #include "bench/bench_rows.h"
 
-#include <fcntl.h>
-#include <spawn.h>
 #include <spdlog/spdlog.h>
-#include <sys/resource.h>
-#include <sys/wait.h>
 
 #include <algorithm>
-#include <cerrno>
-#include <cstring>
 
 #include "database/sqlite_connection.h"
 #include "database/sqlite_statement.h"
@@ -18,10 +12,7 @@
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
 #include "tessera/io/model_statistics.h"
-#include "util/timer.h"
 #include "util/workspace_layout.h"
-
-extern char** environ;
 
 namespace tessera {
 
@@ -34,39 +25,6 @@ namespace {
 constexpr const char* kBenchMark = workspace_layout::kBenchMark;
 
 }  // namespace
-
-// Runs `argv` with stdout and stderr appended to `log`; waits for it.
-ChildResult RunChild(const std::vector<std::string>& argv, const fs::path& log) {
-  std::vector<char*> args;
-  for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
-  args.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log.c_str(),
-                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  const Timer timer;
-  pid_t pid = 0;
-  const int error = posix_spawnp(&pid, args[0], &actions, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  ChildResult result;
-  if (error != 0) {
-    result.exit_code = 127;
-    return result;
-  }
-  int status = 0;
-  struct rusage usage {};
-  while (wait4(pid, &status, 0, &usage) < 0) {
-    if (errno != EINTR) {
-      throw InputError(argv[0] + ": cannot wait for the row's process " + std::to_string(pid) +
-                       ": " + std::strerror(errno));
-    }
-  }
-  result.seconds = timer.ElapsedSeconds();
-  result.peak_memory_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss: KiB
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  return result;
-}
 
 // Pairs matched, pairs verified and their mean number of inliers, from a workspace.
 void ReadMatchingFigures(const fs::path& database_file, BenchRow* row) {

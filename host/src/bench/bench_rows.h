@@ -1,8 +1,8 @@
 #pragma once
 
-// What Tessera's rows and COLMAP's rows of `tessera bench` share: the row, child
-// processes, the figures read back from a database and a model, and bench's scratch
-// folders.
+// What Tessera's rows and COLMAP's rows of `tessera bench` share: the row, the figures
+// read back from a database and a model, and bench's scratch folders. Each row's process
+// runs through util/child_process.h (RunChild: its exit code, time and peak memory).
 
 #include <filesystem>
 #include <limits>
@@ -57,16 +57,6 @@ struct BenchRow {
 };
 
 using BenchGroundTruth = std::map<std::string, GroundTruthPose>;
-
-struct ChildResult {
-  int exit_code = 0;  // 127: could not be started; 128 + n: killed by signal n
-  double peak_memory_mb = kBenchNaN;
-  double seconds = 0;
-};
-
-// Runs `argv` (argv[0] a path, or a name looked up on the PATH) with stdout and stderr
-// appended to `log`; waits for it.
-ChildResult RunChild(const std::vector<std::string>& argv, const std::filesystem::path& log);
 
 // Pairs matched, pairs verified and their mean number of inliers, from a database.
 void ReadMatchingFigures(const std::filesystem::path& database_file, BenchRow* row);

@@ -18,27 +18,13 @@
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
+#include "util/child_process.h"
 #include "util/paths.h"
 
 namespace tessera {
 namespace {
 
 namespace fs = std::filesystem;
-
-// `name` on the PATH, as execvp would find it; empty when it is not there.
-fs::path FindOnPath(const std::string& name) {
-  const char* path = std::getenv("PATH");
-  std::istringstream folders(path != nullptr ? path : "");
-  std::string folder;
-  while (std::getline(folders, folder, ':')) {
-    const fs::path candidate = fs::path(folder.empty() ? "." : folder) / name;
-    std::error_code error;
-    if (fs::is_regular_file(candidate, error) && access(candidate.c_str(), X_OK) == 0) {
-      return candidate;
-    }
-  }
-  return {};
-}
 
 std::string FirstLine(const std::string& text) {
   const size_t start = text.find_first_not_of(" \t\r\n");
@@ -64,7 +50,7 @@ ColmapBinary ProbeColmap(const std::string& given, const std::string& how,
   }
   const fs::path log = scratch / "colmap-version.log";
   fs::remove(log, error);
-  const ChildResult child = RunChild({colmap.path, "-h"}, log);
+  const ChildRun child = RunChild({colmap.path, "-h"}, log);
   const std::string text = fs::exists(log, error) ? ReadFileContents(log) : "";
   if (child.exit_code > 128) {
     throw InputError(colmap.path + ": crashed (signal " + std::to_string(child.exit_code - 128) +
@@ -163,7 +149,7 @@ BenchRow RunColmapMapper(const BenchOptions& options, const ColmapBinary& colmap
   // COLMAP 4 upgrades the database it opens in place: it maps a copy.
   fs::copy_file(database, workspace / "database.db");
   spdlog::info("bench: {} ...", name);
-  const ChildResult child =
+  const ChildRun child =
       RunChild({colmap.path, global ? "global_mapper" : "mapper", "--database_path",
                 (workspace / "database.db").string(), "--image_path", options.images,
                 "--output_path", (workspace / "sparse").string(),
@@ -223,9 +209,9 @@ std::vector<BenchRow> RunColmapPipeline(const BenchOptions& options, const Colma
   ResetBenchWorkspace(folder);
   const fs::path database = folder / "database.db";
   spdlog::info("bench: COLMAP {}: extraction and exhaustive matching ...", colmap.version);
-  const ChildResult extract =
+  const ChildRun extract =
       RunChild(ExtractCommand(options, colmap, database), folder / "colmap.log");
-  ChildResult match;
+  ChildRun match;
   if (extract.exit_code == 0) {
     match = RunChild(MatchCommand(options, colmap, database), folder / "colmap.log");
   }

@@ -15,6 +15,7 @@
 #include "pipeline/pipeline_context.h"
 #include "pipeline/stage_arguments.h"
 #include "pipeline/workspace.h"
+#include "util/child_process.h"
 #include "util/exit_codes.h"
 
 namespace tessera {
@@ -144,7 +145,7 @@ CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions&) {
             }
             std::filesystem::path sbatch;
             if (!options->dry_run) {
-              sbatch = FindInPath("sbatch");
+              sbatch = FindOnPath("sbatch");
               if (sbatch.empty()) {
                 throw InputError(
                     "sbatch not found in PATH: is this a Slurm login node? Use --dry-run to "

@@ -4,9 +4,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include <algorithm>
 #include <memory>
-#include <thread>
 
 #include "cli/commands.h"
 #include "cli/interrupt.h"
@@ -103,26 +101,14 @@ int MappingExitCode(const MapStageSummary& summary, const std::filesystem::path&
 
 }  // namespace
 
-// `map --hierarchical`: the arguments each cluster process gets, and how many run at once
-// (--jobs, else half the cores), each with its share of the cores unless --threads.
+// `map --hierarchical`: the options each cluster process gets, as this one got them.
 HierarchicalMapOptions HierarchicalOptions(const StageOptions& options, int jobs) {
   HierarchicalMapOptions hierarchical;
-  hierarchical.tessera = std::filesystem::canonical("/proc/self/exe").string();
-  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  hierarchical.jobs = jobs > 0 ? jobs : std::max(1, cores / 2);
-  const int threads = options.arguments.threads > 0 ? options.arguments.threads
-                                                    : std::max(1, cores / hierarchical.jobs);
-  hierarchical.cluster_arguments = {"--output", options.output, "--threads",
-                                    std::to_string(threads)};
-  const std::pair<const char*, const std::string*> passed[] = {
-      {"--manifest", &options.arguments.manifest},
-      {"--camera-K", &options.arguments.camera_K},
-      {"--images", &options.images}};
-  for (const auto& [flag, value] : passed) {
-    if (value->empty()) continue;
-    hierarchical.cluster_arguments.push_back(flag);
-    hierarchical.cluster_arguments.push_back(*value);
-  }
+  hierarchical.tessera = std::filesystem::canonical("/proc/self/exe");
+  hierarchical.manifest = options.arguments.manifest;
+  hierarchical.camera_K = options.arguments.camera_K;
+  hierarchical.jobs = jobs;
+  hierarchical.threads = options.arguments.threads;
   return hierarchical;
 }
 

@@ -1,19 +1,11 @@
 #include "distributed/slurm.h"
 
-#include <sys/stat.h>
-#include <sys/wait.h>
-
-#include <array>
-#include <cerrno>
-#include <cstdio>
-#include <cstdlib>
 #include <cstring>
-#include <memory>
-#include <sstream>
 
 #include "io/names.h"
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
+#include "util/child_process.h"
 #include "util/workspace_layout.h"
 
 namespace tessera {
@@ -174,40 +166,21 @@ void WriteSlurmScripts(const std::vector<SlurmScript>& scripts) {
   }
 }
 
-std::filesystem::path FindInPath(const std::string& program) {
-  const char* path = std::getenv("PATH");
-  if (path == nullptr) return {};
-  std::stringstream folders(path);
-  std::string folder;
-  while (std::getline(folders, folder, ':')) {
-    if (folder.empty()) continue;
-    const std::filesystem::path candidate = std::filesystem::path(folder) / program;
-    struct stat info {};
-    if (stat(candidate.c_str(), &info) == 0 && S_ISREG(info.st_mode) && (info.st_mode & S_IXUSR)) {
-      return candidate;
-    }
-  }
-  return {};
-}
-
 std::vector<std::string> SubmitSlurmScripts(const std::filesystem::path& sbatch,
                                             const std::vector<SlurmScript>& scripts) {
   std::vector<std::string> ids;
   for (const SlurmScript& script : scripts) {
-    std::string command = ShellQuote(sbatch.string()) + " --parsable";
-    if (!ids.empty()) command += " --dependency=afterok:" + ids.back();
-    command += " " + ShellQuote(script.path.string()) + " 2>&1";
-    std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
-    if (!pipe) {
+    std::vector<std::string> argv = {sbatch.string(), "--parsable"};
+    if (!ids.empty()) argv.push_back("--dependency=afterok:" + ids.back());
+    argv.push_back(script.path.string());
+    const ChildRun run = RunChild(argv);  // its stdout and stderr, together
+    if (!run.started) {
       throw InputError(sbatch.string() + ": cannot run it to submit " + script.path.string() +
-                       ": " + std::strerror(errno));
+                       ": " + std::strerror(run.error));
     }
-    std::string output;
-    std::array<char, 512> buffer{};
-    while (fgets(buffer.data(), buffer.size(), pipe.get()) != nullptr) output += buffer.data();
-    const int status = pclose(pipe.release());
+    std::string output = run.output;
     while (!output.empty() && (output.back() == '\n' || output.back() == '\r')) output.pop_back();
-    if (status != 0 || output.empty()) {
+    if (run.exit_code != 0 || output.empty()) {
       throw InputError(sbatch.string() + " refused " + script.path.string() + ": " + output);
     }
     // --parsable prints "id" or "id;cluster".

@@ -68,11 +68,9 @@ std::string SbatchQuote(const std::string& word);
 // Throws InputError naming the path it cannot write.
 void WriteSlurmScripts(const std::vector<SlurmScript>& scripts);
 
-// Finds `program` in PATH; empty when it is not there.
-std::filesystem::path FindInPath(const std::string& program);
-
-// Submits the scripts in order with `sbatch --parsable`, each after the previous one
-// (--dependency=afterok); returns the job ids. Throws InputError when sbatch refuses.
+// Submits the scripts in order with `sbatch --parsable` (util/child_process.h's RunChild;
+// `sbatch` a path, FindOnPath), each after the previous one (--dependency=afterok);
+// returns the job ids. Throws InputError when sbatch refuses, with what it said.
 std::vector<std::string> SubmitSlurmScripts(const std::filesystem::path& sbatch,
                                             const std::vector<SlurmScript>& scripts);
 

@@ -206,9 +206,50 @@ TEST(Slurm, NoScriptIsWrittenThroughALink) {
   EXPECT_TRUE(std::filesystem::is_empty(dir.path() / "elsewhere"));
 }
 
-TEST(Slurm, FindsProgramsInPath) {
-  EXPECT_FALSE(FindInPath("sh").empty());
-  EXPECT_TRUE(FindInPath("no-such-program-tessera").empty());
+// A stand-in for sbatch: records each call's arguments, one per line, and answers as
+// sbatch --parsable does ("id;cluster" first, then "id"), or refuses a script named
+// "bad" on stderr.
+std::filesystem::path FakeSbatch(const std::filesystem::path& dir) {
+  const std::filesystem::path sbatch = dir / "sbatch";
+  const std::string calls = (dir / "calls").string(), first = (dir / "first").string();
+  std::ofstream(sbatch) << "#!/bin/sh\n"
+                        << "printf '%s\\n' \"$@\" --- >> '" << calls << "'\n"
+                        << "for script; do :; done\n"  // the last argument
+                        << "case \"$script\" in *bad.sh)\n"
+                        << "  echo 'sbatch: error: Batch job submission failed' >&2; exit 1;;\n"
+                        << "esac\n"
+                        << "if [ -f '" << first << "' ]; then echo 18; exit 0; fi\n"
+                        << "touch '" << first << "'; echo '17;cluster'\n";
+  std::filesystem::permissions(sbatch, std::filesystem::perms::owner_all);
+  return sbatch;
+}
+
+TEST(Slurm, ScriptsAreSubmittedInOrderEachAfterThePreviousOne) {
+  testing::TemporaryDir dir;
+  const std::filesystem::path sbatch = FakeSbatch(dir.path());
+  // A path sbatch gets as one argument, whatever it holds.
+  const std::filesystem::path odd = dir.path() / "it's a $HOME";
+  const std::vector<std::string> ids = SubmitSlurmScripts(
+      sbatch, {{"extract", odd / "extract.sh", ""}, {"merge_extract", odd / "merge.sh", ""}});
+  EXPECT_EQ(ids, (std::vector<std::string>{"17", "18"}));
+  std::ifstream calls(dir.path() / "calls");
+  const std::string text((std::istreambuf_iterator<char>(calls)), {});
+  EXPECT_EQ(text, "--parsable\n" + (odd / "extract.sh").string() +
+                      "\n---\n--parsable\n--dependency=afterok:17\n" + (odd / "merge.sh").string() +
+                      "\n---\n");
+}
+
+TEST(Slurm, ARefusedScriptIsAnInputErrorWithWhatSbatchSaid) {
+  testing::TemporaryDir dir;
+  const std::filesystem::path sbatch = FakeSbatch(dir.path());
+  const std::filesystem::path bad = dir.path() / "bad.sh";
+  try {
+    SubmitSlurmScripts(sbatch, {{"extract", dir.path() / "extract.sh", ""}, {"bad", bad, ""}});
+    FAIL() << "no error";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()), sbatch.string() + " refused " + bad.string() +
+                                             ": sbatch: error: Batch job submission failed");
+  }
 }
 
 // The verbs' arguments, as a user gives them.

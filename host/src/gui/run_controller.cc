@@ -56,8 +56,8 @@ PipelineContext CreateContext(const RunRequest& request) {
 // Extract and match here, then map as `tessera map --hierarchical` (the CLI's entry
 // point, MapHierarchically): partition, a pool of `tessera map --cluster K` processes
 // (the executable beside this one: `tessera gui` is it), the merge. Each process gets
-// the cores' share of its job, the manifest file (`context` was made from it:
-// CreateContext) and the image folder.
+// the manifest file (`context` was made from it: CreateContext); MapHierarchically
+// gives it the workspace, the image folder and its share of the cores.
 RunResult RunHierarchically(const PipelineContext& context, const RunRequest& request,
                             const StageControl& control) {
   const std::filesystem::path manifest =
@@ -74,14 +74,10 @@ RunResult RunHierarchically(const PipelineContext& context, const RunRequest& re
     return run;
   }
   HierarchicalMapOptions hierarchical;
-  hierarchical.tessera = (ExecutableDir() / "tessera").string();
-  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  hierarchical.jobs = request.jobs > 0 ? request.jobs : std::max(1, cores / 2);
-  const int threads = context.manifest.num_threads > 0 ? context.manifest.num_threads
-                                                       : std::max(1, cores / hierarchical.jobs);
-  hierarchical.cluster_arguments = {
-      "--output",   request.output_dir.string(), "--threads", std::to_string(threads),
-      "--manifest", manifest.string(),           "--images",  request.image_dir.string()};
+  hierarchical.tessera = ExecutableDir() / "tessera";
+  hierarchical.manifest = manifest;
+  hierarchical.jobs = request.jobs;                     // 0: the library's default, half the cores
+  hierarchical.threads = context.manifest.num_threads;  // 0: the cores / jobs
   run.summary.map = MapHierarchically(context, options, hierarchical, control);
   if (run.summary.map.status == StageStatus::kCancelled) run.status = StageStatus::kCancelled;
   return run;

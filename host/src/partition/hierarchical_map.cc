@@ -3,7 +3,9 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <thread>
 
+#include "partition/cluster_map.h"
 #include "partition/merge_map_stage.h"
 #include "partition/partition_stage.h"
 #include "partition/process_pool.h"
@@ -51,19 +53,21 @@ MapStageSummary MapHierarchically(const PipelineContext& context, const RunOptio
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
     return clusters.clusters[a].images.size() > clusters.clusters[b].images.size();
   });
+  const int cores = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int jobs = hierarchical.jobs > 0 ? hierarchical.jobs : std::max(1, cores / 2);
+  ClusterProcessOptions process;
+  process.tessera = hierarchical.tessera;
+  process.output_dir = options.output_dir;
+  process.manifest = hierarchical.manifest;
+  process.camera_K = hierarchical.camera_K;
+  process.image_dir = options.image_dir;
+  process.threads = hierarchical.threads > 0 ? hierarchical.threads : std::max(1, cores / jobs);
   std::vector<std::vector<std::string>> commands;
-  for (const int cluster : order) {
-    std::vector<std::string> command = {hierarchical.tessera, "map"};
-    command.insert(command.end(), hierarchical.cluster_arguments.begin(),
-                   hierarchical.cluster_arguments.end());
-    command.push_back("--cluster");
-    command.push_back(std::to_string(cluster));
-    commands.push_back(std::move(command));
-  }
-  spdlog::info("map: {} clusters in {} processes at once", commands.size(), hierarchical.jobs);
+  for (const int cluster : order) commands.push_back(MapClusterCommand(process, cluster));
+  spdlog::info("map: {} clusters in {} processes at once", commands.size(), jobs);
   // SIGINT or SIGTERM to this process reaches the clusters' as SIGTERM: each cancels.
   const std::vector<int> codes =
-      RunProcessPool(commands, hierarchical.jobs, [&] { return control.Cancelled(); });
+      RunProcessPool(commands, jobs, [&] { return control.Cancelled(); });
   const double map_seconds = timer.ElapsedSeconds();
   if (control.Cancelled()) {
     MapStageSummary summary;

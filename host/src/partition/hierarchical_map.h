@@ -2,10 +2,12 @@
 
 // `map --hierarchical`: partitioned mapping on one host, as COLMAP's hierarchical_mapper
 // does it: partition (unless OUTPUT/clusters.json is current), every cluster mapped in a
-// pool of `tessera map --cluster K` processes, then the merge (merge --stage map).
+// pool of processes, each MapCluster (cluster_map.h) through the command line
+// MapClusterCommand writes, then the merge (merge --stage map). Processes, not threads:
+// a cluster's plugin crash or memory ends its own process only, and the mappers and
+// their libraries keep process-wide state (threads, logging).
 
-#include <string>
-#include <vector>
+#include <filesystem>
 
 #include "pipeline/pipeline_context.h"
 #include "pipeline/run_pipeline.h"
@@ -14,10 +16,11 @@
 namespace tessera {
 
 struct HierarchicalMapOptions {
-  std::string tessera;  // the executable the cluster processes run
-  // Arguments every cluster process gets after `map` (--output, --manifest, ...).
-  std::vector<std::string> cluster_arguments;
-  int jobs = 1;  // cluster processes at once
+  std::filesystem::path tessera;   // the executable the cluster processes run
+  std::filesystem::path manifest;  // each cluster process's, as this one's (empty: the default)
+  std::filesystem::path camera_K;  // each cluster process's known intrinsics (empty: none)
+  int jobs = 0;                    // cluster processes at once; 0: half the cores
+  int threads = 0;                 // each cluster process's threads; 0: the cores / jobs
 };
 
 // Throws InputError naming each cluster whose process failed (exit codes other than 0

@@ -39,10 +39,15 @@ std::vector<Reconstruction> ReadClusterModels(const std::filesystem::path& works
                                               const Manifest& manifest) {
   ClusterOutput output = ReadClusterOutput(workspace, cluster, clusters_fingerprint);
   if (output.state == ClusterOutput::State::kFinished) return std::move(output.models);
-  throw InputError(output.problem + "; run `tessera map --cluster " + std::to_string(cluster) +
-                   " --output " + workspace.string() +
-                   (manifest.file.empty() ? "" : " --manifest " + manifest.file.string()) +
-                   "` again" +
+  ClusterProcessOptions process;
+  process.tessera = "tessera";
+  process.output_dir = workspace;
+  process.manifest = manifest.file;
+  std::string command;
+  for (const std::string& word : MapClusterCommand(process, cluster)) {
+    command += (command.empty() ? "" : " ") + word;
+  }
+  throw InputError(output.problem + "; run `" + command + "` again" +
                    (output.state == ClusterOutput::State::kCorrupt
                         ? ", which sets the corrupt folder aside and maps the cluster again"
                         : ""));

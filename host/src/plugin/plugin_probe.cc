@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "plugin/plugin_call.h"
+#include "util/child_process.h"
 
 namespace tessera {
 namespace {
@@ -30,9 +31,12 @@ void WriteLine(int fd, const std::string& line) {
 }
 
 // In the child: quiet, no core files, default signal and exit actions; loads files[first...]
-// and reports "begin i" and "end i" for each on `fd`.
+// and reports "begin i" and "end i" for each on `fd`. Forked without exec, so not through
+// util/child_process's RunChild: the child runs this process's own plugin loader on the
+// files, which is what the probe is for. It dies with `parent` (util/child_process.h).
 [[noreturn]] void ProbeInChild(const std::vector<std::filesystem::path>& files, size_t first,
-                               int fd) {
+                               int fd, pid_t parent) {
+  DieWithParent(parent, SIGKILL);
   const int null = open("/dev/null", O_WRONLY);
   if (null >= 0) {
     dup2(null, STDOUT_FILENO);
@@ -88,6 +92,7 @@ std::vector<std::optional<PluginRecord>> ProbePluginFiles(
     int pipe_fds[2];
     if (pipe2(pipe_fds, O_CLOEXEC) != 0) return records;  // no probe: load as before
     std::fflush(nullptr);  // a child that exits must not flush our buffers again
+    const pid_t parent = getpid();
     const pid_t pid = fork();
     if (pid < 0) {
       close(pipe_fds[0]);
@@ -96,7 +101,7 @@ std::vector<std::optional<PluginRecord>> ProbePluginFiles(
     }
     if (pid == 0) {
       close(pipe_fds[0]);
-      ProbeInChild(files, next, pipe_fds[1]);
+      ProbeInChild(files, next, pipe_fds[1], parent);
     }
     close(pipe_fds[1]);
 

@@ -1,6 +1,9 @@
 #include "util/child_process.h"
 
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #ifdef __linux__
@@ -8,7 +11,12 @@
 #endif
 
 #include <cerrno>
+#include <cstdlib>
+#include <cstring>
+#include <sstream>
 #include <thread>
+
+#include "util/timer.h"
 
 namespace tessera {
 namespace {
@@ -16,8 +24,16 @@ namespace {
 // How often WaitForOne looks for an ended child: short beside the processes it runs.
 constexpr std::chrono::milliseconds kPollInterval(20);
 
+// What a child does with its stdout and stderr, and how it reports a failed exec.
+struct ChildSetup {
+  const char* output_file = nullptr;  // both appended to it
+  int output_fd = -1;                 // both go to it (a pipe's write end)
+  int exec_error_fd = -1;             // gets errno when the program cannot be run
+};
+
 // In the child, between fork and exec: only async-signal-safe calls.
-[[noreturn]] void ExecChild(const std::vector<char*>& argv, pid_t parent, int death_signal) {
+[[noreturn]] void ExecChild(const std::vector<char*>& argv, pid_t parent, int death_signal,
+                            const ChildSetup& setup) {
   DieWithParent(parent, death_signal);
   // The parent's handlers are reset by exec; an ignored signal or a blocked one is not.
   signal(SIGINT, SIG_DFL);
@@ -25,9 +41,73 @@ constexpr std::chrono::milliseconds kPollInterval(20);
   sigset_t none;
   sigemptyset(&none);
   sigprocmask(SIG_SETMASK, &none, nullptr);
-  execv(argv[0], argv.data());
+  int output = setup.output_fd;
+  if (setup.output_file != nullptr) {
+    output = open(setup.output_file, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  }
+  // dup2 clears close-on-exec on the copies only.
+  if (output >= 0 && (dup2(output, STDOUT_FILENO) < 0 || dup2(output, STDERR_FILENO) < 0)) {
+    output = -1;
+  }
+  if (output >= 0 || (setup.output_file == nullptr && setup.output_fd < 0)) {
+    execv(argv[0], argv.data());
+  }
+  if (setup.exec_error_fd >= 0) {
+    const int error = errno;
+    if (write(setup.exec_error_fd, &error, sizeof(error)) < 0) _exit(127);
+  }
   _exit(127);
 }
+
+// argv as execv takes it: pointers into `argv`, made before the fork (the child of a
+// parent with threads may not allocate).
+std::vector<char*> ExecArguments(const std::vector<std::string>& argv) {
+  std::vector<char*> args;
+  for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
+  args.push_back(nullptr);
+  return args;
+}
+
+// Reaps `pid`, waiting for it, with its resource use.
+int WaitFor(pid_t pid, rusage* usage) {
+  int status = 0;
+  while (wait4(pid, &status, 0, usage) < 0) {
+    if (errno != EINTR) return 1 << 8;  // not a child of ours any more: exit code 1
+  }
+  return status;
+}
+
+// Reads `fd` to its end into `text`.
+void ReadAll(int fd, std::string* text) {
+  char buffer[4096];
+  for (;;) {
+    const ssize_t n = read(fd, buffer, sizeof(buffer));
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return;
+    text->append(buffer, static_cast<size_t>(n));
+  }
+}
+
+// A pipe whose ends are closed when it goes (both close-on-exec).
+struct Pipe {
+  int read_fd = -1;
+  int write_fd = -1;
+  bool Open() {
+    int fds[2];
+    if (pipe2(fds, O_CLOEXEC) != 0) return false;
+    read_fd = fds[0];
+    write_fd = fds[1];
+    return true;
+  }
+  void CloseWrite() {
+    if (write_fd >= 0) close(write_fd);
+    write_fd = -1;
+  }
+  ~Pipe() {
+    CloseWrite();
+    if (read_fd >= 0) close(read_fd);
+  }
+};
 
 }  // namespace
 
@@ -38,6 +118,22 @@ void DieWithParent(pid_t parent, int death_signal) {
   // A parent that ended before the request above sent nothing: the child was handed to
   // another process (init, a subreaper) already.
   if (getppid() != parent) raise(death_signal);
+}
+
+std::filesystem::path FindOnPath(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  std::istringstream folders(path != nullptr ? path : "");
+  std::string folder;
+  while (std::getline(folders, folder, ':')) {
+    const std::filesystem::path candidate =
+        std::filesystem::path(folder.empty() ? "." : folder) / name;
+    struct stat info {};
+    if (stat(candidate.c_str(), &info) == 0 && S_ISREG(info.st_mode) &&
+        access(candidate.c_str(), X_OK) == 0) {
+      return candidate;
+    }
+  }
+  return {};
 }
 
 int ExitCodeOfWaitStatus(int wait_status) {
@@ -55,14 +151,11 @@ ChildProcesses::~ChildProcesses() {
 }
 
 std::optional<pid_t> ChildProcesses::Start(const std::vector<std::string>& argv) {
-  // Made before the fork: the child of a parent with threads may not allocate.
-  std::vector<char*> args;
-  for (const std::string& arg : argv) args.push_back(const_cast<char*>(arg.c_str()));
-  args.push_back(nullptr);
+  const std::vector<char*> args = ExecArguments(argv);
   const pid_t parent = getpid();
   const pid_t pid = fork();
   if (pid < 0) return std::nullopt;
-  if (pid == 0) ExecChild(args, parent, death_signal_);
+  if (pid == 0) ExecChild(args, parent, death_signal_, {});
   running_.insert(pid);
   return pid;
 }
@@ -86,6 +179,53 @@ std::optional<ChildProcesses::Ended> ChildProcesses::WaitForOne(std::chrono::mil
 
 void ChildProcesses::SignalAll(int signal_number) const {
   for (const pid_t pid : running_) kill(pid, signal_number);
+}
+
+ChildRun RunChild(const std::vector<std::string>& argv, const std::filesystem::path& output_file) {
+  ChildRun run;
+  Pipe output, exec_error;
+  if ((output_file.empty() && !output.Open()) || !exec_error.Open()) {
+    run.error = errno;
+    return run;
+  }
+  ChildSetup setup;
+  const std::string file = output_file.string();
+  if (!output_file.empty()) setup.output_file = file.c_str();
+  setup.output_fd = output.write_fd;
+  setup.exec_error_fd = exec_error.write_fd;
+  const std::vector<char*> args = ExecArguments(argv);
+  const Timer timer;
+  const pid_t parent = getpid();
+  const pid_t pid = fork();
+  if (pid < 0) {
+    run.error = errno;
+    return run;
+  }
+  if (pid == 0) ExecChild(args, parent, SIGKILL, setup);
+  output.CloseWrite();
+  exec_error.CloseWrite();
+  // The read ends see their end once the child has run its program (close-on-exec) or
+  // ended.
+  std::string error;
+  rusage usage{};
+  try {
+    if (output.read_fd >= 0) ReadAll(output.read_fd, &run.output);
+    ReadAll(exec_error.read_fd, &error);
+  } catch (...) {  // no memory for its output: no child is left behind
+    kill(pid, SIGKILL);
+    WaitFor(pid, &usage);
+    throw;
+  }
+  const int status = WaitFor(pid, &usage);
+  run.seconds = timer.ElapsedSeconds();
+  run.exit_code = ExitCodeOfWaitStatus(status);
+  run.started = error.size() < sizeof(int);
+  if (!run.started) {
+    std::memcpy(&run.error, error.data(), sizeof(int));
+    return run;
+  }
+  run.peak_memory_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss: KiB
+  return run;
 }
 
 }  // namespace tessera

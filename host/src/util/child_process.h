@@ -1,8 +1,11 @@
 #pragma once
 
-// Child processes that stop with the process that started them: the cluster processes
-// of `map --hierarchical` (partition/process_pool.h) and the Python module's stage
-// process (python/src/stage_process.cc).
+// The one way Tessera starts a program: children that stop with the process that started
+// them. The cluster processes of `map --hierarchical` (partition/process_pool.h) run in a
+// pool (ChildProcesses); `bench`'s rows, gnuplot and `slurm`'s sbatch run to their end one
+// at a time (RunChild). Two children fork without exec and so cannot use this: the Python
+// module's stage process (python/src/stage_process.cc, which uses DieWithParent) and the
+// plugin probe (plugin/plugin_probe.cc); both run Tessera's own code in the child.
 //  - A child dies with its parent, however the parent ends (kill -9 included): it asks
 //    the kernel for a signal when its parent goes (PR_SET_PDEATHSIG), then checks that
 //    the parent is still there, for a parent that ended before it asked.
@@ -13,6 +16,8 @@
 #include <sys/types.h>
 
 #include <chrono>
+#include <filesystem>
+#include <limits>
 #include <optional>
 #include <set>
 #include <string>
@@ -30,6 +35,10 @@ void DieWithParent(pid_t parent, int death_signal);
 // The exit code a shell gives a waitpid status: the process's own, 128 + N for a process
 // ended by signal N.
 int ExitCodeOfWaitStatus(int wait_status);
+
+// `name` on the PATH, as execvp finds it (an empty entry is the working folder): the
+// first executable regular file; empty when there is none.
+std::filesystem::path FindOnPath(const std::string& name);
 
 // Children started from argv (argv[0] an executable path, not searched in PATH), which
 // inherit stdout and stderr and die with the thread that started them.
@@ -65,5 +74,25 @@ class ChildProcesses {
   int death_signal_;
   std::set<pid_t> running_;
 };
+
+// What a child run to its end did.
+struct ChildRun {
+  // False when its program did not run: no process could be made, the output file could
+  // not be opened, or exec failed; `error` is the errno, and the exit code 127.
+  bool started = false;
+  int error = 0;
+  int exit_code = 127;  // ExitCodeOfWaitStatus
+  std::string output;   // output_file empty: what it wrote to stdout and stderr
+  double seconds = 0;   // from before the start to its end
+  // Its peak resident memory (the kernel's maxrss); NaN when it did not run.
+  double peak_memory_mb = std::numeric_limits<double>::quiet_NaN();
+};
+
+// Runs argv (argv[0] an executable path, FindOnPath for a name) as ChildProcesses::Start
+// does, and waits for its end; it dies (SIGKILL) with the thread that runs it. Its stdout
+// and stderr both go to ChildRun::output or, `output_file` given, are appended to that
+// file (made if missing).
+ChildRun RunChild(const std::vector<std::string>& argv,
+                  const std::filesystem::path& output_file = {});
 
 }  // namespace tessera

@@ -7,7 +7,12 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
 #include <thread>
+
+#include "test_support.h"
 
 namespace tessera {
 namespace {
@@ -124,6 +129,60 @@ TEST_F(ChildProcessTest, ChildrenLeftWhenTheOwnerGoesAreKilled) {
   // Reaped by the destructor: no longer a child of this process.
   EXPECT_EQ(waitpid(pid, nullptr, WNOHANG), -1);
   EXPECT_EQ(kill(pid, 0), -1);
+}
+
+TEST(RunChild, CapturesStdoutAndStderrTogetherAndTheExitCode) {
+  const ChildRun run = RunChild({"/bin/sh", "-c", "echo out; echo err >&2; exit 3"});
+  EXPECT_TRUE(run.started);
+  EXPECT_EQ(run.exit_code, 3);
+  EXPECT_EQ(run.output, "out\nerr\n");
+  EXPECT_GT(run.peak_memory_mb, 0);
+}
+
+TEST(RunChild, AppendsToTheOutputFileAndGivesTheSignalsCode) {
+  testing::TemporaryDir dir;
+  const std::filesystem::path log = dir.path() / "run.log";
+  std::ofstream(log) << "before\n";
+  EXPECT_EQ(RunChild({"/bin/sh", "-c", "echo one; echo two >&2"}, log).exit_code, 0);
+  const ChildRun killed = RunChild({"/bin/sh", "-c", "echo three; kill -TERM $$"}, log);
+  EXPECT_EQ(killed.exit_code, 128 + SIGTERM);
+  EXPECT_TRUE(killed.output.empty());
+  std::ifstream file(log);
+  EXPECT_EQ(std::string((std::istreambuf_iterator<char>(file)), {}), "before\none\ntwo\nthree\n");
+}
+
+TEST(RunChild, AProgramThatCannotRunIsNotStartedWithItsError) {
+  const ChildRun missing = RunChild({"/nonexistent/program"});
+  EXPECT_FALSE(missing.started);
+  EXPECT_EQ(missing.error, ENOENT);
+  EXPECT_EQ(missing.exit_code, 127);
+  EXPECT_TRUE(std::isnan(missing.peak_memory_mb));
+  // An output file that cannot be made: the program is not run.
+  testing::TemporaryDir dir;
+  const ChildRun unwritable = RunChild({"/bin/sh", "-c", "touch " + (dir.path() / "ran").string()},
+                                       dir.path() / "no-such-folder" / "run.log");
+  EXPECT_FALSE(unwritable.started);
+  EXPECT_EQ(unwritable.exit_code, 127);
+  EXPECT_FALSE(std::filesystem::exists(dir.path() / "ran"));
+}
+
+TEST(FindOnPath, FindsExecutablesAsExecvpDoes) {
+  testing::TemporaryDir dir;
+  const std::filesystem::path bin = dir.path() / "bin";
+  std::filesystem::create_directories(bin / "folder");
+  std::ofstream(bin / "tool") << "#!/bin/sh\n";
+  std::filesystem::permissions(bin / "tool", std::filesystem::perms::owner_all);
+  std::ofstream(bin / "plain") << "not executable\n";
+  const char* saved = std::getenv("PATH");
+  const std::string path = saved != nullptr ? saved : "";
+  setenv("PATH", ("/nonexistent:" + bin.string()).c_str(), 1);
+  EXPECT_EQ(FindOnPath("tool"), bin / "tool");
+  EXPECT_TRUE(FindOnPath("plain").empty());
+  EXPECT_TRUE(FindOnPath("folder").empty());
+  EXPECT_TRUE(FindOnPath("sh").empty());
+  setenv("PATH", path.c_str(), 1);
+  EXPECT_FALSE(FindOnPath("sh").empty());
+  EXPECT_TRUE(FindOnPath("no-such-program-tessera").empty());
 }
 
 TEST(ExitCodeOfWaitStatus, IsTheShellsCode) {
