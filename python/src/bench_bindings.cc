@@ -50,8 +50,7 @@ void BindBench(py::module_& module) {
       },
       py::arg("images"), py::arg("manifests"), py::arg("output") = "bench-output",
       py::arg("ground_truth") = py::none(), py::arg("camera_K") = py::none(),
-      py::arg("with_colmap") = false,
-      py::arg("colmap") = std::vector<std::filesystem::path>{},
+      py::arg("with_colmap") = false, py::arg("colmap") = std::vector<std::filesystem::path>{},
       py::arg("colmap_mapper_only") = false, py::arg("threads") = 0,
       "Runs each manifest (each a `tessera run` of the installed executable, in "
       "OUTPUT/<name>) on the same images and returns the rows `tessera bench --json` "
