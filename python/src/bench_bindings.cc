@@ -25,7 +25,8 @@ void BindBench(py::module_& module) {
       "bench",
       [](const std::filesystem::path& images, const std::vector<std::filesystem::path>& manifests,
          const std::filesystem::path& output, const OptionalPath& ground_truth,
-         const OptionalPath& camera_K, bool with_colmap, int threads) {
+         const OptionalPath& camera_K, bool with_colmap,
+         const std::vector<std::filesystem::path>& colmap, bool colmap_mapper_only, int threads) {
         // Refused as the command line refuses --threads out of 0..1024.
         if (threads < 0 || threads > 1024) {
           throw InputError("threads: " + std::to_string(threads) + " is not in 0..1024");
@@ -37,6 +38,8 @@ void BindBench(py::module_& module) {
         options.ground_truth = ground_truth ? ground_truth->string() : "";
         options.camera_K = camera_K ? camera_K->string() : "";
         options.with_colmap = with_colmap;
+        for (const auto& binary : colmap) options.colmap_binaries.push_back(binary.string());
+        options.colmap_mapper_only = colmap_mapper_only;
         options.threads = threads;
         BenchReport report;
         {
@@ -47,11 +50,14 @@ void BindBench(py::module_& module) {
       },
       py::arg("images"), py::arg("manifests"), py::arg("output") = "bench-output",
       py::arg("ground_truth") = py::none(), py::arg("camera_K") = py::none(),
-      py::arg("with_colmap") = false, py::arg("threads") = 0,
+      py::arg("with_colmap") = false, py::arg("colmap") = std::vector<std::filesystem::path>{},
+      py::arg("colmap_mapper_only") = false, py::arg("threads") = 0,
       "Runs each manifest (each a `tessera run` of the installed executable, in "
       "OUTPUT/<name>) on the same images and returns the rows `tessera bench --json` "
       "writes, one dict per manifest (and COLMAP's): a row that failed keeps its exit_code. "
-      "InputError for bad arguments or a malformed manifest, before any run.");
+      "colmap: the COLMAP binaries to run (--colmap), colmap_mapper_only: COLMAP's mappers "
+      "on the first successful row's database (--colmap-mapper-only); each implies "
+      "with_colmap. InputError for bad arguments or a malformed manifest, before any run.");
 }
 
 }  // namespace tessera::python

@@ -198,17 +198,29 @@ def evaluate(model: PathLike, ground_truth: PathLike) -> Dict[str, Any]:
 
 def bench(images: PathLike, manifests: Sequence[PathLike], output: PathLike = "bench-output",
           ground_truth: Optional[PathLike] = None, camera_K: Optional[PathLike] = None,
-          with_colmap: bool = False, threads: int = 0) -> List[Dict[str, Any]]:
+          with_colmap: bool = False, colmap: Union[PathLike, Sequence[PathLike], None] = None,
+          colmap_mapper_only: bool = False, threads: int = 0) -> List[Dict[str, Any]]:
     """Runs each manifest file (each a `tessera run` of the installed executable, in
     OUTPUT/<name>) on the same images and returns the rows `tessera bench --json` writes,
-    one dict per manifest (and COLMAP's): a row that failed keeps its exit_code."""
+    one dict per manifest (and COLMAP's): a row that failed keeps its exit_code.
+    `colmap` names the COLMAP binary (or a list of them) to run instead of those
+    with_colmap finds (`--colmap PATH`); colmap_mapper_only runs COLMAP's mappers alone on
+    the first successful row's database (`--colmap-mapper-only`); each implies
+    with_colmap."""
     name = "bench"
+    if colmap is None:
+        colmaps: List[Any] = []
+    elif isinstance(colmap, (str, os.PathLike)):
+        colmaps = [colmap]
+    else:
+        colmaps = _paths(name, "colmap", colmap)
     return typing.cast(List[Dict[str, Any]], _call(
         _tessera.bench, images=_path(name, "images", images),
         manifests=_paths(name, "manifests", manifests), output=_path(name, "output", output),
         ground_truth=_optional_path(name, "ground_truth", ground_truth),
         camera_K=_optional_path(name, "camera_K", camera_K),
-        with_colmap=_bool(name, "with_colmap", with_colmap),
+        with_colmap=_bool(name, "with_colmap", with_colmap), colmap=colmaps,
+        colmap_mapper_only=_bool(name, "colmap_mapper_only", colmap_mapper_only),
         threads=_int(name, "threads", threads)))
 
 
