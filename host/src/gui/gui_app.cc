@@ -443,7 +443,6 @@ bool GuiApp::CheckEditedManifest() { return setup_->editor().Check(); }
 bool GuiApp::SaveEditedManifest(const fs::path& file) { return setup_->editor().Save(file); }
 void GuiApp::SetEditorText(const std::string& text) { setup_->editor().SetText(text); }
 const std::string& GuiApp::EditorQuestion() const { return setup_->editor().Question(); }
-void GuiApp::AnswerEditor(bool replace) { setup_->editor().Answer(replace); }
 const std::string& GuiApp::RecipeShown() const { return setup_->RecipeShown(); }
 std::string GuiApp::EditorText() const { return setup_->editor().Text(); }
 const std::string& GuiApp::EditorError() const { return setup_->editor().Error(); }

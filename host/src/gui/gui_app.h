@@ -121,9 +121,8 @@ class GuiApp {
   bool SaveEditedManifest(const std::filesystem::path& file);
   void SetEditorText(const std::string& text);
   // The editor's question before it replaces unsaved text or an existing file (empty:
-  // none), and its answer (true: replace).
+  // none); the window's buttons answer it.
   const std::string& EditorQuestion() const;
-  void AnswerEditor(bool replace);
   // The Recipe box's text in the last frame ("default", "default (edited)", ...).
   const std::string& RecipeShown() const;
   std::string EditorText() const;

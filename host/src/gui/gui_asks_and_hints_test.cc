@@ -29,20 +29,10 @@ TEST_F(GuiWindowTest, APluginChangeAsksBeforeItDropsOptionsTheNewPluginDoesNotTa
                "options": {"ba_local_max_num_iterations": 30, "ba_refine_principal_point": true}}
   }
 })";
-  manifest_ = dir_.path() / "m.json";
-  std::ofstream(manifest_) << text;
-  GuiOptions options;
-  options.manifest = manifest_;
-  GuiApp app(options);
-  app.Frame();
-  app.Frame();
-  Click(&app, "manifest editor");
-  app.Frame();
+  GuiApp app(ManifestOptions(text));
+  OpenEditor(&app);
   const auto pick = [&](const std::string& slot, const std::string& plugin) {
-    Click(&app, "slot " + slot);
-    app.Frame();
-    Click(&app, "plugin " + slot + " " + plugin);
-    app.Frame();
+    PickPlugin(&app, slot, plugin);
     app.Frame();
   };
   pick("mapper", "global");
@@ -72,31 +62,6 @@ TEST_F(GuiWindowTest, APluginChangeAsksBeforeItDropsOptionsTheNewPluginDoesNotTa
   EXPECT_EQ(app.EditorQuestion(), "");
   EXPECT_EQ(app.EditorPlugin("detector"), "sift");
   EXPECT_TRUE(Contains(app.EditorText(), R"("max_num_features": 2000)")) << app.EditorText();
-}
-
-// An older manifest's top-level "mapper" options go when a mapper is picked (they would
-// be refused beside pipeline.mapper): asked first too, naming them.
-TEST_F(GuiWindowTest, PickingAMapperAsksBeforeTheOlderTopLevelMapperOptionsGo) {
-  const std::string text =
-      R"({"mapper": {"init_min_num_inliers": 50}, "pipeline": {"detector": {"plugin": "orb"}}})";
-  manifest_ = dir_.path() / "m.json";
-  std::ofstream(manifest_) << text;
-  GuiOptions options;
-  options.manifest = manifest_;
-  GuiApp app(options);
-  app.Frame();
-  app.Frame();
-  Click(&app, "manifest editor");
-  app.Frame();
-  Click(&app, "slot mapper");
-  app.Frame();
-  Click(&app, "plugin mapper global");
-  app.Frame();
-  EXPECT_TRUE(Contains(app.EditorQuestion(), "init_min_num_inliers")) << app.EditorQuestion();
-  EXPECT_EQ(app.EditorText(), text);
-  app.AnswerEditor(true);
-  EXPECT_EQ(app.EditorPlugin("mapper"), "global");
-  EXPECT_FALSE(Contains(app.EditorText(), "init_min_num_inliers"));
 }
 
 // "map in clusters" (the CLI's map --hierarchical, through MapHierarchically): the

@@ -552,25 +552,12 @@ TEST_F(GuiWindowTest, MapperDropdownShowsAndSetsTheMapper) {
   const std::string slots = R"("detector": {"plugin": "orb"},
       "pair_selector": {"plugin": "exhaustive"}, "matcher": {"plugin": "brute_force"},
       "bundle_adjuster": {"plugin": "ceres"})";
-  manifest_ = dir_.path() / "m.json";
-  std::ofstream(manifest_) << "{\"pipeline\": {" + slots + "}}";
-  GuiOptions options;
-  options.manifest = manifest_;
-  GuiApp app(options);
-  app.Frame();
-  app.Frame();
-  Click(&app, "manifest editor");
-  app.Frame();
+  GuiApp app(ManifestOptions("{\"pipeline\": {" + slots + "}}"));
+  OpenEditor(&app);
   EXPECT_EQ(app.EditorPlugin("mapper"), "incremental");
   EXPECT_EQ(app.EditorPluginDescription("mapper").rfind("Incremental mapping after COLMAP", 0), 0u)
       << app.EditorPluginDescription("mapper");
-  const auto pick_global = [&] {
-    Click(&app, "slot mapper");
-    app.Frame();
-    Click(&app, "plugin mapper global");
-    app.Frame();
-  };
-  pick_global();
+  PickPlugin(&app, "mapper", "global");
   EXPECT_EQ(app.EditorPlugin("mapper"), "global");
   EXPECT_EQ(app.EditorPluginDescription("mapper").rfind("Global mapping after GLOMAP", 0), 0u)
       << app.EditorPluginDescription("mapper");
@@ -583,7 +570,7 @@ TEST_F(GuiWindowTest, MapperDropdownShowsAndSetsTheMapper) {
   app.SetEditorText("{\"mapper\": {\"init_min_num_inliers\": 50}, \"pipeline\": {" + slots + "}}");
   app.Frame();
   EXPECT_EQ(app.EditorPlugin("mapper"), "incremental");
-  pick_global();
+  PickPlugin(&app, "mapper", "global");
   // Asked first (issue 52 item 9): those options go with the rewrite.
   EXPECT_NE(app.EditorQuestion().find("init_min_num_inliers"), std::string::npos);
   Click(&app, "replace answer");
@@ -592,10 +579,7 @@ TEST_F(GuiWindowTest, MapperDropdownShowsAndSetsTheMapper) {
   EXPECT_FALSE(nlohmann::json::parse(app.EditorText()).contains("mapper"));
   EXPECT_TRUE(app.CheckEditedManifest()) << app.EditorError();
   // Picked back: the text names "incremental", no longer the default.
-  Click(&app, "slot mapper");
-  app.Frame();
-  Click(&app, "plugin mapper incremental");
-  app.Frame();
+  PickPlugin(&app, "mapper", "incremental");
   EXPECT_EQ(nlohmann::json::parse(app.EditorText())["pipeline"]["mapper"]["plugin"], "incremental");
 }
 

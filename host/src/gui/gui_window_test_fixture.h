@@ -107,6 +107,31 @@ class GuiWindowTest : public ::testing::Test {
     app->Frame(&typed);
   }
 
+  // Writes `text` to manifest_ (m.json in the test's folder); the options that open it.
+  GuiOptions ManifestOptions(const std::string& text) {
+    manifest_ = dir_.path() / "m.json";
+    std::ofstream(manifest_) << text;
+    GuiOptions options;
+    options.manifest = manifest_;
+    return options;
+  }
+
+  // The window's first frames, then its manifest editor opened.
+  static void OpenEditor(GuiApp* app) {
+    app->Frame();
+    app->Frame();
+    Click(app, "manifest editor");
+    app->Frame();
+  }
+
+  // Picks `plugin` in the editor's dropdown of `slot`.
+  static void PickPlugin(GuiApp* app, const std::string& slot, const std::string& plugin) {
+    Click(app, "slot " + slot);
+    app->Frame();
+    Click(app, "plugin " + slot + " " + plugin);
+    app->Frame();
+  }
+
   static bool Contains(const std::string& text, const std::string& part) {
     return text.find(part) != std::string::npos;
   }

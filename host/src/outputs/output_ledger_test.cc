@@ -114,19 +114,25 @@ TEST(ForgedLedger, AnEntryThatIsNotInNormalFormIsRefused) {
   }
 }
 
+// A ledger forged to name `entry`, one of the workspace's own files, is refused naming
+// it, and the file stays as it was.
+void ExpectForgedWorkspaceEntryRefused(const std::string& entry) {
+  Workspace workspace;
+  WriteText(workspace.output / entry, "workspace");
+  Forge(workspace.output, entry, workspace.output / entry);
+  const std::string error = CommitError(workspace.output);
+  EXPECT_TRUE(Has(error, "the entry '" + entry + "'")) << error;
+  EXPECT_TRUE(Has(error, "the workspace's own")) << error;
+  workspace.ExpectNothingDone();
+  EXPECT_EQ(ReadText(workspace.output / entry), "workspace") << entry;
+}
+
 TEST(ForgedLedger, TheWorkspacesOwnFilesAreRefused) {
   for (const std::string entry :
        {"database.db", "database.db-wal", "cache/matcher/x.idx", "shards/extract-0-of-2.db",
         "video_frames/clip/frame_000000_0.000s.jpg", "frames.json", "clusters.json",
         ".tessera.lock", ".tessera_staging/1/x", "plugin_crashes.log"}) {
-    Workspace workspace;
-    WriteText(workspace.output / entry, "workspace");
-    Forge(workspace.output, entry, workspace.output / entry);
-    const std::string error = CommitError(workspace.output);
-    EXPECT_TRUE(Has(error, "the entry '" + entry + "'")) << error;
-    EXPECT_TRUE(Has(error, "the workspace's own")) << error;
-    workspace.ExpectNothingDone();
-    EXPECT_EQ(ReadText(workspace.output / entry), "workspace") << entry;
+    ExpectForgedWorkspaceEntryRefused(entry);
   }
 }
 
@@ -141,14 +147,7 @@ TEST(ForgedLedger, EveryStateEntryOfTheWorkspaceLayoutIsRefused) {
     }
     const std::string entry = std::string(layout_entry.name) +
                               (layout_entry.kind == WorkspaceEntry::Kind::kFolder ? "/x" : "");
-    Workspace workspace;
-    WriteText(workspace.output / entry, "workspace");
-    Forge(workspace.output, entry, workspace.output / entry);
-    const std::string error = CommitError(workspace.output);
-    EXPECT_TRUE(Has(error, "the entry '" + entry + "'")) << error;
-    EXPECT_TRUE(Has(error, "the workspace's own")) << error;
-    workspace.ExpectNothingDone();
-    EXPECT_EQ(ReadText(workspace.output / entry), "workspace") << entry;
+    ExpectForgedWorkspaceEntryRefused(entry);
   }
 }
 
