@@ -200,7 +200,7 @@ start_hierarchical() {  # start_hierarchical DIR: sets pid, and kids once a clus
   kids=""
   local deadline=$((SECONDS + 60))
   while [ -z "$kids" ] && [ "$SECONDS" -lt "$deadline" ] && kill -0 "$pid" 2> /dev/null; do
-    kids=$(pgrep -P "$pid")
+    kids=$(pgrep -P "$pid" -f -- "--cluster")  # not the plugin probe's child
     sleep 0.05
   done
   [ -n "$kids" ] || { cat "$1.log"; fail "map --hierarchical: no cluster process started"; }

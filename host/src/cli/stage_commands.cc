@@ -82,6 +82,9 @@ void AddMapOptions(CLI::App* sub, StageOptions* options) {
 }
 
 PipelineContext LoadContext(const StageOptions& options) {
+  // Ctrl-C or SIGTERM while the manifest and plugins load (the plugin probe runs in a
+  // child) cancels the stage that follows, as it would the stage itself: exit 130.
+  InterruptToken();
   return LoadPipelineContext(options.arguments);
 }
 
