@@ -8,16 +8,23 @@
 #   with the file it shadows, and run_summary.json records the file that ran;
 # - a map without a model points at "the warnings above" only when there are some;
 # - a bundle adjuster that asks the host for itself is exit 2 naming the chain.
-# usage: plugin_builds_test.sh TESSERA DOWNSCALE SOURCE_DIR TEST_PLUGIN_ROOT BUNDLED_PLUGIN_DIR
+# All of it from an installed prefix, as a plugin author meets it: BUILD_DIR is installed
+# into a temporary prefix, whose tessera and bundled plugins are the ones run.
+# usage: plugin_builds_test.sh BUILD_DIR DOWNSCALE SOURCE_DIR TEST_PLUGIN_ROOT
 set -uo pipefail
-tessera=$1
+build_dir=$1
 downscale=$2
 source_dir=$3
 test_plugins=$4
-bundled=$5
 source "$(dirname "$0")/common.sh"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
+
+cmake --install "$build_dir" --prefix "$work/prefix" > "$work/install.log" ||
+  { cat "$work/install.log"; fail "install into a prefix"; }
+tessera="$work/prefix/bin/tessera"
+bundled="$work/prefix/lib/tessera/plugins"
+[ -x "$tessera" ] && [ -f "$bundled/libtessera_detector_orb.so" ] || fail "the prefix lacks tessera or orb"
 
 images="$source_dir/examples/fountain-P11-small/images"
 "$downscale" "$images" "$work/big" 512 90 > /dev/null || fail "downscale"
