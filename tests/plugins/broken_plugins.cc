@@ -49,12 +49,20 @@ struct NotAnException {
   *reinterpret_cast<volatile int*>(address) = 1;
 }
 
+// A block allocated and dropped: a leak for LeakSanitizer to report at exit, naming this
+// frame (the sanitizer run's check that leak detection is on and reaches into plugins).
+void* volatile g_leak_sink = nullptr;
+[[maybe_unused, gnu::noinline]] void LeakOnPurpose() {
+  g_leak_sink = std::malloc(4096);
+  g_leak_sink = nullptr;
+}
+
 // Options shared by the failing plugins: "fail" says how (none, input_error,
 // option_error, runtime_error, custom, non_std, segv, abort, exit: exit(0), quick_exit:
-// quick_exit(0); bad_indices: a matcher returns a match beyond the keypoints; bad_result: a
-// mapper returns a model with an image renamed) and "in"
-// where (call: the kind's main method; factory: the constructor). A detector fails only
-// on images "on_width" pixels wide when that is not 0.
+// quick_exit(0); leak: 4 KiB allocated and dropped; bad_indices: a matcher returns a
+// match beyond the keypoints; bad_result: a mapper returns a model with an image renamed)
+// and "in" where (call: the kind's main method; factory: the constructor). A detector
+// fails only on images "on_width" pixels wide when that is not 0.
 struct Failure {
   std::string how;
   std::string where;
@@ -64,7 +72,7 @@ struct Failure {
       : how(reader->GetString(
             "fail", "none",
             {"none", "input_error", "option_error", "runtime_error", "custom", "non_std", "segv",
-             "abort", "exit", "quick_exit", "bad_indices", "bad_result"})),
+             "abort", "exit", "quick_exit", "leak", "bad_indices", "bad_result"})),
         where(reader->GetString("in", "call", {"call", "factory"})),
         on_width(reader->Get<int>("on_width", 0, 0, 100000)) {}
 
@@ -79,6 +87,7 @@ struct Failure {
     if (how == "abort") std::abort();
     if (how == "exit") std::exit(0);
     if (how == "quick_exit") std::quick_exit(0);
+    if (how == "leak") LeakOnPurpose();
   }
 };
 
