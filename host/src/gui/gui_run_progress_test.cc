@@ -2,6 +2,7 @@
 // the view graph as the model grows (with the time left), and a resumed run's stages that
 // had nothing left to do read "reused" rather than "0/0".
 
+#include <algorithm>
 #include <fstream>
 #include <set>
 #include <string>
@@ -119,8 +120,11 @@ TEST_F(GuiWindowTest, MapBarMovesWithEachRegistrationAndAResumedRunSaysReused) {
   // Frames as the event loop draws them; the map bar's readings while mapping.
   std::set<size_t> map_done;
   std::set<std::string> map_overlays;
-  std::string map_elided;  // the map bar's whole text, when it was cut short
+  std::set<std::string> map_elided;  // the map bar's whole texts, when they were cut short
   size_t map_total = 0;
+  // Readings with a rate (so a time left) while images remained: with two of them, the
+  // frame drawn between them showed one too.
+  size_t rate_readings = 0;
   ASSERT_TRUE(WaitFor(
       &app,
       [&] {
@@ -128,11 +132,13 @@ TEST_F(GuiWindowTest, MapBarMovesWithEachRegistrationAndAResumedRunSaysReused) {
         if (!status.stages.empty() && status.stages.back().stage == "map" &&
             !status.stages.back().finished) {
           map_done.insert(status.stages.back().done);
+          const StageProgress& map = status.stages.back();
+          if (map.rate_per_s > 0 && map.done < map.total) ++rate_readings;
           map_overlays.insert(StageOverlay(status.stages.back()));
           map_total = status.stages.back().total;
         }
         for (const auto& [rect, text] : app.ElidedTexts()) {
-          if (text.rfind("map: ", 0) == 0) map_elided = text;
+          if (text.rfind("map: ", 0) == 0) map_elided.insert(text);
         }
         return !app.controller().Running();
       },
@@ -147,9 +153,21 @@ TEST_F(GuiWindowTest, MapBarMovesWithEachRegistrationAndAResumedRunSaysReused) {
   size_t between = 0;
   for (const size_t done : map_done) between += done > 0 && done < map_total ? 1 : 0;
   EXPECT_GE(between, 2u) << seen;
-  EXPECT_NE(seen.find(" left"), std::string::npos) << seen;
-  // Cut at its end (the count kept), the whole text recorded for its tooltip.
-  EXPECT_NE(map_elided.find(" left"), std::string::npos) << map_elided;
+  // A rate is shown from kMinRateSeconds into the stage: on a fast machine the images may
+  // all be registered before, and then there is no time left to show.
+  if (rate_readings >= 2) {
+    EXPECT_NE(seen.find(" left"), std::string::npos) << seen;
+    // Cut at its end (the count kept), the whole text recorded for its tooltip: while
+    // mapping, with the time left (the last frames may show the finished text instead).
+    EXPECT_TRUE(std::any_of(map_elided.begin(), map_elided.end(), [](const std::string& text) {
+      return text.find(" left") != std::string::npos;
+    })) << ::testing::PrintToString(map_elided);
+  } else {
+    std::printf(
+        "the images were registered within about %.1f s of the map stage's start: no rate "
+        "was drawn, the time left is not checked\n",
+        kMinRateSeconds);
+  }
   const StageProgress& map = status.stages.at(2);
   ASSERT_EQ(map.stage, "map");
   EXPECT_TRUE(map.finished);
