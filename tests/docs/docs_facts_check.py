@@ -8,7 +8,8 @@ Every Markdown file of the repository (README.md, docs/, each folder's README.md
   `{h,cc}` pair is checked as its two files, and spans with placeholders (`<kind>`, `N`,
   `*`, `...`) are left alone; `examples/NAME` in a guide may be the installed examples
   (tests/third_party_plugin/);
-- each `libtessera_NAME.so.N` names the plugin ABI version of host/include/tessera/plugin.h.
+- each `libtessera_NAME.so.N` names the plugin ABI version of host/include/tessera/plugin.h;
+- README.md's status (the quoted block that starts "> Status:") is at most ten lines.
 The `tessera` commands the docs give are checked against the binary by
 docs_commands_test.py.
 
@@ -23,6 +24,7 @@ TOP = ("host/", "plugins/", "docs/", "tests/", "scripts/", "manifests/", "benchm
        "python/", "examples/", "cmake/", ".ci/")
 CODE_SPAN = re.compile(r"`([^`\n]+)`")
 SONAME = re.compile(r"libtessera_[a-z_]+\.so\.(\d+)\b")
+MAX_STATUS_LINES = 10
 PLACEHOLDER = re.compile(r"[<>*$]|\.\.\.|(^|/)[A-Z][A-Z_0-9]*(/|$|\.)")
 # The installed doc tree puts tests/third_party_plugin/ at examples/ beside the guides.
 INSTALLED_AS = {"examples/": "tests/third_party_plugin/"}
@@ -72,6 +74,18 @@ def looks_like_repository_path(path):
 HOST_FOLDERS = set()
 
 
+def status_lines(readme):
+    """The number of lines of README.md's status block ('> Status:' and the '>' lines after)."""
+    lines = open(readme, encoding="utf-8").read().splitlines()
+    starts = [k for k, line in enumerate(lines) if line.startswith("> Status:")]
+    if not starts:
+        return 0
+    end = starts[0]
+    while end < len(lines) and lines[end].startswith(">"):
+        end += 1
+    return end - starts[0]
+
+
 def main():
     source = os.path.abspath(sys.argv[1] if len(sys.argv) > 1 else ".")
     HOST_FOLDERS.update(os.listdir(os.path.join(source, "host", "src")))
@@ -96,6 +110,11 @@ def main():
                 for path in candidates(span):
                     if looks_like_repository_path(path) and not exists(source, document, path):
                         problems.append(f"{relative}:{number}: `{path}` is not in the repository")
+    status = status_lines(os.path.join(source, "README.md"))
+    if status == 0:
+        problems.append("README.md: no status block (a quoted block starting '> Status:')")
+    elif status > MAX_STATUS_LINES:
+        problems.append(f"README.md: the status is {status} lines; at most {MAX_STATUS_LINES}")
     for problem in problems:
         print(problem)
     print(f"{len(documents)} documents, ABI {abi}, {len(problems)} problems")
