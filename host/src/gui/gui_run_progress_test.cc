@@ -131,11 +131,11 @@ TEST_F(GuiWindowTest, MapBarMovesWithEachRegistrationAndAResumedRunSaysReused) {
         const RunStatus status = app.controller().Status();
         if (!status.stages.empty() && status.stages.back().stage == "map" &&
             !status.stages.back().finished) {
-          map_done.insert(status.stages.back().done);
           const StageProgress& map = status.stages.back();
+          map_done.insert(map.done);
           if (map.rate_per_s > 0 && map.done < map.total) ++rate_readings;
-          map_overlays.insert(StageOverlay(status.stages.back()));
-          map_total = status.stages.back().total;
+          map_overlays.insert(StageOverlay(map));
+          map_total = map.total;
         }
         for (const auto& [rect, text] : app.ElidedTexts()) {
           if (text.rfind("map: ", 0) == 0) map_elided.insert(text);
