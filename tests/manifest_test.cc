@@ -32,7 +32,8 @@ TEST(Manifest, ParsesSlotsCameraVerificationAndPaths) {
        {{"model", "OPENCV"},
         {"single_camera", false},
         {"per_folder", true},
-        {"K", {1000, 1001, 320, 240}}}},
+        {"K", {1000, 1001, 320, 240}},
+        {"require_calibration", true}}},
       {"verification", {{"max_error_px", 2.5}}}};
   const Manifest manifest = Manifest::FromJson(json, "/base", "m.json");
   EXPECT_EQ(manifest.plugin_paths, (std::vector<std::filesystem::path>{"/base/plugins", "/abs"}));
@@ -51,6 +52,10 @@ TEST(Manifest, ParsesSlotsCameraVerificationAndPaths) {
   EXPECT_FALSE(Manifest::FromJson(nlohmann::json::object(), "/base", "m.json").camera.per_folder);
   ASSERT_TRUE(manifest.camera.known_intrinsics);
   EXPECT_EQ((*manifest.camera.known_intrinsics)(1), 1001);
+  EXPECT_EQ(manifest.camera.calibration_required_by, "m.json: camera.require_calibration");
+  EXPECT_EQ(Manifest::FromJson(nlohmann::json::object(), "/base", "m.json")
+                .camera.calibration_required_by,
+            "");
   EXPECT_EQ(manifest.verification.max_error_px, 2.5);
   EXPECT_EQ(manifest.verification.min_num_inliers, 15);
 }
@@ -110,6 +115,8 @@ TEST(Manifest, UnknownKeysNameTheirPathAndTheClosestKey) {
   EXPECT_EQ(ErrorOf({{"camera", {{"model", "OPENCV_FISHEYE"}, {"params", {300, 300, 320, 240}}}}}),
             "m.json: camera.params: OPENCV_FISHEYE takes 8 parameters (fx, fy, cx, cy, k1, k2, "
             "k3, k4), got 4");
+  EXPECT_EQ(ErrorOf({{"camera", {{"require_calibration", "yes"}}}}),
+            "m.json: camera.require_calibration: expected true or false, got a string");
   EXPECT_EQ(ErrorOf({{"camera", {{"mask_path", 3}}}}),
             "m.json: camera.mask_path: expected a folder path");
 }

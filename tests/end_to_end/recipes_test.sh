@@ -1,7 +1,9 @@
 #!/bin/bash
 # Every recipe in manifests/ reconstructs a downscaled copy of fountain-P11 (made here, in
-# a temporary folder, at 1024 px; no K given): all 11 images in model 0, a mean camera
-# position error under 1% of the scene's extent, a mean reprojection error under 1 px.
+# a temporary folder, at 1024 px; no K given, except to a recipe that requires one,
+# `camera.require_calibration`: it must refuse to run without, and hold the set's K scaled
+# to the copy): all 11 images in model 0, a mean camera position error under 1% of the
+# scene's extent, a mean reprojection error under 1 px.
 # Prints, per recipe, verified pairs, registered images and the errors. The
 # gaussian_splatting recipe's OUTPUT/gaussian_splatting must load as the 3DGS trainer
 # loads a scene (tests/tools/check_3dgs_scene.py).
@@ -18,6 +20,37 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
 "$downscale" "$dataset/images" "$work/images" 1024 95 > /dev/null || fail "downscale"
+# The set's K for the copy's size (pixel centres at +0.5, as COLMAP's), written to
+# $work/K.txt; prints fx fy cx cy.
+python3 - "$dataset/K.txt" "$work/images/0000.jpg" "$work/K.txt" << 'PY' > "$work/K.params" ||
+import struct, sys
+K = [float(v) for v in open(sys.argv[1]).read().split()]
+data = open(sys.argv[2], "rb").read()
+at = 2  # the JPEG's frame header (SOF0/SOF2) holds its size
+while data[at + 1] not in (0xC0, 0xC2):
+    at += 2 + struct.unpack(">H", data[at + 2:at + 4])[0]
+height, width = struct.unpack(">HH", data[at + 5:at + 9])
+sx, sy = width / 3072, height / 2048
+fx, fy = K[0] * sx, K[4] * sy
+cx, cy = (K[2] + 0.5) * sx - 0.5, (K[5] + 0.5) * sy - 0.5
+open(sys.argv[3], "w").write(f"{fx!r} 0 {cx!r}\n0 {fy!r} {cy!r}\n0 0 1\n")
+print(fx, fy, cx, cy)
+PY
+  fail "scaling K.txt to the copy"
+# The parameters of model 0's camera 1 (cameras.bin), as "fx fy cx cy" for a PINHOLE one.
+camera_params() {
+  python3 - "$1/cameras.bin" << 'PY'
+import struct, sys
+data = open(sys.argv[1], "rb").read()
+camera_id, model, width, height = struct.unpack("<iiQQ", data[8:32])
+if model != 1:
+    sys.exit(f"camera {camera_id} is model {model}, not PINHOLE (1)")
+print(*struct.unpack("<4d", data[32:64]))
+PY
+}
+requires_calibration() {
+  python3 -c 'import json, sys; sys.exit(not json.load(open(sys.argv[1])).get("camera", {}).get("require_calibration", False))' "$1"
+}
 # The recipe run earlier whose detector and camera settings equal this one's, if any.
 same_features_as() {
   python3 - "$1" "$manifests" "$done_recipes" << 'PY'
@@ -46,8 +79,26 @@ for manifest in "$manifests"/*.json; do
     mkdir -p "$out" && cp "$work/$earlier/database.db" "$out/"
     echo "$recipe: starts from the workspace of $earlier"
   fi
+  given_K=()
+  if requires_calibration "$manifest"; then
+    "$tessera" run --images "$work/images" --output "$work/$recipe-no-K" --manifest "$manifest" \
+      --threads 2 2> "$out.no-K.log"
+    code=$?
+    [ "$code" = 2 ] || fail "$recipe without a K: exit $code, expected 2"
+    grep -q "camera.require_calibration: this recipe holds the intrinsics, and none were given" \
+      "$out.no-K.log" || { cat "$out.no-K.log"; fail "$recipe without a K: no clear error"; }
+    echo "$recipe: refuses to run without a K: $(grep -o 'camera.require_calibration.*' "$out.no-K.log")"
+    given_K=(--camera-K "$work/K.txt")
+  fi
   "$tessera" run --images "$work/images" --output "$out" --manifest "$manifest" \
-    --threads 2 2> "$out.log" || { tail -20 "$out.log"; fail "$recipe: tessera run"; }
+    --threads 2 "${given_K[@]}" 2> "$out.log" || { tail -20 "$out.log"; fail "$recipe: tessera run"; }
+  if [ ${#given_K[@]} -gt 0 ]; then  # the K given is the model's, to the last digit written
+    held=$(camera_params "$out/sparse/0") || fail "$recipe: reading its camera"
+    python3 -c 'import sys; a, b = (list(map(float, x.split())) for x in sys.argv[1:]); sys.exit(max(abs(p - q) for p, q in zip(a, b)) > 1e-9)' \
+      "$held" "$(cat "$work/K.params")" ||
+      fail "$recipe: the camera ($held) is not the K given ($(cat "$work/K.params"))"
+    echo "$recipe: holds the K given ($held)"
+  fi
   verified=$(sqlite3 "$out/database.db" \
     "SELECT COUNT(*) FROM two_view_geometries WHERE rows >= 15 AND config NOT IN (0, 1)")
   scores=$(model_scores "$tessera" "$out/sparse/0" "$dataset/gt") || fail "$recipe: tessera eval"

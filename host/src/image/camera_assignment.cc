@@ -75,11 +75,21 @@ double MedianOf(std::vector<double> values) {
 // that fits none of the images is refused (it was given for another resolution). Each
 // size it does not fit is named in a warning, and those images get the camera their EXIF
 // or the default focal length gives; each size whose centre lies more than 10% of the
-// image's size from the principal point is named in a warning too.
+// image's size from the principal point is named in a warning too. A recipe that holds
+// the intrinsics (settings.calibration_required_by) refuses both: no K, and an image K
+// does not fit, whose guessed focal length it would hold.
 std::vector<bool> ImagesKnownIntrinsicsFit(const std::vector<ImageEntry>& images,
                                            const CameraSettings& settings,
                                            std::vector<std::string>* warnings) {
-  if (!settings.known_intrinsics) return std::vector<bool>(images.size(), false);
+  const bool required = !settings.calibration_required_by.empty();
+  if (!settings.known_intrinsics) {
+    if (required) {
+      throw InputError(settings.calibration_required_by +
+                       ": this recipe holds the intrinsics, and none were given: pass "
+                       "--camera-K FILE, or set camera.K, camera.K_file or camera.params");
+    }
+    return std::vector<bool>(images.size(), false);
+  }
   const Eigen::Vector4d& K = *settings.known_intrinsics;
   const std::string point =
       "the principal point (" + FormatNumber(K(2)) + ", " + FormatNumber(K(3)) + ")";
@@ -105,6 +115,12 @@ std::vector<bool> ImagesKnownIntrinsicsFit(const std::vector<ImageEntry>& images
                                   : "the " + std::to_string(indices.size()) + " images of " +
                                         dimensions + " (the first '" + name + "')";
     const double dx = K(2) - width / 2.0, dy = K(3) - height / 2.0;
+    if (!fits[indices.front()] && required) {
+      throw InputError(settings.calibration_required_by +
+                       ": this recipe holds the intrinsics, and those of " +
+                       settings.known_intrinsics_source + " do not fit " + these + " (" + point +
+                       " lies outside): give them for the images' resolution");
+    }
     if (!fits[indices.front()]) {
       warnings->push_back(settings.known_intrinsics_source + ": " + point + " lies outside " +
                           these +

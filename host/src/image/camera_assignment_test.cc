@@ -346,6 +346,41 @@ TEST(AssignCameras, AKnownKAppliesToTheImagesItFitsAndNamesTheOthers) {
             "the camera");
 }
 
+// A recipe that holds the intrinsics (camera.require_calibration) refuses to guess them:
+// no K at all, or an image K does not fit, is an error naming the manifest's field.
+TEST(AssignCameras, ARecipeHoldingTheIntrinsicsRefusesImagesWithoutThem) {
+  CameraSettings settings;
+  settings.model = "PINHOLE";
+  settings.calibration_required_by = "calibrated.json: camera.require_calibration";
+  const std::vector<ImageEntry> images = {With35mm(Entry("a.jpg", 1024, 683), 50)};
+  try {
+    AssignCameras(images, settings);
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "calibrated.json: camera.require_calibration: this recipe holds the intrinsics, "
+              "and none were given: pass --camera-K FILE, or set camera.K, camera.K_file or "
+              "camera.params");
+  }
+  settings.known_intrinsics = Eigen::Vector4d(919.8, 921.8, 507.1, 335.9);
+  settings.known_intrinsics_source = "K.txt";
+  const CameraAssignment assignment = AssignCameras(images, settings);
+  ASSERT_EQ(assignment.cameras.size(), 1u);
+  const std::vector<double> expected = {919.8, 921.8, 507.1, 335.9};
+  EXPECT_EQ(assignment.cameras[0].params, expected);
+  EXPECT_EQ(assignment.cameras[0].calibration_source, CalibrationSource::kUser);
+  try {
+    AssignCameras({Entry("big.jpg", 1024, 683), Entry("small.jpg", 320, 240)}, settings);
+    FAIL() << "expected an error";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "calibrated.json: camera.require_calibration: this recipe holds the "
+              "intrinsics, and those of K.txt do not fit the 320x240 image 'small.jpg' (the "
+              "principal point (507.1, 335.9) lies outside): give them for the images' "
+              "resolution");
+  }
+}
+
 TEST(AssignCameras, RejectsAnUnknownModel) {
   CameraSettings settings;
   settings.model = "FISHEYE";

@@ -28,6 +28,11 @@ struct CameraSettings {
   // k1..k4 for OPENCV_FISHEYE), set as the initial camera; empty: none. Sets
   // known_intrinsics too.
   std::vector<double> known_params;
+  // Set when the recipe holds the intrinsics (its mapper refines none of them) and so
+  // needs them given: "MANIFEST: camera.require_calibration", for messages; empty: not
+  // required. Without known_intrinsics, or for an image they do not fit, cameras are then
+  // refused instead of made from EXIF or the default focal length, which would be held.
+  std::string calibration_required_by;
   // Folder of image masks (COLMAP's ImageReader.mask_path; see image/image_masks.h);
   // empty: none.
   std::filesystem::path mask_path;

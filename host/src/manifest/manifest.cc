@@ -68,6 +68,9 @@ CameraSettings ParseCamera(const nlohmann::json& json, const std::filesystem::pa
   camera.per_folder = reader.GetBool("per_folder", camera.per_folder);
   camera.default_focal_length_factor = reader.Get<double>(
       "default_focal_length_factor", camera.default_focal_length_factor, 0.1, 10);
+  if (reader.GetBool("require_calibration", false)) {
+    camera.calibration_required_by = "camera.require_calibration";
+  }
   const nlohmann::json K = reader.GetJson("K", nullptr);
   const nlohmann::json K_file = reader.GetJson("K_file", nullptr);
   const nlohmann::json mask_path = reader.GetJson("mask_path", nullptr);
@@ -359,6 +362,9 @@ Manifest Manifest::FromJson(const nlohmann::json& json, const std::filesystem::p
     }
 
     manifest.camera = ParseCamera(camera, base_dir);
+    if (!manifest.camera.calibration_required_by.empty()) {
+      manifest.camera.calibration_required_by.insert(0, source + ": ");
+    }
     manifest.verification = ParseVerification(verification);
     manifest.distributed = ParseDistributed(distributed);
     if (!legacy_mapper.is_null()) {
