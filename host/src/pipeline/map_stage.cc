@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <optional>
+#include <set>
 #include <string>
 
 #include "database/database_feature_reader.h"
@@ -138,6 +139,33 @@ nlohmann::json SummarizeRig(const RigFile& file, const CameraRig& rig, const Map
   return {{"file", file.path().string()},       {"digest", file.digest()},
           {"frames", file.FramesDescription()}, {"poses_known", rig.poses_known},
           {"num_frames", rig.frames.size()},    {"cameras", cameras}};
+}
+
+// A recipe that holds the intrinsics (`required_by`, camera.require_calibration) maps
+// only cameras whose intrinsics were given: one made from EXIF or the default focal
+// length by an earlier extraction is refused, as extraction would refuse to make it. A
+// camera of a COLMAP database is held as it is there, with a warning.
+void CheckCamerasGiven(const MapperInput& input, const std::string& required_by) {
+  if (required_by.empty()) return;
+  std::set<camera_t> used;
+  for (const auto& [image_id, image] : input.images) used.insert(image.camera_id);
+  for (const camera_t camera_id : used) {
+    const Camera& camera = input.cameras.at(camera_id);
+    if (camera.calibration_source == CalibrationSource::kUser) continue;
+    const std::string what = fmt::format(
+        "camera {} ({} {}x{}, focal {:.1f} px, {})", camera_id, camera.ModelName(), camera.width,
+        camera.height, camera.MeanFocalLength(), CalibrationSourceName(camera.calibration_source));
+    if (camera.calibration_source == CalibrationSource::kDatabase) {
+      spdlog::warn("map: {} comes from a COLMAP database, not from a K given to Tessera; {} "
+                   "holds it as it is there",
+                   what, required_by);
+      continue;
+    }
+    throw InputError(required_by + ": this recipe holds the intrinsics, and the workspace's " +
+                     what +
+                     " was not given them: extract again with --camera-K FILE (the cameras are "
+                     "made again; features and matches are kept)");
+  }
 }
 
 // The workspace's mapper input, with the camera rig of `rig` (may be null) over its
@@ -387,6 +415,7 @@ MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& sett
   const MapperInput& input = target.input != nullptr
                                  ? *target.input
                                  : (loaded = LoadMapperInputWithRig(*database, settings.rig));
+  CheckCamerasGiven(input, settings.calibration_required_by);
   const std::filesystem::path image_dir = ImageFolder(settings.image_dir, *database);
   const auto cancelled = [&] {
     if (!control.Cancelled()) return false;

@@ -41,6 +41,9 @@ struct MapSettings {
   // Map even when the models in place were made from the same inputs (`--force-map`);
   // else such models are kept (map_inputs.h).
   bool force = false;
+  // The manifest's camera.calibration_required_by: its mapper holds the intrinsics, so a
+  // camera whose intrinsics were guessed (EXIF, the default) is refused; empty: any.
+  std::string calibration_required_by;
 };
 
 // The mapping summary of a mapper result: models (sparse_dir/<index>), why images were

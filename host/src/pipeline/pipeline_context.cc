@@ -129,6 +129,7 @@ MapSettings PipelineContext::MakeMapSettings(const std::filesystem::path& image_
   settings.image_dir = image_dir;
   settings.mask_dir = manifest.camera.mask_path;
   settings.rig = rig ? &*rig : nullptr;
+  settings.calibration_required_by = manifest.camera.calibration_required_by;
   return settings;
 }
 
