@@ -9,6 +9,8 @@
 #  - Candidates of the features or the camera (more features, full resolution, another
 #    matcher ratio, another camera model, the set's K.txt given and held) run the whole
 #    pipeline (`tessera run`).
+# A recipe that requires a calibration (camera.require_calibration, calibrated.json) gets
+# the set's K.txt in every run, and the camera candidates are left out: it holds K.
 # usage: benchmarks/accuracy_candidates.sh OUT SET [MANIFEST]
 #   SET: a folder of ../shared/datasets with images/, gt/ (*.camera) and K.txt
 #   (fountain-P11, Herz-Jesus-P8). One thread per run (TESSERA_THREADS to change it).
@@ -63,7 +65,7 @@ timed() {
   shift 2
   local start end code
   start=$(date +%s.%N)
-  "$tessera" "$@" --threads "$threads" > "$out/$name.log" 2>&1
+  "$tessera" "$@" --threads "$threads" "${given_K[@]}" > "$out/$name.log" 2>&1
   code=$?
   end=$(date +%s.%N)
   row "$name" "$stage" "$(python3 -c "print(f'{$end - $start:.1f}')")" "$code"
@@ -85,6 +87,10 @@ map_only() {  # NAME with OUT/NAME.json, on a copy of the recipe's database
   timed "$name" "map" map --output "$out/$name" --manifest "$out/$name.json"
 }
 
+given_K=()
+if python3 -c 'import json, sys; sys.exit(not json.load(open(sys.argv[1])).get("camera", {}).get("require_calibration", False))' "$manifest"; then
+  given_K=(--camera-K "$data/K.txt")
+fi
 mapper=pipeline.mapper.options
 adjuster=pipeline.bundle_adjuster.options
 detector=pipeline.detector.options
@@ -108,6 +114,7 @@ variant final-ba-converged "${converged[@]}" && map_only final-ba-converged
 variant features-24000 "$detector.max_num_features=24000" && whole features-24000
 variant full-resolution "$detector.max_image_size=3072" && whole full-resolution
 variant ratio-0.85 "pipeline.matcher.options.ratio=0.85" && whole ratio-0.85
+[ ${#given_K[@]} -gt 0 ] && exit 0  # the camera is given and held
 for model in SIMPLE_PINHOLE PINHOLE RADIAL OPENCV; do
   variant "camera-$model" "camera.model=\"$model\"" && whole "camera-$model"
 done

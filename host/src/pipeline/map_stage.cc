@@ -156,9 +156,10 @@ void CheckCamerasGiven(const MapperInput& input, const std::string& required_by)
         "camera {} ({} {}x{}, focal {:.1f} px, {})", camera_id, camera.ModelName(), camera.width,
         camera.height, camera.MeanFocalLength(), CalibrationSourceName(camera.calibration_source));
     if (camera.calibration_source == CalibrationSource::kDatabase) {
-      spdlog::warn("map: {} comes from a COLMAP database, not from a K given to Tessera; {} "
-                   "holds it as it is there",
-                   what, required_by);
+      spdlog::warn(
+          "map: {} comes from a COLMAP database, not from a K given to Tessera; {} "
+          "holds it as it is there",
+          what, required_by);
       continue;
     }
     throw InputError(required_by + ": this recipe holds the intrinsics, and the workspace's " +
