@@ -1,5 +1,7 @@
 #include "image/camera_assignment.h"
 
+#include <spdlog/fmt/fmt.h>
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -138,6 +140,12 @@ std::vector<bool> ImagesKnownIntrinsicsFit(const std::vector<ImageEntry>& images
 }
 
 }  // namespace
+
+std::string DescribeCamera(const Camera& camera) {
+  return fmt::format("camera {} ({} {}x{}, focal {:.1f} px, {})", camera.camera_id,
+                     camera.ModelName(), camera.width, camera.height, camera.MeanFocalLength(),
+                     CalibrationSourceName(camera.calibration_source));
+}
 
 double FieldOfViewDeg(double focal_px, double longer_side_px) {
   return 2 * std::atan(longer_side_px / 2 / focal_px) * 180 / kPi;

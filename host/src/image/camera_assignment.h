@@ -36,6 +36,9 @@ bool IsPlausibleFocalLength(double focal_px, double longer_side_px);
 // for an image at the top level.
 std::string ImageFolder(const std::string& image_name);
 
+// A camera for messages: "camera 1 (SIMPLE_RADIAL 640x480, focal 768.0 px, default)".
+std::string DescribeCamera(const Camera& camera);
+
 struct FocalLengthPrior {
   double focal_px;
   CalibrationSource source;

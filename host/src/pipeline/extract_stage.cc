@@ -203,10 +203,7 @@ std::string DescribeCameras(const std::vector<Camera>& cameras) {
   constexpr size_t kMaxShown = 3;
   std::string text;
   for (size_t k = 0; k < cameras.size() && k < kMaxShown; ++k) {
-    const Camera& camera = cameras[k];
-    text += fmt::format("{}camera {} ({} {}x{}, focal {:.1f} px, {})", k > 0 ? ", " : "",
-                        camera.camera_id, camera.ModelName(), camera.width, camera.height,
-                        camera.MeanFocalLength(), CalibrationSourceName(camera.calibration_source));
+    text += (k > 0 ? ", " : "") + DescribeCamera(cameras[k]);
   }
   if (cameras.size() > kMaxShown) text += fmt::format(" and {} more", cameras.size() - kMaxShown);
   return text;

@@ -152,9 +152,7 @@ void CheckCamerasGiven(const MapperInput& input, const std::string& required_by)
   for (const camera_t camera_id : used) {
     const Camera& camera = input.cameras.at(camera_id);
     if (camera.calibration_source == CalibrationSource::kUser) continue;
-    const std::string what = fmt::format(
-        "camera {} ({} {}x{}, focal {:.1f} px, {})", camera_id, camera.ModelName(), camera.width,
-        camera.height, camera.MeanFocalLength(), CalibrationSourceName(camera.calibration_source));
+    const std::string what = DescribeCamera(camera);
     if (camera.calibration_source == CalibrationSource::kDatabase) {
       spdlog::warn(
           "map: {} comes from a COLMAP database, not from a K given to Tessera; {} "
