@@ -38,14 +38,13 @@ for focal in "$@"; do
     --manifest manifests/calibrated.json --camera-K "$out/$name.K.txt" \
     --threads "${TESSERA_THREADS:-2}" > "$out/$name.log" 2>&1
   code=$?
-  mean="-" median="-" rotation="-"
+  scores="- | - | -"
   if [ "$code" = 0 ]; then
     [ -z "$first" ] && first=$name
-    scores=$("$tessera" eval "$out/$name/sparse/0" "$data/gt" 2> /dev/null)
-    read -r mean median <<< "$(sed -n 's/^position error (ground-truth units): mean \([^,]*\), median \([^,]*\),.*/\1 \2/p' <<< "$scores")"
-    mean=$(python3 -c "print(f'{1000 * $mean:.2f}')")
-    median=$(python3 -c "print(f'{1000 * $median:.2f}')")
-    rotation=$(sed -n 's/^rotation error (deg): mean \([^,]*\),.*/\1/p' <<< "$scores")
+    scores=$("$tessera" eval --json "$out/$name/sparse/0" "$data/gt" 2> /dev/null | python3 -c '
+import json, sys
+e = json.load(sys.stdin)
+print("%.2f | %.2f | %.4f" % (1000 * e["pos_mean"], 1000 * e["pos_median"], e["rot_mean_deg"]))')
   fi
-  echo "| $set_name | $fx | $fy | $mean | $median | $rotation | $code |"
+  echo "| $set_name | $fx | $fy | $scores | $code |"
 done
