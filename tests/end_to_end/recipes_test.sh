@@ -19,20 +19,15 @@ require_dataset "$dataset"
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 
-"$downscale" "$dataset/images" "$work/images" 1024 95 > /dev/null || fail "downscale"
-# The set's K for the copy's size (pixel centres at +0.5, as COLMAP's), written to
-# $work/K.txt; prints fx fy cx cy.
-python3 - "$dataset/K.txt" "$work/images/0000.jpg" "$work/K.txt" << 'PY' > "$work/K.params" ||
-import struct, sys
+scale=$("$downscale" "$dataset/images" "$work/images" 1024 95) || fail "downscale"
+# The set's K for the copy (the scale the tool printed; pixel centres at +0.5, as
+# COLMAP's), written to $work/K.txt; prints fx fy cx cy.
+python3 - "$dataset/K.txt" "$scale" "$work/K.txt" << 'PY' > "$work/K.params" ||
+import sys
 K = [float(v) for v in open(sys.argv[1]).read().split()]
-data = open(sys.argv[2], "rb").read()
-at = 2  # the JPEG's frame header (SOF0/SOF2) holds its size
-while data[at + 1] not in (0xC0, 0xC2):
-    at += 2 + struct.unpack(">H", data[at + 2:at + 4])[0]
-height, width = struct.unpack(">HH", data[at + 5:at + 9])
-sx, sy = width / 3072, height / 2048
-fx, fy = K[0] * sx, K[4] * sy
-cx, cy = (K[2] + 0.5) * sx - 0.5, (K[5] + 0.5) * sy - 0.5
+s = float(sys.argv[2])
+fx, fy = K[0] * s, K[4] * s
+cx, cy = (K[2] + 0.5) * s - 0.5, (K[5] + 0.5) * s - 0.5
 open(sys.argv[3], "w").write(f"{fx!r} 0 {cx!r}\n0 {fy!r} {cy!r}\n0 0 1\n")
 print(fx, fy, cx, cy)
 PY
