@@ -27,7 +27,7 @@
 // abi_headers.sha256 records it with a hash of every header here, comments and whitespace
 // excluded: the test sdk_abi_check fails when a header changes without a bump (bump it,
 // then run scripts/sdk_abi_check.py --update).
-#define TESSERA_PLUGIN_ABI_VERSION 10
+#define TESSERA_PLUGIN_ABI_VERSION 11
 
 extern "C" {
 // How a binary was built, as far as the C++ objects that cross the plugin boundary
