@@ -79,12 +79,13 @@ found = {(p["kind"], p["name"]): p for p in plugins if p["usable"]}
 assert ("detector", "sift") in found, "bundled sift not found by the installed binary"
 for kind, name in [("detector", "akaze"), ("matcher", "symmetric_ratio"),
                    ("pair_selector", "window_stride"), ("mapper", "strict"),
+                   ("mapper", "stepwise_global"),
                    ("bundle_adjuster", "cauchy"), ("bundle_adjuster", "robust"),
                    ("bundle_adjuster", "pass_through"), ("exporter", "bundler")]:
     assert (kind, name) in found, "%s %s not listed as usable" % (kind, name)
     folder = os.path.dirname(os.path.realpath(found[(kind, name)]["file"]))
     assert folder == os.path.realpath(sys.argv[2]), (kind, name, folder)
-print("plugins --json lists the eight out-of-tree plugins")
+print("plugins --json lists the nine out-of-tree plugins")
 PY
 
 mkdir -p "$work/images"
@@ -168,6 +169,30 @@ for file in cameras.bin images.bin points3D.bin; do
     { echo "pass_through around ceres gave another $file than ceres"; exit 1; }
 done
 echo "robust (Tessera::ceres, Huber) registers 4 of 4; pass_through around ceres gives ceres' model"
+
+# A mapper on the global mapper's public steps (docs/plugins/mapper.md): the sample's 11
+# images, every step but retriangulation, then the finishing step.
+python3 - "$work/prefix/share/tessera/manifests/global.json" "$work/stepwise.json" <<'PY'
+import json, sys
+manifest = json.load(open(sys.argv[1]))
+manifest["plugin_paths"] = ["build/plugins"]
+manifest["pipeline"]["mapper"]["plugin"] = "stepwise_global"
+json.dump(manifest, open(sys.argv[2], "w"))
+PY
+"$tessera" run --images "$examples" --output "$work/stepwise" --manifest "$work/stepwise.json" \
+  2> "$work/stepwise.log" || { cat "$work/stepwise.log"; exit 1; }
+grep -q "stepwise: 1 model(s) without retriangulation" "$work/stepwise.log" &&
+  ! grep -q "retriangulated" "$work/stepwise.log" ||
+  { cat "$work/stepwise.log"; echo "stepwise_global did not run the steps it chose"; exit 1; }
+python3 - "$work/stepwise/mapping_summary.json" <<'PY' || { cat "$work/stepwise.log"; exit 1; }
+import json, sys
+summary = json.load(open(sys.argv[1]))
+model = summary["models"][0]
+assert model["num_images"] == 11, model
+# FinishModels' self-check against the view graph, as for every mapper.
+assert model["view_graph_check"]["verified_pairs"] > 0, model["view_graph_check"]
+PY
+echo "stepwise_global (the global mapper's steps, one by one) registers 11 of 11"
 
 # Through the host's services a crash in the wrapped adjuster is named as the host names
 # a crash of its own plugins (exit code 4), and a wrong name, kind or option is one line

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <set>
 
-#include "partition/cluster_calibration.h"
 #include "partition/partition_stage.h"
 #include "pipeline/load_mapper_input.h"
 #include "pipeline/map_stage.h"
@@ -13,6 +12,7 @@
 #include "pipeline/workspace.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
+#include "tessera/sfm/first_model_calibration.h"
 #include "util/workspace_layout.h"
 
 namespace tessera {

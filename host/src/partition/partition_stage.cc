@@ -10,11 +10,13 @@
 
 #include "distributed/shard_database.h"
 #include "image/camera_assignment.h"
-#include "partition/cluster_calibration.h"
 #include "partition/rotation_consistent_pairs.h"
 #include "pipeline/load_mapper_input.h"
 #include "plugin/bundle_adjuster_guard.h"
 #include "tessera/errors.h"
+#include "tessera/sfm/first_model_calibration.h"
+#include "tessera/sfm/global_mapper_options.h"
+#include "tessera/sfm/verified_pairs.h"
 #include "util/random.h"
 #include "util/timer.h"
 
@@ -83,14 +85,22 @@ std::vector<WeightedEdge> EdgesThatWeighInTheCut(const MapperInput& input, const
   return edges;
 }
 
-// The focal lengths of the cameras without a prior, found once for every cluster
-// (cluster_calibration.h), logged; `input` takes them.
+// The focal lengths of the cameras without a prior, found once for every cluster, by the
+// mappers' own rule (tessera/sfm/first_model_calibration.h) over the pairs the global
+// mapper maps, logged; `input` takes them. Calibrated within a cluster, from its few
+// pairs, a focal length can be far off (fox in clusters of 30: one cluster of 19 images
+// took 671 px against 1,376 px and its model came out folded, so its merge was refused),
+// and clusters with different focal lengths do not fit one another in the merge.
 std::vector<FocalLengthReport> CalibrateForClusters(const PipelineContext& context,
                                                     const Workspace& workspace,
                                                     MapperInput* input) {
   const BundleAdjusterGuard adjuster(context.bundle_adjuster, &workspace.crash_log());
-  std::vector<FocalLengthReport> calibration = CalibrateCamerasWithoutPrior(
-      *input, adjuster, DeriveSeed(context.manifest.seed, kCalibrationStream));
+  const MapperRunState run(*input, adjuster, DeriveSeed(context.manifest.seed, kCalibrationStream));
+  const std::vector<FocalLengthReport> calibration =
+      CalibrateCamerasWithoutPrior(
+          run, VerifiedPairs(*input, static_cast<size_t>(GlobalMapperOptions().min_num_matches)),
+          FirstModelCalibrationOptions())
+          .reports;
   for (const FocalLengthReport& camera : calibration) {
     spdlog::info(
         "partition: camera {}: focal length {:.1f} px (it had no prior; default {:.1f} px) from "

@@ -30,7 +30,7 @@ struct PairGraph {
 PairGraph LoadPairGraph(const Database& database);
 
 // Calibrates the cameras without a focal prior once for every cluster
-// (cluster_calibration.h, with the context's bundle adjuster), cuts the workspace's view
+// (tessera/sfm/first_model_calibration.h, with the context's bundle adjuster), cuts the workspace's view
 // graph by the manifest's `distributed` settings, writes OUTPUT/clusters.json atomically
 // and logs the cut. Throws InputError naming the database when it has no verified pair.
 ClustersFile PartitionWorkspace(const Workspace& workspace, const PipelineContext& context);

@@ -1,5 +1,7 @@
 #include "tessera/sfm/first_model_calibration.h"
 
+#include <spdlog/spdlog.h>
+
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -109,6 +111,97 @@ std::map<camera_t, FirstModelFocalLength> FocalLengthsFromFirstModels(
     pairs = std::move(remaining);
   }
   return refined;
+}
+
+CameraCalibration CalibrateCamerasWithoutPrior(const MapperRunState& run,
+                                               const std::vector<const MapperInput::Pair*>& pairs,
+                                               const FirstModelCalibrationOptions& options) {
+  CameraCalibration calibration;
+  calibration.cameras = run.cameras;
+  std::map<camera_t, FocalLengthReport> by_camera;
+  for (const auto& [camera_id, camera] : calibration.cameras) {
+    if (camera.has_prior_focal_length) continue;
+    FocalLengthReport& report = by_camera[camera_id];
+    report.camera_id = camera_id;
+    report.initial = report.estimated = camera.MeanFocalLength();
+  }
+  if (by_camera.empty() || pairs.empty()) return calibration;
+
+  // 1. From the fundamental matrices, where they determine it.
+  std::set<camera_t> clear_minimum;
+  for (const auto& [camera_id, estimate] :
+       EstimateFocalLengths(run.input, pairs, options.view_graph)) {
+    if (by_camera.count(camera_id) == 0 || estimate.num_pairs == 0) continue;
+    if (estimate.at_search_bound) {
+      spdlog::info(
+          "map: camera {}: the image pairs do not determine its focal length (their best fit "
+          "lies at the end of the range searched, as when every camera aims at one point)",
+          camera_id);
+      continue;
+    }
+    calibration.cameras.at(camera_id).SetFocalLength(estimate.focal_length);
+    FocalLengthReport& report = by_camera.at(camera_id);
+    report.estimated = estimate.focal_length;
+    report.method = "view graph";
+    report.num_pairs = estimate.num_pairs;
+    spdlog::debug("map: camera {}: {:.1f} px from {} pairs' fundamental matrices (cost {:.3f})",
+                  camera_id, estimate.focal_length, estimate.num_pairs, estimate.cost);
+    if (estimate.cost <= kClearFocalMinimumCost) clear_minimum.insert(camera_id);
+  }
+
+  // 2. Refined by bundle adjustment in a first model, mapped once for that alone: with
+  // the structure of many views the focal length is well determined even where pairs
+  // leave it open. The first model holds one scene; where the photos hold several
+  // (several cameras, as in a mixed folder), the cameras it leaves out get first models
+  // of their own, from the pairs among their images.
+  std::set<camera_t> unrefined;
+  for (const auto& [camera_id, report] : by_camera) {
+    if (options.min_view_graph_pairs > 0 && clear_minimum.count(camera_id) > 0 &&
+        report.num_pairs >= static_cast<size_t>(options.min_view_graph_pairs)) {
+      continue;
+    }
+    unrefined.insert(camera_id);
+  }
+  MapperRunState first_models(run.input, run.bundle_adjuster, run.seed);
+  first_models.ransac = run.ransac;
+  first_models.cameras = calibration.cameras;
+  for (const auto& [camera_id, refined] :
+       FocalLengthsFromFirstModels(options.first_model, first_models, unrefined, pairs)) {
+    unrefined.erase(camera_id);
+    if (refined.focal_length == 0) continue;  // implausible: the mapper refines it
+    calibration.cameras.at(camera_id).SetFocalLength(refined.focal_length);
+    FocalLengthReport& report = by_camera.at(camera_id);
+    report.estimated = refined.focal_length;
+    report.method = report.method.empty() ? "first model" : report.method + ", first model";
+    report.num_images = refined.num_images;
+  }
+  // 3. What neither determines keeps the estimate, or its default.
+  for (const camera_t camera_id : unrefined) {
+    spdlog::info(
+        "map: camera {}: no first model of {} images or more to refine its focal length "
+        "from; mapping starts from {:.1f} px",
+        camera_id, kMinFirstModelImages, by_camera.at(camera_id).estimated);
+  }
+  for (const auto& [camera_id, report] : by_camera) {
+    if (report.method.empty()) continue;
+    spdlog::info(
+        "map: camera {} has no focal-length prior: mapping starts from {:.1f} px (from the {}{}) "
+        "instead of the default {:.1f} px",
+        camera_id, report.estimated, report.method,
+        report.num_images > 0 ? fmt::format(" of {} images", report.num_images) : "",
+        report.initial);
+    calibration.reports.push_back(report);
+  }
+  return calibration;
+}
+
+void ApplyCalibration(const std::vector<FocalLengthReport>& calibration, MapperInput* input) {
+  for (const FocalLengthReport& report : calibration) {
+    const auto camera = input->cameras.find(report.camera_id);
+    if (camera == input->cameras.end()) continue;
+    camera->second.SetFocalLength(report.estimated);
+    camera->second.has_prior_focal_length = true;
+  }
 }
 
 }  // namespace tessera

@@ -9,7 +9,7 @@
 
 #include "tessera/io/model_statistics.h"
 #include "tessera/sfm/feature_tracks.h"
-#include "tessera/sfm/focal_length_estimation.h"
+#include "tessera/sfm/first_model_calibration.h"
 #include "tessera/sfm/global_positioning.h"
 #include "tessera/sfm/model_finishing.h"
 #include "tessera/sfm/rotation_averaging.h"
@@ -142,10 +142,6 @@ size_t NumObservationsOf(const Reconstruction& model) {
   return n;
 }
 
-}  // namespace
-
-namespace {
-
 // The inlier matches of every verified pair with at least min_num_matches inliers between
 // two input images.
 std::vector<ImagePairMatches> VerifiedPairMatches(const MapperInput& input,
@@ -166,217 +162,6 @@ std::vector<Track> TracksWithin(const FeatureTracks& tracks, const std::set<imag
     if (restricted.size() >= 2) within.push_back(std::move(restricted));
   }
   return within;
-}
-
-// What mapping one connected part of the view graph shares with the whole run.
-struct PartRun {
-  const MapperInput& input;
-  const std::map<camera_t, Camera>& cameras;
-  const GlobalMapperOptions& options;
-  const std::function<bool()>& should_stop;
-  GlobalMapperResult* result;
-  std::map<image_t, std::string>* reasons;
-  std::function<void(double*)> lap;  // adds the time since the last lap to a step
-
-  bool Stop() const { return should_stop && should_stop(); }
-};
-
-enum class PartOutcome { kModel, kNoModel, kCancelled };
-
-// Steps 6 and 7 for one part: its tracks (those positioned chosen among them), global
-// positioning from a random start, and the model of the positioned images and points,
-// filtered by angles.
-PartOutcome PositionPart(const PartRun& run, size_t part_index, const std::set<image_t>& part,
-                         const FeatureTracks& tracks, const RotationAveragingResult& rotations,
-                         Reconstruction* model_out) {
-  PauseIfTestAsks("global_map.positioning_part");
-  const MapperInput& input = run.input;
-  const std::map<camera_t, Camera>& cameras = run.cameras;
-  const GlobalMapperOptions& options = run.options;
-  const std::function<bool()>& should_stop = run.should_stop;
-  GlobalMapperResult& result = *run.result;
-  GlobalMapperResult::StepSeconds& steps = result.step_seconds;
-  std::map<image_t, std::string>& reasons = *run.reasons;
-  const auto& lap = run.lap;
-  const auto stop = [&run] { return run.Stop(); };
-  // 6. Tracks of the part and global positioning.
-  const std::vector<Track> part_tracks = TracksWithin(tracks, part);
-  std::vector<Track> positioning_tracks;
-  for (const size_t t :
-       SelectTracks(part_tracks, part, static_cast<size_t>(options.tracks_min_length),
-                    static_cast<size_t>(options.tracks_max_per_image))) {
-    positioning_tracks.push_back(part_tracks[t]);
-  }
-  result.num_tracks_positioned += positioning_tracks.size();
-  lap(&steps.tracks);
-  std::map<image_t, Eigen::Matrix3d> part_rotations;
-  for (const image_t image_id : part) {
-    part_rotations[image_id] = rotations.R_cam_from_world.at(image_id);
-  }
-  GlobalPositioningOptions positioning_options;
-  positioning_options.max_num_iterations = options.gp_max_num_iterations;
-  positioning_options.huber_threshold = options.gp_huber_threshold;
-  positioning_options.num_threads = options.num_threads;
-  positioning_options.seed = DeriveSeed(options.seed, kPositioningStream + part_index);
-  const GlobalPositioningResult positions = PositionGlobally(
-      cameras, input.images, part_rotations, positioning_tracks, positioning_options, should_stop);
-  if (positions.cancelled || stop()) return PartOutcome::kCancelled;
-  lap(&steps.positioning);
-  spdlog::info(
-      "global map: part {} ({} images): positioned with {} tracks in {} iterations, cost "
-      "{:.3g} -> {:.3g}",
-      part_index, part.size(), positioning_tracks.size(), positions.num_iterations,
-      positions.initial_cost, positions.final_cost);
-  if (!positions.usable) {
-    for (const image_t image_id : part) reasons[image_id] = "global positioning failed";
-    return PartOutcome::kNoModel;
-  }
-
-  // 7. The model: the positioned images and points, filtered by angles.
-  Reconstruction& model = *model_out;
-  for (const image_t image_id : part) {
-    const auto center = positions.centers.find(image_id);
-    if (center == positions.centers.end()) {
-      reasons[image_id] = "no feature track joins it to the other images of its part";
-      continue;
-    }
-    Image image = input.images.at(image_id);
-    for (Point2D& point2D : image.points2D) point2D.point3D_id = kInvalidPoint3DId;
-    const Eigen::Quaterniond rotation(part_rotations.at(image_id));
-    image.cam_from_world = Rigid3d(rotation, rotation * -center->second);
-    image.registered = true;
-    model.cameras[image.camera_id] = cameras.at(image.camera_id);
-    model.images[image_id] = std::move(image);
-  }
-  for (size_t t = 0; t < positioning_tracks.size(); ++t) {
-    Point3D point3D;
-    point3D.xyz = positions.points[t];
-    const point3D_t point3D_id = t + 1;
-    for (const TrackElement& element : positioning_tracks[t]) {
-      Point2D& point2D = model.images.at(element.image_id).points2D.at(element.point2D_idx);
-      if (point2D.HasPoint3D()) continue;
-      point2D.point3D_id = point3D_id;
-      point3D.track.push_back(element);
-    }
-    if (point3D.track.size() >= 2) {
-      model.points3D.emplace(point3D_id, std::move(point3D));
-    } else {
-      for (const TrackElement& element : point3D.track) {
-        model.images.at(element.image_id).points2D.at(element.point2D_idx).point3D_id =
-            kInvalidPoint3DId;
-      }
-    }
-  }
-  const size_t num_by_angle = FilterObservationsByAngle(options.filter_max_angle_error, &model);
-  const size_t num_by_tri_angle =
-      FilterPointsByTriangulationAngle(options.filter_min_tri_angle, &model);
-  RemoveWeakImages(options.min_num_observations_per_image, "after global positioning", &model,
-                   &reasons);
-  spdlog::info(
-      "global map: part {}: {} images, {} points after filtering {} observations by ray angle "
-      "and {} by triangulation angle",
-      part_index, model.images.size(), model.points3D.size(), num_by_angle, num_by_tri_angle);
-  return PartOutcome::kModel;
-}
-
-// Step 8 for one part: rounds of bundle adjustment and filtering, then rounds of
-// retriangulation of `retriangulation_tracks` and adjustment; kModel when the model keeps
-// enough images.
-PartOutcome RefinePart(const PartRun& run, size_t part_index, const BundleAdjuster& bundle_adjuster,
-                       const std::vector<Track>& retriangulation_tracks,
-                       Reconstruction* model_out) {
-  const GlobalMapperOptions& options = run.options;
-  GlobalMapperResult& result = *run.result;
-  GlobalMapperResult::StepSeconds& steps = result.step_seconds;
-  std::map<image_t, std::string>& reasons = *run.reasons;
-  const auto& lap = run.lap;
-  const auto stop = [&run] { return run.Stop(); };
-  Reconstruction& model = *model_out;
-  // 8. Bundle adjustment and filtering, retriangulation.
-  BundleAdjustmentConfig config;
-  config.refine_focal_length = options.ba_refine_focal_length;
-  config.refine_principal_point = options.ba_refine_principal_point;
-  config.refine_extra_params = options.ba_refine_extra_params;
-  config.max_num_iterations = options.ba_max_num_iterations;
-  config.function_tolerance = options.ba_function_tolerance;
-  bool failed = false;
-  // Adjusts (when `adjust`), then filters; returns whether the filters changed the model.
-  const auto adjust_and_filter = [&](double max_reproj_error, const std::string& when,
-                                     bool adjust) {
-    if (model.images.size() < 2 || model.points3D.empty()) return false;
-    lap(&steps.filtering);
-    if (!adjust) {
-      spdlog::info("global map: part {}: {}: no bundle adjustment, nothing changed since the last",
-                   part_index, when);
-    } else {
-      const BundleAdjustmentSummary summary = bundle_adjuster.Adjust(config, &model);
-      ++result.num_bundle_adjustments;
-      lap(&steps.bundle_adjustment);
-      spdlog::info("global map: part {}: {}: bundle adjustment {}", part_index, when,
-                   summary.BriefReport());
-      if (!summary.usable) {
-        failed = true;
-        for (const auto& [image_id, image] : model.images) {
-          reasons[image_id] = "bundle adjustment failed: " + summary.message;
-        }
-        return false;
-      }
-    }
-    const size_t num_images = model.images.size();
-    const size_t num_by_error = FilterObservationsByReprojectionError(max_reproj_error, &model);
-    const size_t num_by_angle =
-        FilterPointsByTriangulationAngle(options.filter_min_tri_angle, &model);
-    RemoveWeakImages(options.min_num_observations_per_image, when, &model, &reasons);
-    spdlog::info(
-        "global map: part {}: {} observations beyond {:g} px and {} by triangulation angle "
-        "filtered; {} images, {} points, {} observations",
-        part_index, num_by_error, max_reproj_error, num_by_angle, model.images.size(),
-        model.points3D.size(), NumObservationsOf(model));
-    return num_by_error + num_by_angle > 0 || model.images.size() != num_images;
-  };
-  // A round whose model did not change since the last adjustment only filters (at its
-  // lower threshold): adjusting again would not move anything.
-  bool changed = true;
-  for (int round = 0; round < options.ba_num_rounds && !failed; ++round) {
-    if (stop()) return PartOutcome::kCancelled;
-    const double factor = std::max(1, options.ba_num_rounds - round);
-    changed = adjust_and_filter(factor * options.filter_max_reproj_error,
-                                "round " + std::to_string(round + 1), changed);
-  }
-  for (int round = 0; round < kMaxRetriangulationRounds && options.retriangulate && !failed;
-       ++round) {
-    if (stop()) return PartOutcome::kCancelled;
-    TrackTriangulationOptions triangulation;
-    triangulation.max_error_px = options.tri_max_error;
-    triangulation.min_angle_deg = options.tri_min_angle;
-    const size_t num_points = TriangulateTracks(retriangulation_tracks, triangulation, &model);
-    spdlog::info("global map: part {}: retriangulated {} of {} tracks", part_index, num_points,
-                 retriangulation_tracks.size());
-    config.max_num_iterations = options.final_ba_max_num_iterations;
-    config.function_tolerance = options.final_ba_function_tolerance;
-    std::map<image_t, Eigen::Vector3d> centers;
-    for (const auto& [image_id, image] : model.images) centers[image_id] = image.ProjectionCenter();
-    adjust_and_filter(options.filter_max_reproj_error,
-                      "after retriangulation " + std::to_string(round + 1), true);
-    const double shift = LargestCenterShift(centers, model);
-    if (shift <= kMaxSettledShift) break;
-    if (round + 1 < kMaxRetriangulationRounds) {
-      spdlog::info(
-          "global map: part {}: the adjustment moved a camera by {:.1f}% of the cameras' spread: "
-          "retriangulating again",
-          part_index, 100 * shift);
-    }
-  }
-  if (failed) return PartOutcome::kNoModel;
-  if (model.images.size() < static_cast<size_t>(options.min_model_size)) {
-    for (const auto& [image_id, image] : model.images) {
-      reasons[image_id] = "its model kept only " + std::to_string(model.images.size()) +
-                          " images, fewer than min_model_size (" +
-                          std::to_string(options.min_model_size) + ")";
-    }
-    return PartOutcome::kNoModel;
-  }
-  return PartOutcome::kModel;
 }
 
 // Why each input image is in no model: no verified pair, none kept by the view graph,
@@ -409,51 +194,6 @@ void ExplainUnregistered(const MapperInput& input, const GlobalMapperOptions& op
     }
     result.unregistered_reasons[image_id] = reason;
   }
-}
-
-// The verified pairs with at least min_num_matches inliers between two input images, and
-// at least min_relative_pair_strength of the inliers of the strongest pair of each image
-// (the others are counted in result->num_weak_pairs_set_aside); the images they join
-// into `in_verified_pair`.
-std::vector<const MapperInput::Pair*> PairsThatMap(const MapperInput& input,
-                                                   const GlobalMapperOptions& options,
-                                                   std::set<image_t>* in_verified_pair,
-                                                   GlobalMapperResult* result) {
-  const std::vector<const MapperInput::Pair*> pairs =
-      VerifiedPairs(input, static_cast<size_t>(options.min_num_matches));
-  // Weak pairs set aside (GlobalMapperOptions::min_relative_pair_strength).
-  std::vector<const MapperInput::Pair*> strong =
-      StrongPairs(pairs, options.min_relative_pair_strength);
-  result->num_weak_pairs_set_aside += pairs.size() - strong.size();
-  for (const MapperInput::Pair* pair : strong) {
-    in_verified_pair->insert(pair->image_id1);
-    in_verified_pair->insert(pair->image_id2);
-  }
-  result->num_verified_pairs = strong.size();
-  return strong;
-}
-
-// The input's cameras, those without a prior with the focal length the view graph gives
-// where the pairs determine it (recorded in result->estimated_focal_lengths).
-std::map<camera_t, Camera> CamerasWithFocalLengths(
-    const MapperInput& input, const std::vector<const MapperInput::Pair*>& pairs,
-    const GlobalMapperOptions& options, GlobalMapperResult* result) {
-  std::map<camera_t, Camera> cameras = input.cameras;
-  bool any_without_prior = false;
-  for (const auto& [camera_id, camera] : cameras) {
-    any_without_prior = any_without_prior || !camera.has_prior_focal_length;
-  }
-  if (options.estimate_focal_length && any_without_prior && !pairs.empty()) {
-    for (const auto& [camera_id, estimate] :
-         EstimateFocalLengths(input, pairs, FocalLengthEstimationOptions())) {
-      if (estimate.at_search_bound || estimate.num_pairs == 0) continue;
-      cameras.at(camera_id).SetFocalLength(estimate.focal_length);
-      result->estimated_focal_lengths[camera_id] = estimate.focal_length;
-      spdlog::info("global map: camera {}: focal length {:.1f} px from {} pairs", camera_id,
-                   estimate.focal_length, estimate.num_pairs);
-    }
-  }
-  return cameras;
 }
 
 RotationAveragingOptions RotationOptions(const GlobalMapperOptions& options) {
@@ -517,133 +257,359 @@ const char* StepName(const GlobalMapperResult::StepSeconds& steps, const double*
   return "filtering";
 }
 
-GlobalMapperResult CancelledResult(double seconds) {
-  GlobalMapperResult empty;
-  empty.cancelled = true;
-  empty.seconds = seconds;
-  spdlog::info("global map: stopped after {:.1f} s", empty.seconds);
-  return empty;
-}
-
 }  // namespace
 
-GlobalMapperResult GlobalMapper::Reconstruct(
-    const MapperInput& input, const BundleAdjuster& bundle_adjuster,
-    const GlobalMapperOptions& options, std::function<bool()> should_stop,
-    const std::function<void(const std::string&, size_t, size_t)>& on_progress) {
-  options.Check();
-  const auto start_time = std::chrono::steady_clock::now();
-  GlobalMapperResult result;
-  const auto seconds = [&start_time] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time).count();
-  };
-  auto lap_start = start_time;
-  GlobalMapperResult::StepSeconds& steps = result.step_seconds;
-  // Adds the time since the last lap to `step`, and reports the step done.
-  const auto lap = [&lap_start, &steps, &on_progress](double* step) {
-    const auto now = std::chrono::steady_clock::now();
-    *step += std::chrono::duration<double>(now - lap_start).count();
-    lap_start = now;
-    if (on_progress) on_progress(StepName(steps, step), 1, 1);
-  };
-  const auto stop = [&should_stop] { return should_stop && should_stop(); };
-  const auto cancelled = [&] { return CancelledResult(seconds()); };
-  if (stop()) return cancelled();
-  // 1. The pairs that map.
-  std::set<image_t> in_verified_pair;
+GlobalMapper::GlobalMapper(const GlobalMapperOptions& options, const MapperInput& input,
+                           const BundleAdjuster& bundle_adjuster, std::function<bool()> should_stop,
+                           ProgressCallback on_progress)
+    : options_(options),
+      input_(input),
+      bundle_adjuster_(bundle_adjuster),
+      should_stop_(std::move(should_stop)),
+      on_progress_(std::move(on_progress)),
+      start_time_(std::chrono::steady_clock::now()),
+      lap_start_(start_time_),
+      cameras_(input.cameras) {
+  options_.Check();
+}
+
+void GlobalMapper::Lap(double* step) {
+  const auto now = std::chrono::steady_clock::now();
+  *step += std::chrono::duration<double>(now - lap_start_).count();
+  lap_start_ = now;
+  if (on_progress_) on_progress_(StepName(result_.step_seconds, step), 1, 1);
+}
+
+const std::vector<const MapperInput::Pair*>& GlobalMapper::SelectPairs() {
   const std::vector<const MapperInput::Pair*> pairs =
-      PairsThatMap(input, options, &in_verified_pair, &result);
-
-  // 2. Focal lengths of cameras without a prior, from the view graph.
-  const std::map<camera_t, Camera> cameras =
-      CamerasWithFocalLengths(input, pairs, options, &result);
-  if (stop()) return cancelled();
-
-  // 3. The view graph and its rotation-cycle filtering.
-  ViewGraph view_graph = ViewGraph::Build(
-      input, cameras, pairs, DeriveSeed(options.seed, kViewGraphStream), options.num_threads);
-  if (options.filter_view_graph) {
-    result.num_pairs_dropped_by_cycles =
-        view_graph.FilterByRotationCycles(options.view_graph_max_cycle_error, 3);
+      VerifiedPairs(input_, static_cast<size_t>(options_.min_num_matches));
+  // Weak pairs set aside (GlobalMapperOptions::min_relative_pair_strength).
+  pairs_ = StrongPairs(pairs, options_.min_relative_pair_strength);
+  result_.num_weak_pairs_set_aside += pairs.size() - pairs_.size();
+  for (const MapperInput::Pair* pair : pairs_) {
+    in_verified_pair_.insert(pair->image_id1);
+    in_verified_pair_.insert(pair->image_id2);
   }
-  if (stop()) return cancelled();
-  lap(&steps.view_graph);
+  result_.num_verified_pairs = pairs_.size();
+  return pairs_;
+}
 
-  // 4. Rotation averaging.
-  std::vector<const MapperInput::Pair*> pair_of_rotation;
-  const std::vector<RelativeRotation> relative_rotations =
-      RelativeRotations(view_graph, pairs, &pair_of_rotation);
-  const RotationAveragingResult rotations =
-      AverageRotations(relative_rotations, RotationOptions(options), should_stop);
-  if (rotations.cancelled || stop()) return cancelled();
-  result.num_pairs_dropped_by_rotation_averaging = rotations.num_dropped;
-  lap(&steps.rotation_averaging);
-  std::set<image_t> with_rotation_pair;
-  for (const RelativeRotation& rotation : relative_rotations) {
-    with_rotation_pair.insert(rotation.image_id1);
-    with_rotation_pair.insert(rotation.image_id2);
+void GlobalMapper::CalibrateCameras() {
+  cameras_ = input_.cameras;
+  if (!options_.estimate_focal_length || pairs_.empty()) return;
+  // First models, where the view graph leaves a camera open, take the mapper's seed
+  // and bundle adjuster, and the incremental mapper's defaults.
+  const MapperRunState run(input_, bundle_adjuster_, options_.seed);
+  CameraCalibration calibration =
+      CalibrateCamerasWithoutPrior(run, pairs_, FirstModelCalibrationOptions());
+  cameras_ = std::move(calibration.cameras);
+  result_.focal_lengths = std::move(calibration.reports);
+}
+
+GlobalMapper::Status GlobalMapper::BuildViewGraph() {
+  if (Stop()) return Status::kCancelled;
+  view_graph_ = ViewGraph::Build(input_, cameras_, pairs_,
+                                 DeriveSeed(options_.seed, kViewGraphStream), options_.num_threads);
+  if (options_.filter_view_graph) {
+    result_.num_pairs_dropped_by_cycles =
+        view_graph_.FilterByRotationCycles(options_.view_graph_max_cycle_error, 3);
   }
+  if (Stop()) return Status::kCancelled;
+  Lap(&result_.step_seconds.view_graph);
+  return Status::kSuccess;
+}
 
-  // 5. The pairs left, their connected parts and their tracks.
+GlobalMapper::Status GlobalMapper::AverageRotations() {
+  relative_rotations_ = RelativeRotations(view_graph_, pairs_, &pair_of_rotation_);
+  rotations_ =
+      tessera::AverageRotations(relative_rotations_, RotationOptions(options_), should_stop_);
+  if (rotations_.cancelled || Stop()) return Status::kCancelled;
+  result_.num_pairs_dropped_by_rotation_averaging = rotations_.num_dropped;
+  Lap(&result_.step_seconds.rotation_averaging);
+  for (const RelativeRotation& rotation : relative_rotations_) {
+    with_rotation_pair_.insert(rotation.image_id1);
+    with_rotation_pair_.insert(rotation.image_id2);
+  }
+  return Status::kSuccess;
+}
+
+const std::vector<std::set<image_t>>& GlobalMapper::EstablishTracks() {
   ImageGroups groups;
   std::vector<ImagePairMatches> pair_matches;
-  for (size_t r = 0; r < relative_rotations.size(); ++r) {
-    if (rotations.dropped[r]) continue;
-    const MapperInput::Pair& pair = *pair_of_rotation[r];
+  for (size_t r = 0; r < relative_rotations_.size(); ++r) {
+    if (rotations_.dropped[r]) continue;
+    const MapperInput::Pair& pair = *pair_of_rotation_[r];
     groups.Union(pair.image_id1, pair.image_id2);
     pair_matches.push_back({pair.image_id1, pair.image_id2, pair.geometry.inlier_matches});
   }
   std::map<image_t, size_t> num_points2D;
-  for (const auto& [image_id, image] : input.images) num_points2D[image_id] = image.points2D.size();
-  const FeatureTracks tracks = BuildFeatureTracks(pair_matches, num_points2D);
-  result.num_tracks = tracks.tracks.size();
+  for (const auto& [image_id, image] : input_.images)
+    num_points2D[image_id] = image.points2D.size();
+  tracks_ = BuildFeatureTracks(pair_matches, num_points2D);
+  result_.num_tracks = tracks_.tracks.size();
   // Retriangulation takes the matches of every verified pair, those set aside as weak or
   // dropped by the rotations too: once the poses are known, each match is judged by its
   // reprojection, and the right ones join far-apart views that the strong pairs do not.
-  const FeatureTracks retriangulation_tracks =
-      options.retriangulate ? BuildFeatureTracks(VerifiedPairMatches(input, options), num_points2D)
-                            : FeatureTracks();
-  lap(&steps.tracks);
-  LogViewGraph(input, pairs.size(), options, result, rotations);
+  if (options_.retriangulate) {
+    retriangulation_tracks_ =
+        BuildFeatureTracks(VerifiedPairMatches(input_, options_), num_points2D);
+  }
+  Lap(&result_.step_seconds.tracks);
+  LogViewGraph(input_, pairs_.size(), options_, result_, rotations_);
+  parts_ = groups.Groups();
+  return parts_;
+}
 
-  std::map<image_t, std::string> reasons;
-  const PartRun run{input, cameras, options, should_stop, &result, &reasons, lap};
-  const std::vector<std::set<image_t>> parts = groups.Groups();
-  size_t registered = 0;
-  for (size_t part_index = 0; part_index < parts.size(); ++part_index) {
-    const std::set<image_t>& part = parts[part_index];
-    if (part.size() < static_cast<size_t>(options.min_model_size)) {
-      for (const image_t image_id : part) {
-        reasons[image_id] = "its pairs connect only " + std::to_string(part.size()) +
-                            " images, fewer than min_model_size (" +
-                            std::to_string(options.min_model_size) + ")";
-      }
-      continue;
+GlobalMapper::Status GlobalMapper::PositionPart(size_t part_index, Reconstruction* model_out) {
+  const std::set<image_t>& part = parts_.at(part_index);
+  if (part.size() < static_cast<size_t>(options_.min_model_size)) {
+    for (const image_t image_id : part) {
+      reasons_[image_id] = "its pairs connect only " + std::to_string(part.size()) +
+                           " images, fewer than min_model_size (" +
+                           std::to_string(options_.min_model_size) + ")";
     }
-    if (stop()) return cancelled();
-
-    Reconstruction model;
-    PartOutcome outcome = PositionPart(run, part_index, part, tracks, rotations, &model);
-    if (outcome == PartOutcome::kModel) {
-      outcome = RefinePart(run, part_index, bundle_adjuster,
-                           TracksWithin(retriangulation_tracks, part), &model);
-    }
-    if (outcome == PartOutcome::kCancelled) return cancelled();
-    if (outcome == PartOutcome::kNoModel) continue;
-    FinishModel(&model);
-    registered += model.NumRegisteredImages();
-    if (on_progress) on_progress("registration", registered, input.images.size());
-    result.models.push_back(std::move(model));
-    lap(&steps.filtering);
+    return Status::kNoModel;
+  }
+  if (Stop()) return Status::kCancelled;
+  PauseIfTestAsks("global_map.positioning_part");
+  // 6. Tracks of the part and global positioning.
+  const std::vector<Track> part_tracks = TracksWithin(tracks_, part);
+  std::vector<Track> positioning_tracks;
+  for (const size_t t :
+       SelectTracks(part_tracks, part, static_cast<size_t>(options_.tracks_min_length),
+                    static_cast<size_t>(options_.tracks_max_per_image))) {
+    positioning_tracks.push_back(part_tracks[t]);
+  }
+  result_.num_tracks_positioned += positioning_tracks.size();
+  Lap(&result_.step_seconds.tracks);
+  std::map<image_t, Eigen::Matrix3d> part_rotations;
+  for (const image_t image_id : part) {
+    part_rotations[image_id] = rotations_.R_cam_from_world.at(image_id);
+  }
+  GlobalPositioningOptions positioning_options;
+  positioning_options.max_num_iterations = options_.gp_max_num_iterations;
+  positioning_options.huber_threshold = options_.gp_huber_threshold;
+  positioning_options.num_threads = options_.num_threads;
+  positioning_options.seed = DeriveSeed(options_.seed, kPositioningStream + part_index);
+  const GlobalPositioningResult positions =
+      PositionGlobally(cameras_, input_.images, part_rotations, positioning_tracks,
+                       positioning_options, should_stop_);
+  if (positions.cancelled || Stop()) return Status::kCancelled;
+  Lap(&result_.step_seconds.positioning);
+  spdlog::info(
+      "global map: part {} ({} images): positioned with {} tracks in {} iterations, cost "
+      "{:.3g} -> {:.3g}",
+      part_index, part.size(), positioning_tracks.size(), positions.num_iterations,
+      positions.initial_cost, positions.final_cost);
+  if (!positions.usable) {
+    for (const image_t image_id : part) reasons_[image_id] = "global positioning failed";
+    return Status::kNoModel;
   }
 
-  SortModelsLargestFirst(&result.models);
-  ExplainUnregistered(input, options, in_verified_pair, with_rotation_pair, reasons, &result);
-  result.seconds = seconds();
+  // 7. The model: the positioned images and points, filtered by angles.
+  Reconstruction& model = *model_out;
+  for (const image_t image_id : part) {
+    const auto center = positions.centers.find(image_id);
+    if (center == positions.centers.end()) {
+      reasons_[image_id] = "no feature track joins it to the other images of its part";
+      continue;
+    }
+    Image image = input_.images.at(image_id);
+    for (Point2D& point2D : image.points2D) point2D.point3D_id = kInvalidPoint3DId;
+    const Eigen::Quaterniond rotation(part_rotations.at(image_id));
+    image.cam_from_world = Rigid3d(rotation, rotation * -center->second);
+    image.registered = true;
+    model.cameras[image.camera_id] = cameras_.at(image.camera_id);
+    model.images[image_id] = std::move(image);
+  }
+  for (size_t t = 0; t < positioning_tracks.size(); ++t) {
+    Point3D point3D;
+    point3D.xyz = positions.points[t];
+    const point3D_t point3D_id = t + 1;
+    for (const TrackElement& element : positioning_tracks[t]) {
+      Point2D& point2D = model.images.at(element.image_id).points2D.at(element.point2D_idx);
+      if (point2D.HasPoint3D()) continue;
+      point2D.point3D_id = point3D_id;
+      point3D.track.push_back(element);
+    }
+    if (point3D.track.size() >= 2) {
+      model.points3D.emplace(point3D_id, std::move(point3D));
+    } else {
+      for (const TrackElement& element : point3D.track) {
+        model.images.at(element.image_id).points2D.at(element.point2D_idx).point3D_id =
+            kInvalidPoint3DId;
+      }
+    }
+  }
+  const size_t num_by_angle = FilterObservationsByAngle(options_.filter_max_angle_error, &model);
+  const size_t num_by_tri_angle =
+      FilterPointsByTriangulationAngle(options_.filter_min_tri_angle, &model);
+  RemoveWeakImages(options_.min_num_observations_per_image, "after global positioning", &model,
+                   &reasons_);
+  spdlog::info(
+      "global map: part {}: {} images, {} points after filtering {} observations by ray angle "
+      "and {} by triangulation angle",
+      part_index, model.images.size(), model.points3D.size(), num_by_angle, num_by_tri_angle);
+  return Status::kSuccess;
+}
+
+GlobalMapper::Status GlobalMapper::AdjustPart(size_t part_index, Reconstruction* model) {
+  // A round whose model did not change since the last adjustment only filters (at its
+  // lower threshold): adjusting again would not move anything.
+  bool changed = true;
+  for (int round = 0; round < options_.ba_num_rounds; ++round) {
+    if (Stop()) return Status::kCancelled;
+    const double factor = std::max(1, options_.ba_num_rounds - round);
+    const AdjustOutcome outcome =
+        AdjustAndFilter(part_index, PartAdjustmentConfig(/*final=*/false),
+                        factor * options_.filter_max_reproj_error,
+                        "round " + std::to_string(round + 1), changed, model);
+    if (outcome == AdjustOutcome::kFailed) return Status::kNoModel;
+    changed = outcome == AdjustOutcome::kChanged;
+  }
+  return Status::kSuccess;
+}
+
+GlobalMapper::Status GlobalMapper::RetriangulatePart(size_t part_index, Reconstruction* model) {
+  const std::vector<Track> tracks = TracksWithin(retriangulation_tracks_, parts_.at(part_index));
+  for (int round = 0; round < kMaxRetriangulationRounds && options_.retriangulate; ++round) {
+    if (Stop()) return Status::kCancelled;
+    TrackTriangulationOptions triangulation;
+    triangulation.max_error_px = options_.tri_max_error;
+    triangulation.min_angle_deg = options_.tri_min_angle;
+    const size_t num_points = TriangulateTracks(tracks, triangulation, model);
+    spdlog::info("global map: part {}: retriangulated {} of {} tracks", part_index, num_points,
+                 tracks.size());
+    std::map<image_t, Eigen::Vector3d> centers;
+    for (const auto& [image_id, image] : model->images)
+      centers[image_id] = image.ProjectionCenter();
+    if (AdjustAndFilter(part_index, PartAdjustmentConfig(/*final=*/true),
+                        options_.filter_max_reproj_error,
+                        "after retriangulation " + std::to_string(round + 1), true,
+                        model) == AdjustOutcome::kFailed) {
+      return Status::kNoModel;
+    }
+    const double shift = LargestCenterShift(centers, *model);
+    if (shift <= kMaxSettledShift) break;
+    if (round + 1 < kMaxRetriangulationRounds) {
+      spdlog::info(
+          "global map: part {}: the adjustment moved a camera by {:.1f}% of the cameras' spread: "
+          "retriangulating again",
+          part_index, 100 * shift);
+    }
+  }
+  if (model->images.size() < static_cast<size_t>(options_.min_model_size)) {
+    for (const auto& [image_id, image] : model->images) {
+      reasons_[image_id] = "its model kept only " + std::to_string(model->images.size()) +
+                           " images, fewer than min_model_size (" +
+                           std::to_string(options_.min_model_size) + ")";
+    }
+    return Status::kNoModel;
+  }
+  return Status::kSuccess;
+}
+
+BundleAdjustmentConfig GlobalMapper::PartAdjustmentConfig(bool final) const {
+  BundleAdjustmentConfig config;
+  config.refine_focal_length = options_.ba_refine_focal_length;
+  config.refine_principal_point = options_.ba_refine_principal_point;
+  config.refine_extra_params = options_.ba_refine_extra_params;
+  config.max_num_iterations =
+      final ? options_.final_ba_max_num_iterations : options_.ba_max_num_iterations;
+  config.function_tolerance =
+      final ? options_.final_ba_function_tolerance : options_.ba_function_tolerance;
+  return config;
+}
+
+GlobalMapper::AdjustOutcome GlobalMapper::AdjustAndFilter(size_t part_index,
+                                                          const BundleAdjustmentConfig& config,
+                                                          double max_reproj_error,
+                                                          const std::string& when, bool adjust,
+                                                          Reconstruction* model) {
+  GlobalMapperResult::StepSeconds& steps = result_.step_seconds;
+  if (model->images.size() < 2 || model->points3D.empty()) return AdjustOutcome::kUnchanged;
+  Lap(&steps.filtering);
+  if (!adjust) {
+    spdlog::info("global map: part {}: {}: no bundle adjustment, nothing changed since the last",
+                 part_index, when);
+  } else {
+    const BundleAdjustmentSummary summary = bundle_adjuster_.Adjust(config, model);
+    ++result_.num_bundle_adjustments;
+    Lap(&steps.bundle_adjustment);
+    spdlog::info("global map: part {}: {}: bundle adjustment {}", part_index, when,
+                 summary.BriefReport());
+    if (!summary.usable) {
+      for (const auto& [image_id, image] : model->images) {
+        reasons_[image_id] = "bundle adjustment failed: " + summary.message;
+      }
+      return AdjustOutcome::kFailed;
+    }
+  }
+  const size_t num_images = model->images.size();
+  const size_t num_by_error = FilterObservationsByReprojectionError(max_reproj_error, model);
+  const size_t num_by_angle =
+      FilterPointsByTriangulationAngle(options_.filter_min_tri_angle, model);
+  RemoveWeakImages(options_.min_num_observations_per_image, when, model, &reasons_);
+  spdlog::info(
+      "global map: part {}: {} observations beyond {:g} px and {} by triangulation angle "
+      "filtered; {} images, {} points, {} observations",
+      part_index, num_by_error, max_reproj_error, num_by_angle, model->images.size(),
+      model->points3D.size(), NumObservationsOf(*model));
+  return num_by_error + num_by_angle > 0 || model->images.size() != num_images
+             ? AdjustOutcome::kChanged
+             : AdjustOutcome::kUnchanged;
+}
+
+void GlobalMapper::AddModel(Reconstruction model) {
+  FinishModel(&model);
+  num_registered_ += model.NumRegisteredImages();
+  if (on_progress_) on_progress_("registration", num_registered_, input_.images.size());
+  result_.models.push_back(std::move(model));
+  Lap(&result_.step_seconds.filtering);
+}
+
+GlobalMapperResult GlobalMapper::TakeResult() {
+  SortModelsLargestFirst(&result_.models);
+  ExplainUnregistered(input_, options_, in_verified_pair_, with_rotation_pair_, reasons_, &result_);
+  result_.seconds = SecondsSinceStart();
   spdlog::info("global map: {} models, {} images in none, {} bundle adjustments, {:.1f} s",
-               result.models.size(), result.unregistered_reasons.size(),
-               result.num_bundle_adjustments, result.seconds);
-  return result;
+               result_.models.size(), result_.unregistered_reasons.size(),
+               result_.num_bundle_adjustments, result_.seconds);
+  return std::move(result_);
+}
+
+double GlobalMapper::SecondsSinceStart() const {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_time_).count();
+}
+
+GlobalMapperResult GlobalMapper::Reconstruct(const MapperInput& input,
+                                             const BundleAdjuster& bundle_adjuster,
+                                             const GlobalMapperOptions& options,
+                                             std::function<bool()> should_stop,
+                                             const ProgressCallback& on_progress) {
+  GlobalMapper mapper(options, input, bundle_adjuster, std::move(should_stop), on_progress);
+  const auto cancelled = [&mapper] {
+    GlobalMapperResult empty;
+    empty.cancelled = true;
+    empty.seconds = mapper.SecondsSinceStart();
+    spdlog::info("global map: stopped after {:.1f} s", empty.seconds);
+    return empty;
+  };
+  if (mapper.Stop()) return cancelled();
+  mapper.SelectPairs();
+  mapper.CalibrateCameras();
+  if (mapper.BuildViewGraph() == Status::kCancelled) return cancelled();
+  if (mapper.AverageRotations() == Status::kCancelled) return cancelled();
+  mapper.EstablishTracks();
+  for (size_t part_index = 0; part_index < mapper.Parts().size(); ++part_index) {
+    Reconstruction model;
+    Status status = mapper.PositionPart(part_index, &model);
+    if (status == Status::kSuccess) status = mapper.AdjustPart(part_index, &model);
+    if (status == Status::kSuccess) status = mapper.RetriangulatePart(part_index, &model);
+    if (status == Status::kCancelled) return cancelled();
+    if (status == Status::kSuccess) mapper.AddModel(std::move(model));
+  }
+  return mapper.TakeResult();
 }
 
 }  // namespace tessera

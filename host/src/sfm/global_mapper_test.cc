@@ -44,6 +44,71 @@ void ExpectConsistentAndTrue(const SyntheticScene& scene, const Reconstruction& 
   EXPECT_LE(num_wrong, model.points3D.size() / 500) << "points whose track mixes true points";
 }
 
+// The steps are public so that a driver of its own (a verb, a third party's mapper) can
+// run them: called one by one from outside, they give the driver's model bit for bit,
+// and a step can be left out (here retriangulation) or inspected between steps.
+TEST(GlobalMapper, TheStepsCalledOneByOneGiveTheDriversModel) {
+  SyntheticSceneOptions options;
+  options.num_images = 12;
+  options.seed = 5;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  const BundleAdjuster& adjuster = testing::CeresAdjusterOnOneThread();
+  const GlobalMapperResult driven = GlobalMapper::Reconstruct(scene.input, adjuster, {});
+  ASSERT_EQ(driven.models.size(), 1u);
+
+  GlobalMapper mapper({}, scene.input, adjuster);
+  EXPECT_FALSE(mapper.SelectPairs().empty());
+  mapper.CalibrateCameras();
+  ASSERT_EQ(mapper.BuildViewGraph(), GlobalMapper::Status::kSuccess);
+  ASSERT_EQ(mapper.AverageRotations(), GlobalMapper::Status::kSuccess);
+  ASSERT_EQ(mapper.EstablishTracks().size(), 1u);
+  EXPECT_EQ(mapper.Parts()[0].size(), 12u);
+  Reconstruction model;
+  ASSERT_EQ(mapper.PositionPart(0, &model), GlobalMapper::Status::kSuccess);
+  EXPECT_EQ(model.images.size(), 12u);
+  ASSERT_EQ(mapper.AdjustPart(0, &model), GlobalMapper::Status::kSuccess);
+  Reconstruction without_retriangulation = model;
+  ASSERT_EQ(mapper.RetriangulatePart(0, &model), GlobalMapper::Status::kSuccess);
+  mapper.AddModel(std::move(model));
+  const GlobalMapperResult stepped = mapper.TakeResult();
+  ASSERT_EQ(stepped.models.size(), 1u);
+  const Reconstruction& a = driven.models[0];
+  const Reconstruction& b = stepped.models[0];
+  ASSERT_EQ(a.images.size(), b.images.size());
+  for (const auto& [image_id, image] : a.images) {
+    EXPECT_EQ(image.cam_from_world.rotation.coeffs(),
+              b.images.at(image_id).cam_from_world.rotation.coeffs());
+    EXPECT_EQ(image.cam_from_world.translation, b.images.at(image_id).cam_from_world.translation);
+  }
+  EXPECT_EQ(a.points3D.size(), b.points3D.size());
+  EXPECT_EQ(stepped.num_bundle_adjustments, driven.num_bundle_adjustments);
+  // Retriangulation adds the tracks positioning did not choose.
+  EXPECT_GT(b.points3D.size(), without_retriangulation.points3D.size());
+}
+
+// Steps of a part that cannot make a model say so, and leave reasons for its images.
+TEST(GlobalMapper, APartTooSmallForAModelIsNoModelWithItsReason) {
+  SyntheticSceneOptions options;
+  options.num_images = 6;
+  options.seed = 5;
+  const SyntheticScene scene = MakeSyntheticScene(options);
+  GlobalMapperOptions mapper_options;
+  mapper_options.min_model_size = 7;
+  GlobalMapper mapper(mapper_options, scene.input, testing::CeresAdjusterOnOneThread());
+  mapper.SelectPairs();
+  mapper.CalibrateCameras();
+  ASSERT_EQ(mapper.BuildViewGraph(), GlobalMapper::Status::kSuccess);
+  ASSERT_EQ(mapper.AverageRotations(), GlobalMapper::Status::kSuccess);
+  ASSERT_EQ(mapper.EstablishTracks().size(), 1u);
+  Reconstruction model;
+  EXPECT_EQ(mapper.PositionPart(0, &model), GlobalMapper::Status::kNoModel);
+  const GlobalMapperResult result = mapper.TakeResult();
+  EXPECT_TRUE(result.models.empty());
+  ASSERT_EQ(result.unregistered_reasons.size(), 6u);
+  EXPECT_NE(result.unregistered_reasons.begin()->second.find("fewer than min_model_size (7)"),
+            std::string::npos);
+}
+
 TEST(GlobalMapper, MapsThirtyImagesOfASyntheticScene) {
   SyntheticSceneOptions options;
   options.num_images = 30;

@@ -13,7 +13,6 @@
 #include "sfm/model_growth.h"
 #include "sfm/rig_poses.h"
 #include "tessera/sfm/first_model_calibration.h"
-#include "tessera/sfm/focal_length_estimation.h"
 #include "tessera/sfm/model_finishing.h"
 #include "tessera/sfm/model_merger.h"
 #include "tessera/sfm/verified_pairs.h"
@@ -166,92 +165,6 @@ void MergeAlignedModels(const IncrementalMapperOptions& options,
   SortModelsLargestFirst(models);
 }
 
-// Focal lengths of the cameras without a prior, in `cameras`: from the view graph where
-// it determines them, then refined in a first model.
-void EstimateFocalLengthsWithoutPrior(const IncrementalMapperOptions& options,
-                                      const MapperRunState& run,
-                                      const std::vector<const MapperInput::Pair*>& verified_pairs,
-                                      std::map<camera_t, Camera>* cameras,
-                                      std::vector<FocalLengthReport>* reports) {
-  std::map<camera_t, FocalLengthReport> by_camera;
-  std::set<camera_t> clear_minimum;
-  for (const auto& [camera_id, camera] : *cameras) {
-    if (camera.has_prior_focal_length) continue;
-    FocalLengthReport& report = by_camera[camera_id];
-    report.camera_id = camera_id;
-    report.initial = report.estimated = camera.MeanFocalLength();
-  }
-  if (by_camera.empty()) return;
-
-  // 1. From the fundamental matrices, where they determine it.
-  for (const auto& [camera_id, estimate] :
-       EstimateFocalLengths(run.input, verified_pairs, FocalLengthEstimationOptions())) {
-    if (estimate.at_search_bound) {
-      spdlog::info(
-          "map: camera {}: the image pairs do not determine its focal length (their best fit "
-          "lies at the end of the range searched, as when every camera aims at one point)",
-          camera_id);
-      continue;
-    }
-    cameras->at(camera_id).SetFocalLength(estimate.focal_length);
-    FocalLengthReport& report = by_camera.at(camera_id);
-    report.estimated = estimate.focal_length;
-    report.method = "view graph";
-    report.num_pairs = estimate.num_pairs;
-    spdlog::debug("map: camera {}: {:.1f} px from {} pairs' fundamental matrices (cost {:.3f})",
-                  camera_id, estimate.focal_length, estimate.num_pairs, estimate.cost);
-    if (estimate.cost <= kClearFocalMinimumCost) clear_minimum.insert(camera_id);
-  }
-
-  // 2. Refined by bundle adjustment in a first model, mapped once for that alone: with
-  // the structure of many views the focal length is well determined even where pairs
-  // leave it open, and the view-graph checks of the real pass need it to be right. The
-  // first model holds one scene; where the photos hold several (several cameras, as in a
-  // mixed folder), the cameras it leaves out get first models of their own, from the
-  // pairs among their images.
-  // A camera whose focal length many pairs determine needs no first model: the real
-  // pass refines it in every bundle adjustment, and mapping the images twice was half
-  // of the map stage's time.
-  std::set<camera_t> unrefined;
-  for (const auto& [camera_id, report] : by_camera) {
-    if (report.method == "view graph" && clear_minimum.count(camera_id) > 0 &&
-        report.num_pairs >= static_cast<size_t>(options.min_view_graph_focal_pairs) &&
-        options.min_view_graph_focal_pairs > 0) {
-      continue;
-    }
-    unrefined.insert(camera_id);
-  }
-  MapperRunState calibration(run.input, run.bundle_adjuster, run.seed);
-  calibration.ransac = run.ransac;
-  calibration.cameras = *cameras;
-  for (const auto& [camera_id, refined] :
-       FocalLengthsFromFirstModels(options, calibration, unrefined, verified_pairs)) {
-    unrefined.erase(camera_id);
-    if (refined.focal_length == 0) continue;  // implausible: the real pass refines it
-    cameras->at(camera_id).SetFocalLength(refined.focal_length);
-    FocalLengthReport& report = by_camera.at(camera_id);
-    report.estimated = refined.focal_length;
-    report.method = report.method.empty() ? "first model" : report.method + ", first model";
-    report.num_images = refined.num_images;
-  }
-  for (const camera_t camera_id : unrefined) {
-    spdlog::info(
-        "map: camera {}: no first model of {} images or more to refine its focal length "
-        "from; mapping starts from {:.1f} px",
-        camera_id, kMinFirstModelImages, by_camera.at(camera_id).estimated);
-  }
-  for (const auto& [camera_id, report] : by_camera) {
-    if (report.method.empty()) continue;
-    spdlog::info(
-        "map: camera {} has no focal-length prior: mapping starts from {:.1f} px (from the {}{}) "
-        "instead of the default {:.1f} px",
-        camera_id, report.estimated, report.method,
-        report.num_images > 0 ? fmt::format(" of {} images", report.num_images) : "",
-        report.initial);
-    reports->push_back(report);
-  }
-}
-
 // Why each input image is in no model.
 std::map<image_t, std::string> UnregisteredReasons(const IncrementalMapperOptions& options,
                                                    const MapperInput& input,
@@ -325,8 +238,12 @@ MapperResult IncrementalPipeline::Reconstruct(const MapperInput& input,
   const std::vector<const MapperInput::Pair*> verified_pairs =
       VerifiedPairs(input, static_cast<size_t>(options_.min_num_matches));
   if (options_.estimate_focal_length) {
-    EstimateFocalLengthsWithoutPrior(options_, run, verified_pairs, &run.cameras,
-                                     &result.focal_lengths);
+    FirstModelCalibrationOptions calibration;
+    calibration.min_view_graph_pairs = options_.min_view_graph_focal_pairs;
+    calibration.first_model = options_;
+    CameraCalibration calibrated = CalibrateCamerasWithoutPrior(run, verified_pairs, calibration);
+    run.cameras = std::move(calibrated.cameras);
+    result.focal_lengths = std::move(calibrated.reports);
   }
   result.num_pairs_dropped = run.Prepare(options_, verified_pairs);
   result.num_tracks = run.tracks.tracks.size();

@@ -14,6 +14,7 @@
 
 #include "tessera/mapper.h"
 #include "tessera/sfm/export.h"
+#include "tessera/sfm/focal_length_estimation.h"
 #include "tessera/sfm/incremental_mapper.h"
 #include "tessera/sfm/incremental_mapper_options.h"
 
@@ -46,5 +47,47 @@ inline constexpr double kClearFocalMinimumCost = 0.05;
 TESSERA_SFM_EXPORT std::map<camera_t, FirstModelFocalLength> FocalLengthsFromFirstModels(
     const IncrementalMapperOptions& options, const MapperRunState& run,
     std::set<camera_t> to_refine, std::vector<const MapperInput::Pair*> pairs);
+
+// How the cameras without a focal-length prior get one before mapping: one rule for
+// both bundled mappers and the cluster map (partition/), so that a camera starts from
+// the same focal length whichever maps it.
+//   1. The view graph's estimate (the pairs' fundamental matrices) where it lies inside
+//      the range searched.
+//   2. A camera whose estimate has a clear minimum (kClearFocalMinimumCost) from at
+//      least min_view_graph_pairs pairs keeps it: the mapper's bundle adjustments refine
+//      it, and mapping the images twice was half of the map stage's time. Every other
+//      camera gets a first model (FocalLengthsFromFirstModels), which starts from the
+//      estimate where there is one.
+//   3. A camera no first model reaches (or whose first model is implausible) keeps the
+//      estimate, or its default where there is none.
+struct FirstModelCalibrationOptions {
+  // Pairs of a clear view-graph estimate for a camera to need no first model; 0: every
+  // camera without a prior gets one.
+  int min_view_graph_pairs = 10;
+  // Which pairs the view graph's estimate takes, and its search range.
+  FocalLengthEstimationOptions view_graph;
+  // How first models are mapped.
+  IncrementalMapperOptions first_model;
+};
+
+struct CameraCalibration {
+  // The run's cameras, those without a prior with the focal length found.
+  std::map<camera_t, Camera> cameras;
+  // One per camera without a prior whose focal length was found, by id; `method` is
+  // "view graph", "first model" or "view graph, first model".
+  std::vector<FocalLengthReport> reports;
+};
+
+// Calibrates `run.cameras` (the input's, or as a caller set them) over `pairs` (the
+// verified pairs the mapper maps), with `run`'s bundle adjuster, seed and RANSAC
+// settings for first models. Logs each camera's outcome at info.
+TESSERA_SFM_EXPORT CameraCalibration CalibrateCamerasWithoutPrior(
+    const MapperRunState& run, const std::vector<const MapperInput::Pair*>& pairs,
+    const FirstModelCalibrationOptions& options);
+
+// `input` with the calibration's focal lengths held as priors: a mapper starts from them
+// and refines them in bundle adjustment, but does not estimate them again.
+TESSERA_SFM_EXPORT void ApplyCalibration(const std::vector<FocalLengthReport>& calibration,
+                                         MapperInput* input);
 
 }  // namespace tessera
