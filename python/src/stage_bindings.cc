@@ -1,4 +1,4 @@
-// tessera.run, extract, match, map and export: the CLI's verbs with its arguments as
+// tessera.run, extract, match, map, export and triangulate: the CLI's verbs with its arguments as
 // keywords (--camera-K as camera_K), built by the same functions the CLI calls
 // (pipeline/stage_arguments.h, pipeline/run_pipeline.h, pipeline/export_model.h). Each
 // returns its part of the run summary (run: all of run_summary.json) as a dict; each runs
@@ -22,6 +22,7 @@
 #include "pipeline/stage_arguments.h"
 #include "stage_process.h"
 #include "tessera/errors.h"
+#include "toolbox/triangulate_known_poses.h"
 #include "util/workspace_layout.h"
 
 namespace py = pybind11;
@@ -222,6 +223,38 @@ void BindStages(py::module_& module) {
       py::arg("options") = py::none(), py::arg("model_index") = 0, py::arg("masks") = py::none(),
       "Writes a COLMAP model with an exporter plugin (`tessera export`), in a child process; "
       "options: a dict.");
+
+  module.def(
+      "triangulate",
+      [](const std::filesystem::path& output, const OptionalPath& model, const OptionalPath& poses,
+         int model_index, bool refine_intrinsics, const py::object& manifest, int threads) {
+        // Refused as the command line refuses them, before the child starts.
+        if (model_index < 0) {
+          throw InputError("model_index: Value " + std::to_string(model_index) +
+                           " is not a whole number of at least 0");
+        }
+        if (model.has_value() == poses.has_value()) {
+          throw InputError(
+              "model or poses: give one of them (a COLMAP model folder, or a "
+              "transforms.json)");
+        }
+        TriangulateArguments arguments;
+        arguments.output = output;
+        arguments.model = model.value_or(std::filesystem::path());
+        arguments.poses = poses.value_or(std::filesystem::path());
+        arguments.model_index = model_index;
+        arguments.refine_intrinsics = refine_intrinsics;
+        arguments.stage = MakeArguments(manifest, {}, {}, {}, threads);
+        return ToPython(RunInChildProcess(
+            "triangulate", py::none(),
+            [&](const StageControl&) { return TriangulateWorkspace(arguments).ToJson(); },
+            /*runs_to_the_end=*/true));
+      },
+      py::arg("output"), py::arg("model") = py::none(), py::arg("poses") = py::none(),
+      py::arg("model_index") = 0, py::arg("refine_intrinsics") = false, ManifestArg(), ThreadsArg(),
+      "Triangulates the workspace's verified matches for known poses, every pose held "
+      "(`tessera triangulate`), in a child process; model: a COLMAP model folder, or poses: a "
+      "transforms.json; returns the summary `--json` prints.");
 }
 
 }  // namespace tessera::python

@@ -24,7 +24,7 @@ from ._version import __version__
 __all__ = [
     "Camera", "Database", "Error", "Image", "InputError", "NoModelError", "Point3D",
     "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "__version__", "bench",
-    "evaluate", "export", "extract", "map", "match", "plugins", "run",
+    "evaluate", "export", "extract", "map", "match", "plugins", "run", "triangulate",
 ]
 
 PathLike = Union[str, os.PathLike[str]]
@@ -177,6 +177,26 @@ def export(model: PathLike, format: str, output: PathLike, images: Optional[Path
         options=None if options is None else dict(options),
         model_index=_int(name, "model_index", model_index),
         masks=_optional_path(name, "masks", masks)))
+
+
+def triangulate(output: PathLike, model: Optional[PathLike] = None,
+                poses: Optional[PathLike] = None, model_index: int = 0,
+                refine_intrinsics: bool = False, manifest: ManifestLike = None,
+                threads: int = 0) -> Dict[str, Any]:
+    """Triangulates the workspace's verified matches for known poses, every pose held
+    (`tessera triangulate`), and writes output/sparse/<model_index>. model: a COLMAP model
+    folder (text or binary) with cameras and poses, or poses: a transforms.json (nerfstudio,
+    instant-ngp); images are matched by name. refine_intrinsics: focal lengths and
+    distortion refined by the manifest's bundle adjuster, poses held. Returns the summary
+    `--json` prints (images_in_common, num_points3D, mean_reprojection_error, ...);
+    InputError naming the file and image or field on bad input. Runs in a child process."""
+    name = "triangulate"
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.triangulate, output=_path(name, "output", output),
+        model=_optional_path(name, "model", model), poses=_optional_path(name, "poses", poses),
+        model_index=_int(name, "model_index", model_index),
+        refine_intrinsics=_bool(name, "refine_intrinsics", refine_intrinsics),
+        manifest=_manifest(name, manifest), threads=_int(name, "threads", threads)))
 
 
 def plugins(manifest: ManifestLike = None) -> Dict[str, Any]:

@@ -4,9 +4,12 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <initializer_list>
 #include <iterator>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <sstream>
+#include <utility>
 #include <vector>
 
 #include "tessera/errors.h"
@@ -90,6 +93,103 @@ std::vector<double> ReadNumbers(const fs::path& path) {
   return numbers;
 }
 
+// A key of a transforms.json frame: the frame's own, else the file's global one; null
+// when neither has it.
+const nlohmann::json* TransformsKey(const nlohmann::json& global, const nlohmann::json& frame,
+                                    const char* key) {
+  if (frame.contains(key)) return &frame[key];
+  if (global.contains(key)) return &global[key];
+  return nullptr;
+}
+
+// The number under `key`, `fallback` when absent; InputError naming the frame and key
+// when it is not a finite number.
+double TransformsNumber(const nlohmann::json& global, const nlohmann::json& frame, const char* key,
+                        double fallback, const std::string& where) {
+  const nlohmann::json* value = TransformsKey(global, frame, key);
+  if (value == nullptr) return fallback;
+  if (!value->is_number() || !std::isfinite(value->get<double>())) {
+    throw InputError(where + ": \"" + key + "\" is " + value->dump() + ", not a finite number.");
+  }
+  return value->get<double>();
+}
+
+// The camera of one transforms.json frame (TransformsJsonFrame::camera).
+Camera TransformsJsonCamera(const nlohmann::json& global, const nlohmann::json& frame,
+                            const std::string& where) {
+  constexpr double kMissing = std::numeric_limits<double>::quiet_NaN();
+  const auto number = [&](const char* key, double fallback) {
+    return TransformsNumber(global, frame, key, fallback, where);
+  };
+  const double width = number("w", kMissing);
+  const double height = number("h", kMissing);
+  for (const auto& [key, value] : {std::pair{"w", width}, std::pair{"h", height}}) {
+    if (std::isnan(value)) throw InputError(where + ": \"" + key + "\" (image size) is missing.");
+    if (!(value >= 1 && value <= 1e6 && value == std::floor(value))) {
+      throw InputError(where + ": \"" + key + "\" = " + FormatNumber(value) +
+                       " is not an image size in pixels.");
+    }
+  }
+  double fx = number("fl_x", kMissing);
+  if (std::isnan(fx)) {
+    // instant-ngp's files may give the horizontal field of view instead.
+    const double angle = number("camera_angle_x", kMissing);
+    if (std::isnan(angle)) {
+      throw InputError(where + ": neither \"fl_x\" nor \"camera_angle_x\" is given.");
+    }
+    fx = 0.5 * width / std::tan(0.5 * angle);
+  }
+  const double fy = number("fl_y", fx);
+  const double cx = number("cx", width / 2);
+  const double cy = number("cy", height / 2);
+  for (const auto& [key, value] : {std::pair{"fl_x", fx}, std::pair{"fl_y", fy}}) {
+    if (!(value > 0 && value < 1e8)) {
+      throw InputError(where + ": the focal length \"" + key + "\" = " + FormatNumber(value) +
+                       " is not a positive number of pixels.");
+    }
+  }
+  const double k1 = number("k1", 0), k2 = number("k2", 0), k3 = number("k3", 0),
+               k4 = number("k4", 0), p1 = number("p1", 0), p2 = number("p2", 0);
+  std::string model;
+  if (const nlohmann::json* value = TransformsKey(global, frame, "camera_model")) {
+    if (!value->is_string()) throw InputError(where + ": \"camera_model\" is not a string.");
+    model = value->get<std::string>();
+  } else {
+    model = (k1 != 0 || k2 != 0 || k3 != 0 || k4 != 0 || p1 != 0 || p2 != 0) ? "OPENCV" : "PINHOLE";
+  }
+  Camera camera;
+  camera.width = static_cast<size_t>(width);
+  camera.height = static_cast<size_t>(height);
+  camera.has_prior_focal_length = true;
+  camera.calibration_source = CalibrationSource::kUser;
+  // Coefficients a model has no place for are refused, not dropped.
+  const auto refuse_unless_zero = [&](std::initializer_list<std::pair<const char*, double>> keys) {
+    for (const auto& [key, value] : keys) {
+      if (value != 0) {
+        throw InputError(where + ": \"" + key + "\" = " + FormatNumber(value) +
+                         " has no place in camera_model " + model + ".");
+      }
+    }
+  };
+  if (model == "PINHOLE") {
+    refuse_unless_zero({{"k1", k1}, {"k2", k2}, {"k3", k3}, {"k4", k4}, {"p1", p1}, {"p2", p2}});
+    camera.model_id = CameraModelId::kPinhole;
+    camera.params = {fx, fy, cx, cy};
+  } else if (model == "OPENCV") {
+    refuse_unless_zero({{"k3", k3}, {"k4", k4}});
+    camera.model_id = CameraModelId::kOpenCV;
+    camera.params = {fx, fy, cx, cy, k1, k2, p1, p2};
+  } else if (model == "OPENCV_FISHEYE") {
+    refuse_unless_zero({{"p1", p1}, {"p2", p2}});
+    camera.model_id = CameraModelId::kOpenCVFisheye;
+    camera.params = {fx, fy, cx, cy, k1, k2, k3, k4};
+  } else {
+    throw InputError(where + ": camera_model \"" + model +
+                     "\" is not one of PINHOLE, OPENCV, OPENCV_FISHEYE.");
+  }
+  return camera;
+}
+
 }  // namespace
 
 std::map<std::string, GroundTruthPose> ReadStrechaCameras(const fs::path& dir) {
@@ -122,7 +222,7 @@ std::map<std::string, GroundTruthPose> ReadStrechaCameras(const fs::path& dir) {
   return poses;
 }
 
-std::map<std::string, GroundTruthPose> ReadTransformsJson(const fs::path& file) {
+std::vector<TransformsJsonFrame> ReadTransformsJsonFrames(const fs::path& file, bool with_cameras) {
   std::ifstream stream(file);
   if (!stream) throw InputError("Cannot open the ground-truth file " + file.string() + ".");
   nlohmann::json json;
@@ -136,7 +236,7 @@ std::map<std::string, GroundTruthPose> ReadTransformsJson(const fs::path& file) 
   }
   // OpenGL camera axes (x right, y up, z backwards) to OpenCV's (y down, z forwards).
   const Eigen::Matrix3d flip_yz = Eigen::Vector3d(1, -1, -1).asDiagonal();
-  std::map<std::string, GroundTruthPose> poses;
+  std::vector<TransformsJsonFrame> result;
   std::map<std::string, size_t> frame_of_name;
   const nlohmann::json& frames = json["frames"];
   for (size_t i = 0; i < frames.size(); ++i) {
@@ -162,20 +262,32 @@ std::map<std::string, GroundTruthPose> ReadTransformsJson(const fs::path& file) 
       }
       center(row) = (*matrix)[row][3].get<double>();
     }
-    GroundTruthPose pose;
-    pose.R_cam_from_world = (world_from_cam_rotation * flip_yz).transpose();
-    pose.center_in_world = center;
-    const std::string file_path = frame["file_path"].get<std::string>();
-    CheckPose(pose, where + " (" + file_path + ")");
-    const std::string name = fs::path(file_path).filename().string();
-    const auto [it, inserted] = frame_of_name.emplace(name, i);
+    TransformsJsonFrame entry;
+    entry.file_path = frame["file_path"].get<std::string>();
+    entry.pose.R_cam_from_world = (world_from_cam_rotation * flip_yz).transpose();
+    entry.pose.center_in_world = center;
+    CheckPose(entry.pose, where + " (" + entry.file_path + ")");
+    entry.name = fs::path(entry.file_path).filename().string();
+    const auto [it, inserted] = frame_of_name.emplace(entry.name, i);
     if (!inserted) {
-      throw InputError(where + " (" + file_path + ") has the image name " + name + " of frames[" +
-                       std::to_string(it->second) + "], so the two cannot be told apart.");
+      throw InputError(where + " (" + entry.file_path + ") has the image name " + entry.name +
+                       " of frames[" + std::to_string(it->second) +
+                       "], so the two cannot be told apart.");
     }
-    poses[name] = pose;
+    if (with_cameras) {
+      entry.camera = TransformsJsonCamera(json, frame, where + " (" + entry.file_path + ")");
+    }
+    result.push_back(std::move(entry));
   }
-  if (poses.empty()) throw InputError(file.string() + " lists no frames.");
+  if (result.empty()) throw InputError(file.string() + " lists no frames.");
+  return result;
+}
+
+std::map<std::string, GroundTruthPose> ReadTransformsJson(const fs::path& file) {
+  std::map<std::string, GroundTruthPose> poses;
+  for (const TransformsJsonFrame& frame : ReadTransformsJsonFrames(file, false)) {
+    poses[frame.name] = frame.pose;
+  }
   return poses;
 }
 

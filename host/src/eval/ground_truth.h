@@ -7,7 +7,9 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
+#include "tessera/camera.h"
 #include "tessera/reconstruction.h"
 
 namespace tessera {
@@ -32,6 +34,24 @@ std::map<std::string, GroundTruthPose> ReadStrechaCameras(const std::filesystem:
 // Per frame a 4x4 camera-to-world matrix with OpenGL camera axes (y up, z backwards),
 // turned into OpenCV axes by flipping y and z.
 std::map<std::string, GroundTruthPose> ReadTransformsJson(const std::filesystem::path& file);
+
+// One frame of a transforms.json, as ReadTransformsJsonFrames reads it.
+struct TransformsJsonFrame {
+  std::string file_path;  // as the file gives it ("images/r_0.png")
+  std::string name;       // its file name ("r_0.png"), unique in the file
+  GroundTruthPose pose;
+  // With cameras only: the frame's intrinsics, its own keys over the file's global ones
+  // (w, h, fl_x or camera_angle_x, fl_y, cx, cy, k1, k2, k3, k4, p1, p2, camera_model
+  // as nerfstudio writes it: PINHOLE, OPENCV or OPENCV_FISHEYE; without camera_model,
+  // OPENCV when a distortion coefficient is not zero, else PINHOLE). camera_id unset.
+  Camera camera;
+};
+// The frames of a transforms.json in file order, each checked as ReadTransformsJson
+// checks it; `with_cameras`: each frame's camera too, refused (InputError naming the
+// file, frame and key) when a key is missing, not a finite number, out of range, or a
+// distortion the camera model cannot hold.
+std::vector<TransformsJsonFrame> ReadTransformsJsonFrames(const std::filesystem::path& file,
+                                                          bool with_cameras);
 
 // Poses of the registered images of a model, by basename. Throws InputError when two
 // registered images share a basename, since they could not be told apart, or a centre
