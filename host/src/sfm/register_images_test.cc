@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <cstring>
 #include <set>
 
@@ -94,8 +95,14 @@ TEST(RegisterImages, HeldModelComesBackBitIdenticalAndNewPosesAreNearTheTruth) {
     ++num_held_points;
   }
   EXPECT_GT(num_held_points, 0u);
-  // The new images see held points and make new ones.
-  EXPECT_GT(result.model.points3D.size(), result.held.points3D.size());
+  // The new images observe the held points (every image sees the whole cube here).
+  for (const image_t image_id : new_images) {
+    size_t num_observed = 0;
+    for (const Point2D& point2D : result.model.images.at(image_id).points2D) {
+      num_observed += result.held.points3D.count(point2D.point3D_id);
+    }
+    EXPECT_GT(num_observed, 1000u) << "image " << image_id;
+  }
 
   const EvaluationResult held = EvaluateReconstruction(result.held, scene.GroundTruth());
   const EvaluationResult evaluation = EvaluateReconstruction(result.model, scene.GroundTruth());
@@ -109,6 +116,8 @@ TEST(RegisterImages, HeldModelComesBackBitIdenticalAndNewPosesAreNearTheTruth) {
     EXPECT_LT(image.rotation_error_deg, 0.1) << image.name;
   }
   EXPECT_LT(evaluation.position_error_max, 2 * held.position_error_max + 0.005);
+  std::printf("position error max: held model %.5f, with the 3 registered %.5f (scene units)\n",
+              held.position_error_max, evaluation.position_error_max);
 }
 
 TEST(RegisterImages, WithoutHoldingTheLocalAdjustmentsMayMoveTheModel) {
