@@ -26,5 +26,7 @@ void BindEvaluate(pybind11::module_& module);
 
 // tessera.bench (bench_bindings.cc).
 void BindBench(pybind11::module_& module);
+// tessera.register (register_bindings.cc).
+void BindRegister(pybind11::module_& module);
 
 }  // namespace tessera::python

@@ -24,7 +24,7 @@ from ._version import __version__
 __all__ = [
     "Camera", "Database", "Error", "Image", "InputError", "NoModelError", "Point3D",
     "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "__version__", "bench",
-    "evaluate", "export", "extract", "map", "match", "plugins", "run", "triangulate",
+    "evaluate", "export", "extract", "map", "match", "plugins", "register", "run", "triangulate",
 ]
 
 PathLike = Union[str, os.PathLike[str]]
@@ -197,6 +197,24 @@ def triangulate(output: PathLike, model: Optional[PathLike] = None,
         model_index=_int(name, "model_index", model_index),
         refine_intrinsics=_bool(name, "refine_intrinsics", refine_intrinsics),
         manifest=_manifest(name, manifest), threads=_int(name, "threads", threads)))
+def register(output: PathLike, images: Optional[PathLike] = None, manifest: ManifestLike = None,
+             model_index: int = 0, refine_existing: bool = False,
+             camera_K: Optional[PathLike] = None, threads: int = 0,
+             progress: Progress = None) -> Dict[str, Any]:
+    """Registers the images of `images` (default: the workspace's folder) that are in no
+    model into model `model_index` (sparse/N) by the incremental mapper's own
+    registration step, holding the model's cameras, poses and points unless
+    refine_existing (`tessera register`); returns the summary `--json` prints: each new
+    image 'registered' or not with its 'reason'. camera_K: as the workspace was extracted
+    with. Other arguments as run()'s."""
+    name = "register"
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.register, output=_path(name, "output", output),
+        images=_optional_path(name, "images", images), manifest=_manifest(name, manifest),
+        model_index=_int(name, "model_index", model_index),
+        refine_existing=_bool(name, "refine_existing", refine_existing),
+        camera_K=_optional_path(name, "camera_K", camera_K),
+        threads=_int(name, "threads", threads), progress=_progress(name, progress)))
 
 
 def plugins(manifest: ManifestLike = None) -> Dict[str, Any]:

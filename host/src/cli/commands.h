@@ -40,5 +40,6 @@ CommandRegistration RegisterMergeCommand(CLI::App& app, const GlobalOptions& glo
 CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterTriangulateCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterRegisterCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera

@@ -5,8 +5,12 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
 
 #include "database/database.h"
+#include "outputs/output_transaction.h"
 #include "pipeline/mapping_summary.h"
 #include "pipeline/run_summary.h"
 #include "pipeline/stage_control.h"
@@ -88,6 +92,17 @@ struct MapTarget {
 MapStageSummary MapWorkspace(const Workspace& workspace, const MapSettings& settings,
                              const StageScope& scope = {}, const StageControl& control = {},
                              const MapTarget& target = {});
+
+// Writes model `index` into the transaction of `output_dir`, as the map stage writes
+// each of its models: with each of the settings' exporters in its own staging folder, or
+// as COLMAP binary in sparse/<index> when there is none (with its georeference). A
+// failing exporter's error is thrown (the staging folder kept); an exporter quarantined
+// for this model is skipped, named in `quarantined`. `register` writes its model with it.
+void ExportModel(const Reconstruction& model, size_t index,
+                 const std::optional<Georeference>& georeference, const MapSettings& settings,
+                 const std::filesystem::path& image_dir, const std::filesystem::path& output_dir,
+                 const PluginCrashLog& crash_log, OutputTransaction* outputs,
+                 std::vector<std::string>* quarantined);
 
 // Places `result`, made elsewhere from `input`'s images (the merge of cluster models),
 // as MapWorkspace places its own: the settings' exporters, else COLMAP binary in

@@ -658,8 +658,10 @@ size_t IncrementalMapper::FilterPoints(const std::set<point3D_t>& point3D_ids) {
     const auto it = rec.points3D.find(point3D_id);
     if (it == rec.points3D.end()) continue;
     const Track track = it->second.track;
+    const bool held = held_points_.count(point3D_id) > 0;
     for (const TrackElement& element : track) {
       if (!rec.points3D.count(point3D_id)) break;
+      if (held && held_images_.count(element.image_id) > 0) continue;
       const Point3D& point3D = rec.points3D.at(point3D_id);
       if (!obs_.IsConsistent(rec.images.at(element.image_id), element.point2D_idx, point3D.xyz,
                              options_.filter_max_reproj_error)) {
@@ -668,7 +670,7 @@ size_t IncrementalMapper::FilterPoints(const std::set<point3D_t>& point3D_ids) {
       }
     }
     const auto kept = rec.points3D.find(point3D_id);
-    if (kept == rec.points3D.end()) continue;
+    if (kept == rec.points3D.end() || held) continue;
     if (obs_.MaxTriangulationAngle(kept->second.track, kept->second.xyz) <
         options_.filter_min_tri_angle * kDegToRad) {
       num_removed += kept->second.track.size();
@@ -713,6 +715,7 @@ IncrementalMapper::Status IncrementalMapper::LocalBundleAdjustment(image_t image
   std::set<image_t> local_images = {image_id};
   for (const auto& [count, other_id] : neighbours) {
     if (local_images.size() >= static_cast<size_t>(options_.local_ba_num_images)) break;
+    if (held_images_.count(other_id) > 0) continue;  // constant below, as it sees the points
     local_images.insert(other_id);
   }
   for (const image_t local_id : local_images) {
@@ -746,6 +749,7 @@ IncrementalMapper::Status IncrementalMapper::LocalBundleAdjustment(image_t image
   config.function_tolerance = options_.ba_local_function_tolerance;
   for (const point3D_t point3D_id : local_points)
     local.points3D[point3D_id] = rec.points3D.at(point3D_id);
+  HoldHeldModel(local, &config);
 
   const BundleAdjustmentSummary summary = run_.bundle_adjuster.Adjust(config, &local);
   ++run_.num_local_ba;
@@ -753,10 +757,14 @@ IncrementalMapper::Status IncrementalMapper::LocalBundleAdjustment(image_t image
                 constant_images.size(), summary.BriefReport());
   if (summary.usable) {
     for (const image_t id : local_images) {
+      if (held_images_.count(id) > 0) continue;
       rec.images.at(id).cam_from_world = local.images.at(id).cam_from_world;
     }
-    for (const auto& [camera_id, camera] : local.cameras) rec.cameras.at(camera_id) = camera;
+    for (const auto& [camera_id, camera] : local.cameras) {
+      if (held_images_.empty()) rec.cameras.at(camera_id) = camera;
+    }
     for (const auto& [point3D_id, point3D] : local.points3D) {
+      if (held_points_.count(point3D_id) > 0) continue;
       rec.points3D.at(point3D_id).xyz = point3D.xyz;
     }
   } else {
@@ -789,6 +797,7 @@ IncrementalMapper::Status IncrementalMapper::GlobalBundleAdjustment() {
   config.images = obs_.registered_images();
   config.max_num_iterations = options_.ba_global_max_num_iterations;
   config.function_tolerance = options_.ba_global_function_tolerance;
+  HoldHeldModel(rec, &config);
   const BundleAdjustmentSummary summary = run_.bundle_adjuster.Adjust(config, &rec);
   ++run_.num_global_ba;
   spdlog::debug("map: global BA of {} images, {} points: {}", obs_.registered_images().size(),
@@ -811,7 +820,8 @@ IncrementalMapper::Status IncrementalMapper::GlobalRefinement() {
   std::set<point3D_t> all_points;
   for (const auto& [point3D_id, point3D] : obs_.model().points3D) all_points.insert(point3D_id);
   const size_t num_completed = triangulator_.CompleteTracks(all_points);
-  const size_t num_merged = triangulator_.MergeTracks();
+  // Merging moves the merged point: never a held one's.
+  const size_t num_merged = held_points_.empty() ? triangulator_.MergeTracks() : 0;
   const size_t num_created = triangulator_.Retriangulate();
   spdlog::debug("map: refinement: {} observations completed, {} points merged, {} created",
                 num_completed, num_merged, num_created);

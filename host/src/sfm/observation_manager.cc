@@ -92,10 +92,49 @@ void ObservationManager::DeletePoint(point3D_t point3D_id) {
   for (const TrackElement& element : it->second.track) {
     rec_.images.at(element.image_id).points2D[element.point2D_idx].point3D_id = kInvalidPoint3DId;
   }
-  const track_t track_id = track_of_point3D_.at(point3D_id);
-  point3D_of_track_[track_id] = kInvalidPoint3DId;
-  track_of_point3D_.erase(point3D_id);
+  // A restored point may be linked to no track (RestorePoint).
+  const auto track = track_of_point3D_.find(point3D_id);
+  if (track != track_of_point3D_.end()) {
+    point3D_of_track_[track->second] = kInvalidPoint3DId;
+    track_of_point3D_.erase(track);
+  }
   rec_.points3D.erase(it);
+}
+
+void ObservationManager::RestorePoint(point3D_t point3D_id, const Point3D& point3D) {
+  // The canonical tracks of its observations that have no point yet, by how many.
+  std::map<track_t, size_t> free_tracks;
+  for (const TrackElement& element : point3D.track) {
+    const track_t raw = tracks_.TrackOf(element.image_id, element.point2D_idx);
+    if (raw == kInvalidTrackId) continue;
+    const track_t track_id = CanonicalTrack(raw);
+    if (point3D_of_track_[track_id] == kInvalidPoint3DId) ++free_tracks[track_id];
+  }
+  track_t linked = kInvalidTrackId;
+  size_t most = 0;
+  for (const auto& [track_id, count] : free_tracks) {
+    if (count > most) {
+      most = count;
+      linked = track_id;
+    }
+  }
+  rec_.points3D[point3D_id] = point3D;
+  for (const TrackElement& element : point3D.track) {
+    rec_.images.at(element.image_id).points2D.at(element.point2D_idx).point3D_id = point3D_id;
+    images_seeing_points_.insert(element.image_id);
+  }
+  next_point3D_id_ = std::max(next_point3D_id_, point3D_id + 1);
+  if (linked == kInvalidTrackId) return;
+  for (const auto& [track_id, count] : free_tracks) {
+    if (track_id == linked) continue;
+    tracks_.Merge(linked, track_id);
+    merged_into_[track_id] = linked;
+  }
+  for (const TrackElement& element : tracks_.tracks[linked]) {
+    images_seeing_points_.insert(element.image_id);
+  }
+  point3D_of_track_[linked] = point3D_id;
+  track_of_point3D_[point3D_id] = linked;
 }
 
 void ObservationManager::MergePoints(track_t into, track_t from, const Eigen::Vector3d& xyz) {

@@ -4,6 +4,7 @@
 // Frahm, CVPR 2016) with union-find feature tracks (one track, one 3D point):
 //
 //   Initialize          initial pair: relative pose, triangulation, global BA
+//   StartFrom           or an existing model, optionally held fixed (`tessera register`)
 //   NextImages          unregistered images by next-best-view score
 //   RegisterImage       P3P/EPnP LO-RANSAC, checked against the view graph
 //   TriangulateImage    its tracks (IncrementalTriangulator)
@@ -130,6 +131,19 @@ class TESSERA_SFM_EXPORT IncrementalMapper {
   // median angle init_min_tri_angle, then at half and a quarter of it), registers it,
   // triangulates its matches and adjusts it.
   Status Initialize();
+  // Instead of Initialize: starts from `existing`, a model of the input's images (ids
+  // and names as the input's): its cameras, its registered images with their poses and
+  // its points, each linked to the feature track most of its observations are in (the
+  // other tracks of its observations, with no point yet, are merged into it). With
+  // `hold`, the model's cameras, poses and points are held in every later step: bundle
+  // adjustments keep them constant (intrinsics are then not refined at all) and the
+  // point filter removes only observations of other images, so they come back
+  // bit-identical; observations of new images are added to held points. Throws
+  // InputError naming an image of `existing` the input lacks or holds otherwise, and
+  // std::logic_error on a mapper that has registered images already.
+  void StartFrom(const Reconstruction& existing, bool hold);
+  bool IsHeldImage(image_t image_id) const { return held_images_.count(image_id) > 0; }
+  bool IsHeldPoint(point3D_t point3D_id) const { return held_points_.count(point3D_id) > 0; }
   // Unregistered images that see enough of the model's points, best first: coverage
   // of the image by keypoints with a point, times the connection strength (the inliers
   // of its strongest pair with a registered image over those of its strongest pair).
@@ -206,6 +220,9 @@ class TESSERA_SFM_EXPORT IncrementalMapper {
                            size_t* best) const;
   bool ResetImplausiblePrincipalPoints();
   BundleAdjustmentConfig MakeBundleAdjustmentConfig() const;
+  // With a held model (StartFrom): no intrinsics refined, and its poses and points in
+  // `problem` (the model or a local sub-model) constant.
+  void HoldHeldModel(const Reconstruction& problem, BundleAdjustmentConfig* config) const;
   Status Fail(image_t image_id, Status status, const std::string& why);
 
   const IncrementalMapperOptions options_;
@@ -224,7 +241,19 @@ class TESSERA_SFM_EXPORT IncrementalMapper {
   bool local_ba_was_global_ = false;
   // Whether BA moves the principal point now: only in the final global rounds.
   bool refine_principal_point_ = false;
+  // What StartFrom(existing, hold = true) holds fixed.
+  std::set<image_t> held_images_;
+  std::set<point3D_t> held_points_;
 };
+
+// Registers the images of `image_ids` into the mapper's model (after StartFrom), best
+// first as NextImages orders them, each triangulated and locally adjusted, until no more
+// of them registers; then every one left gets its trials again (BeginFinalRounds) in a
+// last pass. `should_stop` is polled before each registration. Returns those
+// registered; why each other one was not is in the run's failure_reasons.
+TESSERA_SFM_EXPORT std::set<image_t> RegisterImages(IncrementalMapper* mapper,
+                                                    const std::set<image_t>& image_ids,
+                                                    const std::function<bool()>& should_stop = {});
 
 // "success", "no initial pair", ...: for the log.
 TESSERA_SFM_EXPORT const char* StatusName(IncrementalMapper::Status status);

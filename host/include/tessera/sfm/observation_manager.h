@@ -54,6 +54,13 @@ class TESSERA_SFM_EXPORT ObservationManager {
   // Deletes the point too when fewer than two observations are left.
   void DeleteObservation(point3D_t point3D_id, const TrackElement& element);
   void DeletePoint(point3D_t point3D_id);
+  // A point of an existing model, under its own id, observed by `point3D.track` (images
+  // of the model, registered). It is linked to the canonical track most of its
+  // observations are in that has no point yet, and the other such tracks of its
+  // observations are merged into that one; an observation of a keypoint in no track, or
+  // in the track of another point, is kept all the same. A point linked to no track is
+  // never completed nor merged. Later points get ids above every restored one.
+  void RestorePoint(point3D_t point3D_id, const Point3D& point3D);
   // Joins the point of track `from` into the point of track `into`, at `xyz`: the
   // observations of `from` move over and the tracks become one.
   void MergePoints(track_t into, track_t from, const Eigen::Vector3d& xyz);
