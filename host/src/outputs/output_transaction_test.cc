@@ -228,8 +228,9 @@ TEST(OutputTransaction, LeftoversOfAKilledRunAreRemovedAndItsOutputsStayTesseras
   WriteText(dir.path() / "sparse/0/images.bin", "new");
   const fs::path leftover = dir.path() / OutputTransaction::kStagingFolderName / "1/set/x";
   WriteText(leftover, "partial");
+  // The ledger's temporary, as a kill during its write leaves it ("." + ".tessera_outputs...").
   const fs::path ledger_temporary =
-      dir.path() / ".tessera_outputs.json.tessera-tmp-999999999-0123456789abcdef";
+      dir.path() / "..tessera_outputs.json.tessera-tmp-999999999-0123456789abcdef";
   WriteText(ledger_temporary, "partial");
   CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "newer"}}}});
   EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.bin"), "newer");
@@ -253,7 +254,7 @@ TEST(OutputTransaction, FilesNamedLikeTemporariesThatAreNotTesserasAreKept) {
       // folder (Tessera writes its outputs in the staging folder, never in place).
       dir.path() / ".notes.txt.tessera-tmp-999999-0123456789abcdef",
       dir.path() / "sparse/0/.images.bin.tessera-tmp-999999-0123456789abcdef",
-      dir.path() / "photos/.tessera_outputs.json.tessera-tmp-999999-0123456789abcdef",
+      dir.path() / "photos/..tessera_outputs.json.tessera-tmp-999999-0123456789abcdef",
   };
   for (const fs::path& path : users) WriteText(path, "mine");
   // A forged ledger naming the user's folder.
