@@ -146,6 +146,15 @@ run_m --images "$work/nested" --output "$work/nested/out" > /dev/null 2>&1
 check "output inside the image folder" 0 "Skipped the folder 'out': it is the output folder" \
   '[ "$(sqlite3 "$work/nested/out/database.db" "SELECT COUNT(*) FROM images")" = 5 ]' -- \
   run_m --images "$work/nested" --output "$work/nested/out"
+# Issue 60: an export put inside the image folder holds only the outputs ledger (no lock,
+# no database): its undistorted copies were ingested as more photos (22 images, not 11).
+subset "$work/exp_in" 11
+run_m --images "$work/exp_in" --output "$work/exp_in_ws" > /dev/null 2>&1
+"$tessera" export --model "$work/exp_in_ws/sparse/0" --format gaussian_splatting \
+  --images "$work/exp_in" --output "$work/exp_in/out" > /dev/null 2>&1
+check "a 3DGS export inside the image folder" 0 "Skipped the folder 'out': it holds Tessera's outputs" \
+  '[ -n "$(ls "$work/exp_in/out/gaussian_splatting/images")" ] && [ "$(sqlite3 "$work/exp_in_ws2/database.db" "SELECT COUNT(*) FROM images")" = 11 ]' -- \
+  run_m --images "$work/exp_in" --output "$work/exp_in_ws2"
 mkdir -p "$work/garbage_db"; head -c 5000 /dev/urandom > "$work/garbage_db/database.db"
 check "database.db not SQLite" 2 "garbage_db/database.db' is not a valid SQLite database" "" -- \
   run_m --images "$work/w" --output "$work/garbage_db"

@@ -121,13 +121,13 @@ check "OUTPUT/sparse a link to another folder" 2 "" "" -- \
 fresh "$work/g"; g_before=$(sums_of "$work/g/sparse")
 check "re-map on a full disk (ulimit -f)" 2 '[ "$(sums_of "$work/g/sparse")" = "$g_before" ] && [ ! -e "$work/g/gaussian_splatting" ]' "" -- \
   bash -c "trap '' XFSZ; ulimit -f 40; exec \"$tessera\" map --images \"$work/d\" --output \"$work/g\" --manifest \"$work/3dgs.json\" --threads 2"
-check "rerun after the full disk: no temporaries left" 0 '[ -z "$(cd "$work/g" && find . -name "*.tmp-*" -o -name .tessera_staging)" ]' "" -- \
+check "rerun after the full disk: no temporaries left" 0 '[ -z "$(cd "$work/g" && find . -name "*tmp-*" -o -name .tessera_staging)" ]' "" -- \
   t map --images "$work/d" --output "$work/g" --manifest "$work/text.json"
 fresh "$work/k"
 check "kill -9 between two renames (strace)" 137 '! { ls "$work/k/sparse/0" | grep -q "\.txt$" && ls "$work/k/sparse/0" | grep -q "\.bin$"; }' "" -- \
   strace -f -qq -o /dev/null -e trace=renameat2 -e inject=renameat2:signal=SIGKILL:when=2 \
     "$tessera" map --images "$work/d" --output "$work/k" --manifest "$work/text.json" --threads 2
-check "rerun after kill -9: whole, no leftovers" 0 '[ -f "$work/k/sparse/0/images.txt" ] && [ -z "$(cd "$work/k" && find . -name "*.tmp-*" -o -name .tessera_staging -o -name "*.bin")" ]' "" -- \
+check "rerun after kill -9: whole, no leftovers" 0 '[ -f "$work/k/sparse/0/images.txt" ] && [ -z "$(cd "$work/k" && find . -name "*tmp-*" -o -name .tessera_staging -o -name "*.bin")" ]' "" -- \
   t map --images "$work/d" --output "$work/k" --manifest "$work/text.json"
 fresh "$work/o"
 manifest "$work/db.json" '[{"plugin": "transforms_json", "options": {"file": "database.db"}}]'
@@ -158,6 +158,18 @@ check "3DGS: absolute and ../ image names" 2 '[ ! -e "$work/names/escape.jpg" ]'
 fresh "$work/lock"; rm -f "$work/lock/.tessera.lock"; ln -s "$work/outside/victim.txt" "$work/lock/.tessera.lock"
 check ".tessera.lock a link to another file" "0 2" "" "" -- \
   t map --images "$work/d" --output "$work/lock" --manifest "$work/bin.json"
+# Issue 60: a hard link is not stopped by O_NOFOLLOW (the victim was truncated to 0
+# bytes); a file of the user's under the lock's name is not Tessera's either.
+fresh "$work/hlock"; rm -f "$work/hlock/.tessera.lock"; ln "$work/outside/victim.txt" "$work/hlock/.tessera.lock"
+check ".tessera.lock a hard link to another file" 2 'grep -q "tessera.lock: is a file with 2 names" "$work/case.log"' "" -- \
+  t map --images "$work/d" --output "$work/hlock" --manifest "$work/bin.json"
+fresh "$work/ulock"; echo "my notes" > "$work/ulock/.tessera.lock"
+check ".tessera.lock a file of the user's" 2 "" "$work/ulock/.tessera.lock" -- \
+  t map --images "$work/d" --output "$work/ulock" --manifest "$work/bin.json"
+# Files named like an interrupted write's temporary, of a process that is gone: the user's.
+fresh "$work/tmpn"; echo mine > "$work/tmpn/.notes.tmp-999999"; echo mine > "$work/tmpn/sparse/0/.draft.tmp-999998"
+check "user files named .NAME.tmp-PID (map)" 0 "" "$work/tmpn/.notes.tmp-999999 $work/tmpn/sparse/0/.draft.tmp-999998" -- \
+  t map --images "$work/d" --output "$work/tmpn" --manifest "$work/bin.json"
 check "Slurm --partition with a newline" 2 '! grep -rqs "^touch pwned" "$work/slurm"' "" -- \
   t slurm --images "$work/d" --output "$work/slurm" --manifest "$work/bin.json" --workers 2 --dry-run --partition $'debug\ntouch pwned'
 check "Slurm --sbatch-arg with a newline" 2 '! grep -rqs "^touch pwned" "$work/slurm2"' "" -- \
@@ -192,6 +204,15 @@ t run --images "$work/d4" --output "$work/small" --manifest "$work/bin.json" > /
 "$tessera" export --model "$work/base/sparse/0" --format gaussian_splatting --images "$work/d" --output "$work/gs" > /dev/null 2>&1
 check "3DGS re-export of a smaller model: no old image left" 0 '[ "$(ls "$work/gs/gaussian_splatting/images" | wc -l)" = 4 ] && [ ! -e "$work/gs/gaussian_splatting/images/0007.jpg" ]' "" -- \
   "$tessera" export --model "$work/small/sparse/0" --format gaussian_splatting --images "$work/d4" --output "$work/gs"
+# Issue 60: a focal length of 0 was exported as 11 black images and fx = 0 (3DGS), and
+# "fl_x": 0.0 (transforms.json). Refused by each exporter, naming the camera; nothing placed.
+"$tessera" export --model "$work/base/sparse/0" --format colmap_text --output "$work/fx0" > /dev/null 2>&1
+awk '!/^#/ && NF { $5 = 0 } { print }' "$work/fx0/sparse/0/cameras.txt" > "$work/fx0/cameras.txt" &&
+  mv "$work/fx0/cameras.txt" "$work/fx0/sparse/0/cameras.txt"
+for format in gaussian_splatting transforms_json colmap_text colmap_binary; do
+  check "focal length 0 exported as $format" 2 'grep -q "camera 1: its focal length f = 0 is not a positive finite number" "$work/case.log" && [ -z "$(cd "$work/fx0_$format" && find . -mindepth 1 ! -path "./.tessera_staging*")" ]' "" -- \
+    "$tessera" export --model "$work/fx0/sparse/0" --format "$format" --images "$work/d" --output "$work/fx0_$format"
+done
 # --- Hand-offs read by their readers (issue 47) -----------------------------------------
 # file_path joined to the JSON's folder as nerfstudio joins it names the image, byte for byte.
 resolves() {
@@ -435,6 +456,13 @@ readback_forged_ledgers() {
   mkdir -p "$work/empty_folder"
   forged "an empty folder outside (folders)" "../empty_folder" "" "" map '[ -d "$work/empty_folder" ]'
   forged "the ledger itself" ".tessera_outputs.json" "$work/base/.tessera_outputs.json" ""
+  # Issue 60: a ledger naming a folder of the user's: its files named like temporaries
+  # (.x.tmp-N, N a process that is gone) were emptied as "left by an interrupted write".
+  o="$work/forged"; fresh "$o"; mkdir -p "$o/photos"
+  echo mine > "$o/photos/.x.tmp-999997"; echo mine > "$o/photos/.y.tmp-999996"
+  forge "$o" "photos"
+  check "forged ledger: a user folder's .x.tmp-N files" 0 "" "$o/photos/.x.tmp-999997 $o/photos/.y.tmp-999996" -- \
+    t map --images "$work/d" --output "$o" --manifest "$work/bin.json"
   # OUTPUT/sparse moved away and replaced by a link to it: every recorded digest matches
   # through the link, and nothing may be removed or replaced through it.
   o="$work/forged"; fresh "$o"; rm -rf "$work/moved_sparse"; mv "$o/sparse" "$work/moved_sparse"

@@ -131,7 +131,7 @@ if [ "$code" = 137 ] || [ "$code" = 9 ]; then
     fail "kill -9 before the second rename: transforms.json is not the old one"
   tess "$work/k2.log" "$work/text.json" map --images "$work/d" --output "$work/k" ||
     { cat "$work/k2.log"; fail "rerun after kill -9"; }
-  leftovers=$(cd "$work/k" && find . -name '.tessera_staging' -o -name '*.tmp-*')
+  leftovers=$(cd "$work/k" && find . -name '.tessera_staging' -o -name '*tmp-*')
   [ -z "$leftovers" ] || fail "kill -9: leftovers after the rerun: $leftovers"
   echo "kill -9 between renames: each entry whole, a rerun completes, no leftovers"
 else

@@ -137,6 +137,12 @@ bool IsTesseraWorkspace(const fs::path& dir) {
          fs::is_regular_file(dir / workspace_layout::kLock, error);
 }
 
+bool HoldsTesseraOutputs(const fs::path& dir) {
+  std::error_code error;
+  return fs::symlink_status(dir / workspace_layout::kOutputLedger, error).type() ==
+         fs::file_type::regular;
+}
+
 namespace {
 
 // The folders a scan leaves out, as canonical paths.
@@ -198,6 +204,12 @@ bool SkipFolder(const fs::directory_entry& entry, const std::string& name,
   }
   if (IsTesseraWorkspace(path)) {
     scan->skipped_folders.push_back(folder + "it is a Tessera workspace.");
+    return true;
+  }
+  if (HoldsTesseraOutputs(path)) {
+    scan->skipped_folders.push_back(folder + "it holds Tessera's outputs (" +
+                                    workspace_layout::kOutputLedger +
+                                    "), which are never read as input.");
     return true;
   }
   // Photos may be missing below these: each is a warning, not a note.

@@ -34,6 +34,10 @@ struct ImageScanOptions {
 // A folder holding a Tessera workspace (a database.db or a .tessera.lock file).
 bool IsTesseraWorkspace(const std::filesystem::path& dir);
 
+// A folder holding Tessera's outputs (an outputs ledger, .tessera_outputs.json): an
+// export's folder, which holds no lock (tessera export --output IMG/out).
+bool HoldsTesseraOutputs(const std::filesystem::path& dir);
+
 // Scans `dir` and its sub-folders (hidden files and folders excepted, counted in one
 // line of skipped_folders) for files ending
 // in .jpg, .jpeg, .png, .tif or .tiff in any case; names are relative to `dir`. The
@@ -48,8 +52,10 @@ bool IsTesseraWorkspace(const std::filesystem::path& dir);
 // file: a folder, a dangling symbolic link, a FIFO, device or socket (or a link to
 // one), a file that cannot be opened (the system's reason quoted); and every folder
 // that cannot be listed or is a symbolic link (not followed). FIFOs and devices are
-// never opened, so none can block the scan. The excluded folders and every Tessera
-// workspace below `dir` are left out, each with a line in skipped_folders. Every
+// never opened, so none can block the scan. The excluded folders, every Tessera
+// workspace and every folder holding Tessera's outputs (HoldsTesseraOutputs: an export
+// put inside the image folder) below `dir` are left out, each with a line in
+// skipped_folders: output never feeds input. Every
 // image gets its size and content hash.
 ImageScan ScanImageFolder(const std::filesystem::path& dir, const ImageScanOptions& options = {});
 

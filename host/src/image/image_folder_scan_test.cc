@@ -339,6 +339,31 @@ TEST(ScanImageFolder, LeavesOutTheOutputFolderAndWorkspacesAndSaysSo) {
   EXPECT_THROW(ScanImageFolder(dir.path(), options), InputError);
 }
 
+// Issue 60 item 3: an export put inside the image folder (export --output IMG/out) holds
+// no lock and no database, only the outputs ledger: its undistorted copies were read as
+// more photos by the next run.
+TEST(ScanImageFolder, LeavesOutAFolderHoldingTesserasOutputsAndSaysSo) {
+  TemporaryDir dir;
+  Write(dir.path() / "a.png", Pattern(32, 24));
+  Write(dir.path() / "out" / "gaussian_splatting" / "images" / "a.png", Pattern(32, 24));
+  std::ofstream(dir.path() / "out" / ".tessera_outputs.json") << "{}";
+  Write(dir.path() / "deep" / "er" / "b.png", Pattern(32, 24));
+  std::ofstream(dir.path() / "deep" / "er" / ".tessera_outputs.json") << "{}";
+  // Not a ledger: a link named like one, in a folder of photos.
+  Write(dir.path() / "linked" / "c.png", Pattern(32, 24));
+  std::filesystem::create_symlink(dir.path() / "out" / ".tessera_outputs.json",
+                                  dir.path() / "linked" / ".tessera_outputs.json");
+  ImageScan scan = ScanImageFolder(dir.path());
+  EXPECT_EQ(Names(scan), (std::vector<std::string>{"a.png", "linked/c.png"}));
+  std::sort(scan.skipped_folders.begin(), scan.skipped_folders.end());  // listing order
+  EXPECT_EQ(scan.skipped_folders,
+            (std::vector<std::string>{
+                "Skipped the folder 'deep/er': it holds Tessera's outputs "
+                "(.tessera_outputs.json), which are never read as input.",
+                "Skipped the folder 'out': it holds Tessera's outputs (.tessera_outputs.json), "
+                "which are never read as input."}));
+}
+
 TEST(ScanImageFolder, LeavesOutTheMaskFolder) {
   TemporaryDir dir;
   Write(dir.path() / "a.png", Pattern(32, 24));

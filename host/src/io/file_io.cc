@@ -9,6 +9,7 @@
 #include <iterator>
 #include <system_error>
 
+#include "temporary_names.h"
 #include "tessera/errors.h"
 
 namespace tessera {
@@ -40,11 +41,15 @@ void WriteFileAtomically(const fs::path& path, const std::string& contents) {
   // In the same folder, so that the rename stays on one file system and is atomic. The
   // temporary is a new file (O_EXCL, O_NOFOLLOW): a link planted under its name is
   // never followed, and the rename replaces a link at `path` instead of writing through.
-  const fs::path temporary = path.parent_path() / ("." + path.filename().string() + ".tmp-" +
-                                                   std::to_string(static_cast<long>(getpid())));
-  unlink(temporary.c_str());
-  const int fd =
-      open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+  // Its name carries Tessera's token and a random part (temporary_names.h): no other
+  // thread or process writes it, and nothing but Tessera's leftovers is ever taken for one.
+  fs::path temporary;
+  int fd = -1;
+  for (int attempt = 0; attempt < 8 && fd < 0; ++attempt) {
+    temporary = path.parent_path() / NewTemporaryFileName(path.filename().string());
+    fd = open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0 && errno != EEXIST) break;
+  }
   if (fd < 0) {
     throw InputError("Cannot create " + temporary.string() + " to write " + path.string() + ": " +
                      std::strerror(errno) + ".");

@@ -1,9 +1,14 @@
 #include "tessera/io/file_io.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
+#include <atomic>
 #include <fstream>
+#include <thread>
+#include <vector>
 
+#include "temporary_names.h"
 #include "tessera/errors.h"
 #include "tessera/io/image_io.h"
 #include "test_support.h"
@@ -27,6 +32,62 @@ TEST(WriteFileAtomically, WritesAndReplacesLeavingNoTemporaryFile) {
   WriteFileAtomically(path, "");
   EXPECT_EQ(fs::file_size(path), 0u);
   EXPECT_EQ(NumEntries(dir.path()), 1u);
+}
+
+// Issue 60 item 2: the temporary was .NAME.tmp-PID, one name for every thread of a
+// process, and each write unlinked it first: two threads writing one file took each
+// other's temporary away ("Cannot rename"), or renamed the other's half-written one.
+TEST(WriteFileAtomically, ThreadsWritingOneFileEachUseTheirOwnTemporary) {
+  testing::TemporaryDir dir;
+  const fs::path path = dir.path() / "shared.json";
+  constexpr int kThreads = 8;
+  constexpr int kWrites = 200;
+  std::atomic<int> failures{0};
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t) {
+    threads.emplace_back([&, t] {
+      // Each thread's contents are long and of its own: a mix or a cut shows.
+      const std::string contents(64 * 1024, static_cast<char>('a' + t));
+      for (int k = 0; k < kWrites; ++k) {
+        try {
+          WriteFileAtomically(path, contents);
+          WriteFileAtomically(dir.path() / ("own-" + std::to_string(t)), contents);
+        } catch (const InputError&) {
+          ++failures;
+        }
+      }
+    });
+  }
+  for (std::thread& thread : threads) thread.join();
+  EXPECT_EQ(failures.load(), 0);
+  const std::string contents = ReadFileContents(path);
+  ASSERT_EQ(contents.size(), 64u * 1024);
+  EXPECT_EQ(contents, std::string(contents.size(), contents[0]));
+  EXPECT_EQ(NumEntries(dir.path()), 1u + kThreads);  // no temporary left
+}
+
+// The temporary's name carries Tessera's token, the process and a random part, new for
+// every write; names a user gives files are never read as one.
+TEST(TemporaryFileNames, CarryTheTokenAndAreReadBackOnlyWhenExact) {
+  const std::string first = NewTemporaryFileName("images.bin");
+  const std::string second = NewTemporaryFileName("images.bin");
+  EXPECT_NE(first, second);
+  const std::string prefix = ".images.bin.tessera-tmp-" + std::to_string(getpid()) + "-";
+  EXPECT_EQ(first.rfind(prefix, 0), 0u) << first;
+  EXPECT_EQ(first.size(), prefix.size() + 16) << first;
+  const auto parsed = ParseTemporaryFileName(first);
+  ASSERT_TRUE(parsed.has_value()) << first;
+  EXPECT_EQ(parsed->target, "images.bin");
+  EXPECT_EQ(parsed->pid, static_cast<long>(getpid()));
+  for (const char* name :
+       {".notes.tmp-999999", ".draft.tmp-999998", "notes.tessera-tmp-1-0123456789abcdef",
+        ".tessera-tmp-1-0123456789abcdef", ".a.tessera-tmp-1-0123456789abcde",
+        ".a.tessera-tmp-1-0123456789abcdeF", ".a.tessera-tmp-1-0123456789abcdef0",
+        ".a.tessera-tmp--0123456789abcdef", ".a.tessera-tmp-01-0123456789abcdef",
+        ".a.tessera-tmp-x-0123456789abcdef", ".a.tessera-tmp-1234567890-0123456789abcdef"}) {
+    EXPECT_FALSE(ParseTemporaryFileName(name).has_value()) << name;
+  }
+  EXPECT_TRUE(ParseTemporaryFileName(".a.tessera-tmp-1-0123456789abcdef").has_value());
 }
 
 TEST(WriteFileAtomically, MissingFolderIsAnInputErrorNamingTheFile) {

@@ -10,9 +10,11 @@
 #include <cerrno>
 #include <cstring>
 #include <iterator>
+#include <optional>
 #include <set>
 
 #include "io/names.h"
+#include "io/temporary_names.h"
 #include "tessera/errors.h"
 #include "util/workspace_layout.h"
 
@@ -84,15 +86,16 @@ void RenameSwap(const fs::path& from, const fs::path& to) {
                    ": cannot replace it with the new output: " + std::strerror(errno));
 }
 
-// .NAME.tmp-PID, the temporary of an atomic write, of a process that is gone.
+// OUTPUT/.NAME.tessera-tmp-PID-RANDOM (io/temporary_names.h), the temporary of an
+// atomic write of NAME that its process left when it ended: only Tessera's token, only
+// for a NAME the workspace layout records at the top of a workspace (the ledger, the
+// crash records, clusters.json, frames.json: the files Tessera writes there in place;
+// the outputs are written in the staging folder), and only of a process that is gone.
+// Nothing else is taken for a leftover: a user's ".notes.tmp-999999" is theirs.
 bool IsLeftoverTemporary(const std::string& name) {
-  const size_t mark = name.rfind(".tmp-");
-  if (name.empty() || name[0] != '.' || mark == std::string::npos || mark == 0) return false;
-  const std::string pid = name.substr(mark + 5);
-  if (pid.empty() || pid.size() > 9 || pid.find_first_not_of("0123456789") != std::string::npos) {
-    return false;
-  }
-  const pid_t process = static_cast<pid_t>(std::stol(pid));
+  const std::optional<TemporaryFileName> parsed = ParseTemporaryFileName(name);
+  if (!parsed || !IsWorkspaceFile(parsed->target)) return false;
+  const pid_t process = static_cast<pid_t>(parsed->pid);
   return process != getpid() && kill(process, 0) != 0 && errno == ESRCH;
 }
 
@@ -126,8 +129,9 @@ OutputTransaction::OutputTransaction(fs::path output_folder, Mode mode)
       fs::remove_all(entry.path(), error);
     }
   }
+  // At the top only: the folders a ledger names may be the user's (a ledger can be
+  // edited), and Tessera writes nothing in them but by renames from the staging folder.
   RemoveLeftoverTemporaries(output_);
-  for (const std::string& folder : ledger_.folders()) RemoveLeftoverTemporaries(output_ / folder);
   staging_ = root / std::to_string(static_cast<long>(getpid()));
   fs::create_directories(staging_, error);
   if (error) {

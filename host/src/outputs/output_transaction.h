@@ -16,8 +16,9 @@
 //      reader sees the old model or the new one, never a mix;
 //   5. removes what Tessera wrote before and the set no longer holds (never a file it
 //      did not write, never through a link) and records the set alone (Mode).
-// The caller holds the output folder (the workspace lock). Temporaries an earlier
-// process left behind are removed when a transaction begins.
+// The caller holds the output folder (the workspace lock). What an earlier process left
+// in the staging folder, and the temporaries of its atomic writes at the top of OUTPUT
+// (Tessera's token only: io/temporary_names.h), are removed when a transaction begins.
 
 #include <filesystem>
 #include <map>
@@ -57,9 +58,10 @@ class OutputTransaction {
   };
 
   // Removes what an earlier process left in OUTPUT/.tessera_staging, and leftover
-  // temporaries of atomic writes (.NAME.tmp-PID of a process that is gone) in OUTPUT
-  // and the folders Tessera recorded. Throws InputError naming the path when the
-  // staging folder is a link or not a folder.
+  // temporaries of atomic writes in OUTPUT: .NAME.tessera-tmp-PID-RANDOM of a process
+  // that is gone, NAME a file of the workspace layout (util/workspace_layout.h). No
+  // other name, and nothing in the folders a ledger names. Throws InputError naming the
+  // path when the staging folder is a link or not a folder.
   explicit OutputTransaction(std::filesystem::path output_folder, Mode mode = Mode::kWholeSet);
   // Without Commit: the staging folder is removed, unless Keep() was called.
   ~OutputTransaction();

@@ -228,11 +228,42 @@ TEST(OutputTransaction, LeftoversOfAKilledRunAreRemovedAndItsOutputsStayTesseras
   WriteText(dir.path() / "sparse/0/images.bin", "new");
   const fs::path leftover = dir.path() / OutputTransaction::kStagingFolderName / "1/set/x";
   WriteText(leftover, "partial");
-  WriteText(dir.path() / "sparse/0/.images.bin.tmp-999999999", "partial");
+  // The ledger's temporary, as a kill during its write leaves it ("." + ".tessera_outputs...").
+  const fs::path ledger_temporary =
+      dir.path() / "..tessera_outputs.json.tessera-tmp-999999999-0123456789abcdef";
+  WriteText(ledger_temporary, "partial");
   CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "newer"}}}});
   EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.bin"), "newer");
   EXPECT_FALSE(fs::exists(leftover));
-  EXPECT_FALSE(fs::exists(dir.path() / "sparse/0/.images.bin.tmp-999999999"));
+  EXPECT_FALSE(fs::exists(ledger_temporary));
+}
+
+// Issue 60 item 2: a PID that no longer runs made any ".NAME.tmp-PID" a leftover of an
+// interrupted write, in OUTPUT and in every folder the ledger names (which a forged
+// ledger can point at a folder of the user's). Only Tessera's token, for a file of the
+// workspace layout at the top of OUTPUT, is a leftover now.
+TEST(OutputTransaction, FilesNamedLikeTemporariesThatAreNotTesserasAreKept) {
+  const testing::TemporaryDir dir;
+  CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "a"}}}});
+  const std::vector<fs::path> users = {
+      dir.path() / ".notes.tmp-999999",
+      dir.path() / "sparse/0/.draft.tmp-999998",
+      dir.path() / "photos/.x.tmp-5",
+      dir.path() / "photos/.x.tmp-999997",
+      // Tessera's token, but for a name Tessera does not write at the top, or in a
+      // folder (Tessera writes its outputs in the staging folder, never in place).
+      dir.path() / ".notes.txt.tessera-tmp-999999-0123456789abcdef",
+      dir.path() / "sparse/0/.images.bin.tessera-tmp-999999-0123456789abcdef",
+      dir.path() / "photos/..tessera_outputs.json.tessera-tmp-999999-0123456789abcdef",
+  };
+  for (const fs::path& path : users) WriteText(path, "mine");
+  // A forged ledger naming the user's folder.
+  OutputLedger forged = OutputLedger::Read(dir.path());
+  forged.AddFolder("photos");
+  forged.Write(dir.path());
+  CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "b"}}}},
+            OutputTransaction::Mode::kAddToSet);
+  for (const fs::path& path : users) EXPECT_EQ(ReadText(path), "mine") << path;
 }
 
 TEST(OutputTransaction, AddingToTheSetKeepsTheOtherModels) {

@@ -2,12 +2,14 @@
 
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
 #include <optional>
 #include <thread>
+#include <vector>
 
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
@@ -82,11 +84,94 @@ TEST(WorkspaceLock, ALockFileThatIsASymbolicLinkIsRefusedAndItsTargetKept) {
   } catch (const InputError& error) {
     EXPECT_NE(std::string(error.what())
                   .find(WorkspaceLock::LockFile(workspace).string() +
-                        ": cannot open the workspace lock file"),
+                        ": is a symbolic link, not the workspace lock file Tessera makes"),
               std::string::npos)
         << error.what();
   }
   EXPECT_EQ(ReadFileContents(target), "keep me\n");
+}
+
+// Issue 60 item 2: O_NOFOLLOW does not stop a hard link, and the lock was truncated on
+// taking it: OUT/.tessera.lock, a hard link to a file elsewhere, emptied that file.
+TEST(WorkspaceLock, ALockFileThatIsAHardLinkIsRefusedAndTheFileKept) {
+  testing::TemporaryDir dir;
+  const auto workspace = dir.path() / "out";
+  std::filesystem::create_directories(workspace);
+  const auto target = dir.path() / "precious.txt";
+  WriteFileAtomically(target, "keep me\n");
+  std::filesystem::create_hard_link(target, WorkspaceLock::LockFile(workspace));
+  try {
+    WorkspaceLock lock(workspace);
+    FAIL() << "a lock file that is a hard link was taken";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              WorkspaceLock::LockFile(workspace).string() +
+                  ": is a file with 2 names (a hard link: its contents are those of a file "
+                  "elsewhere), not the workspace lock file Tessera makes; Tessera changed "
+                  "nothing in it: move it away, or choose another output folder");
+  }
+  EXPECT_EQ(ReadFileContents(target), "keep me\n");
+  // Even a hard link to a lock of Tessera's own (the contents it writes): another name.
+  std::filesystem::remove(WorkspaceLock::LockFile(workspace));
+  WriteFileAtomically(target, "pid 1\nsince 2026-01-01T00:00:00Z\n");
+  std::filesystem::create_hard_link(target, WorkspaceLock::LockFile(workspace));
+  EXPECT_THROW(WorkspaceLock lock(workspace), InputError);
+  EXPECT_EQ(ReadFileContents(target), "pid 1\nsince 2026-01-01T00:00:00Z\n");
+}
+
+// A file of the user's under the lock's name, with one name: refused unless it holds
+// what Tessera writes there (nothing, or its own record), and never shrunk.
+TEST(WorkspaceLock, AFileTesseraDidNotWriteIsRefusedAndKept) {
+  testing::TemporaryDir dir;
+  const auto workspace = dir.path() / "out";
+  std::filesystem::create_directories(workspace);
+  const auto lock_file = WorkspaceLock::LockFile(workspace);
+  for (const std::string& contents :
+       std::vector<std::string>{"my notes\n", "pid 12\n", "pid 12\nsince yesterday\n",
+                                "pid 12\nsince 2026-01-01T00:00:00Z\nmore\n",
+                                "pid 12\nsince 2026-01-01T00:00:00Z", std::string(5000, 'x')}) {
+    WriteFileAtomically(lock_file, contents);
+    try {
+      WorkspaceLock lock(workspace);
+      FAIL() << "a lock file holding '" << contents << "' was taken";
+    } catch (const InputError& error) {
+      EXPECT_NE(
+          std::string(error.what())
+              .find(lock_file.string() + ": holds " +
+                    (contents.size() > 256 ? "more than 256" : std::to_string(contents.size())) +
+                    " bytes that Tessera did not write"),
+          std::string::npos)
+          << error.what();
+    }
+    EXPECT_EQ(ReadFileContents(lock_file), contents);
+  }
+  // A folder or a FIFO: refused without opening it (a FIFO would block the open).
+  std::filesystem::remove(lock_file);
+  ASSERT_EQ(mkfifo(lock_file.c_str(), 0644), 0);
+  EXPECT_THROW(WorkspaceLock lock(workspace), InputError);
+  std::filesystem::remove(lock_file);
+  std::filesystem::create_directory(lock_file);
+  EXPECT_THROW(WorkspaceLock lock(workspace), InputError);
+  std::filesystem::remove(lock_file);
+  // An empty file (as a released lock is) and a record of Tessera's are taken.
+  WriteFileAtomically(lock_file, "");
+  { WorkspaceLock lock(workspace); }
+  WriteFileAtomically(lock_file, "pid 12\nsince 2026-01-01T00:00:00Z\n");
+  std::string stale;
+  WorkspaceLock lock(workspace, &stale);
+  EXPECT_EQ(stale, "process 12 (since 2026-01-01T00:00:00Z)");
+}
+
+// A hard link made while the lock is held: the release leaves the file as it is.
+TEST(WorkspaceLock, ReleasingALockGivenAnotherNameLeavesItsContents) {
+  testing::TemporaryDir dir;
+  const auto workspace = dir.path() / "out";
+  const auto other = dir.path() / "other.txt";
+  {
+    WorkspaceLock lock(workspace);
+    std::filesystem::create_hard_link(WorkspaceLock::LockFile(workspace), other);
+  }
+  EXPECT_EQ(ReadFileContents(other).rfind("pid " + std::to_string(getpid()) + "\nsince ", 0), 0u);
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
 #include "tessera/testing/synthetic_model.h"
@@ -81,6 +83,31 @@ TEST(ColmapBinaryExporter, RecordOrderFromMustBeAModel) {
               std::string::npos)
         << error.what();
   }
+}
+
+// Issue 60 item 5: a camera no lens has (a focal length of 0, a NaN principal point) is
+// refused naming the camera and the model folder; nothing is written.
+TEST(ColmapBinaryExporter, ACameraWithoutAPositiveFiniteFocalLengthIsRefused) {
+  Reconstruction model =
+      testing::MakeSyntheticModel(Camera::Create(7, CameraModelId::kPinhole, 200, 160, 120), 3, 40);
+  model.cameras.at(7).params[0] = 0;
+  const auto exporter = testing::LoadBundledPlugin<Exporter>("exporter", "colmap_binary");
+  testing::TemporaryDir output;
+  ExportContext context;
+  context.output_dir = output.path();
+  try {
+    testing::Unguarded(exporter).Export(model, context);
+    ADD_FAILURE() << "a focal length of 0 was exported";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              (output.path() / "sparse" / "0").string() +
+                  ": camera 7: its focal length fx = 0 is not a positive finite number of "
+                  "pixels; the model is broken (was it edited?), and nothing was exported");
+  }
+  model.cameras.at(7).params[0] = 200;
+  model.cameras.at(7).params[3] = std::nan("");
+  EXPECT_THROW(testing::Unguarded(exporter).Export(model, context), InputError);
+  EXPECT_TRUE(fs::is_empty(output.path()));
 }
 
 }  // namespace

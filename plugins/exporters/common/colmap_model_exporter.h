@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <string>
 
+#include "common/exported_camera.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/exporter_paths.h"
 #include "tessera/io/georeference_io.h"
@@ -30,6 +31,12 @@ class ColmapModelExporter : public Exporter {
   // Writes OUTPUT/sparse/<model_index>/{cameras,images,points3D}.{txt|bin}, and
   // georeference.json beside them for a model in a GPS-anchored ENU frame.
   void Export(const Reconstruction& reconstruction, const ExportContext& context) const override {
+    // COLMAP and every reader of its models take a focal length of 0 at its word.
+    try {
+      CheckExportedCameras(reconstruction);
+    } catch (const InputError& error) {
+      throw InputError(SparseModelDir(context).string() + ": " + error.what());
+    }
     if (context.georeference) WriteGeoreference(*context.georeference, SparseModelDir(context));
     if (record_order_from_.empty()) {
       WriteColmapModel(reconstruction, SparseModelDir(context), format_);

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "common/exported_camera.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/exporter_paths.h"
 #include "tessera/io/file_io.h"
@@ -315,6 +316,12 @@ class GaussianSplattingExporter : public Exporter {
       throw InputError(root.string() +
                        ": the gaussian_splatting exporter needs the image folder to undistort "
                        "(tessera export --images DIR)");
+    }
+    // Before anything is written: a focal length of 0 would undistort every image to black.
+    try {
+      CheckExportedCameras(reconstruction);
+    } catch (const InputError& error) {
+      throw InputError((root / "sparse" / "0").string() + ": " + error.what());
     }
     CheckImageNames(reconstruction, root);
     Reconstruction undistorted = reconstruction;

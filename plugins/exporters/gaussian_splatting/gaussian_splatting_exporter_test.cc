@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <opencv2/imgcodecs.hpp>
@@ -15,6 +16,13 @@ namespace tessera {
 namespace {
 
 namespace fs = std::filesystem;
+
+// A number as the exporters' messages show it.
+std::string FormatValue(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.10g", value);
+  return text;
+}
 
 // A smooth pattern over the normalized image plane: an undistorted image shows it at
 // K_pinhole^-1 of each pixel, the original (distorted) one at CamFromImg.
@@ -594,6 +602,43 @@ TEST(GaussianSplattingExporter, APrincipalPointOutsideTheImageIsRefusedNamingThe
                         "60.000000) lies outside its 160x120 image"),
               std::string::npos)
         << error.what();
+  }
+}
+
+// Issue 60 item 5: a focal length of 0 undistorted every image to black and wrote
+// fx = 0 into the model. Refused before anything is written, naming the camera.
+TEST(GaussianSplattingExporter, AFocalLengthThatIsNotPositiveAndFiniteIsRefusedNamingIt) {
+  const Reconstruction good =
+      testing::MakeSyntheticModel(Camera::Create(3, CameraModelId::kPinhole, 140, 160, 120), 2, 50);
+  testing::TemporaryDir images;
+  for (const auto& [image_id, image] : good.images) {
+    ASSERT_TRUE(cv::imwrite((images.path() / image.name).string(),
+                            cv::Mat(120, 160, CV_8UC3, cv::Scalar::all(90))));
+  }
+  const auto exporter = testing::LoadBundledPlugin<Exporter>("exporter", "gaussian_splatting");
+  const std::pair<size_t, double> cases[] = {{0, 0.0},
+                                             {1, -140.0},
+                                             {0, std::numeric_limits<double>::quiet_NaN()},
+                                             {1, std::numeric_limits<double>::infinity()}};
+  for (const auto& [index, value] : cases) {
+    Reconstruction model = good;
+    model.cameras.at(3).params[index] = value;
+    testing::TemporaryDir output;
+    ExportContext context;
+    context.output_dir = output.path();
+    context.image_dir = images.path();
+    try {
+      testing::Unguarded(exporter).Export(model, context);
+      ADD_FAILURE() << "a focal length of " << value << " was exported";
+    } catch (const InputError& error) {
+      const std::string label = index == 0 ? "fx" : "fy";
+      EXPECT_NE(std::string(error.what())
+                    .find("camera 3: its focal length " + label + " = " + FormatValue(value) +
+                          " is not a positive finite number of pixels"),
+                std::string::npos)
+          << error.what();
+    }
+    EXPECT_TRUE(fs::is_empty(output.path())) << value;
   }
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "common/exported_camera.h"
 #include "tessera/io/exporter_paths.h"
 #include "tessera/io/file_io.h"
 #include "tessera/sdk.h"
@@ -143,6 +144,10 @@ class TransformsJsonExporter : public Exporter {
 
     nlohmann::json json = nlohmann::json::object();
     try {
+      // Readers take "fl_x": 0.0 at its word: a camera no lens has is refused.
+      for (const Image* image : frames) {
+        CheckExportedCamera(reconstruction.cameras.at(image->camera_id));
+      }
       if (shared_camera) json = Intrinsics(reconstruction.cameras.at(frames.front()->camera_id));
       // Both readers take the camera model from the top level only: one for all frames.
       size_t num_fisheye = 0;

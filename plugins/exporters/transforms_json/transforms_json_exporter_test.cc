@@ -1,8 +1,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -221,6 +223,44 @@ TEST(TransformsJsonExporter, WithoutAnImageFolderOnlyPathsThatResolve) {
   ExpectFilePathsResolve(model, output.path() / "transforms.json");
   EXPECT_EQ(ReadJson(output.path() / "transforms.json")["frames"][0]["file_path"],
             "images/img_1.png");
+}
+
+// Issue 60 item 5: a focal length of 0 was written as "fl_x": 0.0, which nerfstudio and
+// instant-ngp take at its word. Refused, naming the camera; nothing is written.
+TEST(TransformsJsonExporter, AFocalLengthThatIsNotPositiveAndFiniteIsRefusedNamingIt) {
+  const Reconstruction good = testing::MakeSyntheticModel(
+      Camera::Create(2, CameraModelId::kSimpleRadial, 100, 80, 60), 2, 30);
+  testing::TemporaryDir output;
+  WriteImages(good, output.path() / "images");
+  const auto exporter = testing::LoadBundledPlugin<Exporter>("exporter", "transforms_json");
+  for (const double value : {0.0, -100.0, std::nan("")}) {
+    Reconstruction model = good;
+    model.cameras.at(2).params[0] = value;
+    try {
+      testing::Unguarded(exporter).Export(model, ContextFor(output.path(), ""));
+      ADD_FAILURE() << "a focal length of " << value << " was exported";
+    } catch (const InputError& error) {
+      EXPECT_NE(std::string(error.what())
+                    .find("transforms.json: camera 2: its focal length f = " +
+                          std::string(value == 0  ? "0"
+                                      : value < 0 ? "-100"
+                                                  : "nan") +
+                          " is not a positive finite number of pixels"),
+                std::string::npos)
+          << error.what();
+    }
+    EXPECT_FALSE(fs::exists(output.path() / "transforms.json"));
+  }
+  // A principal point or a size that is not one: refused too.
+  Reconstruction model = good;
+  model.cameras.at(2).params[2] = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(testing::Unguarded(exporter).Export(model, ContextFor(output.path(), "")),
+               InputError);
+  model = good;
+  model.cameras.at(2).width = 0;
+  EXPECT_THROW(testing::Unguarded(exporter).Export(model, ContextFor(output.path(), "")),
+               InputError);
+  EXPECT_FALSE(fs::exists(output.path() / "transforms.json"));
 }
 
 }  // namespace
