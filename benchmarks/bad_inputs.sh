@@ -332,7 +332,7 @@ k_file K_tiny.txt 1e-9 0 253.5315 0 1e-9 167.963 0 0
 k_file K_huge.txt 1e12 0 253.5315 0 1e12 167.963 0 0
 printf '\xEF\xBB\xBF' > "$work/K_bom.txt"; cat "$work/K512.txt" >> "$work/K_bom.txt"
 held() { t run --manifest "$work/held.json" --images "$work/w" --output "$work/cal_$tried" "$@"; }
-check "held K with skew 150" 2 "held.json: camera.require_calibration: .* K_skew.txt: K\[0\]\[1\] \(the skew\) is 150" "" -- \
+check "held K with skew 150" 2 "held.json: camera.require_calibration: .*/K_skew.txt: K\[0\]\[1\] \(the skew\) is 150" "" -- \
   held --camera-K "$work/K_skew.txt"
 check "K with skew 150 (not held)" 0 "K_skew.txt: K\[0\]\[1\] \(the skew\) is 150, not 0" "" -- \
   run_m --images "$work/w" --output "$work/cal_skew" --camera-K "$work/K_skew.txt"
