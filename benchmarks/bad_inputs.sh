@@ -322,6 +322,68 @@ check "slurm --output with quotes, \$, \` and #" 0 "slurm: wrote" \
   '[ "$(sed -n "s/^exec [^ ]* /printf \"%s\\\\n\" /p" "$odd/slurm/map.sh" | bash | sed -n "/^--output$/{n;p}")" = "$odd" ] && grep -q "^#SBATCH --output=\"" "$odd/slurm/map.sh"' -- \
   t slurm --images "$work/w" --output "$odd" --workers 2 --dry-run --manifest "$work/m.json"
 
+# Calibration: a K is checked as input wherever it is given; a recipe that holds the
+# intrinsics (camera.require_calibration) refuses what is wrong (exit 2), any other run
+# warns; `map --camera-K` applies it or refuses it.
+python3 - "$work/m.json" "$work/held.json" <<'PY'
+import json, sys
+manifest = json.load(open(sys.argv[1]))
+manifest["camera"]["require_calibration"] = True
+json.dump(manifest, open(sys.argv[2], "w"))
+PY
+k_file() { printf '%s %s %s\n%s %s %s\n%s %s 1\n' "${@:2}" > "$work/$1"; }  # NAME 8 NUMBERS
+k_file K512.txt 459.9135 0 253.5315 0 460.916 167.963 0 0
+k_file K_skew.txt 459.9135 150 253.5315 0 460.916 167.963 0 0
+k_file K_row.txt 459.9135 0 253.5315 0 460.916 167.963 5 7
+k_file K_tenth.txt 459.9135 0 253.5315 0 45.9916 167.963 0 0
+k_file K1024.txt 919.827 0 507.063 0 921.832 335.926 0 0
+k_file K_tiny.txt 1e-9 0 253.5315 0 1e-9 167.963 0 0
+k_file K_huge.txt 1e12 0 253.5315 0 1e12 167.963 0 0
+printf '\xEF\xBB\xBF' > "$work/K_bom.txt"; cat "$work/K512.txt" >> "$work/K_bom.txt"
+held() { t run --manifest "$work/held.json" --images "$work/w" --output "$work/cal_$tried" "$@"; }
+check "held K with skew 150" 2 "held.json: camera.require_calibration: .*/K_skew.txt: K\[0\]\[1\] \(the skew\) is 150" "" -- \
+  held --camera-K "$work/K_skew.txt"
+check "K with skew 150 (not held)" 0 "K_skew.txt: K\[0\]\[1\] \(the skew\) is 150, not 0" "" -- \
+  run_m --images "$work/w" --output "$work/cal_skew" --camera-K "$work/K_skew.txt"
+check "K with bottom row 5 7 1" 2 "K_row.txt: the bottom row K\[2\] is '5 7 1', not '0 0 1'" "" -- \
+  held --camera-K "$work/K_row.txt"
+check "held K with fy = fx / 10" 2 "K_tenth.txt: (fy = 45.99 px is implausible|the aspect ratio)" "" -- \
+  held --camera-K "$work/K_tenth.txt"
+check "held 1024 px K on 512 px photos" 2 "K1024.txt do not fit the 5 images of 512x342 .*lies [0-9]+ px from their centre" "" -- \
+  held --camera-K "$work/K1024.txt"
+mkdir -p "$work/mixed_sizes"; cp "$work/w"/000[0-3].jpg "$work/mixed_sizes/"
+cp "$root/examples/fountain-P11-small/images/0004.jpg" "$work/mixed_sizes/"
+check "mixed sizes: 512 px K, one 1024 px image" 0 "K512.txt: the principal point .* lies [0-9]+ px from the centre of the 1024x683 image '0004.jpg'.*K is not used there" \
+  '[ "$(sqlite3 "$work/mixed_out/database.db" "SELECT COUNT(*) FROM tessera_camera_priors WHERE source = '"'user'"'")" = 1 ]' -- \
+  run_m --images "$work/mixed_sizes" --output "$work/mixed_out" --camera-K "$work/K512.txt"
+check "mixed sizes, held" 2 "K512.txt do not fit the 1024x683 image '0004.jpg'" "" -- \
+  t run --manifest "$work/held.json" --images "$work/mixed_sizes" --output "$work/mixed_held" --camera-K "$work/K512.txt"
+cp -r "$work/w_out" "$work/map_K"
+check "map --camera-K" 0 "re-created the cameras of 5 images as camera 1 \(SIMPLE_RADIAL 512x342, focal 460.4 px, user\)" \
+  '[ "$(sqlite3 "$work/map_K/database.db" "SELECT source FROM tessera_camera_priors")" = user ]' -- \
+  t map --manifest "$work/m.json" --images "$work/w2" --output "$work/map_K" --camera-K "$work/K512.txt"
+check "K file with a UTF-8 BOM" 0 "camera 1: SIMPLE_RADIAL 512x342 focal 460.4 px \(user\)" "" -- \
+  run_m --images "$work/w" --output "$work/cal_bom" --camera-K "$work/K_bom.txt"
+mkdir -p "$work/K_dir"
+check "K is a folder" 2 "K_dir is a folder, not a file" "" -- \
+  run_m --images "$work/w" --output "$work/cal_dir" --camera-K "$work/K_dir"
+check "fx = 1e-9" 2 "K_tiny.txt: fx = 1e-09 px is implausible for the camera of the 5 images of 512x342" "" -- \
+  run_m --images "$work/w" --output "$work/cal_tiny" --camera-K "$work/K_tiny.txt"
+check "fx = 1e12" 2 "K_huge.txt: fx = 1e\+12 px is implausible for the camera of the 5 images of 512x342" "" -- \
+  run_m --images "$work/w" --output "$work/cal_huge" --camera-K "$work/K_huge.txt"
+
+# Stale results: an image that had no features when its pairs were matched (a crashing
+# detector, here its features removed by hand) and is detected again has its pairs
+# matched again, and is registered.
+subset "$work/stale" 5
+t extract --manifest "$work/m.json" --images "$work/stale" --output "$work/stale_out" > /dev/null 2>&1
+sqlite3 "$work/stale_out/database.db" "DELETE FROM keypoints WHERE image_id = 5; DELETE FROM descriptors WHERE image_id = 5;
+  DELETE FROM tessera_features WHERE image_id = 5" 2> /dev/null
+t match --manifest "$work/m.json" --output "$work/stale_out" > /dev/null 2>&1
+check "image detected after its pairs were matched" 0 "match: 4 matched pairs were matched from other features" \
+  '[ "$(registered "$work/stale_out")" = 5 ]' -- \
+  run_m --images "$work/stale" --output "$work/stale_out"
+
 echo
 echo "inputs tried: $tried"
 echo "crashes: $crashes"

@@ -249,6 +249,45 @@ TEST(Manifest, KFileOfOtherThanNineFiniteNumbersNamesTheFileAndTheCulprit) {
   EXPECT_EQ(error_of("2759.48 0 1520.69\n0 2764.16 1006.81\n0 0 1\n"), "no error");
 }
 
+// A BOM (Windows editors) read as part of the first number; a folder as "found 0".
+TEST(Manifest, KFileWithABomIsReadAndAFolderIsNamedAsSuch) {
+  testing::TemporaryDir dir;
+  const auto k_file = dir.path() / "K.txt";
+  std::ofstream(k_file) << "\xEF\xBB\xBF"
+                        << "574.892 0 316.9\n0 576.1 209.9\n0 0 1\n";
+  const Eigen::Matrix3d K = ReadCalibrationMatrixFile(k_file);
+  EXPECT_DOUBLE_EQ(K(0, 0), 574.892);
+  EXPECT_DOUBLE_EQ(K(1, 2), 209.9);
+  try {
+    ReadCalibrationMatrixFile(dir.path());
+    FAIL() << "a folder was read";
+  } catch (const InputError& error) {
+    EXPECT_EQ(std::string(error.what()), dir.path().string() + " is a folder, not a file.");
+  }
+}
+
+// camera.K and K_file are checked as given: a skew or aspect ratio recorded as a problem,
+// a focal length that is not positive refused naming the entry.
+TEST(Manifest, AGivenKIsCheckedAsACalibration) {
+  testing::TemporaryDir dir;
+  std::ofstream(dir.path() / "K.txt") << "2759.48 150 1520.69\n0 2764.16 1006.81\n0 0 1\n";
+  std::ofstream(dir.path() / "m.json") << R"({"camera": {"K_file": "K.txt"}})";
+  const Manifest manifest = Manifest::Load(dir.path() / "m.json");
+  ASSERT_EQ(manifest.camera.known_intrinsics_problems.size(), 1u);
+  EXPECT_NE(manifest.camera.known_intrinsics_problems[0].find("K[0][1] (the skew) is 150"),
+            std::string::npos);
+  std::ofstream(dir.path() / "bad.json") << R"({"camera": {"K": [0, 900, 500, 300]}})";
+  try {
+    Manifest::Load(dir.path() / "bad.json");
+    FAIL() << "fx = 0 was taken";
+  } catch (const InputError& error) {
+    EXPECT_NE(std::string(error.what())
+                  .find("camera.K: fx is 0: focal lengths must be positive finite numbers"),
+              std::string::npos)
+        << error.what();
+  }
+}
+
 // A second "pipeline" replaced the first, which then read as "pipeline.detector:
 // missing"; any key given twice in one object is refused, named by its path.
 TEST(Manifest, ADuplicateKeyIsRefusedNamingItsPathAndTheFile) {

@@ -338,11 +338,25 @@ TEST(PluginLoader, DiscoveryListsRefusedFilesWithoutThrowing) {
   size_t refused = 0;
   for (const auto& record : registry.records()) refused += record.usable() ? 0 : 1;
   // no_info, wrong_abi, abi_one, old_string_abi, unknown_kind, no_factory, the second
-  // twin, and crash_on_load, which the probe refused without this process ever loading it.
-  EXPECT_EQ(refused, 8u);
+  // twin, and crash_on_load and term_on_load, which the probe refused without this process
+  // ever loading them.
+  EXPECT_EQ(refused, 9u);
   EXPECT_EQ(registry.NamesOfKind("pair_selector"),
             (std::vector<std::string>{"consecutive", "failing_pair_selector", "float_only",
                                       "throws", "twin"}));
+}
+
+// A probe child ended by SIGTERM (or SIGINT: an interrupt reaching it) was "crashes on
+// load (SIGTERM)": an interrupt is never called a crash of the plugin.
+TEST(PluginLoader, AProbeChildEndedByAnInterruptIsNotACrash) {
+  const PluginRegistry registry = PluginRegistry::Discover({kRoot / "term_on_load"});
+  ASSERT_EQ(registry.records().size(), 1u);
+  const PluginRecord& record = registry.records().front();
+  EXPECT_FALSE(record.usable());
+  EXPECT_NE(record.refusal.find("not inspected: the plugin scan was interrupted (SIGTERM)"),
+            std::string::npos)
+      << record.refusal;
+  EXPECT_EQ(record.refusal.find("crash"), std::string::npos) << record.refusal;
 }
 
 TEST(PluginLoader, ObjectsOutliveTheRegistryThatMadeThem) {

@@ -307,6 +307,17 @@ std::string ReadCrashRecord(int fd) {
                            "; what was finished is kept and the same call resumes (what "
                            "crashes a plugin twice is skipped or refused)");
   }
+  if (WIFSIGNALED(status) &&
+      (WTERMSIG(status) == SIGINT || WTERMSIG(status) == SIGTERM || WTERMSIG(status) == SIGHUP)) {
+    // Ended by an interrupt (the child cancels on the first; a second, or one sent before
+    // its handlers were in place, ends it): interrupted, as in-process, never a crash.
+    PyErr_SetString(PyExc_KeyboardInterrupt,
+                    ("tessera." + verb + ": interrupted (the stage's process was ended by SIG" +
+                     std::string(sigabbrev_np(WTERMSIG(status))) +
+                     "); what was finished is kept and the same call resumes")
+                        .c_str());
+    throw py::error_already_set();
+  }
   if (WIFSIGNALED(status)) {
     const char* name = sigabbrev_np(WTERMSIG(status));
     throw std::runtime_error("tessera." + verb + ": the stage's process was ended by SIG" +

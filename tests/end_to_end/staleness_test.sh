@@ -5,6 +5,7 @@
 #     single_camera and default_focal_length_factor in the manifest): the cameras are
 #     re-created (logged, naming the settings), no image is detected again, and the model
 #     is byte for byte that of a fresh workspace with the new settings;
+#     `map --camera-K` applies K as extract would (a K with fx = 1e12 is refused, exit 2);
 #  2. exhaustive, then `window` 2: mapping leaves out the pairs the window does not choose
 #     (logged), nothing is matched again, and the model is that of a fresh workspace with
 #     `window` 2; exhaustive again matches nothing again.
@@ -72,6 +73,28 @@ tess "$work/3f.log" "$work/other.json" "$work/fresh_other"
 tess "$work/4.log" "$work/other.json" "$work/out"
 if grep -q "re-created the cameras" "$work/4.log"; then fail "unchanged settings re-created the cameras"; fi
 echo "camera.model, single_camera, default_focal_length_factor: the same; unchanged: kept"
+
+# 1b. map --camera-K applies K to the workspace's cameras as extract does (features and
+#     matches kept, the geometries verified again): the model of a fresh workspace with K,
+#     never the old cameras; a K no lens gives on these images is refused, the cameras kept.
+tess "$work/8.log" "$work/m.json" "$work/map_K"
+map_K() {  # map_K LOG K_FILE: `map --camera-K` on map_K
+  "$tessera" map --images "$work/images" --output "$work/map_K" --manifest "$work/m.json" \
+    --threads 2 --camera-K "$2" > "$1" 2>&1
+}
+printf '1e12 0 253.5315\n0 1e12 167.963\n0 0 1\n' > "$work/K_far.txt"
+cameras() { sqlite3 "$work/map_K/database.db" 'SELECT hex(params) FROM cameras'; }
+before=$(cameras)
+map_K "$work/9.log" "$work/K_far.txt"
+code=$?
+[ "$code" = 2 ] || { cat "$work/9.log"; fail "map --camera-K with fx = 1e12: exit $code, expected 2"; }
+[ "$(cameras)" = "$before" ] || fail "a refused --camera-K changed the cameras"
+expect_log "$work/9.log" "$work/K_far.txt: fx = 1e+12 px is implausible for the camera of the 6 images of 512x342"
+map_K "$work/10.log" "$work/K.txt" || { tail -30 "$work/10.log"; fail "map --camera-K"; }
+expect_log "$work/10.log" "re-created the cameras of 6 images as camera 1 (SIMPLE_RADIAL 512x342, focal 460.4 px, user)"
+[ "$(model_of "$work/map_K")" = "$(model_of "$work/fresh_K")" ] ||
+  fail "map --camera-K: the model differs from a fresh workspace's with K"
+echo "map --camera-K: applied to the cameras (matches kept), the model of a fresh workspace; fx = 1e12 refused"
 
 # 2. Pair selection.
 tess "$work/5.log" "$work/m.json" "$work/pairs"

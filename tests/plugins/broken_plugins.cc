@@ -4,6 +4,7 @@
 // TESSERA_TEST_CASE_* macro defined; see tests/CMakeLists.txt.
 
 #include <algorithm>
+#include <csignal>
 #include <cstdint>
 #include <cstdlib>
 #include <exception>
@@ -100,13 +101,31 @@ struct Failure {
   return failure;
 }
 
+// Besides the shared options: "wrap" ({"plugin": NAME, "options": {...}}) detects with
+// that detector, made by the host, instead of the grid below, so that a run with it
+// registers images; "only_if_env" (a variable name) fails only while that variable is
+// set, so that a test can "fix" the plugin without changing its options (which would
+// make every image's features stale).
 class FailingDetector : public tessera::Detector {
  public:
-  explicit FailingDetector(const nlohmann::json& options)
-      : failure_(ReadFailure(options, &effective_options_)) {}
+  explicit FailingDetector(const nlohmann::json& options) : reader_(options), failure_(&reader_) {
+    const nlohmann::json wrap = reader_.GetJson("wrap", nullptr);
+    only_if_env_ = reader_.GetString("only_if_env", "");
+    reader_.Finish();
+    effective_options_ = reader_.Effective();
+    failure_.Trigger("factory");
+    if (wrap.is_object()) {
+      wrapped_ = host().Create<tessera::Detector>("detector", wrap.value("plugin", ""),
+                                                  wrap.value("options", nlohmann::json::object()));
+    }
+  }
   // Keypoints on a 4x4 grid, each described by the 16 pixels of its neighbourhood.
   tessera::FeatureSet Detect(const tessera::ImageView& image) const override {
-    if (failure_.on_width == 0 || failure_.on_width == image.width) failure_.Trigger("call");
+    const bool armed = only_if_env_.empty() || std::getenv(only_if_env_.c_str()) != nullptr;
+    if (armed && (failure_.on_width == 0 || failure_.on_width == image.width)) {
+      failure_.Trigger("call");
+    }
+    if (wrapped_) return wrapped_->Detect(image);
     tessera::FeatureSet features;
     if (image.width < 8 || image.height < 8) return features;
     features.descriptors.data.resize(16, 16);
@@ -121,10 +140,15 @@ class FailingDetector : public tessera::Detector {
     }
     return features;
   }
-  tessera::DescriptorMetric Metric() const override { return tessera::DescriptorMetric::kL2; }
+  tessera::DescriptorMetric Metric() const override {
+    return wrapped_ ? wrapped_->Metric() : tessera::DescriptorMetric::kL2;
+  }
 
  private:
+  tessera::OptionReader reader_;
   Failure failure_;
+  std::string only_if_env_;
+  std::unique_ptr<tessera::Detector> wrapped_;
 };
 
 class FailingMatcher : public tessera::Matcher {
@@ -247,6 +271,15 @@ TESSERA_PLUGIN(exporter, FailingExporter, "failing_exporter", "1.0.0", "Fails on
   return 0;
 }();
 TESSERA_PLUGIN(pair_selector, TestPairSelector, "crash_on_load", "1.0.0", "Crashes when loaded")
+
+#elif defined(TESSERA_TEST_CASE_TERM_ON_LOAD)
+// A static initialiser ended by SIGTERM, as a probe child that an interrupt reaches is: the
+// probe must not call that a crash of the plugin.
+[[maybe_unused]] static const int term_on_load = [] {
+  std::raise(SIGTERM);
+  return 0;
+}();
+TESSERA_PLUGIN(pair_selector, TestPairSelector, "term_on_load", "1.0.0", "Ended by SIGTERM")
 
 #elif defined(TESSERA_TEST_CASE_NO_INFO)
 // Exports a function, but no info record.

@@ -170,9 +170,7 @@ CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions&) {
             // The whole manifest and every plugin are checked here, not on the cluster.
             PipelineContext context = PipelineContext::Create(slurm.manifest);
             if (!options->camera_K.empty()) {
-              const Eigen::Matrix3d K = ReadCalibrationMatrixFile(options->camera_K);
-              context.manifest.camera.known_intrinsics =
-                  Eigen::Vector4d(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
+              ReadKnownIntrinsicsFile(options->camera_K, &context.manifest.camera);
             }
             if (options->camera_per_folder) context.manifest.camera.per_folder = true;
             const RunOptions run{slurm.image_dir, slurm.output_dir};

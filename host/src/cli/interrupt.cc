@@ -37,6 +37,8 @@ const CancellationToken& InterruptToken() {
   return Token();
 }
 
+bool InterruptRequested() { return Token().IsCancelled(); }
+
 int ReportInterrupted(const char* verb) {
   spdlog::warn(
       "{}: interrupted; the images and pairs finished are kept in the workspace: run the same "

@@ -13,6 +13,10 @@ namespace tessera {
 // they cancel.
 const CancellationToken& InterruptToken();
 
+// Whether SIGINT or SIGTERM came since InterruptToken installed the handlers (false before):
+// an error that follows an interrupt is reported as the interrupt (main.cc).
+bool InterruptRequested();
+
 // Logs that the verb was interrupted, what was kept and how to resume; returns
 // kExitInterrupted (cli/exit_codes.h).
 int ReportInterrupted(const char* verb);

@@ -8,6 +8,7 @@
 #include <iostream>
 
 #include "cli/commands.h"
+#include "cli/interrupt.h"
 #include "plugin/plugin_call.h"
 #include "tessera/errors.h"
 #include "util/exit_codes.h"
@@ -44,15 +45,25 @@ int main(int argc, char** argv) {
 
   for (const auto& command : commands) {
     if (!command.subcommand->parsed()) continue;
+    const std::string verb = command.subcommand->get_name();
+    // What fails once Ctrl-C or SIGTERM came (a plugin scan cut short, a child ended) is
+    // the interrupt's doing: reported as the interrupt, exit 130, never as a crash.
+    const auto interrupted = [&](const std::exception& error) {
+      spdlog::warn("{}: stopped by the interrupt: {}", verb, error.what());
+      return ReportInterrupted(verb.c_str());
+    };
     try {
       return command.run();
     } catch (const PluginError& error) {
+      if (InterruptRequested()) return interrupted(error);
       spdlog::error("{}", error.what());
       return error.input_error() ? kExitBadInput : kExitInternalError;
     } catch (const InputError& error) {
+      if (InterruptRequested()) return interrupted(error);
       spdlog::error("{}", error.what());
       return kExitBadInput;
     } catch (const std::exception& error) {
+      if (InterruptRequested()) return interrupted(error);
       spdlog::error("internal error: {}", error.what());
       return kExitInternalError;
     }

@@ -159,7 +159,10 @@ bool Database::ExistsKeypoints(image_t image_id) const {
 
 void Database::WriteKeypoints(image_t image_id, const FeatureKeypoints& keypoints) {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
-  impl_->keypoints.Write(image_id, keypoints);
+  impl_->connection.Atomically("write the keypoints of image " + std::to_string(image_id), [&] {
+    const std::string digest = impl_->keypoints.Write(image_id, keypoints);
+    impl_->tessera.WriteFeaturesDigest(image_id, "keypoints", digest);
+  });
 }
 
 FeatureKeypoints Database::ReadKeypoints(image_t image_id) const {
@@ -184,7 +187,10 @@ bool Database::ExistsDescriptors(image_t image_id) const {
 
 void Database::WriteDescriptors(image_t image_id, const FeatureDescriptors& descriptors) {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
-  impl_->descriptors.Write(image_id, descriptors);
+  impl_->connection.Atomically("write the descriptors of image " + std::to_string(image_id), [&] {
+    const std::string digest = impl_->descriptors.Write(image_id, descriptors);
+    impl_->tessera.WriteFeaturesDigest(image_id, "descriptors", digest);
+  });
 }
 
 std::optional<int> Database::DescriptorDimension() const {
@@ -210,7 +216,51 @@ bool Database::ExistsMatches(image_t image_id1, image_t image_id2) const {
 
 void Database::WriteMatches(image_t image_id1, image_t image_id2, const FeatureMatches& matches) {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
-  impl_->matches.Write(image_id1, image_id2, matches);
+  const auto [first, second] = PairIdToImagePair(ImagePairToPairId(image_id1, image_id2));
+  impl_->connection.Atomically("write the matches of images " + std::to_string(image_id1) +
+                                   " and " + std::to_string(image_id2),
+                               [&] {
+                                 impl_->matches.Write(image_id1, image_id2, matches);
+                                 impl_->tessera.WritePairFeatures(
+                                     ImagePairToPairId(image_id1, image_id2),
+                                     impl_->tessera.ReadFeatureDigest(first),
+                                     impl_->tessera.ReadFeatureDigest(second));
+                               });
+}
+
+std::vector<image_pair_t> Database::ReadPairsWithStaleMatches() const {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  const std::map<image_t, std::string> digests = impl_->tessera.ReadFeatureDigests();
+  const auto records = impl_->tessera.ReadPairFeatures();
+  const auto current = [&](image_t image_id) {
+    const auto it = digests.find(image_id);
+    return it == digests.end() ? std::string() : it->second;
+  };
+  std::vector<image_pair_t> stale;
+  for (const image_pair_t pair_id : impl_->matches.ReadPairIds()) {
+    const auto [image_id1, image_id2] = PairIdToImagePair(pair_id);
+    const auto record = records.find(pair_id);
+    // Matches written before the record was kept count as made from features without one.
+    const std::pair<std::string, std::string> made_from =
+        record == records.end() ? std::pair<std::string, std::string>() : record->second;
+    if (made_from.first != current(image_id1) || made_from.second != current(image_id2)) {
+      stale.push_back(pair_id);
+    }
+  }
+  return stale;
+}
+
+void Database::DeleteMatches(const std::vector<image_pair_t>& pair_ids) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  impl_->connection.Atomically("delete matches", [&] {
+    for (const image_pair_t pair_id : pair_ids) {
+      const std::string id = std::to_string(pair_id);
+      impl_->connection.Exec("DELETE FROM two_view_geometries WHERE pair_id = " + id +
+                                 "; DELETE FROM matches WHERE pair_id = " + id +
+                                 "; DELETE FROM tessera_pair_features WHERE pair_id = " + id + ";",
+                             "delete the matches of pair " + id);
+    }
+  });
 }
 
 FeatureMatches Database::ReadMatches(image_t image_id1, image_t image_id2) const {
@@ -279,8 +329,9 @@ void Database::ClearKeypointsAndDescriptors() {
   impl_->connection.Atomically(operation, [&] {
     impl_->connection.Exec(
         "DELETE FROM two_view_geometries; DELETE FROM matches; DELETE FROM descriptors; "
-        "DELETE FROM keypoints; DELETE FROM tessera_stages WHERE stage IN "
-        "('features', 'matches', 'two_view_geometries');",
+        "DELETE FROM keypoints; DELETE FROM tessera_features; DELETE FROM tessera_pair_features; "
+        "DELETE FROM tessera_stages WHERE stage IN ('features', 'matches', "
+        "'two_view_geometries');",
         operation);
   });
 }
@@ -290,8 +341,9 @@ void Database::ClearMatches() {
   const std::string operation = "clear the matches";
   impl_->connection.Atomically(operation, [&] {
     impl_->connection.Exec(
-        "DELETE FROM two_view_geometries; DELETE FROM matches; DELETE FROM tessera_stages "
-        "WHERE stage IN ('matches', 'two_view_geometries');",
+        "DELETE FROM two_view_geometries; DELETE FROM matches; DELETE FROM "
+        "tessera_pair_features; DELETE FROM tessera_stages WHERE stage IN ('matches', "
+        "'two_view_geometries');",
         operation);
   });
 }
@@ -363,6 +415,8 @@ void Database::DeleteImage(image_t image_id) {
   impl_->connection.Atomically(operation, [&] {
     impl_->connection.Exec(
         "DELETE FROM two_view_geometries WHERE " + pairs + "; DELETE FROM matches WHERE " + pairs +
+            "; DELETE FROM tessera_pair_features WHERE " + pairs +
+            "; DELETE FROM tessera_features WHERE image_id = " + id +
             "; DELETE FROM descriptors WHERE image_id = " + id +
             "; DELETE FROM keypoints WHERE image_id = " + id +
             "; DELETE FROM tessera_images WHERE image_id = " + id +

@@ -141,6 +141,15 @@ class Database {
   FeatureMatches ReadMatches(image_t image_id1, image_t image_id2) const;
   // Every pair with a row in `matches`, empty ones included, sorted.
   std::vector<image_pair_t> ReadMatchedPairIds() const;
+  // What matches are made from: each write records the features its two images have then
+  // (tessera_pair_features, with the digest of each image's keypoints and descriptors
+  // that their writes record in tessera_features). The pairs whose matches were made
+  // from other features than their images have now (an image detected again, e.g. after
+  // a crashing detector was fixed): stale, sorted. Matches written before the records
+  // were kept count as made from features without a record.
+  std::vector<image_pair_t> ReadPairsWithStaleMatches() const;
+  // Removes the matches of these pairs with their two-view geometries and records.
+  void DeleteMatches(const std::vector<image_pair_t>& pair_ids);
   size_t NumMatchedPairs() const;
 
   // Two-view geometry of (image_id1, image_id2), relating image_id1 to image_id2

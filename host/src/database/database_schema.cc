@@ -92,11 +92,20 @@ constexpr const char* kCreateTesseraTables =
     "    hash         TEXT                  NOT NULL,"
     "    skip_reason  TEXT);"
     "CREATE TABLE IF NOT EXISTS tessera_pairs"
-    "   (pair_id  INTEGER  PRIMARY KEY  NOT NULL);";
+    "   (pair_id  INTEGER  PRIMARY KEY  NOT NULL);"
+    "CREATE TABLE IF NOT EXISTS tessera_features"
+    "   (image_id     INTEGER  PRIMARY KEY  NOT NULL,"
+    "    keypoints    TEXT,"
+    "    descriptors  TEXT);"
+    "CREATE TABLE IF NOT EXISTS tessera_pair_features"
+    "   (pair_id    INTEGER  PRIMARY KEY  NOT NULL,"
+    "    features1  TEXT                NOT NULL,"
+    "    features2  TEXT                NOT NULL);";
 
 // Columns that Tessera reads or writes, per COLMAP table. Others may exist (newer
-// COLMAP versions add some); these must. tessera_pairs is not among them: a read-only
-// database made before it is still read (TesseraRecords::ReadSelectedPairs).
+// COLMAP versions add some); these must. tessera_pairs, tessera_features and
+// tessera_pair_features are not among them: a read-only database made before them is
+// still read (TesseraRecords::ReadSelectedPairs, ReadFeatureDigests, ReadPairFeatures).
 const std::map<std::string, std::vector<std::string>>& RequiredColumns() {
   static const std::map<std::string, std::vector<std::string>> columns = {
       {"cameras", {"camera_id", "model", "width", "height", "params", "prior_focal_length"}},

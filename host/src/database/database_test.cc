@@ -410,6 +410,55 @@ TEST_F(DatabaseTest, ClearsCascade) {
   EXPECT_EQ(database.NumCameras(), 2u);
 }
 
+// Matches made while an image had no features (its detector crashed) were reused after it
+// was detected: a pair is current only while both its images have the features it was
+// matched from.
+TEST_F(DatabaseTest, MatchesAreStaleOnceAnImageOfThePairHasOtherFeatures) {
+  Database database(DatabasePath());
+  AddCamerasAndImages(&database);
+  FeatureDescriptors descriptors;
+  descriptors.data = FeatureDescriptors::Matrix::Constant(1, 32, 7);
+  for (const image_t image_id : {1u, 2u}) {
+    database.WriteKeypoints(image_id, {FeatureKeypoint(1, 2)});
+    database.WriteDescriptors(image_id, descriptors);
+  }
+  database.WriteMatches(1, 2, {{0, 0}});
+  database.WriteMatches(3, 1, {});  // image 3 has no features yet
+  database.WriteMatches(2, 3, {});
+  TwoViewGeometry geometry;
+  geometry.config = TwoViewGeometry::UNCALIBRATED;
+  geometry.inlier_matches = {{0, 0}};
+  database.WriteTwoViewGeometry(1, 3, geometry);
+  EXPECT_TRUE(database.ReadPairsWithStaleMatches().empty());
+
+  // Image 3 detected: its pairs are stale, the pair (1, 2) is not.
+  database.WriteKeypoints(3, {FeatureKeypoint(3, 4)});
+  database.WriteDescriptors(3, descriptors);
+  EXPECT_EQ(database.ReadPairsWithStaleMatches(),
+            (std::vector<image_pair_t>{ImagePairToPairId(1, 3), ImagePairToPairId(2, 3)}));
+  database.DeleteMatches(database.ReadPairsWithStaleMatches());
+  EXPECT_FALSE(database.ExistsMatches(1, 3));
+  EXPECT_FALSE(database.ExistsTwoViewGeometry(1, 3));
+  EXPECT_TRUE(database.ExistsMatches(1, 2));
+  database.WriteMatches(1, 3, {{0, 0}});
+  EXPECT_TRUE(database.ReadPairsWithStaleMatches().empty());
+
+  // The same features written again keep the pair current; other ones do not.
+  database.WriteKeypoints(3, {FeatureKeypoint(3, 4)});
+  EXPECT_TRUE(database.ReadPairsWithStaleMatches().empty());
+  database.WriteKeypoints(1, {FeatureKeypoint(5, 6)});
+  EXPECT_EQ(database.ReadPairsWithStaleMatches(),
+            (std::vector<image_pair_t>{ImagePairToPairId(1, 2), ImagePairToPairId(1, 3)}));
+
+  // A workspace matched before the records: its pairs count as current until an image is
+  // detected again.
+  RawDatabase raw(DatabasePath());
+  raw.Exec("DELETE FROM tessera_features; DELETE FROM tessera_pair_features;");
+  EXPECT_TRUE(database.ReadPairsWithStaleMatches().empty());
+  database.ClearKeypointsAndDescriptors();
+  EXPECT_EQ(raw.Row("SELECT COUNT(*) FROM tessera_features"), (std::vector<std::string>{"0"}));
+}
+
 TEST_F(DatabaseTest, StageProvenanceRoundTrip) {
   const nlohmann::json provenance = {
       {"plugin", "sift"}, {"version", "1.2.0"}, {"options", {{"max_num_features", 8192}}}};

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "database/colmap_row_codecs.h"
+#include "database/tessera_records.h"
 
 namespace tessera {
 
@@ -11,13 +12,15 @@ bool DescriptorsTable::Exists(image_t image_id) const {
                              "look up the descriptors of image " + std::to_string(image_id));
 }
 
-void DescriptorsTable::Write(image_t image_id, const FeatureDescriptors& descriptors) const {
+std::string DescriptorsTable::Write(image_t image_id, const FeatureDescriptors& descriptors) const {
   SqliteStatement::Use use(write_, "write the descriptors of image " + std::to_string(image_id));
   use.BindInt64(1, image_id);
   use.BindInt64(2, descriptors.data.rows());
   use.BindInt64(3, descriptors.data.cols());
   use.BindBlob(4, descriptors.data.data(), static_cast<size_t>(descriptors.data.size()));
   use.Step();
+  return FeaturesBlobDigest(descriptors.data.data(), static_cast<size_t>(descriptors.data.size()),
+                            descriptors.data.rows(), descriptors.data.cols());
 }
 
 FeatureDescriptors DescriptorsTable::Read(image_t image_id, DescriptorMetric metric,

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <string>
+
 // COLMAP's `descriptors` table: uint8 rows x cols per image. The table has no place for
 // the metric, so readers say which one the stage's detector produced.
 
@@ -19,7 +21,8 @@ class DescriptorsTable {
   explicit DescriptorsTable(const SqliteConnection& connection) : connection_(connection) {}
 
   bool Exists(image_t image_id) const;
-  void Write(image_t image_id, const FeatureDescriptors& descriptors) const;
+  // Returns the digest of what it wrote (FeaturesBlobDigest).
+  std::string Write(image_t image_id, const FeatureDescriptors& descriptors) const;
   // Empty for an image without a row; see Database::ReadDescriptors for expected_cols.
   FeatureDescriptors Read(image_t image_id, DescriptorMetric metric, int64_t expected_cols) const;
   // The width of one non-empty row, from its header; nullopt when there is none.

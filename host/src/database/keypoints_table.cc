@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "database/colmap_row_codecs.h"
+#include "database/tessera_records.h"
 
 namespace tessera {
 
@@ -12,7 +13,7 @@ bool KeypointsTable::Exists(image_t image_id) const {
                              "look up the keypoints of image " + std::to_string(image_id));
 }
 
-void KeypointsTable::Write(image_t image_id, const FeatureKeypoints& keypoints) const {
+std::string KeypointsTable::Write(image_t image_id, const FeatureKeypoints& keypoints) const {
   const std::vector<float> blob = KeypointsToBlob(keypoints);
   SqliteStatement::Use use(write_, "write the keypoints of image " + std::to_string(image_id));
   use.BindInt64(1, image_id);
@@ -20,6 +21,8 @@ void KeypointsTable::Write(image_t image_id, const FeatureKeypoints& keypoints) 
   use.BindInt64(3, 6);
   use.BindBlob(4, blob.data(), sizeof(float) * blob.size());
   use.Step();
+  return FeaturesBlobDigest(blob.data(), sizeof(float) * blob.size(),
+                            static_cast<int64_t>(keypoints.size()), 6);
 }
 
 FeatureKeypoints KeypointsTable::Read(image_t image_id) const {

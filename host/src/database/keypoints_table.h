@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <map>
+#include <string>
 
 #include "database/sqlite_statement.h"
 #include "tessera/features.h"
@@ -18,7 +19,8 @@ class KeypointsTable {
   explicit KeypointsTable(const SqliteConnection& connection) : connection_(connection) {}
 
   bool Exists(image_t image_id) const;
-  void Write(image_t image_id, const FeatureKeypoints& keypoints) const;
+  // Returns the digest of what it wrote (FeaturesBlobDigest).
+  std::string Write(image_t image_id, const FeatureKeypoints& keypoints) const;
   FeatureKeypoints Read(image_t image_id) const;  // empty for an image without a row
   size_t NumKeypoints() const;                    // summed over all images
   std::map<image_t, size_t> ReadNumKeypointsPerImage() const;

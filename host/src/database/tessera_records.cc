@@ -1,5 +1,9 @@
 #include "database/tessera_records.h"
 
+#include <xxhash.h>
+
+#include <cinttypes>
+#include <cstdio>
 #include <utility>
 
 #include "tessera/errors.h"
@@ -18,7 +22,29 @@ std::optional<double> OptionalFromJson(const nlohmann::json& json, const char* k
 
 std::string TextOrEmpty(const char* text) { return text != nullptr ? text : ""; }
 
+// Whether the database has `table` (a read-only one made before it has not).
+bool HasTable(const SqliteConnection& connection, const std::string& table) {
+  const SqliteStatement statement(
+      connection, "SELECT 1 FROM sqlite_master WHERE type = 'table' AND name = ?;", false);
+  SqliteStatement::Use use(statement, "look up table " + table);
+  use.BindText(1, table);
+  return use.Step();
+}
+
 }  // namespace
+
+std::string FeaturesBlobDigest(const void* data, size_t bytes, int64_t rows, int64_t cols) {
+  XXH3_state_t* state = XXH3_createState();
+  XXH3_64bits_reset(state);
+  XXH3_64bits_update(state, &rows, sizeof(rows));
+  XXH3_64bits_update(state, &cols, sizeof(cols));
+  if (bytes > 0) XXH3_64bits_update(state, data, bytes);
+  const uint64_t digest = XXH3_64bits_digest(state);
+  XXH3_freeState(state);
+  char text[17];
+  std::snprintf(text, sizeof(text), "%016" PRIx64, digest);
+  return text;
+}
 
 nlohmann::json ImageMetadataToJson(const ImageMetadata& metadata) {
   nlohmann::json json = {{"make", metadata.make},
@@ -179,6 +205,81 @@ std::optional<std::vector<image_pair_t>> TesseraRecords::ReadSelectedPairs() con
   std::vector<image_pair_t> pair_ids;
   while (use.Step()) pair_ids.push_back(static_cast<image_pair_t>(use.ColumnInt64(0)));
   return pair_ids;
+}
+
+void TesseraRecords::WriteFeaturesDigest(image_t image_id, const std::string& column,
+                                         const std::string& digest) const {
+  if (column != "keypoints" && column != "descriptors") {
+    throw std::logic_error("WriteFeaturesDigest: unknown column " + column);
+  }
+  const SqliteStatement write(connection_,
+                              "INSERT INTO tessera_features(image_id, " + column +
+                                  ") VALUES(?, ?) ON CONFLICT(image_id) DO UPDATE SET " + column +
+                                  " = excluded." + column + ";",
+                              false);
+  SqliteStatement::Use use(write,
+                           "write the " + column + " digest of image " + std::to_string(image_id));
+  use.BindInt64(1, image_id);
+  use.BindText(2, digest);
+  use.Step();
+}
+
+std::map<image_t, std::string> TesseraRecords::ReadFeatureDigests() const {
+  std::map<image_t, std::string> digests;
+  if (!HasTable(connection_, "tessera_features")) return digests;
+  const SqliteStatement read(
+      connection_, "SELECT image_id, keypoints, descriptors FROM tessera_features;", false);
+  SqliteStatement::Use use(read, "read the feature digests");
+  while (use.Step()) {
+    digests[static_cast<image_t>(use.ColumnInt64(0))] =
+        TextOrEmpty(use.ColumnText(1)) + "/" + TextOrEmpty(use.ColumnText(2));
+  }
+  return digests;
+}
+
+std::string TesseraRecords::ReadFeatureDigest(image_t image_id) const {
+  if (!read_feature_digest_) {
+    if (!HasTable(connection_, "tessera_features")) return "";
+    read_feature_digest_ = std::make_unique<SqliteStatement>(
+        connection_, "SELECT keypoints, descriptors FROM tessera_features WHERE image_id = ?;",
+        false);
+  }
+  SqliteStatement::Use use(*read_feature_digest_,
+                           "read the feature digest of image " + std::to_string(image_id));
+  use.BindInt64(1, image_id);
+  if (!use.Step()) return "";
+  return TextOrEmpty(use.ColumnText(0)) + "/" + TextOrEmpty(use.ColumnText(1));
+}
+
+void TesseraRecords::WritePairFeatures(image_pair_t pair_id, const std::string& features1,
+                                       const std::string& features2) const {
+  if (!write_pair_features_) {
+    write_pair_features_ = std::make_unique<SqliteStatement>(
+        connection_,
+        "INSERT OR REPLACE INTO tessera_pair_features(pair_id, features1, features2) "
+        "VALUES(?, ?, ?);",
+        false);
+  }
+  SqliteStatement::Use use(*write_pair_features_,
+                           "write the features of pair " + std::to_string(pair_id));
+  use.BindInt64(1, static_cast<int64_t>(pair_id));
+  use.BindText(2, features1);
+  use.BindText(3, features2);
+  use.Step();
+}
+
+std::map<image_pair_t, std::pair<std::string, std::string>> TesseraRecords::ReadPairFeatures()
+    const {
+  std::map<image_pair_t, std::pair<std::string, std::string>> pairs;
+  if (!HasTable(connection_, "tessera_pair_features")) return pairs;
+  const SqliteStatement read(
+      connection_, "SELECT pair_id, features1, features2 FROM tessera_pair_features;", false);
+  SqliteStatement::Use use(read, "read the features of the matched pairs");
+  while (use.Step()) {
+    pairs[static_cast<image_pair_t>(use.ColumnInt64(0))] = {TextOrEmpty(use.ColumnText(1)),
+                                                            TextOrEmpty(use.ColumnText(2))};
+  }
+  return pairs;
 }
 
 }  // namespace tessera

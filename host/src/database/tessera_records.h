@@ -3,10 +3,13 @@
 // Tessera's own tables (prefixed `tessera_`, which COLMAP ignores): the provenance of
 // each stage (tessera_stages), the calibration source of each camera
 // (tessera_camera_priors), each image's EXIF metadata (tessera_image_metadata), the
-// image files the images table was made from (tessera_images) and the pairs the last
-// pair selection chose (tessera_pairs).
+// image files the images table was made from (tessera_images), the pairs the last
+// pair selection chose (tessera_pairs), a digest of each image's features
+// (tessera_features) and the features each pair's matches were computed from
+// (tessera_pair_features).
 
 #include <map>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +21,9 @@
 #include "tessera/image_metadata.h"
 
 namespace tessera {
+
+// XXH3-64 of a features blob and its shape, 16 hex digits: what tessera_features records.
+std::string FeaturesBlobDigest(const void* data, size_t bytes, int64_t rows, int64_t cols);
 
 class TesseraRecords {
  public:
@@ -48,6 +54,22 @@ class TesseraRecords {
                           const nlohmann::json& provenance) const;
   std::optional<std::vector<image_pair_t>> ReadSelectedPairs() const;
 
+  // tessera_features: the digest of an image's keypoints or descriptors (`column`, one of
+  // "keypoints", "descriptors"), written with them. Read: each image's
+  // "KEYPOINTS/DESCRIPTORS" digests (an empty part for one without a record); empty for a
+  // database without the table (read-only, made before it). Prepared on use, as
+  // tessera_pairs's.
+  void WriteFeaturesDigest(image_t image_id, const std::string& column,
+                           const std::string& digest) const;
+  std::map<image_t, std::string> ReadFeatureDigests() const;
+  // One image's, as ReadFeatureDigests gives it ("" without a record).
+  std::string ReadFeatureDigest(image_t image_id) const;
+  // tessera_pair_features: the features (ReadFeatureDigests's text, "" for none) of the
+  // two images, in pair id order, that the pair's matches were computed from.
+  void WritePairFeatures(image_pair_t pair_id, const std::string& features1,
+                         const std::string& features2) const;
+  std::map<image_pair_t, std::pair<std::string, std::string>> ReadPairFeatures() const;
+
  private:
   const SqliteConnection& connection_;
   SqliteStatement read_stage_{connection_,
@@ -70,6 +92,9 @@ class TesseraRecords {
       "INSERT OR REPLACE INTO tessera_images(name, image_id, size, hash, skip_reason) "
       "VALUES(?, ?, ?, ?, ?);"};
   SqliteStatement delete_image_file_{connection_, "DELETE FROM tessera_images WHERE name = ?;"};
+  // Prepared on first use (the tables may be missing from a read-only database).
+  mutable std::unique_ptr<SqliteStatement> read_feature_digest_;
+  mutable std::unique_ptr<SqliteStatement> write_pair_features_;
 };
 
 }  // namespace tessera

@@ -73,13 +73,47 @@ double MedianOf(std::vector<double> values) {
   return values.size() % 2 == 1 ? values[mid] : (values[mid - 1] + values[mid]) / 2;
 }
 
-// Which images a known K applies to: those whose size holds its principal point. A K
+// "the 640x480 image 'a.jpg'", "the 3 images of 640x480 (the first 'a.jpg')".
+std::string DescribeImagesOfSize(const std::vector<ImageEntry>& images,
+                                 const std::vector<size_t>& indices) {
+  const ImageEntry& first = images[indices.front()];
+  const std::string dimensions = std::to_string(first.width) + "x" + std::to_string(first.height);
+  return indices.size() == 1 ? "the " + dimensions + " image '" + first.name + "'"
+                             : "the " + std::to_string(indices.size()) + " images of " +
+                                   dimensions + " (the first '" + first.name + "')";
+}
+
+// Refuses a focal length of K that no lens gives on images of this size (K in other units,
+// or a typo): a field of view outside [kMinPlausibleFieldOfViewDeg,
+// kMaxPlausibleFieldOfViewDeg] across the longer side.
+void CheckKnownFocalLengths(const CameraSettings& settings, const ImageEntry& image,
+                            const std::string& these) {
+  const Eigen::Vector4d& K = *settings.known_intrinsics;
+  const double longer = std::max(image.width, image.height);
+  for (const auto& [focal, name] : {std::pair{K(0), "fx"}, std::pair{K(1), "fy"}}) {
+    if (IsPlausibleFocalLength(focal, longer)) continue;
+    throw InputError(
+        settings.known_intrinsics_source + ": " + name + " = " + FormatNumber(focal) +
+        " px is implausible for the camera of " + these + ": a field of view of " +
+        FormatNumber(FieldOfViewDeg(focal, longer)) + " degrees across the longer side, outside [" +
+        FormatNumber(kMinPlausibleFieldOfViewDeg) + ", " +
+        FormatNumber(kMaxPlausibleFieldOfViewDeg) + "]; give K in pixels of these images");
+  }
+}
+
+// Which images a known K applies to. The K is checked as input first: what is wrong with
+// it regardless of the images (settings.known_intrinsics_problems), and a focal length no
+// lens gives on the images (always refused). It applies to the images of a size whose
+// interior holds its principal point; when some size also has its centre within 10% of
+// the image size of the principal point, only such sizes: on a folder of mixed sizes a K
+// made for one size is not given to another whose interior merely holds the point. A K
 // that fits none of the images is refused (it was given for another resolution). Each
 // size it does not fit is named in a warning, and those images get the camera their EXIF
-// or the default focal length gives; each size whose centre lies more than 10% of the
-// image's size from the principal point is named in a warning too. A recipe that holds
-// the intrinsics (settings.calibration_required_by) refuses both: no K, and an image K
-// does not fit, whose guessed focal length it would hold.
+// or the default focal length gives; each size it applies to whose centre lies more than
+// 10% of the image's size from the principal point is named in a warning too. A recipe
+// that holds the intrinsics (settings.calibration_required_by) refuses all of these: no
+// K, a problem of K, an image K does not fit or fits off centre, whose guessed or
+// doubtful focal length it would hold.
 std::vector<bool> ImagesKnownIntrinsicsFit(const std::vector<ImageEntry>& images,
                                            const CameraSettings& settings,
                                            std::vector<std::string>* warnings) {
@@ -95,45 +129,78 @@ std::vector<bool> ImagesKnownIntrinsicsFit(const std::vector<ImageEntry>& images
   const Eigen::Vector4d& K = *settings.known_intrinsics;
   const std::string point =
       "the principal point (" + FormatNumber(K(2)) + ", " + FormatNumber(K(3)) + ")";
-  std::vector<bool> fits(images.size());
   std::map<std::pair<int, int>, std::vector<size_t>> images_by_size;
   for (size_t i = 0; i < images.size(); ++i) {
-    fits[i] = K(2) > 0 && K(2) < images[i].width && K(3) > 0 && K(3) < images[i].height;
     images_by_size[{images[i].width, images[i].height}].push_back(i);
   }
-  if (!images.empty() && std::find(fits.begin(), fits.end(), true) == fits.end()) {
+  const auto inside = [&](int width, int height) {
+    return K(2) > 0 && K(2) < width && K(3) > 0 && K(3) < height;
+  };
+  const auto centred = [&](int width, int height) {
+    return inside(width, height) && std::abs(K(2) - width / 2.0) <= 0.1 * width &&
+           std::abs(K(3) - height / 2.0) <= 0.1 * height;
+  };
+  bool any_inside = false, any_centred = false;
+  for (const auto& [size, indices] : images_by_size) {
+    any_inside = any_inside || inside(size.first, size.second);
+    any_centred = any_centred || centred(size.first, size.second);
+  }
+  if (!images.empty() && !any_inside) {
     const ImageEntry& first = images.front();
     throw InputError(settings.known_intrinsics_source + ": " + point + " lies outside image '" +
                      first.name + "' (" + std::to_string(first.width) + "x" +
                      std::to_string(first.height) +
                      "); the intrinsics must be given for the images' resolution");
   }
+  std::vector<bool> fits(images.size(), false);
+  bool problems_said = false;
   for (const auto& [size, indices] : images_by_size) {
     const auto [width, height] = size;
-    const std::string dimensions = std::to_string(width) + "x" + std::to_string(height);
-    const std::string& name = images[indices.front()].name;
-    const std::string these = indices.size() == 1
-                                  ? "the " + dimensions + " image '" + name + "'"
-                                  : "the " + std::to_string(indices.size()) + " images of " +
-                                        dimensions + " (the first '" + name + "')";
+    const std::string these = DescribeImagesOfSize(images, indices);
+    const bool applies = inside(width, height) && (centred(width, height) || !any_centred);
+    if (applies) {
+      CheckKnownFocalLengths(settings, images[indices.front()], these);
+      if (!settings.known_intrinsics_problems.empty() && required) {
+        throw InputError(settings.calibration_required_by +
+                         ": this recipe holds the intrinsics, and those given for the camera "
+                         "of " +
+                         these + " are wrong: " + settings.known_intrinsics_problems.front());
+      }
+      if (!problems_said) {
+        for (const std::string& problem : settings.known_intrinsics_problems) {
+          warnings->push_back(problem);
+        }
+        problems_said = true;
+      }
+      for (const size_t i : indices) fits[i] = true;
+    }
     const double dx = K(2) - width / 2.0, dy = K(3) - height / 2.0;
-    if (!fits[indices.front()] && required) {
+    const std::string distance = FormatNumber(std::round(std::hypot(dx, dy))) + " px";
+    const std::string off_centre = point + " lies " + distance + " from the centre of " + these;
+    if (required && !(applies && centred(width, height))) {
       throw InputError(settings.calibration_required_by +
                        ": this recipe holds the intrinsics, and those of " +
                        settings.known_intrinsics_source + " do not fit " + these + " (" + point +
-                       " lies outside): give them for the images' resolution");
+                       (inside(width, height) ? " lies " + distance +
+                                                    " from their centre, more than 10% of the "
+                                                    "image size"
+                                              : " lies outside") +
+                       "): give them for the images' resolution");
     }
-    if (!fits[indices.front()]) {
+    if (!inside(width, height)) {
       warnings->push_back(settings.known_intrinsics_source + ": " + point + " lies outside " +
                           these +
                           "; K is not used there: the EXIF or the default "
                           "focal length gives the camera");
-    } else if (std::abs(dx) > 0.1 * width || std::abs(dy) > 0.1 * height) {
-      warnings->push_back(
-          settings.known_intrinsics_source + ": " + point + " lies " +
-          FormatNumber(std::round(std::hypot(dx, dy))) + " px from the centre of " + these +
-          ", more than 10% of the image size: were the intrinsics given for another "
-          "resolution?");
+    } else if (!applies) {
+      warnings->push_back(settings.known_intrinsics_source + ": " + off_centre +
+                          ", more than 10% of the image size, while K fits images of another "
+                          "size; K is not used there: the EXIF or the default focal length "
+                          "gives the camera");
+    } else if (!centred(width, height)) {
+      warnings->push_back(settings.known_intrinsics_source + ": " + off_centre +
+                          ", more than 10% of the image size: were the intrinsics given for "
+                          "another resolution?");
     }
   }
   return fits;

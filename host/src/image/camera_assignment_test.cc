@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "image/image_folder_scan.h"
+#include "image/known_intrinsics.h"
 #include "image/sensor_database.h"
 #include "manifest/manifest.h"
 #include "tessera/errors.h"
@@ -379,6 +380,137 @@ TEST(AssignCameras, ARecipeHoldingTheIntrinsicsRefusesImagesWithoutThem) {
               "principal point (507.1, 335.9) lies outside): give them for the images' "
               "resolution");
   }
+}
+
+// A given K is checked as input (issue 60): what needs no image when it is set, the rest
+// when the cameras are made; a recipe that holds the intrinsics refuses what is wrong,
+// naming the file, the entry and the images, and any other run warns.
+Eigen::Matrix3d MatrixK(double fx, double skew, double cx, double fy, double cy, double k20 = 0,
+                        double k21 = 0) {
+  Eigen::Matrix3d K;
+  K << fx, skew, cx, 0, fy, cy, k20, k21, 1;
+  return K;
+}
+
+std::string ErrorOfAssign(const std::vector<ImageEntry>& images, const CameraSettings& settings) {
+  try {
+    AssignCameras(images, settings);
+  } catch (const InputError& error) {
+    return error.what();
+  }
+  return "no error";
+}
+
+TEST(KnownIntrinsics, ASkewOrAnAspectRatioOutOfRangeWarnsAndIsRefusedWhenHeld) {
+  const std::vector<ImageEntry> images = {Entry("a.jpg", 1024, 683), Entry("b.jpg", 1024, 683)};
+  CameraSettings settings;
+  SetKnownIntrinsics(MatrixK(919.8, 150, 507.1, 921.8, 335.9), "K.txt", &settings);
+  CameraAssignment assignment = AssignCameras(images, settings);
+  ASSERT_EQ(assignment.warnings.size(), 1u);
+  EXPECT_EQ(assignment.warnings[0],
+            "K.txt: K[0][1] (the skew) is 150, not 0: Tessera's camera models have no skew, and "
+            "it would be dropped");
+  settings.calibration_required_by = "calibrated.json: camera.require_calibration";
+  EXPECT_EQ(ErrorOfAssign(images, settings),
+            "calibrated.json: camera.require_calibration: this recipe holds the intrinsics, and "
+            "those given for the camera of the 2 images of 1024x683 (the first 'a.jpg') are "
+            "wrong: K.txt: K[0][1] (the skew) is 150, not 0: Tessera's camera models have no "
+            "skew, and it would be dropped");
+
+  CameraSettings tenth;
+  SetKnownIntrinsics(MatrixK(2000, 0, 507.1, 200, 335.9), "K.txt", &tenth);
+  assignment = AssignCameras(images, tenth);
+  ASSERT_EQ(assignment.warnings.size(), 1u);
+  EXPECT_EQ(assignment.warnings[0],
+            "K.txt: the aspect ratio fy / fx (K[1][1] (fy) / K[0][0] (fx)) is 0.1, outside [0.5, "
+            "2]: is one of them mistyped?");
+  tenth.calibration_required_by = "calibrated.json: camera.require_calibration";
+  EXPECT_NE(ErrorOfAssign(images, tenth).find("are wrong: K.txt: the aspect ratio fy / fx"),
+            std::string::npos);
+  CameraSettings json_k;
+  SetKnownIntrinsics(Eigen::Vector4d(919.8, 3000, 507.1, 335.9), "camera.K", &json_k);
+  ASSERT_EQ(json_k.known_intrinsics_problems.size(), 1u);
+  EXPECT_EQ(json_k.known_intrinsics_problems[0],
+            "camera.K: the aspect ratio fy / fx (fy / fx) is 3.26158, outside [0.5, 2]: is one of "
+            "them mistyped?");
+}
+
+TEST(KnownIntrinsics, NotACalibrationMatrixIsRefused) {
+  CameraSettings settings;
+  const auto error_of = [&](const Eigen::Matrix3d& K) {
+    try {
+      SetKnownIntrinsics(K, "K.txt", &settings);
+    } catch (const InputError& error) {
+      return std::string(error.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(error_of(MatrixK(919.8, 0, 507.1, 921.8, 335.9, 5, 7)),
+            "K.txt: the bottom row K[2] is '5 7 1', not '0 0 1': not a calibration matrix");
+  EXPECT_EQ(error_of(MatrixK(919.8, 0, 0, 921.8, 0, 507.1, 335.9)),
+            "K.txt: the bottom row K[2] is '507.1 335.9 1', not '0 0 1': not a calibration "
+            "matrix (it looks transposed: cx and cy belong in the last column)");
+  EXPECT_EQ(error_of(MatrixK(-919.8, 0, 507.1, 921.8, 335.9)),
+            "K.txt: K[0][0] (fx) is -919.8: focal lengths must be positive finite numbers of "
+            "pixels");
+  EXPECT_EQ(error_of(MatrixK(919.8, 0, 507.1, 921.8, 335.9)), "no error");
+  EXPECT_FALSE(settings.known_intrinsics_problems.size());
+}
+
+// fx = 1e-9 or 1e12 ran into "no pair of images initialised a model" (exit 3).
+TEST(KnownIntrinsics, AFocalLengthNoLensGivesIsRefusedNamingTheCamera) {
+  const std::vector<ImageEntry> images = {Entry("a.jpg", 1024, 683)};
+  for (const double focal : {1e-9, 1e12}) {
+    CameraSettings settings;
+    SetKnownIntrinsics(MatrixK(focal, 0, 507.1, focal, 335.9), "K.txt", &settings);
+    const std::string error = ErrorOfAssign(images, settings);
+    EXPECT_EQ(error.rfind("K.txt: fx = ", 0), 0u) << error;
+    EXPECT_NE(error.find(" px is implausible for the camera of the 1024x683 image 'a.jpg': a "
+                         "field of view of "),
+              std::string::npos)
+        << error;
+  }
+}
+
+// A 1024 px K on 640 px photos: held with only a warning by a recipe that holds it.
+TEST(KnownIntrinsics, AKForAnotherResolutionIsRefusedWhenHeld) {
+  const std::vector<ImageEntry> images = {Entry("a.jpg", 640, 427), Entry("b.jpg", 640, 427)};
+  CameraSettings settings;
+  SetKnownIntrinsics(MatrixK(919.8, 0, 507.1, 921.8, 335.9), "K.txt", &settings);
+  const CameraAssignment assignment = AssignCameras(images, settings);
+  ASSERT_EQ(assignment.warnings.size(), 1u);
+  EXPECT_NE(assignment.warnings[0].find("lies 224 px from the centre"), std::string::npos);
+  settings.calibration_required_by = "calibrated.json: camera.require_calibration";
+  EXPECT_EQ(ErrorOfAssign(images, settings),
+            "calibrated.json: camera.require_calibration: this recipe holds the intrinsics, and "
+            "those of K.txt do not fit the 2 images of 640x427 (the first 'a.jpg') (the "
+            "principal point (507.1, 335.9) lies 224 px from their centre, more than 10% of the "
+            "image size): give them for the images' resolution");
+}
+
+// Mixed sizes: the 640 px K went to the 1024 px camera too (its point inside the image).
+TEST(KnownIntrinsics, OnMixedSizesAKIsGivenOnlyToTheSizeItFits) {
+  const std::vector<ImageEntry> images = {Entry("small.jpg", 640, 427),
+                                          Entry("big.jpg", 1024, 683)};
+  CameraSettings settings;
+  SetKnownIntrinsics(MatrixK(574.9, 0, 316.9, 576.1, 209.9), "K640.txt", &settings);
+  const CameraAssignment assignment = AssignCameras(images, settings);
+  ASSERT_EQ(assignment.cameras.size(), 2u);
+  EXPECT_EQ(assignment.cameras[0].calibration_source, CalibrationSource::kUser);
+  EXPECT_EQ(assignment.cameras[1].calibration_source, CalibrationSource::kDefault);
+  EXPECT_DOUBLE_EQ(assignment.cameras[1].params[1], 512.0);  // its own centre
+  ASSERT_EQ(assignment.warnings.size(), 1u);
+  EXPECT_EQ(assignment.warnings[0],
+            "K640.txt: the principal point (316.9, 209.9) lies 235 px from the centre of the "
+            "1024x683 image 'big.jpg', more than 10% of the image size, while K fits images of "
+            "another size; K is not used there: the EXIF or the default focal length gives the "
+            "camera");
+  settings.calibration_required_by = "calibrated.json: camera.require_calibration";
+  EXPECT_EQ(ErrorOfAssign(images, settings),
+            "calibrated.json: camera.require_calibration: this recipe holds the intrinsics, and "
+            "those of K640.txt do not fit the 1024x683 image 'big.jpg' (the principal point "
+            "(316.9, 209.9) lies 235 px from their centre, more than 10% of the image size): "
+            "give them for the images' resolution");
 }
 
 TEST(AssignCameras, RejectsAnUnknownModel) {

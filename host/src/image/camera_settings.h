@@ -24,6 +24,11 @@ struct CameraSettings {
   std::optional<Eigen::Vector4d> known_intrinsics;
   // Where known_intrinsics came from ("camera.K" or a K.txt file), for messages.
   std::string known_intrinsics_source;
+  // What is wrong with them that needs no image (a skew, an aspect ratio out of range:
+  // known_intrinsics.h), one line each naming the source and the entry: refused when the
+  // calibration is required (calibration_required_by), else warnings. Set with them by
+  // SetKnownIntrinsics.
+  std::vector<std::string> known_intrinsics_problems;
   // Every parameter of the model, in COLMAP's order (camera.params; e.g. fx, fy, cx, cy,
   // k1..k4 for OPENCV_FISHEYE), set as the initial camera; empty: none. Sets
   // known_intrinsics too.

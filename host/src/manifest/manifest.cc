@@ -9,9 +9,11 @@
 #include <sstream>
 #include <thread>
 
+#include "image/known_intrinsics.h"
 #include "tessera/camera.h"
 #include "tessera/camera_models.h"
 #include "tessera/errors.h"
+#include "tessera/io/file_io.h"
 #include "tessera/options.h"
 
 namespace tessera {
@@ -90,16 +92,12 @@ CameraSettings ParseCamera(const nlohmann::json& json, const std::filesystem::pa
         !std::all_of(K.begin(), K.end(), [](const auto& v) { return v.is_number(); })) {
       throw OptionError("camera.K", "expected [fx, fy, cx, cy] in pixels");
     }
-    camera.known_intrinsics = Eigen::Vector4d(K[0], K[1], K[2], K[3]);
-    camera.known_intrinsics_source = "camera.K";
+    SetKnownIntrinsics(Eigen::Vector4d(K[0], K[1], K[2], K[3]), "camera.K", &camera);
   }
   if (!K_file.is_null()) {
     if (!K_file.is_string()) throw OptionError("camera.K_file", "expected a file path");
     const auto file = Resolve(base_dir, K_file.get<std::string>());
-    const Eigen::Matrix3d matrix = ReadCalibrationMatrixFile(file);
-    camera.known_intrinsics =
-        Eigen::Vector4d(matrix(0, 0), matrix(1, 1), matrix(0, 2), matrix(1, 2));
-    camera.known_intrinsics_source = file.string();
+    ReadKnownIntrinsicsFile(file, &camera);
   }
   if (!params.is_null()) {
     const CameraModelId model_id = CameraModelNameToId(camera.model);
@@ -121,13 +119,9 @@ CameraSettings ParseCamera(const nlohmann::json& json, const std::filesystem::pa
     camera.known_params = params.get<std::vector<double>>();
     Camera probe = Camera::Create(0, model_id, 1, 1, 1);
     probe.params = camera.known_params;
-    camera.known_intrinsics = Eigen::Vector4d(probe.FocalLengthX(), probe.FocalLengthY(),
-                                              probe.PrincipalPointX(), probe.PrincipalPointY());
-    camera.known_intrinsics_source = "camera.params";
-  }
-  if (camera.known_intrinsics &&
-      ((*camera.known_intrinsics)(0) <= 0 || (*camera.known_intrinsics)(1) <= 0)) {
-    throw OptionError(camera.known_intrinsics_source, "focal lengths must be positive");
+    SetKnownIntrinsics(Eigen::Vector4d(probe.FocalLengthX(), probe.FocalLengthY(),
+                                       probe.PrincipalPointX(), probe.PrincipalPointY()),
+                       "camera.params", &camera);
   }
   return camera;
 }
@@ -219,8 +213,10 @@ DistributedSettings ParseDistributed(const nlohmann::json& json) {
 }  // namespace
 
 Eigen::Matrix3d ReadCalibrationMatrixFile(const std::filesystem::path& file) {
-  std::ifstream stream(file);
-  if (!stream) throw InputError(file.string() + ": cannot read the calibration matrix file");
+  // Names a folder as such; a BOM (as Windows editors write) is not part of a number.
+  std::string text = ReadFileContents(file);
+  if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
+  std::istringstream stream(text);
   // Every token is read: a tenth number means the file is not what the user thinks.
   std::vector<double> numbers;
   std::string token;
@@ -239,11 +235,11 @@ Eigen::Matrix3d ReadCalibrationMatrixFile(const std::filesystem::path& file) {
   }
   Eigen::Matrix3d K;
   for (int i = 0; i < 9; ++i) K(i / 3, i % 3) = numbers[i];
-  if (K(0, 0) <= 0 || K(1, 1) <= 0 || K(2, 2) != 1) {
-    throw InputError(file.string() +
-                     ": not a calibration matrix (need fx, fy > 0 and K[2][2] = 1)");
-  }
-  return K;
+  return K;  // checked as a calibration by SetKnownIntrinsics
+}
+
+void ReadKnownIntrinsicsFile(const std::filesystem::path& file, CameraSettings* camera) {
+  SetKnownIntrinsics(ReadCalibrationMatrixFile(file), file.string(), camera);
 }
 
 Manifest Manifest::Load(const std::filesystem::path& file) {

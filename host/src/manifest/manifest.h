@@ -75,7 +75,14 @@ struct Manifest {
   int EffectiveNumThreads() const;
 };
 
-// Reads a 3x3 intrinsic matrix from a text file of nine numbers (K.txt).
+// Reads a 3x3 intrinsic matrix from a text file of nine finite numbers (K.txt; a UTF-8 BOM
+// is skipped). Throws InputError naming the file (a folder: "PATH is a folder, not a
+// file"). Whether it is a calibration is SetKnownIntrinsics's to check
+// (image/known_intrinsics.h).
 Eigen::Matrix3d ReadCalibrationMatrixFile(const std::filesystem::path& file);
+
+// Reads `file` (ReadCalibrationMatrixFile) as the camera's known intrinsics, checked and
+// set by SetKnownIntrinsics (image/known_intrinsics.h): --camera-K over the manifest's.
+void ReadKnownIntrinsicsFile(const std::filesystem::path& file, CameraSettings* camera);
 
 }  // namespace tessera

@@ -1,5 +1,6 @@
 #include "partition/hierarchical_map.h"
 
+#include <signal.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -9,8 +10,10 @@
 #include "partition/merge_map_stage.h"
 #include "partition/partition_stage.h"
 #include "partition/process_pool.h"
+#include "pipeline/run_pipeline.h"
 #include "pipeline/workspace.h"
 #include "tessera/errors.h"
+#include "util/exit_codes.h"
 #include "util/timer.h"
 
 namespace tessera {
@@ -46,6 +49,17 @@ MapStageSummary MapHierarchically(const PipelineContext& context, const RunOptio
                                   const StageControl& control) {
   const Timer timer;
   context.Require("bundle_adjuster", "map");
+  {
+    // --camera-K is applied here, once: the cluster processes read the workspace only.
+    Workspace::Options open;
+    open.require_database_for = "map --hierarchical";
+    const auto workspace = Workspace::Open(options.output_dir, open);
+    if (!ApplyGivenIntrinsicsToWorkspace(context, *workspace, options, control)) {
+      MapStageSummary summary;
+      summary.status = StageStatus::kCancelled;
+      return summary;
+    }
+  }
   const ClustersFile clusters = CurrentClusters(context, options);
   // Biggest first, so that the slowest cluster starts first.
   std::vector<int> order;
@@ -69,7 +83,12 @@ MapStageSummary MapHierarchically(const PipelineContext& context, const RunOptio
   const std::vector<int> codes =
       RunProcessPool(commands, jobs, [&] { return control.Cancelled(); });
   const double map_seconds = timer.ElapsedSeconds();
-  if (control.Cancelled()) {
+  // A cluster process interrupted on its own (exit 130, or ended by SIGINT, SIGTERM or
+  // SIGHUP) stops the map as an interrupt of this one does: never a failure or a crash.
+  const bool cluster_interrupted = std::any_of(codes.begin(), codes.end(), [](int code) {
+    return code == kExitInterrupted || code == 128 + SIGTERM || code == 128 + SIGHUP;
+  });
+  if (control.Cancelled() || cluster_interrupted) {
     MapStageSummary summary;
     summary.status = StageStatus::kCancelled;
     spdlog::warn(

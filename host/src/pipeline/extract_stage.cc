@@ -269,15 +269,16 @@ bool SameCameras(const std::vector<Image*>& images, const std::map<camera_t, Cam
 // from the current ones for every image, as a new workspace would make them, and the
 // two-view geometries that used a changed camera's intrinsics are discarded. Features
 // and matches do not depend on the cameras and stay. Updates the images' camera ids.
-void UpdateCameras(const ImageScan& scan, const CameraSettings& settings,
-                   std::vector<Image>* images, Database* database) {
+// Returns how many geometries were discarded.
+size_t UpdateCameras(const ImageScan& scan, const CameraSettings& settings,
+                     std::vector<Image>* images, Database* database) {
   const nlohmann::json record = CameraSettingsRecord(settings);
   std::optional<nlohmann::json> stored = database->ReadStageProvenance(Database::kCamerasStage);
   // Workspaces made before camera.per_folder existed made their cameras without it.
   if (stored && stored->is_object() && !stored->contains("per_folder")) {
     (*stored)["per_folder"] = false;
   }
-  if (stored == record) return;
+  if (stored == record) return 0;
   std::vector<ImageEntry> entries;
   std::vector<Image*> registered;  // in scan order, as a new workspace numbers cameras
   for (size_t i = 0; i < images->size(); ++i) {
@@ -288,6 +289,7 @@ void UpdateCameras(const ImageScan& scan, const CameraSettings& settings,
   std::map<camera_t, Camera> cameras;
   for (Camera& camera : database->ReadAllCameras()) cameras[camera.camera_id] = camera;
   const CameraAssignment assignment = AssignCameras(entries, settings);
+  size_t num_discarded = 0;
   if (!SameCameras(registered, cameras, assignment)) {
     for (const auto& warning : assignment.warnings) spdlog::warn("{}", warning);
     const std::vector<const Camera*> assigned = AssignedCameras(assignment);
@@ -301,7 +303,7 @@ void UpdateCameras(const ImageScan& scan, const CameraSettings& settings,
     }
     Database::Transaction transaction(database);
     database->ReplaceCameras(assignment.cameras, image_cameras);
-    const size_t num_discarded = DiscardGeometriesOfChangedCameras(before, after, database);
+    num_discarded = DiscardGeometriesOfChangedCameras(before, after, database);
     transaction.Commit();
     for (size_t k = 0; k < registered.size(); ++k) {
       registered[k]->camera_id = assignment.image_camera_ids[k];
@@ -319,6 +321,7 @@ void UpdateCameras(const ImageScan& scan, const CameraSettings& settings,
                  WhyCamerasChanged(stored, record));
   }
   database->WriteStageProvenance(Database::kCamerasStage, record);
+  return num_discarded;
 }
 
 // Stores each image's EXIF metadata for pair selectors, so that matching needs no
@@ -611,6 +614,49 @@ ExtractionSummary ExtractFeatures(const Workspace& workspace, const ExtractSetti
   }
   summary.seconds = timer.ElapsedSeconds();
   return summary;
+}
+
+bool ApplyGivenIntrinsics(const Workspace& workspace, const std::filesystem::path& image_dir,
+                          const CameraSettings& settings, int64_t max_image_pixels) {
+  if (!settings.known_intrinsics) return false;
+  Database* database = &workspace.database();
+  // Only the intrinsics are the map's to change: the other camera settings stay those the
+  // cameras were made with (a map has no --camera-per-folder, and its manifest may differ).
+  const std::optional<nlohmann::json> stored =
+      database->ReadStageProvenance(Database::kCamerasStage);
+  CameraSettings effective = settings;
+  if (stored && stored->is_object()) {
+    effective.model = stored->value("model", settings.model);
+    effective.single_camera = stored->value("single_camera", settings.single_camera);
+    effective.per_folder = stored->value("per_folder", false);
+    effective.default_focal_length_factor =
+        stored->value("default_focal_length_factor", settings.default_focal_length_factor);
+  }
+  if (stored == CameraSettingsRecord(effective)) return false;
+  if (!settings.known_params.empty() && effective.model != settings.model) {
+    throw InputError("camera.params: given for camera.model " + settings.model +
+                     ", and the workspace's cameras are " + effective.model +
+                     ": extract again with this manifest");
+  }
+  const std::filesystem::path folder = ImageFolder(image_dir, *database);
+  std::error_code error;
+  if (folder.empty() || !std::filesystem::is_directory(folder, error)) {
+    throw InputError(settings.known_intrinsics_source +
+                     ": the workspace's cameras were made with other intrinsics, and the "
+                     "image folder" +
+                     (folder.empty() ? "" : " " + folder.string()) +
+                     " is not there to make them again from: pass --images");
+  }
+  const ImageScan scan =
+      ScanImageFolder(folder, workspace.ScanOptions(settings.mask_path, max_image_pixels));
+  std::vector<Image> images(scan.images.size());
+  for (size_t i = 0; i < scan.images.size(); ++i) {
+    images[i].image_id = kInvalidImageId;
+    if (auto existing = database->ReadImageWithName(scan.images[i].name)) images[i] = *existing;
+  }
+  spdlog::info("map: the intrinsics of {} are applied to the workspace's cameras",
+               settings.known_intrinsics_source);
+  return UpdateCameras(scan, effective, &images, database) > 0;
 }
 
 void LogExtraction(const ExtractionSummary& s) {

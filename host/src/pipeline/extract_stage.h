@@ -55,6 +55,20 @@ struct ExtractSettings {
 ExtractionSummary ExtractFeatures(const Workspace& workspace, const ExtractSettings& settings,
                                   const StageScope& scope = {}, const StageControl& control = {});
 
+// The map stage's share of the cameras (`map --camera-K FILE`, or a manifest's camera.K,
+// camera.K_file, camera.params): when intrinsics are given and the workspace's cameras
+// were made with other camera settings, they are made again from the images of
+// `image_dir` (the one extract recorded when empty) as extract would make them (each K
+// checked, applied to the cameras it fits), and the two-view geometries that used the old
+// intrinsics are discarded; features and matches are kept. The other camera settings
+// (model, single_camera, per_folder, default_focal_length_factor) stay those the cameras
+// were made with. Throws InputError when the K
+// is refused, or when the image folder is not there to make the cameras from. Without
+// given intrinsics, or with those the cameras were made with, it does nothing. Returns
+// whether two-view geometries were discarded (matching verifies them again).
+bool ApplyGivenIntrinsics(const Workspace& workspace, const std::filesystem::path& image_dir,
+                          const CameraSettings& settings, int64_t max_image_pixels);
+
 // The stage's closing log line.
 void LogExtraction(const ExtractionSummary& summary);
 

@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <map>
 #include <optional>
 #include <set>
 #include <string>
@@ -17,6 +18,7 @@
 #include "pipeline/workspace.h"
 #include "plugin/bundle_adjuster_guard.h"
 #include "plugin/plugin_call.h"
+#include "plugin/plugin_crash_log.h"
 #include "tessera/io/colmap_model_io.h"
 #include "tessera/io/file_io.h"
 #include "tessera/io/georeference_io.h"
@@ -267,6 +269,60 @@ void RemoveRunSummary(const std::filesystem::path& output_dir) {
   }
 }
 
+// The images and pairs left out by a quarantine (plugin_crashes.tsv) in the summary's
+// `quarantined`, as the exporters' are: those of the detector that made the workspace's
+// features, and of the matcher that matched them. An image the detector skipped so has no
+// features, and its `unregistered` reason says so, not that no pair verified.
+void NoteQuarantines(const Workspace& workspace, const MapperInput& input,
+                     MappingSummary* mapping) {
+  const Database& database = workspace.database();
+  // {"plugin": NAME, ...} (PluginInstance::Provenance), for features directly and for
+  // matches under "matcher"; "" when not recorded (a COLMAP database).
+  const auto plugin_of = [](const std::optional<nlohmann::json>& slot) {
+    return slot && slot->is_object() ? slot->value("plugin", std::string()) : std::string();
+  };
+  const std::string detector = plugin_of(database.ReadStageProvenance(Database::kFeaturesStage));
+  const auto matches = database.ReadStageProvenance(Database::kMatchesStage);
+  const std::string matcher =
+      plugin_of(matches && matches->is_object() && matches->contains("matcher")
+                    ? std::optional<nlohmann::json>(matches->at("matcher"))
+                    : std::nullopt);
+  std::map<std::string, std::string> image_of_subject;
+  for (const auto& [image_id, image] : input.images) {
+    image_of_subject[ImageSubject(image.name)] = image.name;
+  }
+  std::map<std::string, std::string> reasons;  // by image name
+  std::set<std::pair<std::string, std::string>> seen;
+  const PluginCrashLog& crashes = workspace.crash_log();
+  for (const PluginCrash& crash : crashes.history()) {
+    const bool detected = crash.plugin == detector && !detector.empty() &&
+                          crash.stage == PluginStageName(PluginStage::kDetect) &&
+                          image_of_subject.count(crash.subject) > 0;
+    const bool matched = crash.plugin == matcher && !matcher.empty() &&
+                         crash.stage == PluginStageName(PluginStage::kMatch);
+    if ((!detected && !matched) ||
+        !seen.insert({crash.plugin + "\t" + crash.stage, crash.subject}).second) {
+      continue;
+    }
+    const PluginStage stage = detected ? PluginStage::kDetect : PluginStage::kMatch;
+    if (!crashes.IsQuarantined(crash.plugin, stage, crash.subject)) continue;
+    const std::string kind = detected ? "detector" : "matcher";
+    mapping->quarantined.push_back(kind + " '" + crash.plugin + "' skipped for " + crash.subject +
+                                   ": it crashed twice " + PluginStageActivity(stage) + " it (" +
+                                   workspace_layout::kPluginCrashesStem + ".tsv)");
+    if (detected) {
+      reasons[image_of_subject.at(crash.subject)] =
+          "quarantined: it crashed detector '" + crash.plugin +
+          "' twice (plugin_crashes.tsv), so it has no features; fix or rebuild the detector "
+          "(its crash records are then set aside), or choose another";
+    }
+  }
+  for (MappingSummary::Unregistered& image : mapping->unregistered) {
+    const auto reason = reasons.find(image.image);
+    if (reason != reasons.end()) image.reason = reason->second;
+  }
+}
+
 // Places the models of `result`, their exports and OUTPUT/mapping_summary.json (with
 // `inputs`, what they were made from, or null) as one set (OutputTransaction): with no
 // model, what the earlier runs wrote is removed.
@@ -289,6 +345,7 @@ bool PlaceMapOutputs(const Workspace& workspace, const MapSettings& settings,
   }
   mapping.partition = target.partition;
   mapping.inputs = inputs;
+  NoteQuarantines(workspace, input, &mapping);
   summary->num_models = result.models.size();
   CreateFolder(output_dir);
   OutputTransaction outputs(output_dir);

@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <atomic>
 #include <list>
 #include <map>
@@ -216,6 +217,16 @@ void InvalidateStaleResults(const MatchSettings& settings, const WorkspaceDescri
     spdlog::info("match: the verification settings changed; discarding old two-view geometries");
     database->ClearTwoViewGeometries();
   }
+  // A pair is matched from the features of both its images: one detected again since
+  // (a crashing detector fixed, an image that had none) makes its matches stale.
+  const std::vector<image_pair_t> stale = database->ReadPairsWithStaleMatches();
+  if (!stale.empty()) {
+    spdlog::info(
+        "match: {} matched pairs were matched from other features than their images have now "
+        "(an image was detected again); discarding their matches, to match them again",
+        stale.size());
+    database->DeleteMatches(stale);
+  }
   database->WriteStageProvenance(Database::kMatchesStage, matches_provenance);
   database->WriteStageProvenance(Database::kTwoViewGeometriesStage, geometries_provenance);
 }
@@ -243,6 +254,8 @@ MatchPlan PlanMatching(const Workspace& workspace, const MatchSettings& settings
       &source != &results &&
       source.ReadStageProvenance(Database::kMatchesStage) == provenance.matches &&
       source.ReadStageProvenance(Database::kTwoViewGeometriesStage) == provenance.geometries;
+  std::vector<image_pair_t> stale_in_source;
+  if (source_current) stale_in_source = source.ReadPairsWithStaleMatches();
   const std::string& matcher = settings.matcher->name();
   for (size_t p = 0; p < plan.pairs.size(); ++p) {
     if (!in_scope.at(p)) continue;
@@ -252,7 +265,11 @@ MatchPlan PlanMatching(const Workspace& workspace, const MatchSettings& settings
     const auto done = [&](const Database& database) {
       return database.ExistsMatches(id1, id2) && database.ExistsTwoViewGeometry(id1, id2);
     };
-    if (done(results) || (source_current && done(source))) {
+    const bool current_in_source =
+        source_current && done(source) &&
+        !std::binary_search(stale_in_source.begin(), stale_in_source.end(),
+                            ImagePairToPairId(id1, id2));
+    if (done(results) || current_in_source) {
       ++plan.num_reused;
     } else if (workspace.IsQuarantined(matcher, PluginStage::kMatch,
                                        PairSubject(images[i].name, images[j].name))) {

@@ -66,7 +66,9 @@ MatchProvenance MakeMatchProvenance(const MatchSettings& settings,
 // discarded; the provenance of what this run makes is recorded. Pair selection itself
 // only decides which pairs exist, so changing it keeps every pair already matched, and
 // MatchFeatures records the pairs chosen (Database::WriteSelectedPairs): mapping uses
-// those only.
+// those only. A pair whose matches were made from other features than its two images
+// have now (Database::ReadPairsWithStaleMatches: an image detected again) loses its
+// matches and geometry, and is matched again.
 void InvalidateStaleResults(const MatchSettings& settings, const WorkspaceDescriptors& descriptors,
                             Database* database);
 

@@ -66,6 +66,21 @@ MatchingSummary RunMatch(const PipelineContext& context, const RunOptions& optio
   return MatchFeatures(*workspace, context.MakeMatchSettings(), {}, control);
 }
 
+bool ApplyGivenIntrinsicsToWorkspace(const PipelineContext& context, const Workspace& workspace,
+                                     const RunOptions& options, const StageControl& control) {
+  if (!ApplyGivenIntrinsics(workspace, options.image_dir, context.manifest.camera,
+                            context.manifest.max_image_pixels)) {
+    return true;
+  }
+  context.Require("pair_selector", "map --camera-K");
+  context.Require("matcher", "map --camera-K");
+  context.UseWorkspaceCaches(workspace);
+  const MatchingSummary matched =
+      MatchFeatures(workspace, context.MakeMatchSettings(), {}, control);
+  LogMatching(matched);
+  return matched.status != StageStatus::kCancelled;
+}
+
 MapStageSummary RunMap(const PipelineContext& context, const RunOptions& options,
                        const StageControl& control) {
   context.Require("bundle_adjuster", "map");
@@ -75,6 +90,12 @@ MapStageSummary RunMap(const PipelineContext& context, const RunOptions& options
   CheckImagesUnchanged(
       *workspace, options.image_dir,
       workspace->ScanOptions(context.manifest.camera.mask_path, context.manifest.max_image_pixels));
+  // --camera-K is applied (or refused), never ignored.
+  if (!ApplyGivenIntrinsicsToWorkspace(context, *workspace, options, control)) {
+    MapStageSummary cancelled;
+    cancelled.status = StageStatus::kCancelled;
+    return cancelled;
+  }
   MapSettings settings = context.MakeMapSettings(options.image_dir);
   settings.force = options.force_map;
   return MapWorkspace(*workspace, settings, {}, control);

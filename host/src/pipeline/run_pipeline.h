@@ -12,6 +12,7 @@
 #include "pipeline/pipeline_context.h"
 #include "pipeline/run_summary.h"
 #include "pipeline/stage_control.h"
+#include "pipeline/workspace.h"
 
 namespace tessera {
 
@@ -45,6 +46,13 @@ ExtractionSummary RunExtract(const PipelineContext& context, const RunOptions& o
 // `match`: matches and verifies the pairs the selectors choose. image_dir is not used.
 MatchingSummary RunMatch(const PipelineContext& context, const RunOptions& options,
                          const StageControl& control = {});
+
+// `map --camera-K FILE` (and a manifest's given intrinsics): ApplyGivenIntrinsics, then
+// the pairs whose geometries used the old intrinsics verified again from their matches
+// (the match stage, which matches no pair that has matches). Returns false when
+// cancelled meanwhile.
+bool ApplyGivenIntrinsicsToWorkspace(const PipelineContext& context, const Workspace& workspace,
+                                     const RunOptions& options, const StageControl& control);
 
 // `map`: maps an existing workspace (InputError when it has no database) after checking
 // that its images are unchanged; options.image_dir empty: the folder extract recorded.

@@ -25,9 +25,7 @@ PipelineContext LoadPipelineContext(const StageArguments& arguments) {
   PipelineContext context = CreateContext(arguments);
   if (arguments.threads > 0) context.manifest.num_threads = arguments.threads;
   if (!arguments.camera_K.empty()) {
-    const Eigen::Matrix3d K = ReadCalibrationMatrixFile(arguments.camera_K);
-    context.manifest.camera.known_intrinsics = Eigen::Vector4d(K(0, 0), K(1, 1), K(0, 2), K(1, 2));
-    context.manifest.camera.known_intrinsics_source = arguments.camera_K;
+    ReadKnownIntrinsicsFile(arguments.camera_K, &context.manifest.camera);
   }
   if (!arguments.masks.empty()) context.manifest.camera.mask_path = arguments.masks;
   if (arguments.camera_per_folder) context.manifest.camera.per_folder = true;

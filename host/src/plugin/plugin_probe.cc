@@ -53,14 +53,22 @@ void WriteLine(int fd, const std::string& line) {
   _exit(0);
 }
 
+// Signals a user or a parent sends to stop a process: a child they end was interrupted,
+// not crashed, and the file is not blamed.
+bool IsInterruptSignal(int signal_number) {
+  return signal_number == SIGINT || signal_number == SIGTERM || signal_number == SIGHUP;
+}
+
 std::string Describe(int status) {
   if (WIFSIGNALED(status)) {
     const int signal_number = WTERMSIG(status);
     const char* abbreviation = sigabbrev_np(signal_number);
-    return "crashes on load (" +
-           (abbreviation != nullptr ? "SIG" + std::string(abbreviation)
-                                    : "signal " + std::to_string(signal_number)) +
-           ")";
+    const std::string name = abbreviation != nullptr ? "SIG" + std::string(abbreviation)
+                                                     : "signal " + std::to_string(signal_number);
+    if (IsInterruptSignal(signal_number)) {
+      return "not inspected: the plugin scan was interrupted (" + name + ")";
+    }
+    return "crashes on load (" + name + ")";
   }
   return "ends the process on load (exit code " + std::to_string(WEXITSTATUS(status)) + ")";
 }
