@@ -586,7 +586,7 @@ assert len(set(names)) == len(names) == 3, names' "$bc/case$tried/report.json" 2
     if [ -s "$bc/sleep.pid" ] && kill -0 "$(cat "$bc/sleep.pid")" 2> /dev/null; then
       verdict="COLMAP left running"; hangs=$((hangs + 1)); kill -9 "$(cat "$bc/sleep.pid")"
     fi
-    printf "%-52s exit %s  %s\n" "bench children: SIG${signal%%:*} to the bench${signal#INT}${signal#TERM}" "$code" "$verdict"
+    printf "%-52s exit %s  %s\n" "bench children: SIG${signal%%:*} to the bench$([ "${signal#*:}" = group ] && echo "'s group" || echo " alone")" "$code" "$verdict"
     [ "$verdict" = ok ] || tail -3 "$bc/sig.log" | sed 's/^/    /'
   done
 }
