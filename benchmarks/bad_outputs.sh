@@ -17,6 +17,7 @@
 # Issue 47's hand-offs are read as their readers read them: transforms.json's file_path
 # joined to the JSON's folder, the 3DGS trainer's camera (check_3dgs_scene.py) on a
 # principal point moved off the centre, and the mean error against colmap model_analyzer.
+# The bench children section (issue 60) counts hangs and reports lost too (see there).
 # Every count but the first ("cases tried") must be 0. On a 512 px copy of
 # examples/fountain-P11-small with ORB (a few seconds per case).
 # usage: benchmarks/bad_outputs.sh [TESSERA]
@@ -477,6 +478,148 @@ readback_forged_ledgers() {
 }
 readback_forged_ledgers
 # --- End of read-back: forged ledgers ---------------------------------------------------
+# --- Bench children (issue 60) -------------------------------------------------------------
+# `tessera bench` with hostile COLMAP binaries (fake ones, shell scripts written here) beside
+# one Tessera row, and signals to the bench while a COLMAP step runs. Beside the counts above
+# (a crash: an exit code other than expected; files outside: the sentinel tree, which a
+# version "3.8/../../../../outside/pwn" aims at), each case counts:
+#   hangs            the bench still running 120 s after it began (or 20 s after a signal)
+#   reports lost     a bench that ran rows and printed no table, or wrote no JSON, or lost
+#                    the Tessera row (its row, exit 0, its workspace's database)
+#   unclear          the expected line not said, an error line of 1000 characters or more,
+#                    raw control bytes in the log, or an interrupt reported as a crash
+hangs=0 lost=0
+bench_children() {
+  local bc=$work/bc
+  mkdir -p "$bc"
+  fake() {  # fake NAME HELP EXTRACT MAPPER: a COLMAP running those shell lines
+    cat > "$bc/$1" <<SH
+#!/bin/bash
+args=("\$@")
+get() { local i; for ((i = 0; i < \${#args[@]}; i++)); do [ "\${args[i]}" = "\$1" ] && echo "\${args[i+1]}"; done; }
+db=\$(get --database_path); out=\$(get --output_path)
+case "\$1" in
+  -h) $2 ;;
+  feature_extractor) $3 ;;
+  exhaustive_matcher) : ;;
+  mapper|global_mapper) $4 ;;
+esac
+SH
+    chmod +x "$bc/$1"
+  }
+  local help='echo "COLMAP 3.8 -- Structure-from-Motion"; echo "  mapper"'
+  local copy_db="cp '$work/base/database.db' \"\$db\""
+  local sleeper="echo \$\$ > '$bc/sleep.pid'; exec sleep 600"
+  fake good "$help" "$copy_db" ":"
+  fake long_version 'printf "COLMAP 3.8"; head -c 30000 /dev/zero | tr "\\0" x; echo' "$copy_db" ":"
+  fake dotdot 'echo "COLMAP 3.8/../../../../outside/pwn"' "$copy_db" ":"
+  fake silent 'exec sleep 600' "$copy_db" ":"
+  fake slow_extract "$help" "$sleeper" ":"
+  fake huge 'head -c 100000000 /dev/zero | tr "\\0" x' "$copy_db" ":"
+  fake binary 'head -c 3000 /dev/urandom; printf "\\001\\033[31m\\377"' "$copy_db" ":"
+  fake garbage_db "$help" "head -c 5000 /dev/urandom > \"\$db\"" ":"
+  fake garbage_model "$help" "$copy_db" 'mkdir -p "$out/0"; for f in cameras images points3D; do head -c 300 /dev/urandom > "$out/0/$f.bin"; done'
+  fake removes_output "$help" "$copy_db" 'rm -rf "$out"'
+  fake crashes "$help" "$copy_db" 'kill -SEGV $$'
+  # bench_child NAME EXPECTED_CODE REPORT MESSAGE FOREIGN -- BENCH ARGS...: REPORT "rows"
+  # when the bench runs rows (then the table, the JSON and the Tessera row must be there);
+  # MESSAGE a regex the log must hold ("" none); FOREIGN files of the user's that must stay.
+  bench_child() {
+    local name=$1 expected=$2 report=$3 message=$4 foreign_files=$5
+    shift 6
+    tried=$((tried + 1))
+    local out=$bc/case$tried sums="" after="" f verdict=ok
+    rm -rf "$out"; mkdir -p "$out"
+    for f in $foreign_files; do sums+="$(sha1sum "$f" 2>&1)"; done
+    timeout 120 "$tessera" bench --images "$work/d" --output "$out/out" --threads 2 \
+      --json "$out/report.json" "$@" > "$out/table.md" 2> "$out/log"
+    local code=$?
+    if [ "$code" = 124 ]; then verdict=hang; hangs=$((hangs + 1))
+    elif [ "$code" != "$expected" ] && [ "$code" != 0 ] && [ "$code" != 2 ] && [ "$code" != 3 ]; then
+      verdict="crash"; crashes=$((crashes + 1))
+    elif [ "$code" != "$expected" ]; then verdict="silent wrong output (exit $code)"; silent=$((silent + 1))
+    elif [ "$report" = rows ] && { ! grep -q "^| bin |" "$out/table.md" || ! python3 - "$out/report.json" <<'PY'
+import json, os, sys
+rows = json.load(open(sys.argv[1]))["rows"]
+tessera = [r for r in rows if not r["plugins"].startswith("COLMAP")]
+assert tessera and all(r["exit_code"] == 0 and os.path.exists(r["workspace"] + "/database.db")
+                       for r in tessera), rows
+PY
+    }; then verdict="report lost"; lost=$((lost + 1))
+    elif { [ -n "$message" ] && ! grep -qE -- "$message" "$out/log"; } || [ "$(wc -L < "$out/log")" -ge 1000 ] ||
+         LC_ALL=C grep -qP '[^\t\x20-\x7e]' "$out/log"; then
+      verdict="unclear message"; unclear=$((unclear + 1))
+    fi
+    if [ "$(snapshot "$work/outside")" != "$sentinel" ]; then
+      verdict="files outside touched"; outside=$((outside + 1))
+      rm -rf "$work/outside"; mkdir -p "$work/outside/models/0"
+      echo "precious" > "$work/outside/victim.txt"; echo "model" > "$work/outside/models/0/images.bin"
+    fi
+    for f in $foreign_files; do after+="$(sha1sum "$f" 2>&1)"; done
+    [ "$sums" = "$after" ] || { verdict="foreign files deleted"; foreign=$((foreign + 1)); }
+    printf "%-52s exit %s  %s\n" "bench children: $name" "$code" "$verdict"
+    [ "$code" = 0 ] || grep -m1 '\[error\]' "$out/log" | cut -c1-150 | sed 's/^/    /'
+    [ "$verdict" = ok ] || tail -c 600 "$out/log" | tail -3 | cut -c1-300 | sed 's/^/    /'
+  }
+  local long="long_version" bin_json="$work/bin.json"
+  bench_child "30,000-character version line" 0 rows "" "" -- --colmap "$bc/$long" "$bin_json"
+  bench_child "version 3.8/../../../../outside/pwn" 0 rows "colmap-3.8_.._.._.._.._outside_pwn-incremental" "" -- --colmap "$bc/dotdot" "$bin_json"
+  bench_child "silent on -h (--child-timeout 3)" 2 none "silent: no answer to -h \(its version\) within 3 s" "" -- \
+    --child-timeout 3 --colmap "$bc/silent" "$bin_json"
+  bench_child "sleeping in feature_extractor (--child-timeout 3)" 2 rows "timed out after 3 s" "" -- \
+    --child-timeout 3 --colmap "$bc/slow_extract" "$bin_json"
+  tried=$((tried + 1))
+  if [ -s "$bc/sleep.pid" ] && kill -0 "$(cat "$bc/sleep.pid")" 2> /dev/null; then
+    echo "    the timed-out COLMAP still runs"; hangs=$((hangs + 1)); kill -9 "$(cat "$bc/sleep.pid")"
+  else printf "%-52s %s\n" "bench children: the timed-out COLMAP is gone" ok; fi
+  bench_child "100 MB on one line from -h" 2 none "huge: does not say it is COLMAP" "" -- --colmap "$bc/huge" "$bin_json"
+  bench_child "binary output from -h" 2 none "binary: does not say it is COLMAP \(its -h begins '.*\\\\x" "" -- --colmap "$bc/binary" "$bin_json"
+  bench_child "garbage database" 2 rows "colmap-3.8-incremental ended with exit code 2: .*database.db" "" -- --colmap "$bc/garbage_db" "$bin_json"
+  bench_child "garbage model" 2 rows "colmap-3.8-incremental ended with exit code 2: .*\.bin" "" -- --colmap "$bc/garbage_model" "$bin_json"
+  bench_child "a mapper that removes its output" 2 rows "output folder is gone" "" -- --colmap "$bc/removes_output" "$bin_json"
+  bench_child "a mapper that crashes" 2 rows "mapper crashed \(signal 11\)" "" -- --colmap "$bc/crashes" "$bin_json"
+  cp "$work/bin.json" "$bc/colmap-3.8-incremental.json"
+  bench_child "manifest named colmap-3.8-incremental.json" 0 rows "" "" -- --colmap "$bc/good" "$bin_json" "$bc/colmap-3.8-incremental.json"
+  bench_child "--colmap X --colmap X" 0 rows "" "" -- --colmap "$bc/good" --colmap "$bc/good" "$bin_json"
+  python3 -c 'import json, sys; names = [r["manifest"] for r in json.load(open(sys.argv[1]))["rows"]]
+assert len(set(names)) == len(names) == 3, names' "$bc/case$tried/report.json" 2> /dev/null ||
+    { echo "    two rows of one name"; silent=$((silent + 1)); }
+  mkdir -p "$bc/user/out/colmap/colmap-3.8/incremental"; echo mine > "$bc/user/out/colmap/colmap-3.8/incremental/notes.txt"
+  echo mine > "$bc/user/out/notes.txt"
+  check "bench children: a user's folder where a COLMAP row goes" 2 "" "$bc/user/out/notes.txt $bc/user/out/colmap/colmap-3.8/incremental/notes.txt" -- \
+    "$tessera" bench --images "$work/d" --output "$bc/user/out" --threads 2 --colmap "$bc/good" "$bin_json"
+  # Signals while COLMAP sleeps in feature_extractor: to the bench alone, and to its group.
+  local signal target
+  for signal in INT TERM INT:group; do
+    tried=$((tried + 1))
+    rm -f "$bc/sleep.pid"; rm -rf "$bc/sig"
+    setsid "$tessera" bench --images "$work/d" --output "$bc/sig" --threads 2 --colmap "$bc/slow_extract" \
+      "$bin_json" > "$bc/sig.md" 2> "$bc/sig.log" &
+    local pid=$! deadline=$((SECONDS + 120))
+    while [ ! -s "$bc/sleep.pid" ] && [ "$SECONDS" -lt "$deadline" ]; do sleep 0.1; done
+    target=$pid; [ "${signal#*:}" = group ] && target=-$pid
+    kill -"${signal%%:*}" -- "$target"
+    deadline=$((SECONDS + 20))
+    while kill -0 "$pid" 2> /dev/null && [ "$SECONDS" -lt "$deadline" ]; do sleep 0.1; done
+    local verdict=ok code
+    if kill -0 "$pid" 2> /dev/null; then
+      verdict=hang; hangs=$((hangs + 1)); kill -9 "$pid"
+    fi
+    wait "$pid"; code=$?
+    if [ "$verdict" = ok ] && [ "$code" != 130 ]; then verdict="crash (exit $code)"; crashes=$((crashes + 1)); fi
+    if [ "$verdict" = ok ] && { ! grep -q "bench: interrupted" "$bc/sig.log" || grep -q crashed "$bc/sig.log"; }; then
+      verdict="unclear message"; unclear=$((unclear + 1))
+    fi
+    if [ "$verdict" = ok ] && ! grep -q "^| bin |" "$bc/sig.md"; then verdict="report lost"; lost=$((lost + 1)); fi
+    if [ -s "$bc/sleep.pid" ] && kill -0 "$(cat "$bc/sleep.pid")" 2> /dev/null; then
+      verdict="COLMAP left running"; hangs=$((hangs + 1)); kill -9 "$(cat "$bc/sleep.pid")"
+    fi
+    printf "%-52s exit %s  %s\n" "bench children: SIG${signal%%:*} to the bench$([ "${signal#*:}" = group ] && echo "'s group" || echo " alone")" "$code" "$verdict"
+    [ "$verdict" = ok ] || tail -3 "$bc/sig.log" | sed 's/^/    /'
+  done
+}
+bench_children
+# --- End of bench children -----------------------------------------------------------------
 
 echo
 echo "cases tried: $tried"
@@ -488,4 +631,6 @@ echo "unclear messages: $unclear"
 echo "models removed by a failed run: $removed"
 echo "orphans after kill -9 of a parent: $orphans"
 echo "cluster processes left 20 s after a signal to their parent: $left_running"
-[ $((crashes + silent + outside + foreign + unclear + removed + orphans + left_running)) = 0 ]
+echo "hangs (bench children): $hangs"
+echo "reports lost (bench children): $lost"
+[ $((crashes + silent + outside + foreign + unclear + removed + orphans + left_running + hangs + lost)) = 0 ]

@@ -66,6 +66,12 @@ def _int(function: str, name: str, value: object) -> int:
     return int(value)
 
 
+def _number(function: str, name: str, value: object) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{function}(): {name} must be a number, not {_type_name(value)}")
+    return float(value)
+
+
 def _bool(function: str, name: str, value: object) -> bool:
     if not isinstance(value, bool):
         raise TypeError(f"{function}(): {name} must be a bool, not {_type_name(value)}")
@@ -237,14 +243,17 @@ def evaluate(model: PathLike, ground_truth: PathLike) -> Dict[str, Any]:
 def bench(images: PathLike, manifests: Sequence[PathLike], output: PathLike = "bench-output",
           ground_truth: Optional[PathLike] = None, camera_K: Optional[PathLike] = None,
           with_colmap: bool = False, colmap: Union[PathLike, Sequence[PathLike], None] = None,
-          colmap_mapper_only: bool = False, threads: int = 0) -> List[Dict[str, Any]]:
+          colmap_mapper_only: bool = False, threads: int = 0,
+          child_timeout: float = 0) -> List[Dict[str, Any]]:
     """Runs each manifest file (each a `tessera run` of the installed executable, in
-    OUTPUT/<name>) on the same images and returns the rows `tessera bench --json` writes,
+    OUTPUT/tessera/<name>) on the same images and returns the rows `tessera bench --json` writes,
     one dict per manifest (and COLMAP's): a row that failed keeps its exit_code.
     `colmap` names the COLMAP binary (or a list of them) to run instead of those
     with_colmap finds (`--colmap PATH`); colmap_mapper_only runs COLMAP's mappers alone on
     the first successful row's database (`--colmap-mapper-only`); each implies
-    with_colmap."""
+    with_colmap. child_timeout: the seconds each row's process (a `tessera run`, each
+    COLMAP step) may run before its row says it timed out (`--child-timeout`; 0: the
+    default). A failing row keeps its exit_code and its error."""
     name = "bench"
     if colmap is None:
         colmaps: List[Any] = []
@@ -259,7 +268,8 @@ def bench(images: PathLike, manifests: Sequence[PathLike], output: PathLike = "b
         camera_K=_optional_path(name, "camera_K", camera_K),
         with_colmap=_bool(name, "with_colmap", with_colmap), colmap=colmaps,
         colmap_mapper_only=_bool(name, "colmap_mapper_only", colmap_mapper_only),
-        threads=_int(name, "threads", threads)))
+        threads=_int(name, "threads", threads),
+        child_timeout=_number(name, "child_timeout", child_timeout)))
 
 
 # ---- pycolmap's names, where the meaning is the same ----

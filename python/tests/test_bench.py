@@ -49,7 +49,7 @@ def test_bench_names_colmap_as_the_cli_does(sample, tmp_path):
                            match=r"no_colmap: no such file \(named by --colmap\)"):
             tessera.bench(images=images, manifests=[manifest], output=tmp_path / "x",
                           colmap=colmap, colmap_mapper_only=True)
-        assert not (tmp_path / "x" / "manifest").exists(), "a row ran before the check"
+        assert not (tmp_path / "x" / "tessera" / "manifest").exists(), "a row ran before the check"
     with pytest.raises(TypeError, match="colmap"):
         tessera.bench(images=images, manifests=[manifest], output=tmp_path / "x", colmap=[1])
     with pytest.raises(TypeError, match="colmap_mapper_only"):

@@ -106,8 +106,8 @@ PY
   "$work/orb_exhaustive.json" "$work/broken.json" > "$work/3.md" 2> "$work/3.log"
 code=$?
 [ "$code" -eq 2 ] || { cat "$work/3.log"; fail "a broken manifest gave exit code $code, not 2"; }
-grep -q "^| orb_exhaustive |.*| 0 |$" "$work/3.md" || fail "the good row is missing"
-grep -q "^| broken |.*| 2 |$" "$work/3.md" || fail "the broken row is missing"
+grep -q "^| orb_exhaustive |.*| 0 | - |$" "$work/3.md" || fail "the good row is missing"
+grep -q "^| broken |.*| 2 | exited with code 2: .*no_such_matcher.* |$" "$work/3.md" || fail "the broken row is missing"
 grep -q "broken ended with exit code 2" "$work/3.log" || fail "no error line for the broken row"
 "$tessera" bench --images "$images" --output "$work/out4" "$work/missing.json" \
   > /dev/null 2> "$work/4.log"

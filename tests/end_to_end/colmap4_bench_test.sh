@@ -34,7 +34,7 @@ trap 'rm -rf "$work"' EXIT
 # COLMAP 4 behind a wrapper that notes the Tessera row's database checksum at each call.
 cat > "$work/colmap4" <<EOF
 #!/bin/bash
-sha256sum "$work/out/global/database.db" >> "$work/sums.txt" 2> /dev/null
+sha256sum "$work/out/tessera/global/database.db" >> "$work/sums.txt" 2> /dev/null
 exec "$colmap4" "\$@"
 EOF
 chmod +x "$work/colmap4"
@@ -45,7 +45,7 @@ TESSERA_COLMAP="$work/colmap4" "$tessera" bench --images "$work/images" --gt "$g
   "$source_dir/manifests/global.json" > "$work/1.md" 2> "$work/1.log" ||
   { cat "$work/1.log"; fail "tessera bench exited $?"; }
 cat "$work/1.md"
-sha256sum "$work/out/global/database.db" >> "$work/sums.txt"
+sha256sum "$work/out/tessera/global/database.db" >> "$work/sums.txt"
 with_colmap3=0
 if have_colmap; then with_colmap3=1; else
   skip_part_or_fail "colmap (3.8) is not installed: its row is not tested"; fi
@@ -83,9 +83,9 @@ def schema(path):
     db = sqlite3.connect("file:%s?mode=ro" % path, uri=True)
     tables = {row[0] for row in db.execute("select name from sqlite_master where type='table'")}
     return db.execute("pragma user_version").fetchone()[0], tables
-version, tables = schema(sys.argv[1] + "/global/database.db")
+version, tables = schema(sys.argv[1] + "/tessera/global/database.db")
 assert "frames" not in tables and "rigs" not in tables, tables
-copy = glob.glob(sys.argv[1] + "/colmap-4.*-global/database.db")[0]
+copy = glob.glob(sys.argv[1] + "/colmap/colmap-4.*/global/database.db")[0]
 copy_version, copy_tables = schema(copy)
 assert "frames" in copy_tables and copy_version > version, (copy_version, version, copy_tables)
 print("original schema %d, COLMAP 4's copy upgraded to %d" % (version, copy_version))
@@ -105,7 +105,7 @@ check_refused() {  # BINARY EXPECTED_TEXT
   [ "$code" -eq 2 ] || { cat "$out.log"; fail "--colmap $1 gave exit code $code, not 2"; }
   grep -q -- "$1: $2" "$out.log" || { cat "$out.log"; fail "--colmap $1: no line '$1: $2'"; }
   [ "$(grep -c . "$out.log")" -eq 1 ] || { cat "$out.log"; fail "--colmap $1: not one line"; }
-  [ ! -d "$out/global" ] || fail "--colmap $1: a row ran before the binary was refused"
+  [ ! -d "$out/tessera/global" ] || fail "--colmap $1: a row ran before the binary was refused"
 }
 check_refused "$work/missing" "no such file (named by --colmap)"
 check_refused "$work/not_executable" "not executable"

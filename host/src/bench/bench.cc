@@ -5,6 +5,8 @@
 // manifest whose detector and camera settings equal an earlier one's starts from a copy of that
 // workspace's features (not its matches), and its row says so. Prints a Markdown
 // table; --json and --csv write the same rows to files, --chart draws them (gnuplot).
+// Each row works in a folder of its own (OUTPUT/tessera/<name>, OUTPUT/colmap/<binary>/),
+// and a row that fails is a row with its error: the other rows run and are reported.
 
 #include "bench/bench.h"
 
@@ -34,6 +36,8 @@
 #include "util/child_process.h"
 #include "util/exit_codes.h"
 #include "util/paths.h"
+#include "util/strings.h"
+#include "util/tessera_commands.h"
 #include "util/workspace_layout.h"
 
 namespace tessera {
@@ -89,10 +93,47 @@ std::string PairsBySelector(const BenchRow& row) {
   return text;
 }
 
+// OUTPUT/tessera/<name>: a Tessera row's workspace.
+fs::path TesseraWorkspace(const BenchOptions& options, const std::string& name) {
+  return fs::path(options.output) / "tessera" / name;
+}
+
+// A Tessera row's figures, read back from its workspace after its run ended with 0.
+void ReadTesseraRow(const fs::path& workspace, const GroundTruth* ground_truth, BenchRow* row) {
+  const RunSummary run =
+      RunSummary::FromJson(ReadJsonFile(workspace / workspace_layout::kRunSummary));
+  row->extract_seconds = run.extract.seconds;
+  row->match_seconds = run.match.seconds;
+  row->map_seconds = run.map.seconds;
+  row->total_seconds = run.total_seconds;
+  row->num_models = run.map.num_models;
+  row->num_selected_pairs = run.match.num_pairs;
+  row->pairs_per_selector = run.match.pairs_per_selector;
+  if (!run.plugins.empty()) {
+    row->plugins_used = run.plugins;
+    row->plugins = DescribePlugins(run.plugins);
+  }
+  ReadMatchingFigures(workspace / workspace_layout::kDatabase, row);
+  const MappingSummary mapping =
+      MappingSummary::FromJson(ReadJsonFile(workspace / workspace_layout::kMappingSummary));
+  if (!mapping.models.empty()) {
+    const MappingSummary::Model& model = mapping.models.front();
+    row->num_registered = model.num_images;
+    row->num_points = model.num_points3D;
+    row->mean_track_length = model.mean_track_length;
+    row->mean_reprojection_error = model.mean_reprojection_error;
+    const fs::path model_dir = workspace / workspace_layout::kModelsFolder / "0";
+    if (ground_truth != nullptr && fs::exists(model_dir / "images.bin")) {
+      ScoreModel(ReadColmapModel(model_dir), ground_truth, row);
+    }
+  }
+}
+
+// A manifest's row: its `tessera run` in its own workspace. A failure is the row's error.
 BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_truth,
                      const std::string& manifest_file, const nlohmann::json& manifest,
-                     const std::string& name, const std::string& shared_from,
-                     const fs::path& workspace) {
+                     const std::string& name, const std::string& shared_from) {
+  const fs::path workspace = TesseraWorkspace(options, name);
   BenchRow row;
   row.name = name;
   row.workspace = workspace.string();
@@ -100,53 +141,42 @@ BenchRow RunManifest(const BenchOptions& options, const GroundTruth* ground_trut
                 " / " + SlotPlugin(manifest, "matcher") + " / " + SlotPlugin(manifest, "mapper") +
                 " / " + SlotPlugin(manifest, "bundle_adjuster") + " / " +
                 SlotPlugin(manifest, "exporters");
-  ResetBenchWorkspace(workspace);
-  if (!shared_from.empty()) {
-    fs::copy_file(fs::path(options.output) / shared_from / workspace_layout::kDatabase,
-                  workspace / workspace_layout::kDatabase);
-    // Only the features are shared: a workspace keeps pairs matched under another pair
-    // selector, and those would make this row map pairs its own selector never chose.
-    Workspace::Open(workspace)->database().ClearMatches();
-    row.extract_shared_with = shared_from;
-  }
-  std::vector<std::string> argv = {
-      TesseraExecutable().string(), "run",        "--images",   options.images, "--output",
-      workspace.string(),           "--manifest", manifest_file};
-  if (options.threads > 0) argv.insert(argv.end(), {"--threads", std::to_string(options.threads)});
-  if (!options.camera_K.empty()) argv.insert(argv.end(), {"--camera-K", options.camera_K});
-  if (options.camera_per_folder) argv.push_back("--camera-per-folder");
   row.log = (workspace / "run.log").string();
-  spdlog::info("bench: {} ({}) ...", name, row.plugins);
-  const ChildRun child = RunChild(argv, workspace / "run.log");
-  row.exit_code = child.exit_code;
-  row.peak_memory_mb = child.peak_memory_mb;
-  if (!fs::exists(workspace / workspace_layout::kRunSummary)) return row;  // failed before the end
-  const RunSummary run =
-      RunSummary::FromJson(ReadJsonFile(workspace / workspace_layout::kRunSummary));
-  row.extract_seconds = run.extract.seconds;
-  row.match_seconds = run.match.seconds;
-  row.map_seconds = run.map.seconds;
-  row.total_seconds = run.total_seconds;
-  row.num_models = run.map.num_models;
-  row.num_selected_pairs = run.match.num_pairs;
-  row.pairs_per_selector = run.match.pairs_per_selector;
-  if (!run.plugins.empty()) {
-    row.plugins_used = run.plugins;
-    row.plugins = DescribePlugins(run.plugins);
-  }
-  ReadMatchingFigures(workspace / workspace_layout::kDatabase, &row);
-  const MappingSummary mapping =
-      MappingSummary::FromJson(ReadJsonFile(workspace / workspace_layout::kMappingSummary));
-  if (!mapping.models.empty()) {
-    const MappingSummary::Model& model = mapping.models.front();
-    row.num_registered = model.num_images;
-    row.num_points = model.num_points3D;
-    row.mean_track_length = model.mean_track_length;
-    row.mean_reprojection_error = model.mean_reprojection_error;
-    const fs::path model_dir = workspace / workspace_layout::kModelsFolder / "0";
-    if (ground_truth != nullptr && fs::exists(model_dir / "images.bin")) {
-      ScoreModel(ReadColmapModel(model_dir), ground_truth, &row);
+  try {
+    ResetBenchWorkspace(workspace);
+    if (!shared_from.empty()) {
+      fs::copy_file(TesseraWorkspace(options, shared_from) / workspace_layout::kDatabase,
+                    workspace / workspace_layout::kDatabase);
+      // Only the features are shared: a workspace keeps pairs matched under another pair
+      // selector, and those would make this row map pairs its own selector never chose.
+      Workspace::Open(workspace)->database().ClearMatches();
+      row.extract_shared_with = shared_from;
     }
+    BenchRunArguments run;
+    run.tessera = TesseraExecutable();
+    run.images = options.images;
+    run.output = workspace;
+    run.manifest = manifest_file;
+    run.camera_K = options.camera_K;
+    run.camera_per_folder = options.camera_per_folder;
+    run.threads = options.threads;
+    spdlog::info("bench: {} ({}) ...", name, row.plugins);
+    const ChildRun child = RunChild(BenchRunCommand(run), BenchChildOptions(options, row.log));
+    row.exit_code = child.timed_out ? 124 : child.exit_code;
+    row.peak_memory_mb = child.peak_memory_mb;
+    if (child.exit_code != 0 || child.timed_out || child.stopped) {
+      // Its own error line says what went wrong; a crash or a timeout has none.
+      const std::string line = LastLogLine(row.log, "[error]");
+      row.error =
+          ChildFailure(child, BenchChildTimeout(options), line.empty() ? "see " + row.log : line);
+      if (!fs::exists(workspace / workspace_layout::kRunSummary)) return row;
+    }
+    if (fs::exists(workspace / workspace_layout::kRunSummary)) {
+      ReadTesseraRow(workspace, ground_truth, &row);
+    }
+  } catch (const std::exception& exception) {
+    row.error = PrintableExcerpt(exception.what(), 600);
+    if (row.exit_code == 0) row.exit_code = kExitBadInput;
   }
   return row;
 }
@@ -181,8 +211,16 @@ const std::vector<std::string>& Columns() {
                                                    "position error % of extent",
                                                    "rotation error deg",
                                                    "wrong (>5 deg)",
-                                                   "exit code"};
+                                                   "exit code",
+                                                   "error"};
   return columns;
+}
+
+// A cell's text that keeps the Markdown table whole: no '|' (the error lines are already
+// one line of printable text).
+std::string TableText(std::string text) {
+  std::replace(text.begin(), text.end(), '|', '/');
+  return text;
 }
 
 std::vector<std::string> Cells(const BenchRow& row) {
@@ -210,7 +248,8 @@ std::vector<std::string> Cells(const BenchRow& row) {
           Format(row.rotation_error_mean_deg, 3),
           row.num_wrongly_registered < 0 ? std::string("-")
                                          : std::to_string(row.num_wrongly_registered),
-          std::to_string(row.exit_code)};
+          std::to_string(row.exit_code),
+          row.error.empty() ? std::string("-") : TableText(row.error)};
 }
 
 nlohmann::json ToJson(const BenchRow& row) {
@@ -222,6 +261,7 @@ nlohmann::json ToJson(const BenchRow& row) {
           {"plugins_used", row.plugins_used},
           {"workspace", row.workspace},
           {"exit_code", row.exit_code},
+          {"error", row.error.empty() ? nlohmann::json(nullptr) : nlohmann::json(row.error)},
           {"extract_shared_with", row.extract_shared_with},
           {"matches_of", row.matches_of},
           {"extract_seconds", number(row.extract_seconds)},
@@ -325,11 +365,12 @@ void WriteChart(const BenchOptions& options, const std::vector<BenchRow>& rows) 
            << "unset multiplot\n";
   }
   WriteFileAtomically(dir / "chart.gp", script.str());
-  const ChildRun gnuplot =
-      RunChild({FindOnPath("gnuplot").string(), (dir / "chart.gp").string()}, dir / "chart.log");
-  if (gnuplot.exit_code != 0) {
-    throw InputError(options.chart_file + ": gnuplot failed (exit code " +
-                     std::to_string(gnuplot.exit_code) + "), see " + (dir / "chart.log").string());
+  const ChildRun gnuplot = RunChild({FindOnPath("gnuplot").string(), (dir / "chart.gp").string()},
+                                    BenchChildOptions(options, dir / "chart.log"));
+  if (gnuplot.exit_code != 0 || gnuplot.timed_out) {
+    throw InputError(
+        options.chart_file + ": gnuplot " +
+        ChildFailure(gnuplot, BenchChildTimeout(options), "see " + (dir / "chart.log").string()));
   }
 }
 
@@ -342,19 +383,28 @@ std::string ExtractionKey(const nlohmann::json& manifest) {
          (manifest.contains("camera") ? manifest.at("camera").dump() : "");
 }
 
-// Every row is printed and written first; then the first failure decides the exit code.
+// Every row is printed and written first; then each failure is logged, and the first
+// decides the exit code.
 int ExitCodeOfRows(const std::vector<BenchRow>& rows) {
+  int code = kExitSuccess;
   for (const BenchRow& row : rows) {
-    if (row.exit_code != 0) {
-      spdlog::error("bench: {} ended with exit code {}; its log: {}", row.name, row.exit_code,
-                    row.log);
-      // A documented exit code stays what it is; a signal or failure to start is 1.
-      const bool documented = row.exit_code == kExitBadInput || row.exit_code == kExitNoModel ||
-                              row.exit_code == kExitPluginCrash;
-      return documented ? row.exit_code : static_cast<int>(kExitInternalError);
+    if (row.exit_code == 0 && row.error.empty()) continue;
+    spdlog::error("bench: {} ended with exit code {}{}; its log: {}", row.name, row.exit_code,
+                  row.error.empty() ? "" : ": " + row.error, row.log);
+    if (code != kExitSuccess) continue;
+    // A documented exit code stays what it is; a COLMAP row's failure or a timeout is the
+    // bench's input (the binary, --child-timeout); a signal or failure to start is 1.
+    const bool documented = row.exit_code == kExitBadInput || row.exit_code == kExitNoModel ||
+                            row.exit_code == kExitPluginCrash;
+    if (documented) {
+      code = row.exit_code;
+    } else if (row.colmap || row.exit_code == 124) {
+      code = kExitBadInput;
+    } else {
+      code = kExitInternalError;
     }
   }
-  return kExitSuccess;
+  return code;
 }
 
 // COLMAP's rows: its whole pipeline, or (--colmap-mapper-only) its mappers on the
@@ -366,8 +416,9 @@ std::vector<BenchRow> RunColmapRows(const BenchOptions& options,
   std::vector<BenchRow> rows;
   const BenchRow* source = nullptr;
   if (options.colmap_mapper_only && !colmaps.empty()) {
-    const auto ok = std::find_if(tessera_rows.begin(), tessera_rows.end(),
-                                 [](const BenchRow& row) { return row.exit_code == 0; });
+    const auto ok = std::find_if(tessera_rows.begin(), tessera_rows.end(), [](const BenchRow& row) {
+      return row.exit_code == 0 && row.error.empty();
+    });
     if (ok == tessera_rows.end()) {
       spdlog::warn(
           "bench: --colmap-mapper-only: no manifest's run ended with exit code 0, so "
@@ -377,6 +428,7 @@ std::vector<BenchRow> RunColmapRows(const BenchOptions& options,
     source = &*ok;
   }
   for (const ColmapBinary& colmap : colmaps) {
+    if (options.stop_requested && options.stop_requested()) break;
     for (BenchRow& row : source != nullptr
                              ? RunColmapMappers(options, colmap, ground_truth, *source)
                              : RunColmapPipeline(options, colmap, ground_truth)) {
@@ -421,6 +473,11 @@ BenchReport RunBenchReport(const BenchOptions& options) {
   if (!options.ground_truth.empty() && !fs::exists(options.ground_truth)) {
     throw InputError(options.ground_truth + ": --gt does not exist");
   }
+  if (!(options.child_timeout >= 0) || !std::isfinite(options.child_timeout)) {
+    throw InputError("--child-timeout " + std::to_string(options.child_timeout) +
+                     ": not a number of seconds (0: the default, " +
+                     std::to_string(static_cast<int>(kBenchChildTimeoutSeconds)) + " s)");
+  }
   if (!options.chart_file.empty() && FindOnPath("gnuplot").empty()) {
     throw InputError("--chart " + options.chart_file +
                      ": needs gnuplot, which is not installed (Debian package gnuplot-nox)");
@@ -440,9 +497,11 @@ BenchReport RunBenchReport(const BenchOptions& options) {
     } catch (const nlohmann::json::exception& error) {
       throw InputError(file + ": not a JSON manifest: " + error.what());
     }
-    std::string name = fs::path(file).stem().string();
+    // The row's name is its folder's: the file's stem made a file name, made unique.
+    const std::string stem = SafeFileName(fs::path(file).stem().string(), 100);
+    std::string name = stem;
     for (int suffix = 2; std::find(names.begin(), names.end(), name) != names.end(); ++suffix) {
-      name = fs::path(file).stem().string() + "-" + std::to_string(suffix);
+      name = stem + "-" + std::to_string(suffix);
     }
     names.push_back(name);
     keys.push_back(ExtractionKey(manifest));
@@ -450,52 +509,62 @@ BenchReport RunBenchReport(const BenchOptions& options) {
   }
   CreateFolder(options.output);
   // Every row's folder is checked before the first row runs.
-  for (const std::string& name : names) CheckBenchWorkspace(fs::path(options.output) / name);
+  CheckBenchFolder(fs::path(options.output) / "tessera");
+  for (const std::string& name : names) CheckBenchWorkspace(TesseraWorkspace(options, name));
   // COLMAP's binaries are asked their versions before the first row runs too.
   const bool with_colmap =
       options.with_colmap || !options.colmap_binaries.empty() || options.colmap_mapper_only;
   std::vector<ColmapBinary> colmaps;
-  if (with_colmap) colmaps = FindColmapBinaries(options, options.output);
+  if (with_colmap) colmaps = FindColmapBinaries(options);
   if (with_colmap && colmaps.empty()) {
     spdlog::warn(
         "bench: no COLMAP found (no --colmap, TESSERA_COLMAP, {} or colmap on the "
         "PATH): no COLMAP rows",
         kColmap4Anchor);
   }
+  AssignColmapLabels(&colmaps, names);  // no COLMAP row is named as a manifest's
+  if (!colmaps.empty()) CheckBenchFolder(fs::path(options.output) / "colmap");
   for (const ColmapBinary& colmap : colmaps) {
-    CheckBenchWorkspace(fs::path(options.output) / ("colmap-" + colmap.version));
-    for (const std::string& name : ColmapRowNames(colmap)) {
-      CheckBenchWorkspace(fs::path(options.output) / name);
-    }
+    CheckBenchFolder(ColmapFolder(options, colmap));
+    for (const fs::path& folder : ColmapWorkspaces(options, colmap)) CheckBenchWorkspace(folder);
   }
+  const auto stopped = [&options] { return options.stop_requested && options.stop_requested(); };
 
   std::vector<BenchRow> rows;
-  for (size_t i = 0; i < options.manifests.size(); ++i) {
+  for (size_t i = 0; i < options.manifests.size() && !stopped(); ++i) {
     std::string shared_from;
     for (size_t j = 0; j < i && !keys[i].empty(); ++j) {
-      if (keys[j] == keys[i] && rows[j].exit_code == 0) {
+      if (keys[j] == keys[i] && rows[j].exit_code == 0 && rows[j].error.empty()) {
         shared_from = names[j];
         break;
       }
     }
-    rows.push_back(RunManifest(options, gt, options.manifests[i], manifests[i], names[i],
-                               shared_from, fs::path(options.output) / names[i]));
+    rows.push_back(
+        RunManifest(options, gt, options.manifests[i], manifests[i], names[i], shared_from));
   }
   const size_t num_tessera_rows = rows.size();
-  for (BenchRow& row : RunColmapRows(options, colmaps, gt, rows)) rows.push_back(std::move(row));
+  if (!stopped()) {
+    for (BenchRow& row : RunColmapRows(options, colmaps, gt, rows)) rows.push_back(std::move(row));
+  }
+  const bool interrupted = stopped();
 
   std::cout << MarkdownTable(rows);
   PrintShares(rows, num_tessera_rows);
   nlohmann::json json = {{"images", options.images},
                          {"ground_truth", options.ground_truth},
                          {"hardware_threads", std::thread::hardware_concurrency()},
+                         {"interrupted", interrupted},
                          {"rows", nlohmann::json::array()}};
   for (const BenchRow& row : rows) json["rows"].push_back(ToJson(row));
   if (!options.json_file.empty()) WriteFileAtomically(options.json_file, json.dump(2) + "\n");
   if (!options.csv_file.empty()) WriteFileAtomically(options.csv_file, Csv(rows));
+  if (interrupted) {
+    spdlog::error("bench: interrupted; the rows above are those that ran (of {} manifests{})",
+                  options.manifests.size(), colmaps.empty() ? "" : " and COLMAP's rows");
+    return {kExitInterrupted, true, json};
+  }
   if (!options.chart_file.empty()) WriteChart(options, rows);
-
-  return {ExitCodeOfRows(rows), json};
+  return {ExitCodeOfRows(rows), false, json};
 }
 
 int RunBench(const BenchOptions& options) { return RunBenchReport(options).exit_code; }

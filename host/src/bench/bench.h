@@ -2,17 +2,26 @@
 
 // `tessera bench`: several manifests (and COLMAP) on the same images, compared.
 
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 namespace tessera {
 
+// How long each child of a bench may run (a Tessera row's `tessera run`, each COLMAP
+// step) when --child-timeout does not say: generous, so that only a hang reaches it.
+constexpr double kBenchChildTimeoutSeconds = 12 * 3600;
+// How long a COLMAP binary has to answer `-h` (at most --child-timeout).
+constexpr double kColmapProbeTimeoutSeconds = 60;
+
 struct BenchOptions {
   std::string images;
   std::string ground_truth;  // empty: no accuracy columns
-  std::string output;        // folder of the workspaces, one per manifest
-  std::string json_file;     // each empty: not written
+  // The bench's folder: OUTPUT/tessera/<row> for each manifest, OUTPUT/colmap/<binary>/
+  // for COLMAP's rows (colmap_rows.h), each row's folder its own.
+  std::string output;
+  std::string json_file;  // each empty: not written
   std::string csv_file;
   std::string chart_file;
   std::string camera_K;
@@ -26,6 +35,12 @@ struct BenchOptions {
   // with_colmap), instead of COLMAP's whole pipeline.
   bool colmap_mapper_only = false;
   int threads = 0;
+  // Seconds each child may run before it is stopped and its row says "timed out"; 0:
+  // kBenchChildTimeoutSeconds (and kColmapProbeTimeoutSeconds for `colmap -h`).
+  double child_timeout = 0;
+  // Polled while children run (may be empty): once true (Ctrl-C), the running child's
+  // process group is stopped, no other row starts, and the bench ends "interrupted".
+  std::function<bool()> stop_requested;
   std::vector<std::string> manifests;
 };
 
@@ -33,14 +48,19 @@ struct BenchOptions {
 // ({"images", "ground_truth", "hardware_threads", "rows": [...]}).
 struct BenchReport {
   int exit_code = 0;
+  bool interrupted = false;  // stop_requested came true: exit_code is 130
   nlohmann::json json;
 };
 
 // Runs every manifest as its own `tessera run` child process (this executable), reads
 // back each run's run_summary.json and mapping_summary.json (RunSummary,
-// MappingSummary), prints the Markdown table and writes the files asked for. Returns
-// the exit code: 0 when every row ended with 0, else the first failing row's documented
-// code (2, 3 or 4), or 1. Throws InputError for bad options or a malformed manifest.
+// MappingSummary), prints the Markdown table and writes the files asked for. Rows are
+// independent: a row that fails (its child's exit code, a timeout, a COLMAP output that
+// does not read) has its error in the table and the JSON, and the other rows run.
+// Returns the exit code: 0 when every row ended with 0, 130 when interrupted, else the
+// first failing row's: its documented code (2, 3 or 4), 2 for a COLMAP row or a timeout,
+// or 1. Throws InputError for bad options, a malformed manifest or a COLMAP binary that
+// cannot be used, before any row runs.
 int RunBench(const BenchOptions& options);
 // The same, with the rows (for the Python module).
 BenchReport RunBenchReport(const BenchOptions& options);

@@ -5,6 +5,9 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <sstream>
 
 #include "database/sqlite_connection.h"
 #include "database/sqlite_statement.h"
@@ -12,6 +15,7 @@
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
 #include "tessera/io/model_statistics.h"
+#include "util/strings.h"
 #include "util/workspace_layout.h"
 
 namespace tessera {
@@ -95,6 +99,70 @@ void ResetBenchWorkspace(const fs::path& folder) {
   fs::remove_all(folder, error);
   CreateFolder(folder);
   WriteFileAtomically(folder / kBenchMark, "made by tessera bench; replaced by each bench run\n");
+}
+
+void CheckBenchFolder(const fs::path& folder) {
+  std::error_code error;
+  const fs::file_type type = fs::symlink_status(folder, error).type();
+  if (type == fs::file_type::not_found || type == fs::file_type::directory) return;
+  throw InputError(folder.string() +
+                   ": exists and is not a folder that tessera bench made (a link or a file), "
+                   "so nothing is written through it; choose another --output or move it away");
+}
+
+std::string LastLogLine(const fs::path& log, const std::string& marker) {
+  std::ifstream file(log, std::ios::binary);
+  if (!file) return "";
+  constexpr std::streamoff kTail = 64 * 1024;
+  file.seekg(0, std::ios::end);
+  const std::streamoff size = file.tellg();
+  file.seekg(std::max<std::streamoff>(0, size - kTail));
+  std::string text(static_cast<size_t>(std::min(size, kTail)), '\0');
+  file.read(text.data(), static_cast<std::streamsize>(text.size()));
+  text.resize(static_cast<size_t>(file.gcount()));
+  size_t end = text.size();
+  while (end > 0) {
+    const size_t start = text.rfind('\n', end - 1);
+    const size_t begin = start == std::string::npos ? 0 : start + 1;
+    const std::string_view line = std::string_view(text).substr(begin, end - begin);
+    const bool blank = line.find_first_not_of(" \t\r") == std::string_view::npos;
+    if (!blank && (marker.empty() || line.find(marker) != std::string_view::npos)) {
+      return PrintableExcerpt(line, 300);
+    }
+    if (start == std::string::npos) break;
+    end = start;
+  }
+  return "";
+}
+
+double BenchChildTimeout(const BenchOptions& options) {
+  return options.child_timeout > 0 ? options.child_timeout : kBenchChildTimeoutSeconds;
+}
+
+RunChildOptions BenchChildOptions(const BenchOptions& options, const fs::path& log) {
+  RunChildOptions child;
+  child.output_file = log;
+  child.timeout_seconds = BenchChildTimeout(options);
+  child.stop_requested = options.stop_requested;
+  return child;
+}
+
+std::string ChildFailure(const ChildRun& child, double timeout_seconds, const std::string& detail) {
+  std::string what;
+  if (child.timed_out) {
+    std::ostringstream seconds;
+    seconds << timeout_seconds;
+    what = "timed out after " + seconds.str() + " s (--child-timeout)";
+  } else if (child.stopped) {
+    what = "interrupted";
+  } else if (!child.started) {
+    what = std::string("could not be started: ") + std::strerror(child.error);
+  } else if (child.exit_code > 128) {
+    what = "crashed (signal " + std::to_string(child.exit_code - 128) + ")";
+  } else {
+    what = "exited with code " + std::to_string(child.exit_code);
+  }
+  return detail.empty() ? what : what + ": " + detail;
 }
 
 }  // namespace tessera

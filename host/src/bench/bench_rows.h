@@ -10,9 +10,11 @@
 #include <string>
 #include <vector>
 
+#include "bench/bench.h"
 #include "eval/ground_truth.h"
 #include "pipeline/run_summary.h"
 #include "tessera/reconstruction.h"
+#include "util/child_process.h"
 
 namespace tessera {
 
@@ -28,6 +30,10 @@ struct BenchRow {
   std::string workspace;
   std::string log;  // the row's log file, named when the row fails
   int exit_code = 0;
+  // Why the row failed, one line ("timed out after 5 s", COLMAP's last log line, a file
+  // that does not read); empty when it did not.
+  std::string error;
+  bool colmap = false;              // one of COLMAP's rows
   std::string extract_shared_with;  // the row whose features this one started from
   std::string matches_of;           // the row whose database this one mapped (a copy)
   double extract_seconds = kBenchNaN;
@@ -71,6 +77,26 @@ void ScoreModel(const Reconstruction& model, const BenchGroundTruth* ground_trut
 
 // Throws InputError naming `folder` when it exists and bench did not make it.
 void CheckBenchWorkspace(const std::filesystem::path& folder);
+
+// Throws InputError naming `folder` (OUTPUT/tessera, OUTPUT/colmap, ...: a folder of row
+// folders) when it exists and is not a folder (a link to one included).
+void CheckBenchFolder(const std::filesystem::path& folder);
+
+// The last line of `log` with text on it, read from its last 64 KiB, as a one-line
+// excerpt (PrintableExcerpt); with `marker`, the last line holding it. Empty when none.
+std::string LastLogLine(const std::filesystem::path& log, const std::string& marker = "");
+
+// How long each of the bench's children may run: --child-timeout, else
+// kBenchChildTimeoutSeconds.
+double BenchChildTimeout(const BenchOptions& options);
+
+// RunChild's options for a child of the bench: its output appended to `log`, the bench's
+// timeout and its stop request.
+RunChildOptions BenchChildOptions(const BenchOptions& options, const std::filesystem::path& log);
+
+// The error of a child that did not end with 0: "timed out after N s", "interrupted",
+// "crashed (signal N)", or "exited with code N", and `detail` (a log line) after it.
+std::string ChildFailure(const ChildRun& child, double timeout_seconds, const std::string& detail);
 
 // Empties a row's workspace (CheckBenchWorkspace passed) and marks it as bench's.
 void ResetBenchWorkspace(const std::filesystem::path& folder);

@@ -5,6 +5,7 @@
 
 #include "bench/bench.h"
 #include "cli/commands.h"
+#include "cli/interrupt.h"
 
 namespace tessera {
 
@@ -37,8 +38,19 @@ CommandRegistration RegisterBenchCommand(CLI::App& app, const GlobalOptions&) {
   sub->add_flag("--colmap-mapper-only", options->colmap_mapper_only,
                 "COLMAP's mappers alone, on a copy of the first manifest's database (the "
                 "same matches), instead of COLMAP's whole pipeline (implies --with-colmap)");
+  sub->add_option("--child-timeout", options->child_timeout,
+                  "Seconds each row's process (a tessera run, each COLMAP step) may run before "
+                  "it is stopped and its row says it timed out (default: 12 hours; COLMAP's -h: "
+                  "60 s)")
+      ->check(CLI::PositiveNumber);
   sub->add_option("MANIFEST", options->manifests, "Manifests to compare")->required();
-  return {sub, [options]() { return RunBench(*options); }};
+  return {sub, [options]() {
+            // Ctrl-C or SIGTERM stops the running row's processes; the rows that ran are
+            // printed, and the bench ends with 130.
+            const CancellationToken& interrupt = InterruptToken();
+            options->stop_requested = [&interrupt] { return interrupt.IsCancelled(); };
+            return RunBench(*options);
+          }};
 }
 
 }  // namespace tessera

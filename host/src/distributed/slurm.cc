@@ -6,10 +6,15 @@
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
 #include "util/child_process.h"
+#include "util/strings.h"
+#include "util/tessera_commands.h"
 #include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
+
+// sbatch answers at once or not at all (a controller that does not respond).
+constexpr double kSbatchTimeoutSeconds = 120;
 
 // `path` in a Slurm filename pattern, where % starts a replacement (%j, %a): %% is a %.
 std::string PercentEscaped(const std::string& path) {
@@ -39,11 +44,13 @@ std::string Header(const SlurmOptions& options, const std::string& name, bool ar
   return text;
 }
 
-std::string CommonArgs(const SlurmOptions& options) {
-  std::string args = " --output " + ShellQuote(options.output_dir.string());
-  if (!options.manifest.empty()) args += " --manifest " + ShellQuote(options.manifest.string());
-  if (options.threads > 0) args += " --threads " + std::to_string(options.threads);
-  return args;
+// A word of a script's command line: as it is when the shell reads it so (a verb, an
+// option, a number), else in single quotes.
+std::string ScriptWord(const std::string& word) {
+  const bool plain = !word.empty() && word.find_first_not_of(
+                                          "abcdefghijklmnopqrstuvwxyz"
+                                          "0123456789-_") == std::string::npos;
+  return plain ? word : ShellQuote(word);
 }
 
 void CheckScriptValue(const std::string& option, const std::string& value) {
@@ -95,53 +102,47 @@ std::string ArraySpec(const std::vector<int>& indices) {
 
 std::vector<SlurmScript> MakeSlurmScripts(const SlurmOptions& options, const SlurmPlan& plan) {
   CheckSlurmOptions(options);
-  const std::string tessera = ShellQuote(options.tessera.string());
-  const std::string images = ShellQuote(options.image_dir.string());
-  const std::string n = std::to_string(options.workers);
-  const std::string common = CommonArgs(options);
-  const std::string camera_K =
-      (options.camera_K.empty() ? "" : " --camera-K " + ShellQuote(options.camera_K.string())) +
-      (options.camera_per_folder ? " --camera-per-folder" : "");
-  const std::string shard = " --shard \"$SLURM_ARRAY_TASK_ID/" + n + "\"";
+  SlurmJobArguments arguments;
+  arguments.tessera = options.tessera;
+  arguments.image_dir = options.image_dir;
+  arguments.output_dir = options.output_dir;
+  arguments.manifest = options.manifest;
+  arguments.camera_K = options.camera_K;
+  arguments.camera_per_folder = options.camera_per_folder;
+  arguments.workers = options.workers;
+  arguments.threads = options.threads;
+  const std::string task_shard = "$SLURM_ARRAY_TASK_ID/" + std::to_string(options.workers);
   std::vector<SlurmScript> scripts;
-  const auto add = [&](const std::string& name, bool array, const std::vector<int>& indices,
-                       const std::string& command) {
+  const auto add = [&](const std::string& name, SlurmJob job, const std::vector<int>& indices) {
+    const bool array = IsSlurmArrayJob(job);
     std::string text = Header(options, name, array);
     if (array)
       text.insert(text.find("#SBATCH --output"), "#SBATCH --array=" + ArraySpec(indices) + "\n");
-    text += "exec " + tessera + " " + command + "\n";
+    const std::vector<std::string> argv = SlurmJobCommand(arguments, job, task_shard);
+    text += "exec";
+    for (size_t k = 0; k < argv.size(); ++k) {
+      // The shard word, last, in double quotes: the shell expands $SLURM_ARRAY_TASK_ID.
+      text += " " + (array && k + 1 == argv.size() ? "\"" + argv[k] + "\"" : ScriptWord(argv[k]));
+    }
+    text += "\n";
     scripts.push_back(
         {name, options.output_dir / workspace_layout::kSlurmFolder / (name + ".sh"), text});
   };
-  if (!plan.extract_shards.empty()) {
-    add("extract", true, plan.extract_shards,
-        "extract --images " + images + common + camera_K + shard);
-  }
-  add("merge_extract", false, {},
-      "merge --output " + ShellQuote(options.output_dir.string()) + " --stage extract --shards " +
-          n);
-  if (!plan.match_shards.empty()) {
-    add("match", true, plan.match_shards, "match" + common + shard);
-  }
-  add("merge_match", false, {},
-      "merge --output " + ShellQuote(options.output_dir.string()) + " --stage match --shards " + n);
+  if (!plan.extract_shards.empty()) add("extract", SlurmJob::kExtract, plan.extract_shards);
+  add("merge_extract", SlurmJob::kMergeExtract, {});
+  if (!plan.match_shards.empty()) add("match", SlurmJob::kMatch, plan.match_shards);
+  add("merge_match", SlurmJob::kMergeMatch, {});
   if (!options.partitioned) {
-    add("map", false, {}, "map --images " + images + common);
+    add("map", SlurmJob::kMap, {});
     return scripts;
   }
   // The number of clusters is known only once partition has run: shard K of N maps
   // clusters K, K+N, ..., each skipped when already mapped, so a rerun maps what is left.
-  std::string manifest;
-  if (!options.manifest.empty()) manifest = " --manifest " + ShellQuote(options.manifest.string());
-  add("partition", false, {},
-      "partition --output " + ShellQuote(options.output_dir.string()) + manifest);
+  add("partition", SlurmJob::kPartition, {});
   std::vector<int> all(static_cast<size_t>(options.workers));
   for (int k = 0; k < options.workers; ++k) all[static_cast<size_t>(k)] = k;
-  add("map", true, all,
-      "map --images " + images + common + " --cluster-shard \"$SLURM_ARRAY_TASK_ID/" + n + "\"");
-  add("merge_map", false, {},
-      "merge --stage map --images " + images + " --output " +
-          ShellQuote(options.output_dir.string()) + manifest);
+  add("map", SlurmJob::kMapClusters, all);
+  add("merge_map", SlurmJob::kMergeMap, {});
   return scripts;
 }
 
@@ -173,15 +174,23 @@ std::vector<std::string> SubmitSlurmScripts(const std::filesystem::path& sbatch,
     std::vector<std::string> argv = {sbatch.string(), "--parsable"};
     if (!ids.empty()) argv.push_back("--dependency=afterok:" + ids.back());
     argv.push_back(script.path.string());
-    const ChildRun run = RunChild(argv);  // its stdout and stderr, together
+    RunChildOptions child;
+    child.timeout_seconds = kSbatchTimeoutSeconds;
+    const ChildRun run = RunChild(argv, child);  // its stdout and stderr, together
     if (!run.started) {
       throw InputError(sbatch.string() + ": cannot run it to submit " + script.path.string() +
                        ": " + std::strerror(run.error));
     }
+    if (run.timed_out) {
+      throw InputError(sbatch.string() + ": no answer within " +
+                       std::to_string(static_cast<int>(kSbatchTimeoutSeconds)) +
+                       " s to the submission of " + script.path.string());
+    }
     std::string output = run.output;
     while (!output.empty() && (output.back() == '\n' || output.back() == '\r')) output.pop_back();
     if (run.exit_code != 0 || output.empty()) {
-      throw InputError(sbatch.string() + " refused " + script.path.string() + ": " + output);
+      throw InputError(sbatch.string() + " refused " + script.path.string() + ": " +
+                       PrintableExcerpt(output, 400));
     }
     // --parsable prints "id" or "id;cluster".
     ids.push_back(output.substr(0, output.find(';')));

@@ -187,24 +187,6 @@ MapStageSummary MapCluster(const PipelineContext& context, const RunOptions& opt
   return MapWorkspace(*workspace, settings, {}, control, target);
 }
 
-std::vector<std::string> MapClusterCommand(const ClusterProcessOptions& options, int cluster) {
-  std::vector<std::string> command = {
-      options.tessera.string(), "map",      "--cluster",
-      std::to_string(cluster),  "--output", options.output_dir.string()};
-  const std::pair<const char*, const std::filesystem::path*> paths[] = {
-      {"--manifest", &options.manifest},
-      {"--camera-K", &options.camera_K},
-      {"--images", &options.image_dir}};
-  for (const auto& [flag, value] : paths) {
-    if (value->empty()) continue;
-    command.push_back(flag);
-    command.push_back(value->string());
-  }
-  if (options.threads > 0)
-    command.insert(command.end(), {"--threads", std::to_string(options.threads)});
-  return command;
-}
-
 MapStageSummary MapClusterShard(const PipelineContext& context, const RunOptions& options,
                                 const Shard& shard, const StageControl& control) {
   const ClustersFile clusters = ClustersFile::Read(ClustersFilePath(options.output_dir));

@@ -15,6 +15,7 @@
 #include "pipeline/stage_control.h"
 #include "tessera/mapper.h"
 #include "tessera/reconstruction.h"
+#include "util/tessera_commands.h"
 
 namespace tessera {
 
@@ -54,22 +55,9 @@ MapperInput RestrictMapperInput(const MapperInput& input, const std::vector<std:
 MapStageSummary MapCluster(const PipelineContext& context, const RunOptions& options, int cluster,
                            const StageControl& control = {});
 
-// What a process that maps one cluster (MapCluster, through `tessera map --cluster K`) is
-// given beside the cluster: the same workspace, images, manifest and intrinsics as the
-// process that starts it.
-struct ClusterProcessOptions {
-  std::filesystem::path tessera;     // the executable
-  std::filesystem::path output_dir;  // the workspace
-  std::filesystem::path manifest;    // empty: the default manifest
-  std::filesystem::path camera_K;    // empty: none
-  std::filesystem::path image_dir;   // empty: the folder extract recorded
-  int threads = 0;                   // 0: not given (the manifest's, else all cores)
-};
-
-// The command line that maps cluster `cluster` in a process of its own (argv; `map
-// --hierarchical`'s pool runs it, and a message that advises mapping a cluster again
-// prints it). The one place outside cli/ that writes `map --cluster`'s arguments.
-std::vector<std::string> MapClusterCommand(const ClusterProcessOptions& options, int cluster);
+// ClusterProcessOptions and MapClusterCommand, the command line that maps one cluster in a
+// process of its own (MapCluster through `tessera map --cluster K`), are in
+// util/tessera_commands.h with every other `tessera` command line.
 
 // Every cluster c with c mod N == K (`shard` K/N), one after the other: a task of the
 // Slurm mapping array, whose size is fixed before partition has counted the clusters.

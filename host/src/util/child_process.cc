@@ -1,6 +1,7 @@
 #include "util/child_process.h"
 
 #include <fcntl.h>
+#include <poll.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/stat.h>
@@ -10,6 +11,7 @@
 #include <sys/prctl.h>
 #endif
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdlib>
 #include <cstring>
@@ -29,12 +31,14 @@ struct ChildSetup {
   const char* output_file = nullptr;  // both appended to it
   int output_fd = -1;                 // both go to it (a pipe's write end)
   int exec_error_fd = -1;             // gets errno when the program cannot be run
+  bool own_group = false;             // a process group of its own (RunChild)
 };
 
 // In the child, between fork and exec: only async-signal-safe calls.
 [[noreturn]] void ExecChild(const std::vector<char*>& argv, pid_t parent, int death_signal,
                             const ChildSetup& setup) {
   DieWithParent(parent, death_signal);
+  if (setup.own_group) setpgid(0, 0);
   // The parent's handlers are reset by exec; an ignored signal or a blocked one is not.
   signal(SIGINT, SIG_DFL);
   signal(SIGTERM, SIG_DFL);
@@ -86,6 +90,46 @@ void ReadAll(int fd, std::string* text) {
     if (n <= 0) return;
     text->append(buffer, static_cast<size_t>(n));
   }
+}
+
+// A child's output kept within kChildOutputHead + kChildOutputTail bytes.
+class BoundedOutput {
+ public:
+  void Append(const char* data, size_t size) {
+    total_ += size;
+    const size_t to_head = std::min(size, kChildOutputHead - head_.size());
+    head_.append(data, to_head);
+    tail_.append(data + to_head, size - to_head);
+    if (tail_.size() > 2 * kChildOutputTail) tail_.erase(0, tail_.size() - kChildOutputTail);
+  }
+  size_t total() const { return total_; }
+  std::string Text() const {
+    if (tail_.size() <= kChildOutputTail) return head_ + tail_;
+    const size_t left_out = total_ - head_.size() - kChildOutputTail;
+    return head_ + "\n[... " + std::to_string(left_out) + " bytes left out ...]\n" +
+           tail_.substr(tail_.size() - kChildOutputTail);
+  }
+
+ private:
+  std::string head_;
+  std::string tail_;
+  size_t total_ = 0;
+};
+
+enum class ReadResult { kData, kNothingYet, kEnd };
+
+// Reads what `fd` has now into `output`, waiting up to `timeout_ms` for something; kEnd
+// once every writer has closed it.
+ReadResult ReadSome(int fd, int timeout_ms, BoundedOutput* output) {
+  pollfd ready{fd, POLLIN, 0};
+  if (poll(&ready, 1, timeout_ms) <= 0) return ReadResult::kNothingYet;  // or interrupted
+  char buffer[65536];
+  const ssize_t size = read(fd, buffer, sizeof(buffer));
+  if (size < 0)
+    return errno == EINTR || errno == EAGAIN ? ReadResult::kNothingYet : ReadResult::kEnd;
+  if (size == 0) return ReadResult::kEnd;
+  output->Append(buffer, static_cast<size_t>(size));
+  return ReadResult::kData;
 }
 
 // A pipe whose ends are closed when it goes (both close-on-exec).
@@ -182,17 +226,25 @@ void ChildProcesses::SignalAll(int signal_number) const {
 }
 
 ChildRun RunChild(const std::vector<std::string>& argv, const std::filesystem::path& output_file) {
+  RunChildOptions options;
+  options.output_file = output_file;
+  return RunChild(argv, options);
+}
+
+ChildRun RunChild(const std::vector<std::string>& argv, const RunChildOptions& options) {
   ChildRun run;
   Pipe output, exec_error;
-  if ((output_file.empty() && !output.Open()) || !exec_error.Open()) {
+  const bool capture = options.output_file.empty();
+  if ((capture && !output.Open()) || !exec_error.Open()) {
     run.error = errno;
     return run;
   }
   ChildSetup setup;
-  const std::string file = output_file.string();
-  if (!output_file.empty()) setup.output_file = file.c_str();
+  const std::string file = options.output_file.string();
+  if (!capture) setup.output_file = file.c_str();
   setup.output_fd = output.write_fd;
   setup.exec_error_fd = exec_error.write_fd;
+  setup.own_group = true;
   const std::vector<char*> args = ExecArguments(argv);
   const Timer timer;
   const pid_t parent = getpid();
@@ -202,26 +254,68 @@ ChildRun RunChild(const std::vector<std::string>& argv, const std::filesystem::p
     return run;
   }
   if (pid == 0) ExecChild(args, parent, SIGKILL, setup);
+  // The child does this too; whichever comes first, the group exists before any signal.
+  setpgid(pid, pid);
   output.CloseWrite();
   exec_error.CloseWrite();
-  // The read ends see their end once the child has run its program (close-on-exec) or
-  // ended.
-  std::string error;
+  const auto kill_group = [pid](int signal_number) {
+    if (kill(-pid, signal_number) != 0) kill(pid, signal_number);
+  };
   rusage usage{};
+  int status = 0;
+  BoundedOutput captured;
   try {
-    if (output.read_fd >= 0) ReadAll(output.read_fd, &run.output);
+    // The exec error pipe sees its end once the child has run its program (close-on-exec)
+    // or ended.
+    std::string error;
     ReadAll(exec_error.read_fd, &error);
-  } catch (...) {  // no memory for its output: no child is left behind
-    kill(pid, SIGKILL);
+    run.started = error.size() < sizeof(int);
+    if (!run.started) std::memcpy(&run.error, error.data(), sizeof(int));
+    bool reading = capture;
+    double stop_at = -1;  // when SIGTERM went; -1: not asked to stop
+    bool killed = false;
+    for (;;) {
+      if (reading) {
+        reading = ReadSome(output.read_fd, 20, &captured) != ReadResult::kEnd;
+      } else {
+        poll(nullptr, 0, 20);
+      }
+      const pid_t ended = wait4(pid, &status, WNOHANG, &usage);
+      if (ended == pid) break;
+      if (ended < 0 && errno != EINTR) {
+        status = 1 << 8;  // not a child of ours any more: exit code 1
+        break;
+      }
+      const double elapsed = timer.ElapsedSeconds();
+      if (stop_at < 0) {
+        run.timed_out = options.timeout_seconds > 0 && elapsed >= options.timeout_seconds;
+        run.stopped = !run.timed_out && options.stop_requested && options.stop_requested();
+        if (run.timed_out || run.stopped) {
+          kill_group(SIGTERM);
+          stop_at = elapsed;
+        }
+      } else if (!killed && elapsed - stop_at >= kChildStopGraceSeconds) {
+        kill_group(SIGKILL);
+        killed = true;
+      }
+    }
+    // What it started in its group and left running would hold the pipe open.
+    kill(-pid, SIGKILL);
+    // The rest of its output: up to the pipe's end, or a pause (a process outside its group
+    // holding it open).
+    while (reading && ReadSome(output.read_fd, 100, &captured) == ReadResult::kData) {
+    }
+  } catch (...) {  // no memory: no child is left behind
+    kill_group(SIGKILL);
     WaitFor(pid, &usage);
     throw;
   }
-  const int status = WaitFor(pid, &usage);
   run.seconds = timer.ElapsedSeconds();
   run.exit_code = ExitCodeOfWaitStatus(status);
-  run.started = error.size() < sizeof(int);
+  run.output = captured.Text();
+  run.output_bytes = captured.total();
   if (!run.started) {
-    std::memcpy(&run.error, error.data(), sizeof(int));
+    run.exit_code = 127;
     return run;
   }
   run.peak_memory_mb = static_cast<double>(usage.ru_maxrss) / 1024.0;  // ru_maxrss: KiB

@@ -16,7 +16,9 @@
 #include <sys/types.h>
 
 #include <chrono>
+#include <cstddef>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <set>
@@ -75,6 +77,16 @@ class ChildProcesses {
   std::set<pid_t> running_;
 };
 
+// What RunChild keeps of a child's output when it captures it: the first kChildOutputHead
+// bytes and the last kChildOutputTail, so that a child printing without end (100 MB on one
+// line) costs no more memory than this.
+constexpr size_t kChildOutputHead = 64 * 1024;
+constexpr size_t kChildOutputTail = 16 * 1024;
+
+// How long a child asked to stop (a timeout, a stop request) has to end after SIGTERM
+// before its process group gets SIGKILL.
+constexpr double kChildStopGraceSeconds = 3.0;
+
 // What a child run to its end did.
 struct ChildRun {
   // False when its program did not run: no process could be made, the output file could
@@ -82,16 +94,36 @@ struct ChildRun {
   bool started = false;
   int error = 0;
   int exit_code = 127;  // ExitCodeOfWaitStatus
-  std::string output;   // output_file empty: what it wrote to stdout and stderr
-  double seconds = 0;   // from before the start to its end
+  // output_file empty: what it wrote to stdout and stderr, the first kChildOutputHead and
+  // the last kChildOutputTail bytes with a line saying how many were left out between.
+  std::string output;
+  size_t output_bytes = 0;  // all it wrote (output_file empty)
+  bool timed_out = false;   // stopped at RunChildOptions::timeout_seconds
+  bool stopped = false;     // stopped because stop_requested returned true
+  double seconds = 0;       // from before the start to its end
   // Its peak resident memory (the kernel's maxrss); NaN when it did not run.
   double peak_memory_mb = std::numeric_limits<double>::quiet_NaN();
 };
 
+struct RunChildOptions {
+  // Empty: stdout and stderr are captured in ChildRun::output; else appended to this file
+  // (made if missing).
+  std::filesystem::path output_file;
+  // More than 0: the child is stopped once it has run this long (ChildRun::timed_out).
+  double timeout_seconds = 0;
+  // Polled while the child runs (may be empty); once it returns true the child is stopped
+  // (ChildRun::stopped): Ctrl-C of the process that runs it.
+  std::function<bool()> stop_requested;
+};
+
 // Runs argv (argv[0] an executable path, FindOnPath for a name) as ChildProcesses::Start
-// does, and waits for its end; it dies (SIGKILL) with the thread that runs it. Its stdout
-// and stderr both go to ChildRun::output or, `output_file` given, are appended to that
-// file (made if missing).
+// does, in a process group of its own, and waits for its end; it dies (SIGKILL) with the
+// thread that runs it. A child stopped (timeout, stop request) gets SIGTERM, and its group
+// SIGKILL kChildStopGraceSeconds later; whatever it started in its group is killed
+// once it has ended, so that nothing it left behind holds its output open.
+ChildRun RunChild(const std::vector<std::string>& argv, const RunChildOptions& options);
+
+// RunChild without a timeout: its output to `output_file` (empty: captured).
 ChildRun RunChild(const std::vector<std::string>& argv,
                   const std::filesystem::path& output_file = {});
 

@@ -166,6 +166,66 @@ TEST(RunChild, AProgramThatCannotRunIsNotStartedWithItsError) {
   EXPECT_FALSE(std::filesystem::exists(dir.path() / "ran"));
 }
 
+// A child that sleeps on, and a grandchild in its group that holds its output open, end at
+// the timeout: the whole group is stopped, and the run says it timed out.
+TEST(RunChild, AChildPastItsTimeoutIsStoppedWithItsGroup) {
+  testing::TemporaryDir dir;
+  const std::filesystem::path pid_file = dir.path() / "grandchild.pid";
+  RunChildOptions options;
+  options.timeout_seconds = 0.5;
+  const auto start = std::chrono::steady_clock::now();
+  const ChildRun run = RunChild(
+      {"/bin/sh", "-c", "sleep 600 & echo $! > " + pid_file.string() + "; echo begun; wait"},
+      options);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  EXPECT_TRUE(run.timed_out);
+  EXPECT_FALSE(run.stopped);
+  EXPECT_EQ(run.exit_code, 128 + SIGTERM);
+  EXPECT_EQ(run.output, "begun\n");
+  EXPECT_LT(seconds, 0.5 + kChildStopGraceSeconds + 2);
+  std::ifstream file(pid_file);
+  pid_t grandchild = 0;
+  ASSERT_TRUE(file >> grandchild);
+  // The grandchild is gone (or a zombie of init's, about to be reaped).
+  bool gone = false;
+  for (int k = 0; k < 100 && !gone; ++k) {
+    std::ifstream status("/proc/" + std::to_string(grandchild) + "/status");
+    std::string line;
+    gone = !status;
+    while (!gone && std::getline(status, line)) gone = line.rfind("State:\tZ", 0) == 0;
+    if (!gone) std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  EXPECT_TRUE(gone) << "the grandchild " << grandchild << " outlived the timeout";
+}
+
+// A child that ignores SIGTERM is killed kChildStopGraceSeconds after it.
+TEST(RunChild, AChildThatIgnoresTheStopRequestIsKilled) {
+  RunChildOptions options;
+  // Asked to stop once the shell has set its trap.
+  const auto start = std::chrono::steady_clock::now();
+  options.stop_requested = [start] {
+    return std::chrono::steady_clock::now() - start > std::chrono::milliseconds(500);
+  };
+  const ChildRun run = RunChild({"/bin/sh", "-c", "trap '' TERM; sleep 600 & wait"}, options);
+  EXPECT_TRUE(run.stopped);
+  EXPECT_FALSE(run.timed_out);
+  EXPECT_EQ(run.exit_code, 128 + SIGKILL);
+  EXPECT_LT(run.seconds, 0.5 + kChildStopGraceSeconds + 2);
+}
+
+// 20 MB on one line: the head and the tail are kept, the bytes between counted.
+TEST(RunChild, KeepsTheHeadAndTheTailOfALongOutput) {
+  const ChildRun run = RunChild(
+      {"/bin/sh", "-c", "printf START; head -c 20000000 /dev/zero | tr '\\0' x; printf END"});
+  EXPECT_EQ(run.exit_code, 0);
+  EXPECT_EQ(run.output_bytes, 20000008u);  // START, 20 MB, END
+  EXPECT_LT(run.output.size(), kChildOutputHead + kChildOutputTail + 100);
+  EXPECT_EQ(run.output.substr(0, 6), "STARTx");
+  EXPECT_EQ(run.output.substr(run.output.size() - 4), "xEND");
+  EXPECT_NE(run.output.find("bytes left out"), std::string::npos);
+}
+
 TEST(FindOnPath, FindsExecutablesAsExecvpDoes) {
   testing::TemporaryDir dir;
   const std::filesystem::path bin = dir.path() / "bin";

@@ -55,4 +55,47 @@ std::vector<std::string> Split(const std::string& text, char separator) {
   return pieces;
 }
 
+std::string PrintableExcerpt(std::string_view text, size_t max_chars) {
+  std::string excerpt;
+  size_t used = 0;
+  for (; used < text.size(); ++used) {
+    const unsigned char c = static_cast<unsigned char>(text[used]);
+    std::string piece;
+    if (c == '\n') {
+      piece = "\\n";
+    } else if (c == '\r') {
+      piece = "\\r";
+    } else if (c == '\t') {
+      piece = "\\t";
+    } else if (c < 0x20 || c >= 0x7f) {
+      static const char kHex[] = "0123456789abcdef";
+      piece = std::string("\\x") + kHex[c >> 4] + kHex[c & 15];
+    } else {
+      piece = std::string(1, static_cast<char>(c));
+    }
+    if (excerpt.size() + piece.size() > max_chars) break;
+    excerpt += piece;
+  }
+  if (used < text.size()) excerpt += "... (" + std::to_string(text.size() - used) + " more bytes)";
+  return excerpt;
+}
+
+std::string_view FirstLine(std::string_view text) {
+  const size_t start = text.find_first_not_of(" \t\r\n");
+  if (start == std::string_view::npos) return {};
+  const size_t end = text.find_first_of("\r\n", start);
+  return text.substr(start, end == std::string_view::npos ? std::string_view::npos : end - start);
+}
+
+std::string SafeFileName(std::string_view text, size_t max_chars) {
+  std::string name;
+  for (const char c : text.substr(0, max_chars)) {
+    const bool safe =
+        std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-';
+    name += safe && static_cast<unsigned char>(c) < 0x80 ? c : '_';
+  }
+  if (name.empty() || name == "." || name == "..") name = "_" + name;
+  return name;
+}
+
 }  // namespace tessera

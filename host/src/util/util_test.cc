@@ -15,6 +15,7 @@
 #include "util/paths.h"
 #include "util/random.h"
 #include "util/strings.h"
+#include "util/tessera_commands.h"
 #include "util/warning_count.h"
 
 namespace tessera {
@@ -126,6 +127,45 @@ TEST(OptionReader, ChecksTypesAndRangesAndRecordsEffectiveOptions) {
     EXPECT_EQ(std::string(error.what()), "o.x = 11.0 is out of range [0, 10]");
   }
   EXPECT_THROW(OptionReader(nlohmann::json::array()), OptionError);
+}
+
+// What a child printed reaches a message short and printable, whatever it was.
+TEST(PrintableExcerpt, EscapesAndCuts) {
+  EXPECT_EQ(PrintableExcerpt("COLMAP 3.8", 100), "COLMAP 3.8");
+  EXPECT_EQ(PrintableExcerpt("a\nb\t\x01\x1b[31m\xff", 100), "a\\nb\\t\\x01\\x1b[31m\\xff");
+  EXPECT_EQ(PrintableExcerpt(std::string(1000, 'x'), 10), "xxxxxxxxxx... (990 more bytes)");
+  // An escape is never cut in two.
+  EXPECT_EQ(PrintableExcerpt("ab\x01", 4), "ab... (1 more bytes)");
+  EXPECT_EQ(FirstLine("\n  COLMAP 3.8\r\nusage"), "COLMAP 3.8");
+  EXPECT_EQ(FirstLine(" \n "), "");
+}
+
+TEST(SafeFileName, IsOneFileNameOfSafeCharacters) {
+  EXPECT_EQ(SafeFileName("colmap-3.8", 64), "colmap-3.8");
+  EXPECT_EQ(SafeFileName("colmap-3.8/../../x y", 64), "colmap-3.8_.._.._x_y");
+  EXPECT_EQ(SafeFileName("..", 64), "_..");
+  EXPECT_EQ(SafeFileName("", 64), "_");
+  EXPECT_EQ(SafeFileName("\xc3\xa9t\xc3\xa9", 64), "__t__");
+  EXPECT_EQ(SafeFileName(std::string(100, 'a'), 10), std::string(10, 'a'));
+}
+
+// bench's `tessera run`, written where every `tessera` command line is.
+TEST(TesseraCommands, BenchRunCommand) {
+  BenchRunArguments run;
+  run.tessera = "/opt/bin/tessera";
+  run.images = "/photos";
+  run.output = "/bench/tessera/fast";
+  run.manifest = "fast.json";
+  EXPECT_EQ(BenchRunCommand(run),
+            (std::vector<std::string>{"/opt/bin/tessera", "run", "--images", "/photos", "--output",
+                                      "/bench/tessera/fast", "--manifest", "fast.json"}));
+  run.threads = 2;
+  run.camera_K = "K.txt";
+  run.camera_per_folder = true;
+  EXPECT_EQ(BenchRunCommand(run),
+            (std::vector<std::string>{"/opt/bin/tessera", "run", "--images", "/photos", "--output",
+                                      "/bench/tessera/fast", "--manifest", "fast.json", "--threads",
+                                      "2", "--camera-K", "K.txt", "--camera-per-folder"}));
 }
 
 }  // namespace
