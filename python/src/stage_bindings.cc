@@ -22,6 +22,8 @@
 #include "pipeline/stage_arguments.h"
 #include "stage_process.h"
 #include "tessera/errors.h"
+#include "toolbox/model_adjustment.h"
+#include "toolbox/model_alignment.h"
 #include "util/workspace_layout.h"
 
 namespace py = pybind11;
@@ -222,6 +224,50 @@ void BindStages(py::module_& module) {
       py::arg("options") = py::none(), py::arg("model_index") = 0, py::arg("masks") = py::none(),
       "Writes a COLMAP model with an exporter plugin (`tessera export`), in a child process; "
       "options: a dict.");
+  module.def(
+      "adjust",
+      [](const std::filesystem::path& model, const std::filesystem::path& output,
+         const py::object& manifest, const std::vector<std::string>& hold) {
+        AdjustArguments arguments;
+        arguments.model = model;
+        arguments.output = output;
+        if (py::isinstance<py::dict>(manifest)) {
+          arguments.manifest_json = ToJson(manifest);
+        } else if (!manifest.is_none()) {
+          arguments.manifest = manifest.cast<std::filesystem::path>();
+        }
+        arguments.hold = hold;
+        // Refused before the child starts, as the command line refuses --hold.
+        ParseHeldBlocks(hold, "hold");
+        return ToPython(RunInChildProcess(
+            "adjust", py::none(),
+            [&](const StageControl&) { return AdjustModel(arguments).ToJson(); },
+            /*runs_to_the_end=*/true));
+      },
+      py::arg("model"), py::arg("output"), py::arg("manifest") = py::none(),
+      py::arg("hold") = std::vector<std::string>(),
+      "Bundle-adjusts a COLMAP model and filters its points (`tessera adjust`), in a child "
+      "process; hold: blocks held constant (intrinsics, poses, points).");
+  module.def(
+      "align",
+      [](const std::filesystem::path& model, const std::filesystem::path& output,
+         const OptionalPath& reference, bool gps, bool upright, const OptionalPath& images) {
+        AlignArguments arguments;
+        arguments.model = model;
+        arguments.output = output;
+        arguments.reference = reference.value_or(std::filesystem::path());
+        arguments.gps = gps;
+        arguments.upright = upright;
+        arguments.images = images.value_or(std::filesystem::path());
+        return ToPython(RunInChildProcess(
+            "align", py::none(),
+            [&](const StageControl&) { return AlignModel(arguments).ToJson(); },
+            /*runs_to_the_end=*/true));
+      },
+      py::arg("model"), py::arg("output"), py::arg("reference") = py::none(),
+      py::arg("gps") = false, py::arg("upright") = false, py::arg("images") = py::none(),
+      "Moves a COLMAP model onto a reference model, onto its images' GPS or upright "
+      "(`tessera align`), in a child process; writes alignment.json beside it.");
 }
 
 }  // namespace tessera::python

@@ -23,8 +23,8 @@ from ._version import __version__
 
 __all__ = [
     "Camera", "Database", "Error", "Image", "InputError", "NoModelError", "Point3D",
-    "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "__version__", "bench",
-    "evaluate", "export", "extract", "map", "match", "plugins", "run",
+    "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "__version__", "adjust",
+    "align", "bench", "evaluate", "export", "extract", "map", "match", "plugins", "run",
 ]
 
 PathLike = Union[str, os.PathLike[str]]
@@ -177,6 +177,37 @@ def export(model: PathLike, format: str, output: PathLike, images: Optional[Path
         options=None if options is None else dict(options),
         model_index=_int(name, "model_index", model_index),
         masks=_optional_path(name, "masks", masks)))
+
+
+def adjust(model: PathLike, output: PathLike, manifest: ManifestLike = None,
+           hold: Sequence[str] = ()) -> Dict[str, Any]:
+    """Bundle-adjusts a COLMAP model with the manifest's bundle adjuster, then filters its
+    points as the mappers do (`tessera adjust`), in a child process; hold: the blocks held
+    constant ("intrinsics", "poses", "points"). Returns the summary: the mean reprojection
+    error before and after, the points filtered."""
+    name = "adjust"
+    if isinstance(hold, str) or not all(isinstance(block, str) for block in hold):
+        raise TypeError(f"adjust(): hold must be a list of str, not {_type_name(hold)}")
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.adjust, model=_path(name, "model", model), output=_path(name, "output", output),
+        manifest=_manifest(name, manifest), hold=list(hold)))
+
+
+def align(model: PathLike, output: PathLike, reference: Optional[PathLike] = None,
+          gps: bool = False, upright: bool = False,
+          images: Optional[PathLike] = None) -> Dict[str, Any]:
+    """Moves a COLMAP model by a similarity (`tessera align`), in a child process: onto the
+    model `reference` (over the images both hold), onto its images' GPS (gps=True; images:
+    their folder) or upright (upright=True). Writes the model and alignment.json into
+    output; returns the summary (scale, rotation, translation, inliers, residuals)."""
+    name = "align"
+    for flag, value in (("gps", gps), ("upright", upright)):
+        if not isinstance(value, bool):
+            raise TypeError(f"align(): {flag} must be a bool, not {_type_name(value)}")
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.align, model=_path(name, "model", model), output=_path(name, "output", output),
+        reference=_optional_path(name, "reference", reference), gps=gps, upright=upright,
+        images=_optional_path(name, "images", images)))
 
 
 def plugins(manifest: ManifestLike = None) -> Dict[str, Any]:

@@ -12,7 +12,8 @@ std::vector<CommandRegistration> RegisterCommands(CLI::App& app, const GlobalOpt
           RegisterBenchCommand(app, global),  RegisterPluginsCommand(app, global),
           RegisterVocabCommand(app, global),  RegisterPartitionCommand(app, global),
           RegisterMergeCommand(app, global),  RegisterSlurmCommand(app, global),
-          RegisterGuiCommand(app, global)};
+          RegisterGuiCommand(app, global),    RegisterAdjustCommand(app, global),
+          RegisterAlignCommand(app, global)};
 }
 
 CLI::Validator AtLeast(int64_t minimum) {

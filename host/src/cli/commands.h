@@ -39,5 +39,7 @@ CommandRegistration RegisterPartitionCommand(CLI::App& app, const GlobalOptions&
 CommandRegistration RegisterMergeCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterAdjustCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterAlignCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera
