@@ -251,7 +251,8 @@ void BindStages(py::module_& module) {
   module.def(
       "align",
       [](const std::filesystem::path& model, const std::filesystem::path& output,
-         const OptionalPath& reference, bool gps, bool upright, const OptionalPath& images) {
+         const OptionalPath& reference, bool gps, bool upright, const OptionalPath& images,
+         const std::optional<std::vector<double>>& gps_sigma) {
         AlignArguments arguments;
         arguments.model = model;
         arguments.output = output;
@@ -259,6 +260,14 @@ void BindStages(py::module_& module) {
         arguments.gps = gps;
         arguments.upright = upright;
         arguments.images = images.value_or(std::filesystem::path());
+        if (gps_sigma) {
+          if (!gps) throw InputError("gps_sigma: only with gps=True");
+          if (gps_sigma->empty() || gps_sigma->size() > 2) {
+            throw InputError("gps_sigma: expected (horizontal,) or (horizontal, vertical) metres");
+          }
+          arguments.gps_horizontal_sigma = gps_sigma->front();
+          arguments.gps_vertical_sigma = gps_sigma->back();
+        }
         return ToPython(RunInChildProcess(
             "align", py::none(),
             [&](const StageControl&) { return AlignModel(arguments).ToJson(); },
@@ -266,6 +275,7 @@ void BindStages(py::module_& module) {
       },
       py::arg("model"), py::arg("output"), py::arg("reference") = py::none(),
       py::arg("gps") = false, py::arg("upright") = false, py::arg("images") = py::none(),
+      py::arg("gps_sigma") = py::none(),
       "Moves a COLMAP model onto a reference model, onto its images' GPS or upright "
       "(`tessera align`), in a child process; writes alignment.json beside it.");
 }

@@ -194,20 +194,30 @@ def adjust(model: PathLike, output: PathLike, manifest: ManifestLike = None,
 
 
 def align(model: PathLike, output: PathLike, reference: Optional[PathLike] = None,
-          gps: bool = False, upright: bool = False,
-          images: Optional[PathLike] = None) -> Dict[str, Any]:
+          gps: bool = False, upright: bool = False, images: Optional[PathLike] = None,
+          gps_sigma: Union[float, Sequence[float], None] = None) -> Dict[str, Any]:
     """Moves a COLMAP model by a similarity (`tessera align`), in a child process: onto the
     model `reference` (over the images both hold), onto its images' GPS (gps=True; images:
-    their folder) or upright (upright=True). Writes the model and alignment.json into
+    their folder; gps_sigma: the tags' standard deviation in metres, horizontal or
+    (horizontal, vertical)) or upright (upright=True). Writes the model and alignment.json into
     output; returns the summary (scale, rotation, translation, inliers, residuals)."""
     name = "align"
     for flag, value in (("gps", gps), ("upright", upright)):
         if not isinstance(value, bool):
             raise TypeError(f"align(): {flag} must be a bool, not {_type_name(value)}")
+    sigma = None
+    if isinstance(gps_sigma, numbers.Real) and not isinstance(gps_sigma, bool):
+        sigma = [float(gps_sigma)]
+    elif gps_sigma is not None:
+        if isinstance(gps_sigma, str) or not all(
+                isinstance(v, numbers.Real) and not isinstance(v, bool) for v in gps_sigma):
+            raise TypeError(f"align(): gps_sigma must be a number or a sequence of numbers, not "
+                            f"{_type_name(gps_sigma)}")
+        sigma = [float(v) for v in gps_sigma]
     return typing.cast(Dict[str, Any], _call(
         _tessera.align, model=_path(name, "model", model), output=_path(name, "output", output),
         reference=_optional_path(name, "reference", reference), gps=gps, upright=upright,
-        images=_optional_path(name, "images", images)))
+        images=_optional_path(name, "images", images), gps_sigma=sigma))
 
 
 def plugins(manifest: ManifestLike = None) -> Dict[str, Any]:

@@ -33,7 +33,8 @@ model="$work/ws/sparse/0"
 [ -f "$model/images.txt" ] || fail "no text model"
 
 # 1. --gps, the images as the workspace recorded them.
-"$tessera" align --model "$model" --output "$work/gps" --gps --json > "$work/gps.json" ||
+"$tessera" align --model "$model" --output "$work/gps" --gps --gps-sigma 0.25 --json \
+  > "$work/gps.json" ||
   fail "align --gps"
 [ -f "$work/gps/georeference.json" ] && [ -f "$work/gps/alignment.json" ] ||
   fail "align --gps wrote no georeference.json or alignment.json"

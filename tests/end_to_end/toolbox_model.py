@@ -3,7 +3,7 @@
   transform MODEL OUT                  the model moved by the known similarity below
   check_similarity ALIGNMENT_JSON TOL  alignment.json against the known similarity
   up_angle MODEL                       the angle (deg) of the cameras' mean up from +Z
-  same_poses A B                       exit 1 unless images.txt poses are identical text
+  same_poses A B                       exit 1 unless images.txt poses are the same numbers
   gps_distances MODEL TAGS             centres' distances (m) to their tags, in the frame
                                        of MODEL/georeference.json: prints mean max
   rename MODEL OUT                     every image renamed (no name shared)
@@ -138,8 +138,8 @@ def up_angle(model):
 
 
 def same_poses(a, b):
-    pa = {f[-1]: f[1:8] for f, _ in read_images(a)}
-    pb = {f[-1]: f[1:8] for f, _ in read_images(b)}
+    pa = {f[-1]: tuple(map(float, f[1:8])) for f, _ in read_images(a)}
+    pb = {f[-1]: tuple(map(float, f[1:8])) for f, _ in read_images(b)}
     sys.exit(0 if pa == pb and pa else 1)
 
 

@@ -1,12 +1,15 @@
-// `tessera align --model M --output DIR (--reference REF | --gps [--images DIR] | --upright)
+// `tessera align --model M --output DIR (--reference REF | --gps [--images DIR]
+// [--gps-sigma H[,V]] | --upright)
 // [--json]`: a model moved by a similarity onto another model, onto its images' GPS, or
 // upright, written with alignment.json (toolbox/model_alignment.h).
 
 #include <spdlog/spdlog.h>
 
+#include <cstdio>
 #include <iostream>
 
 #include "cli/commands.h"
+#include "tessera/errors.h"
 #include "toolbox/model_alignment.h"
 #include "util/exit_codes.h"
 
@@ -19,6 +22,7 @@ CommandRegistration RegisterAlignCommand(CLI::App& app, const GlobalOptions&) {
     std::string reference;
     bool gps = false;
     std::string images;
+    std::string gps_sigma;
     bool upright = false;
     bool json = false;
   };
@@ -35,6 +39,10 @@ CommandRegistration RegisterAlignCommand(CLI::App& app, const GlobalOptions&) {
                 "Align onto the images' EXIF GPS, in east-north-up metres about their median");
   sub->add_option("--images", options->images,
                   "With --gps: the images' folder (default: the one the workspace recorded)");
+  sub->add_option("--gps-sigma", options->gps_sigma,
+                  "With --gps: the tags' standard deviation in metres, H or H,V (horizontal, "
+                  "vertical; default 5,10, as the mappers' gps_horizontal_sigma and "
+                  "gps_vertical_sigma)");
   sub->add_flag("--upright", options->upright,
                 "Put the cameras' mean up direction on +Z and the ground plane at z = 0");
   sub->add_flag("--json", options->json, "Print the summary as JSON");
@@ -47,6 +55,19 @@ CommandRegistration RegisterAlignCommand(CLI::App& app, const GlobalOptions&) {
     arguments.gps = options->gps;
     arguments.images = options->images;
     arguments.upright = options->upright;
+    if (!options->gps_sigma.empty()) {
+      if (!options->gps) throw InputError("--gps-sigma: only with --gps");
+      double values[2];
+      char tail = 0;
+      const int read =
+          std::sscanf(options->gps_sigma.c_str(), "%lf,%lf%c", &values[0], &values[1], &tail);
+      if (read != 1 && read != 2) {
+        throw InputError("--gps-sigma: expected H or H,V (metres), got '" + options->gps_sigma +
+                         "'");
+      }
+      arguments.gps_horizontal_sigma = values[0];
+      arguments.gps_vertical_sigma = read == 2 ? values[1] : values[0];
+    }
     const AlignSummary summary = AlignModel(arguments);
     if (options->json) {
       std::cout << summary.ToJson().dump(2) << std::endl;

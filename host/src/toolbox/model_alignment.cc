@@ -220,8 +220,8 @@ Alignment AlignToReference(const Reconstruction& model, const Reconstruction& re
 }
 
 Alignment AlignToGps(const Reconstruction& model, const std::map<image_t, ImageMetadata>& metadata,
-                     const std::string& model_name, uint64_t seed) {
-  const GpsAnchoringOptions options;
+                     const std::string& model_name, const GpsAnchoringOptions& options,
+                     uint64_t seed) {
   const GpsSimilarity found = EstimateGpsSimilarity(metadata, options, seed, model);
   if (!found.report.anchored) {
     throw InputError(model_name + ": cannot be aligned to its GPS: " + found.report.reason);
@@ -426,6 +426,12 @@ AlignSummary AlignModel(const AlignArguments& arguments) {
   if (!arguments.images.empty() && !arguments.gps) {
     throw InputError("--images: only with --gps");
   }
+  for (const double sigma : {arguments.gps_horizontal_sigma, arguments.gps_vertical_sigma}) {
+    if (!(sigma >= 1e-3 && sigma <= 1e6)) {
+      throw InputError("--gps-sigma: " + std::to_string(sigma) +
+                       " is not a standard deviation in [0.001, 1e6] metres");
+    }
+  }
   std::vector<std::filesystem::path> held = {arguments.model, arguments.output};
   if (!arguments.reference.empty()) held.push_back(arguments.reference);
   const auto workspaces = HoldEnclosingWorkspaces(held);
@@ -461,7 +467,10 @@ AlignSummary AlignModel(const AlignArguments& arguments) {
                          " lies in no workspace that recorded its images' folder");
       }
     }
-    summary.alignment = AlignToGps(model, ReadImageGps(model, images), model_name);
+    GpsAnchoringOptions options;
+    options.horizontal_sigma_m = arguments.gps_horizontal_sigma;
+    options.vertical_sigma_m = arguments.gps_vertical_sigma;
+    summary.alignment = AlignToGps(model, ReadImageGps(model, images), model_name, options);
   } else {
     summary.alignment = AlignUpright(model, model_name);
   }

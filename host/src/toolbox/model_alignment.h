@@ -19,6 +19,7 @@
 #include "tessera/georeference.h"
 #include "tessera/image_metadata.h"
 #include "tessera/reconstruction.h"
+#include "tessera/sfm/gps_anchoring.h"
 
 namespace tessera {
 
@@ -67,7 +68,8 @@ Alignment AlignToReference(const Reconstruction& model, const Reconstruction& re
 // the mappers' outlier handling (tessera/sfm/gps_similarity.h). Throws InputError with
 // the reason when the tags cannot anchor the model.
 Alignment AlignToGps(const Reconstruction& model, const std::map<image_t, ImageMetadata>& metadata,
-                     const std::string& model_name, uint64_t seed = 0);
+                     const std::string& model_name,
+                     const GpsAnchoringOptions& options = GpsAnchoringOptions(), uint64_t seed = 0);
 
 struct UprightOptions {
   // The ground plane's normal lies within this angle of the cameras' mean up direction.
@@ -97,7 +99,11 @@ struct AlignArguments {
   std::filesystem::path reference;  // --reference
   bool gps = false;                 // --gps
   std::filesystem::path images;     // with gps: the images' folder (empty: as recorded)
-  bool upright = false;             // --upright
+  // With gps: the tags' standard deviations, metres (the mappers' gps_horizontal_sigma
+  // and gps_vertical_sigma); centres within 5 of them agree with the similarity.
+  double gps_horizontal_sigma = GpsAnchoringOptions().horizontal_sigma_m;
+  double gps_vertical_sigma = GpsAnchoringOptions().vertical_sigma_m;
+  bool upright = false;  // --upright
 };
 
 struct AlignSummary {
