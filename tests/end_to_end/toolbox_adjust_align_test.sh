@@ -82,7 +82,7 @@ fox="$shared/datasets/fox/images"
 if [ -d "$fox" ]; then
   mkdir -p "$work/fox_all" "$work/fox_images"
   "$downscale" "$fox" "$work/fox_all" 480 90 > /dev/null || fail "downscale fox"
-  ls "$work/fox_all" | sort | awk 'NR % 4 == 1' | head -12 |
+  ls "$work/fox_all" | sort | awk 'NR % 2 == 1' | head -12 |
     while read -r f; do cp "$work/fox_all/$f" "$work/fox_images/"; done
   "$tessera" run --images "$work/fox_images" --output "$work/fox" --manifest "$work/m.json" \
     --threads 2 > "$work/fox.log" 2>&1 || { tail -20 "$work/fox.log"; fail "run fox"; }

@@ -76,9 +76,13 @@ def centre(q, t):
     return tuple(-x for x in rotate(qconj(q), t))
 
 
-def copy_model(model, out):
+def copy_model(model, out, same_frame=True):
+    """The model's files; its georeference.json too when the frame stays."""
     os.makedirs(out, exist_ok=True)
-    for name in ("cameras.txt", "images.txt", "points3D.txt"):
+    names = ["cameras.txt", "images.txt", "points3D.txt"]
+    if same_frame and os.path.exists(os.path.join(model, "georeference.json")):
+        names.append("georeference.json")
+    for name in names:
         shutil.copy(os.path.join(model, name), out)
 
 
@@ -98,7 +102,7 @@ def perturb(model, out, shift, degrees, seed):
 
 
 def transform(model, out):
-    copy_model(model, out)
+    copy_model(model, out, same_frame=False)
     qs = quat_axis_angle(AXIS, ANGLE)
     images = read_images(model)
     for fields, _ in images:

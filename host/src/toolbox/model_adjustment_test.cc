@@ -54,7 +54,7 @@ TEST(AdjustReconstruction, BringsPerturbedPosesBackToTheOriginalError) {
   PerturbPoses(&model);
   const AdjustmentResult result = AdjustReconstruction(testing::CeresAdjusterOnOneThread(),
                                                        AdjustmentSettings(), HeldBlocks(), &model);
-  EXPECT_GT(result.mean_reprojection_error_before, 5 * original_error);
+  EXPECT_GT(result.mean_reprojection_error_before, 3 * original_error);
   EXPECT_LE(result.mean_reprojection_error_after, 1.05 * original_error);
   EXPECT_EQ(result.num_points3D_before, original.points3D.size());
   EXPECT_EQ(result.num_points3D_after + result.num_points3D_filtered, result.num_points3D_before);
