@@ -14,7 +14,7 @@ void BindErrors(pybind11::module_& module);
 // tessera.Reconstruction, Camera, Image, Point3D (model_bindings.cc).
 void BindModel(pybind11::module_& module);
 
-// tessera.run, extract, match, map, export, triangulate (stage_bindings.cc).
+// tessera.run, extract, match, map, export, triangulate, adjust, align (stage_bindings.cc).
 void BindStages(pybind11::module_& module);
 
 // tessera.Database (database_bindings.cc).

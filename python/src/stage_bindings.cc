@@ -23,6 +23,8 @@
 #include "stage_process.h"
 #include "tessera/errors.h"
 #include "toolbox/triangulate_known_poses.h"
+#include "toolbox/model_adjustment.h"
+#include "toolbox/model_alignment.h"
 #include "util/workspace_layout.h"
 
 namespace py = pybind11;
@@ -255,6 +257,60 @@ void BindStages(py::module_& module) {
       "Triangulates the workspace's verified matches for known poses, every pose held "
       "(`tessera triangulate`), in a child process; model: a COLMAP model folder, or poses: a "
       "transforms.json; returns the summary `--json` prints.");
+  module.def(
+      "adjust",
+      [](const std::filesystem::path& model, const std::filesystem::path& output,
+         const py::object& manifest, const std::vector<std::string>& hold) {
+        AdjustArguments arguments;
+        arguments.model = model;
+        arguments.output = output;
+        if (py::isinstance<py::dict>(manifest)) {
+          arguments.manifest_json = ToJson(manifest);
+        } else if (!manifest.is_none()) {
+          arguments.manifest = manifest.cast<std::filesystem::path>();
+        }
+        arguments.hold = hold;
+        // Refused before the child starts, as the command line refuses --hold.
+        ParseHeldBlocks(hold, "hold");
+        return ToPython(RunInChildProcess(
+            "adjust", py::none(),
+            [&](const StageControl&) { return AdjustModel(arguments).ToJson(); },
+            /*runs_to_the_end=*/true));
+      },
+      py::arg("model"), py::arg("output"), py::arg("manifest") = py::none(),
+      py::arg("hold") = std::vector<std::string>(),
+      "Bundle-adjusts a COLMAP model and filters its points (`tessera adjust`), in a child "
+      "process; hold: blocks held constant (intrinsics, poses, points).");
+  module.def(
+      "align",
+      [](const std::filesystem::path& model, const std::filesystem::path& output,
+         const OptionalPath& reference, bool gps, bool upright, const OptionalPath& images,
+         const std::optional<std::vector<double>>& gps_sigma) {
+        AlignArguments arguments;
+        arguments.model = model;
+        arguments.output = output;
+        arguments.reference = reference.value_or(std::filesystem::path());
+        arguments.gps = gps;
+        arguments.upright = upright;
+        arguments.images = images.value_or(std::filesystem::path());
+        if (gps_sigma) {
+          if (!gps) throw InputError("gps_sigma: only with gps=True");
+          if (gps_sigma->empty() || gps_sigma->size() > 2) {
+            throw InputError("gps_sigma: expected (horizontal,) or (horizontal, vertical) metres");
+          }
+          arguments.gps_horizontal_sigma = gps_sigma->front();
+          arguments.gps_vertical_sigma = gps_sigma->back();
+        }
+        return ToPython(RunInChildProcess(
+            "align", py::none(),
+            [&](const StageControl&) { return AlignModel(arguments).ToJson(); },
+            /*runs_to_the_end=*/true));
+      },
+      py::arg("model"), py::arg("output"), py::arg("reference") = py::none(),
+      py::arg("gps") = false, py::arg("upright") = false, py::arg("images") = py::none(),
+      py::arg("gps_sigma") = py::none(),
+      "Moves a COLMAP model onto a reference model, onto its images' GPS or upright "
+      "(`tessera align`), in a child process; writes alignment.json beside it.");
 }
 
 }  // namespace tessera::python

@@ -23,8 +23,9 @@ from ._version import __version__
 
 __all__ = [
     "Camera", "Database", "Error", "Image", "InputError", "NoModelError", "Point3D",
-    "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "__version__", "bench",
-    "evaluate", "export", "extract", "map", "match", "plugins", "register", "run", "triangulate",
+    "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "__version__", "adjust",
+    "align", "bench", "evaluate", "export", "extract", "map", "match", "plugins", "register",
+    "run", "triangulate",
 ]
 
 PathLike = Union[str, os.PathLike[str]]
@@ -203,6 +204,8 @@ def triangulate(output: PathLike, model: Optional[PathLike] = None,
         model_index=_int(name, "model_index", model_index),
         refine_intrinsics=_bool(name, "refine_intrinsics", refine_intrinsics),
         manifest=_manifest(name, manifest), threads=_int(name, "threads", threads)))
+
+
 def register(output: PathLike, images: Optional[PathLike] = None, manifest: ManifestLike = None,
              model_index: int = 0, refine_existing: bool = False,
              camera_K: Optional[PathLike] = None, threads: int = 0,
@@ -221,6 +224,47 @@ def register(output: PathLike, images: Optional[PathLike] = None, manifest: Mani
         refine_existing=_bool(name, "refine_existing", refine_existing),
         camera_K=_optional_path(name, "camera_K", camera_K),
         threads=_int(name, "threads", threads), progress=_progress(name, progress)))
+
+
+def adjust(model: PathLike, output: PathLike, manifest: ManifestLike = None,
+           hold: Sequence[str] = ()) -> Dict[str, Any]:
+    """Bundle-adjusts a COLMAP model with the manifest's bundle adjuster, then filters its
+    points as the mappers do (`tessera adjust`), in a child process; hold: the blocks held
+    constant ("intrinsics", "poses", "points"). Returns the summary: the mean reprojection
+    error before and after, the points filtered."""
+    name = "adjust"
+    if isinstance(hold, str) or not all(isinstance(block, str) for block in hold):
+        raise TypeError(f"adjust(): hold must be a list of str, not {_type_name(hold)}")
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.adjust, model=_path(name, "model", model), output=_path(name, "output", output),
+        manifest=_manifest(name, manifest), hold=list(hold)))
+
+
+def align(model: PathLike, output: PathLike, reference: Optional[PathLike] = None,
+          gps: bool = False, upright: bool = False, images: Optional[PathLike] = None,
+          gps_sigma: Union[float, Sequence[float], None] = None) -> Dict[str, Any]:
+    """Moves a COLMAP model by a similarity (`tessera align`), in a child process: onto the
+    model `reference` (over the images both hold), onto its images' GPS (gps=True; images:
+    their folder; gps_sigma: the tags' standard deviation in metres, horizontal or
+    (horizontal, vertical)) or upright (upright=True). Writes the model and alignment.json into
+    output; returns the summary (scale, rotation, translation, inliers, residuals)."""
+    name = "align"
+    for flag, value in (("gps", gps), ("upright", upright)):
+        if not isinstance(value, bool):
+            raise TypeError(f"align(): {flag} must be a bool, not {_type_name(value)}")
+    sigma = None
+    if isinstance(gps_sigma, numbers.Real) and not isinstance(gps_sigma, bool):
+        sigma = [float(gps_sigma)]
+    elif gps_sigma is not None:
+        if isinstance(gps_sigma, str) or not all(
+                isinstance(v, numbers.Real) and not isinstance(v, bool) for v in gps_sigma):
+            raise TypeError(f"align(): gps_sigma must be a number or a sequence of numbers, not "
+                            f"{_type_name(gps_sigma)}")
+        sigma = [float(v) for v in gps_sigma]
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.align, model=_path(name, "model", model), output=_path(name, "output", output),
+        reference=_optional_path(name, "reference", reference), gps=gps, upright=upright,
+        images=_optional_path(name, "images", images), gps_sigma=sigma))
 
 
 def plugins(manifest: ManifestLike = None) -> Dict[str, Any]:

@@ -13,7 +13,8 @@ std::vector<CommandRegistration> RegisterCommands(CLI::App& app, const GlobalOpt
           RegisterVocabCommand(app, global),  RegisterPartitionCommand(app, global),
           RegisterMergeCommand(app, global),  RegisterSlurmCommand(app, global),
           RegisterGuiCommand(app, global),    RegisterTriangulateCommand(app, global),
-          RegisterRegisterCommand(app, global)};
+          RegisterRegisterCommand(app, global), RegisterAdjustCommand(app, global),
+          RegisterAlignCommand(app, global)};
 }
 
 CLI::Validator AtLeast(int64_t minimum) {

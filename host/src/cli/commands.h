@@ -41,5 +41,7 @@ CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions& glo
 CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterTriangulateCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterRegisterCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterAdjustCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterAlignCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera

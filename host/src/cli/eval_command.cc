@@ -1,4 +1,5 @@
-// `tessera eval MODEL GT [--json] [--no-align [--gt-origin LAT,LON,ALT]]`: accuracy of a
+// `tessera eval MODEL GT [--json] [--no-align [--gt-origin LAT,LON,ALT]] [--alignment FILE]`:
+// accuracy of a
 // COLMAP-format model against ground-truth poses (Strecha *.camera files, a transforms.json or
 // another model), as eval_gt.py scores it.
 
@@ -9,6 +10,7 @@
 
 #include "cli/commands.h"
 #include "pipeline/evaluate_model.h"
+#include "toolbox/model_alignment.h"
 #include "util/exit_codes.h"
 
 namespace tessera {
@@ -27,6 +29,7 @@ CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions&) {
     bool json = false;
     bool no_align = false;
     std::string gt_origin;
+    std::string alignment;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("eval", "Score a model's camera poses against ground truth");
@@ -43,6 +46,9 @@ CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions&) {
   sub->add_option("--gt-origin", options->gt_origin,
                   "With --no-align: the ground truth is in east-north-up metres about "
                   "LAT,LON,ALT (degrees, degrees, metres)");
+  sub->add_option("--alignment", options->alignment,
+                  "An alignment.json of `tessera align`: the model is moved by it first (with "
+                  "--no-align: then scored in the ground truth's frame as it is)");
 
   auto run = [options]() {
     std::optional<Georeference> gt_origin;
@@ -61,8 +67,10 @@ CommandRegistration RegisterEvalCommand(CLI::App& app, const GlobalOptions&) {
       gt_origin = Georeference{values[0], values[1], values[2], "ENU"};
     }
     if (gt_origin && !options->no_align) throw InputError("--gt-origin: needs --no-align");
-    const EvaluationResult result =
-        EvaluateModelFolder(options->model, options->ground_truth, options->no_align, gt_origin);
+    std::optional<Similarity3d> moved_by;
+    if (!options->alignment.empty()) moved_by = ReadAlignmentFile(options->alignment);
+    const EvaluationResult result = EvaluateModelFolder(options->model, options->ground_truth,
+                                                        options->no_align, gt_origin, moved_by);
     if (options->json) {
       std::cout << result.ToJson().dump(2) << std::endl;
     } else {

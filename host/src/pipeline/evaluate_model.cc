@@ -33,12 +33,18 @@ std::map<std::string, GroundTruthPose> IntoFrame(std::map<std::string, GroundTru
 
 EvaluationResult EvaluateModelFolder(const std::filesystem::path& model_dir,
                                      const std::filesystem::path& ground_truth, bool no_align,
-                                     const std::optional<Georeference>& gt_origin) {
+                                     const std::optional<Georeference>& gt_origin,
+                                     const std::optional<Similarity3d>& model_moved_by) {
   // A model of a workspace is read while no run can rewrite it.
   const auto workspaces = HoldEnclosingWorkspaces({model_dir});
-  const Reconstruction model = ReadColmapModel(model_dir);
+  Reconstruction model = ReadColmapModel(model_dir);
+  if (model_moved_by) TransformModel(*model_moved_by, &model);
   auto poses = ReadGroundTruth(ground_truth);
   if (!no_align) return EvaluateReconstruction(model, poses, model_dir);
+  if (model_moved_by) {
+    if (gt_origin) throw InputError("--gt-origin: not with --alignment, which gives the frame");
+    return EvaluateReconstruction(model, poses, model_dir, Similarity3d());
+  }
 
   const std::optional<Georeference> frame = ReadGeoreference(model_dir);
   if (!frame) {

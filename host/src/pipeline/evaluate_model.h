@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "eval/evaluation.h"
+#include "geometry/similarity_transform.h"
 #include "tessera/errors.h"
 #include "tessera/georeference.h"
 
@@ -21,10 +22,14 @@ namespace tessera {
 // (MODEL/georeference.json) and the ground truth's frame known: east-north-up metres about
 // `gt_origin`, or a georeferenced model folder. Its poses are moved into the model's frame
 // and scored there. Throws InputError saying which is missing.
-EvaluationResult EvaluateModelFolder(const std::filesystem::path& model_dir,
-                                     const std::filesystem::path& ground_truth,
-                                     bool no_align = false,
-                                     const std::optional<Georeference>& gt_origin = std::nullopt);
+//
+// `model_moved_by` (an alignment.json of `tessera align`): the model is moved by it first;
+// with `no_align` it is then scored in the ground truth's frame as it is (no
+// georeference.json needed: the alignment put it there).
+EvaluationResult EvaluateModelFolder(
+    const std::filesystem::path& model_dir, const std::filesystem::path& ground_truth,
+    bool no_align = false, const std::optional<Georeference>& gt_origin = std::nullopt,
+    const std::optional<Similarity3d>& model_moved_by = std::nullopt);
 
 // Why a result could not be scored (result.aligned false), naming both inputs: the
 // user's to fix (wrong ground truth, names that do not match), so bad input.

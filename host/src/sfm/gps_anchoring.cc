@@ -12,6 +12,7 @@
 #include "geometry/similarity_estimator.h"
 #include "geometry/similarity_transform.h"
 #include "sfm/option_ranges.h"
+#include "tessera/sfm/gps_similarity.h"
 #include "util/random.h"
 
 namespace tessera {
@@ -222,14 +223,14 @@ std::vector<size_t> AgreeingTags(const std::vector<Eigen::Vector3d>& centres,
 
 }  // namespace
 
-GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& metadata,
-                                    const BundleAdjuster& bundle_adjuster,
+GpsSimilarity EstimateGpsSimilarity(const std::map<image_t, ImageMetadata>& metadata,
                                     const GpsAnchoringOptions& options, uint64_t seed,
-                                    Reconstruction* model) {
+                                    const Reconstruction& model) {
   options.Check();
-  GpsAnchoringReport report;
+  GpsSimilarity result;
+  GpsAnchoringReport& report = result.report;
   std::vector<image_t> tagged;
-  for (const auto& [image_id, image] : model->images) {
+  for (const auto& [image_id, image] : model.images) {
     const auto it = metadata.find(image_id);
     if (image.registered && it != metadata.end() && it->second.gps) tagged.push_back(image_id);
   }
@@ -238,26 +239,27 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
   const size_t min_num_images = static_cast<size_t>(std::max(3, options.min_num_images));
   if (geotagged.size() < min_num_images) {
     report.reason = std::to_string(geotagged.size()) + " of its " +
-                    std::to_string(model->images.size()) + " images have GPS" +
+                    std::to_string(model.images.size()) + " images have GPS" +
                     (report.set_aside.empty()
                          ? ""
                          : " (" + std::to_string(report.set_aside.size()) + " more set aside)") +
                     ", fewer than " + std::to_string(min_num_images);
-    return report;
+    return result;
   }
   // A first frame about the median tag, for the search; the final one is about the tags
   // the similarity agrees with.
   const Georeference median = MedianPosition(metadata, geotagged);
   std::vector<Eigen::Vector3d> centres, enu;
   for (const image_t image_id : geotagged) {
-    centres.push_back(model->images.at(image_id).ProjectionCenter());
+    centres.push_back(model.images.at(image_id).ProjectionCenter());
     enu.push_back(EnuFromWgs84(*metadata.at(image_id).gps, median));
   }
   report.reason = DegenerateSpread(enu, options.horizontal_sigma_m);
-  if (!report.reason.empty()) return report;
+  if (!report.reason.empty()) return result;
 
-  const double threshold =
+  result.threshold_m =
       options.max_error_sigmas * std::max(options.horizontal_sigma_m, options.vertical_sigma_m);
+  const double threshold = result.threshold_m;
   const std::vector<size_t> inliers = AgreeingTags(centres, enu, threshold, options, seed);
   report.num_agreeing = inliers.size();
   if (inliers.size() < 3 ||
@@ -266,7 +268,7 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
                     " of its " + std::to_string(geotagged.size()) +
                     " geotagged images fit one similarity within " +
                     std::to_string(static_cast<int>(std::lround(threshold))) + " m";
-    return report;
+    return result;
   }
   // The origin: the median of the agreeing tags; every tag again in its frame.
   std::vector<image_t> agreeing;
@@ -278,17 +280,46 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
   std::vector<Eigen::Vector3d> src, dst;
   for (const size_t i : inliers) src.push_back(centres[i]), dst.push_back(enu[i]);
   const Similarity3d sim = EstimateSimilarity(src, dst);
+  result.scale = sim.scale;
+  result.rotation = sim.rotation;
+  result.translation = sim.translation;
+  result.images = geotagged;
+  result.enu = enu;
+  result.agreeing.assign(geotagged.size(), false);
+  for (const size_t i : inliers) result.agreeing[i] = true;
+  std::vector<double> errors;
+  for (size_t i = 0; i < geotagged.size(); ++i)
+    errors.push_back((sim * centres[i] - enu[i]).norm());
+  report.mean_error_m = std::accumulate(errors.begin(), errors.end(), 0.0) / errors.size();
+  report.median_error_m = Median(errors);
+  report.anchored = true;
+  return result;
+}
+
+GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& metadata,
+                                    const BundleAdjuster& bundle_adjuster,
+                                    const GpsAnchoringOptions& options, uint64_t seed,
+                                    Reconstruction* model) {
+  const GpsSimilarity found = EstimateGpsSimilarity(metadata, options, seed, *model);
+  GpsAnchoringReport report = found.report;
+  if (!report.anchored) return report;
+  report.anchored = false;
+  Similarity3d sim;
+  sim.scale = found.scale;
+  sim.rotation = found.rotation;
+  sim.translation = found.translation;
 
   Reconstruction anchored = *model;
   TransformModel(sim, &anchored);
   BundleAdjustmentConfig config;
   config.max_num_iterations = options.ba_max_num_iterations;
-  for (const size_t i : inliers) {
+  for (size_t i = 0; i < found.images.size(); ++i) {
+    if (!found.agreeing[i]) continue;
     PositionPrior prior;
-    prior.position = enu[i];
+    prior.position = found.enu[i];
     prior.sigma = Eigen::Vector3d(options.horizontal_sigma_m, options.horizontal_sigma_m,
                                   options.vertical_sigma_m);
-    config.position_priors[geotagged[i]] = prior;
+    config.position_priors[found.images[i]] = prior;
   }
   const BundleAdjustmentSummary summary = bundle_adjuster.Adjust(config, &anchored);
   if (!summary.usable) {
@@ -296,12 +327,13 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
     return report;
   }
   std::vector<double> errors;
-  for (size_t i = 0; i < geotagged.size(); ++i) {
-    errors.push_back((anchored.images.at(geotagged[i]).ProjectionCenter() - enu[i]).norm());
+  for (size_t i = 0; i < found.images.size(); ++i) {
+    errors.push_back(
+        (anchored.images.at(found.images[i]).ProjectionCenter() - found.enu[i]).norm());
   }
   report.mean_error_m = std::accumulate(errors.begin(), errors.end(), 0.0) / errors.size();
   report.median_error_m = Median(errors);
-  if (report.median_error_m > threshold) {
+  if (report.median_error_m > found.threshold_m) {
     report.reason = "its GPS contradicts it: after adjustment the median camera is " +
                     std::to_string(report.median_error_m) + " m from its GPS position";
     return report;
