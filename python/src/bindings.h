@@ -27,4 +27,7 @@ void BindEvaluate(pybind11::module_& module);
 // tessera.bench (bench_bindings.cc).
 void BindBench(pybind11::module_& module);
 
+// tessera.import_features, import_matches (import_bindings.cc).
+void BindImport(pybind11::module_& module);
+
 }  // namespace tessera::python

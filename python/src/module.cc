@@ -39,4 +39,5 @@ PYBIND11_MODULE(_tessera, module) {
   tessera::python::BindPlugins(module);
   tessera::python::BindEvaluate(module);
   tessera::python::BindBench(module);
+  tessera::python::BindImport(module);
 }

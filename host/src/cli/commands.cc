@@ -12,7 +12,7 @@ std::vector<CommandRegistration> RegisterCommands(CLI::App& app, const GlobalOpt
           RegisterBenchCommand(app, global),  RegisterPluginsCommand(app, global),
           RegisterVocabCommand(app, global),  RegisterPartitionCommand(app, global),
           RegisterMergeCommand(app, global),  RegisterSlurmCommand(app, global),
-          RegisterGuiCommand(app, global)};
+          RegisterGuiCommand(app, global),    RegisterImportCommand(app, global)};
 }
 
 CLI::Validator AtLeast(int64_t minimum) {

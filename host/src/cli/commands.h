@@ -39,5 +39,6 @@ CommandRegistration RegisterPartitionCommand(CLI::App& app, const GlobalOptions&
 CommandRegistration RegisterMergeCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterSlurmCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterGuiCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterImportCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera
