@@ -15,6 +15,8 @@ packages=(
   xvfb xauth libgl1-mesa-dri
   # The Python module (python/) and its tests and example.
   pybind11-dev python3-dev python3-pytest python3-matplotlib
+  # OpenCV's Python API: the features that import_end_to_end and test_import.py import.
+  python3-opencv
   # `pip install .` offline (pyproject.toml, setup.py: --no-build-isolation) and the
   # typing test (mypy --strict on examples/python).
   python3-venv python3-setuptools python3-wheel mypy

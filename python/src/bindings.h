@@ -29,4 +29,7 @@ void BindBench(pybind11::module_& module);
 // tessera.register (register_bindings.cc).
 void BindRegister(pybind11::module_& module);
 
+// tessera.import_features, import_matches (import_bindings.cc).
+void BindImport(pybind11::module_& module);
+
 }  // namespace tessera::python

@@ -40,4 +40,5 @@ PYBIND11_MODULE(_tessera, module) {
   tessera::python::BindEvaluate(module);
   tessera::python::BindBench(module);
   tessera::python::BindRegister(module);
+  tessera::python::BindImport(module);
 }

@@ -24,8 +24,8 @@ from ._version import __version__
 __all__ = [
     "Camera", "Database", "Error", "Image", "InputError", "NoModelError", "Point3D",
     "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "__version__", "adjust",
-    "align", "bench", "evaluate", "export", "extract", "map", "match", "plugins", "register",
-    "run", "triangulate",
+    "align", "bench", "evaluate", "export", "extract", "import_features", "import_matches",
+    "map", "match", "plugins", "register", "run", "triangulate",
 ]
 
 PathLike = Union[str, os.PathLike[str]]
@@ -164,6 +164,63 @@ def map(output: PathLike, images: Optional[PathLike] = None, manifest: ManifestL
         _tessera.map, output=_path(name, "output", output),
         images=_optional_path(name, "images", images), manifest=_manifest(name, manifest),
         camera_K=_optional_path(name, "camera_K", camera_K),
+        threads=_int(name, "threads", threads), progress=_progress(name, progress)))
+
+
+def import_features(output: PathLike,
+                    features: Mapping[str, Tuple[npt.ArrayLike, npt.ArrayLike]],
+                    images: Optional[PathLike] = None, manifest: ManifestLike = None,
+                    camera_K: Optional[PathLike] = None, threads: int = 0,
+                    progress: Progress = None) -> Dict[str, Any]:
+    """Imports features made elsewhere (`tessera import --features`), e.g. a learned
+    model's: features maps each image's name (relative to images) to (keypoints,
+    descriptors), keypoints an N x 2 (x y) or N x 4 (x y scale orientation) array in
+    pixels with the centre of the top-left pixel at (0.5, 0.5) (OpenCV's + 0.5),
+    descriptors N x D, uint8 or float. Whole numbers 0..255 are stored as they are;
+    other values as unit vectors, round(128 + 256 v). The images are ingested as
+    extract() ingests them (images: default, the folder the workspace records). Returns
+    the import's summary. Arguments as run()'s."""
+    name = "import_features"
+    if not isinstance(features, Mapping):
+        raise TypeError(f"{name}(): features must be a dict {{name: (keypoints, descriptors)}}, "
+                        f"not {_type_name(features)}")
+    arrays = {}
+    for key, value in features.items():
+        if not isinstance(key, str):
+            raise TypeError(f"{name}(): features keys must be image names (str), not "
+                            f"{_type_name(key)}")
+        if not isinstance(value, Sequence) or len(value) != 2:
+            raise TypeError(f"{name}(): features[{key!r}] must be a tuple (keypoints, "
+                            f"descriptors), not {_type_name(value)}")
+        arrays[key] = (np.asarray(value[0]), np.asarray(value[1]))
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.import_features, output=_path(name, "output", output), features=arrays,
+        images=_optional_path(name, "images", images), manifest=_manifest(name, manifest),
+        camera_K=_optional_path(name, "camera_K", camera_K),
+        threads=_int(name, "threads", threads), progress=_progress(name, progress)))
+
+
+def import_matches(output: PathLike, matches: Mapping[Tuple[str, str], npt.ArrayLike],
+                   verified: bool = False, manifest: ManifestLike = None, threads: int = 0,
+                   progress: Progress = None) -> Dict[str, Any]:
+    """Imports matches made elsewhere (`tessera import --matches --match-type raw`):
+    matches maps (name1, name2) to an M x 2 array of keypoint indices (row i of name1,
+    row j of name2). They are verified geometrically with the manifest's verification
+    settings unless verified=True; the pairs become the ones map() maps. Returns the
+    import's summary. Arguments as run()'s."""
+    name = "import_matches"
+    if not isinstance(matches, Mapping):
+        raise TypeError(f"{name}(): matches must be a dict {{(name1, name2): M x 2 array}}, "
+                        f"not {_type_name(matches)}")
+    arrays = {}
+    for key, value in matches.items():
+        if not (isinstance(key, tuple) and len(key) == 2 and all(isinstance(k, str) for k in key)):
+            raise TypeError(f"{name}(): matches keys must be (name1, name2) tuples of str, "
+                            f"not {key!r}")
+        arrays[key] = np.asarray(value)
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.import_matches, output=_path(name, "output", output), matches=arrays,
+        verified=_bool(name, "verified", verified), manifest=_manifest(name, manifest),
         threads=_int(name, "threads", threads), progress=_progress(name, progress)))
 
 

@@ -14,7 +14,7 @@ std::vector<CommandRegistration> RegisterCommands(CLI::App& app, const GlobalOpt
           RegisterMergeCommand(app, global),  RegisterSlurmCommand(app, global),
           RegisterGuiCommand(app, global),    RegisterTriangulateCommand(app, global),
           RegisterRegisterCommand(app, global), RegisterAdjustCommand(app, global),
-          RegisterAlignCommand(app, global)};
+          RegisterAlignCommand(app, global),  RegisterImportCommand(app, global)};
 }
 
 CLI::Validator AtLeast(int64_t minimum) {

@@ -43,5 +43,6 @@ CommandRegistration RegisterTriangulateCommand(CLI::App& app, const GlobalOption
 CommandRegistration RegisterRegisterCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterAdjustCommand(CLI::App& app, const GlobalOptions& global);
 CommandRegistration RegisterAlignCommand(CLI::App& app, const GlobalOptions& global);
+CommandRegistration RegisterImportCommand(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace tessera

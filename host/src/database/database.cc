@@ -404,14 +404,34 @@ void Database::DeleteImageFile(const std::string& name) {
   impl_->tessera.DeleteImageFile(name);
 }
 
+namespace {
+
+// The SQL condition on pair_id of the pairs of an image: pair_id = id1 * kMaxNumImages +
+// id2 with id1 < id2.
+std::string PairsOfImage(const std::string& id) {
+  const std::string max = std::to_string(kMaxNumImages);
+  return "(pair_id / " + max + " = " + id + " OR pair_id % " + max + " = " + id + ")";
+}
+
+}  // namespace
+
+void Database::DeletePairsOfImage(image_t image_id) {
+  std::lock_guard<std::recursive_mutex> lock(mutex_);
+  const std::string id = std::to_string(image_id);
+  const std::string operation = "delete the pairs of image " + id;
+  const std::string pairs = PairsOfImage(id);
+  impl_->connection.Atomically(operation, [&] {
+    impl_->connection.Exec("DELETE FROM two_view_geometries WHERE " + pairs +
+                               "; DELETE FROM matches WHERE " + pairs + ";",
+                           operation);
+  });
+}
+
 void Database::DeleteImage(image_t image_id) {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
   const std::string id = std::to_string(image_id);
   const std::string operation = "delete image " + id;
-  // pair_id = id1 * kMaxNumImages + id2 with id1 < id2.
-  const std::string max = std::to_string(kMaxNumImages);
-  const std::string pairs =
-      "(pair_id / " + max + " = " + id + " OR pair_id % " + max + " = " + id + ")";
+  const std::string pairs = PairsOfImage(id);
   impl_->connection.Atomically(operation, [&] {
     impl_->connection.Exec(
         "DELETE FROM two_view_geometries WHERE " + pairs + "; DELETE FROM matches WHERE " + pairs +

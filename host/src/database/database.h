@@ -212,6 +212,10 @@ class Database {
   void WriteImageFile(const ImageFile& file);     // replaces the row of the same name
   void DeleteImageFile(const std::string& name);
 
+  // Removes the matches and two-view geometries of every pair of the image (its
+  // features were replaced: `tessera import`).
+  void DeletePairsOfImage(image_t image_id);
+
   // Removes an image and everything made from it: its keypoints, descriptors, the
   // matches and two-view geometries of its pairs, its tessera_images row, and its
   // camera when no other image uses it.

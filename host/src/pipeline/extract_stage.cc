@@ -344,6 +344,19 @@ void WriteImageMetadata(const ImageScan& scan, const std::vector<Image>& images,
   }
 }
 
+// Features that `tessera import` wrote are neither reused nor replaced by a detector's
+// without the user's word: a detector's would be matched against them.
+void RefuseImportedFeatures(const Database& database, const std::string& detector) {
+  const auto stored = database.ReadStageProvenance(Database::kFeaturesStage);
+  if (!stored || !IsImportedFeatures(*stored)) return;
+  throw InputError(database.path().string() +
+                   ": the workspace's features were imported (`tessera import`); extract would "
+                   "replace them with detector '" +
+                   detector +
+                   "''s. Run `tessera match` and `tessera map` on it, or extract into a new "
+                   "workspace");
+}
+
 // Step 1: the usable images of the folder; the entries skipped are logged and counted.
 ImageScan ScanImages(const Workspace& workspace, const ExtractSettings& settings,
                      ExtractionSummary* summary) {
@@ -554,6 +567,16 @@ class ImageDetector {
 
 }  // namespace
 
+IngestedImages IngestImages(const ImageScan& scan, const CameraSettings& camera, Database* database,
+                            ExtractionSummary* summary) {
+  IngestedImages ingested;
+  ingested.skipped_before = ReconcileImages(scan, database, summary);
+  ingested.images = RegisterImages(scan, camera, ingested.skipped_before, database);
+  UpdateCameras(scan, camera, &ingested.images, database);
+  WriteImageMetadata(scan, ingested.images, database);
+  return ingested;
+}
+
 ExtractionSummary ExtractFeatures(const Workspace& workspace, const ExtractSettings& settings,
                                   const StageScope& scope, const StageControl& control) {
   const Timer timer;
@@ -562,16 +585,14 @@ ExtractionSummary ExtractFeatures(const Workspace& workspace, const ExtractSetti
     throw std::logic_error("ExtractFeatures: no detector");
   }
   Database* database = &workspace.database();
+  RefuseImportedFeatures(*database, settings.detector->name());
   const ImageScan scan = ScanImages(workspace, settings, &summary);
   const ImageMasks masks = FindMasks(settings.camera.mask_path, scan);
   RecordProvenance(settings, masks, database);
-  const std::map<std::string, std::string> skipped_before =
-      ReconcileImages(scan, database, &summary);
-  std::vector<Image> images = RegisterImages(scan, settings.camera, skipped_before, database);
-  UpdateCameras(scan, settings.camera, &images, database);
-  WriteImageMetadata(scan, images, database);
+  const IngestedImages ingested = IngestImages(scan, settings.camera, database, &summary);
+  const std::vector<Image>& images = ingested.images;
   const std::vector<size_t> todo =
-      PlanDetection(workspace, settings, scope, scan, images, skipped_before, &summary);
+      PlanDetection(workspace, settings, scope, scan, images, ingested.skipped_before, &summary);
 
   ImageDetector detector(workspace, settings, masks);
   std::mutex progress_mutex;

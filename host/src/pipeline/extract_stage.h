@@ -1,10 +1,12 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <string>
 #include <vector>
 
 #include "image/camera_settings.h"
+#include "image/image_folder_scan.h"
 #include "pipeline/run_summary.h"
 #include "pipeline/stage_control.h"
 #include "pipeline/stage_scope.h"
@@ -68,6 +70,23 @@ ExtractionSummary ExtractFeatures(const Workspace& workspace, const ExtractSetti
 // whether two-view geometries were discarded (matching verifies them again).
 bool ApplyGivenIntrinsics(const Workspace& workspace, const std::filesystem::path& image_dir,
                           const CameraSettings& settings, int64_t max_image_pixels);
+// The ingestion steps of ExtractFeatures (reconcile, register, cameras, metadata) on
+// `scan`, without detection: images changed or gone are removed with what was made from
+// them, new ones added with cameras from EXIF or `camera`, cameras made again when the
+// camera settings changed. `tessera import` ingests its images so too.
+struct IngestedImages {
+  std::vector<Image> images;  // per scanned image; image_id kInvalidImageId: skipped before
+  std::map<std::string, std::string> skipped_before;  // file name -> why an earlier run skipped it
+};
+IngestedImages IngestImages(const ImageScan& scan, const CameraSettings& camera, Database* database,
+                            ExtractionSummary* summary);
+
+// Whether a features provenance record is what `tessera import` writes (it has an
+// "imported" key, which no detector's record has): a detector never replaces such
+// features silently.
+inline bool IsImportedFeatures(const nlohmann::json& provenance) {
+  return provenance.is_object() && provenance.contains("imported");
+}
 
 // The stage's closing log line.
 void LogExtraction(const ExtractionSummary& summary);
