@@ -13,7 +13,7 @@ logger.addHandler(logging.NullHandler())
 
 # The stages whose lines start "stage: ..."; other lines belong to the stage last named.
 STAGES = ("extract", "match", "map", "export", "partition", "merge", "georeference", "plugins",
-          "run", "bench", "triangulate", "register", "adjust", "align")
+          "run", "bench", "triangulate", "register", "adjust", "align", "import")
 _PREFIX = re.compile(r"^([a-z_]+):")
 # spdlog's levels (trace, debug, info, warn, err, critical) as logging's.
 _LEVELS = (logging.DEBUG, logging.DEBUG, logging.INFO, logging.WARNING, logging.ERROR,
