@@ -267,6 +267,33 @@ TEST(Cli, MissingManifestIsExitCode2) {
       << result.output;
 }
 
+// `--manifest fast` is the bundled recipe from any working folder; a file of that name in
+// the working folder wins; a name that is neither is refused with the list of recipes.
+TEST(Cli, ManifestNamesABundledRecipeFromAnotherFolder) {
+  testing::TemporaryDir dir;
+  std::filesystem::create_directories(dir.path() / "images");
+  const std::filesystem::path sample =
+      testing::SourceDir() / "examples" / "fountain-P11-small" / "images";
+  for (const char* name : {"0000.jpg", "0001.jpg"}) {
+    std::filesystem::copy_file(sample / name, dir.path() / "images" / name);
+  }
+  const std::string in_dir = "cd " + dir.path().string() + " &&";
+  auto result = RunTessera("extract --images images --output out --manifest fast -q", in_dir);
+  EXPECT_EQ(result.exit_code, 0) << result.output;
+  result = RunTessera("extract --images images --output out2 --manifest fst", in_dir);
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find("fst: cannot read the manifest: no such file, nor a recipe (the "
+                               "recipes: "),
+            std::string::npos)
+      << result.output;
+  EXPECT_NE(result.output.find("fast, "), std::string::npos) << result.output;
+  std::ofstream(dir.path() / "fast.json") << R"({"pipeline": {"detector": {"plugin": "nosuch"}}})";
+  result = RunTessera("extract --images images --output out3 --manifest fast.json", in_dir);
+  EXPECT_EQ(result.exit_code, 2) << result.output;
+  EXPECT_NE(result.output.find((dir.path() / "fast.json").string()), std::string::npos)
+      << result.output;
+}
+
 // A two-image text model in exactly the layout the COLMAP text writer produces.
 void WriteSmallTextModel(const std::filesystem::path& dir) {
   std::filesystem::create_directories(dir);

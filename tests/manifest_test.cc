@@ -4,8 +4,10 @@
 
 #include <fstream>
 
+#include "manifest/recipes.h"
 #include "tessera/errors.h"
 #include "test_support.h"
+#include "util/paths.h"
 
 namespace tessera {
 namespace {
@@ -336,6 +338,44 @@ TEST(Manifest, DistributedClusterSizesDefaultAndAreChecked) {
       << too_small;
   EXPECT_NE(ErrorOf({{"distributed", {{"cluster_size", 30}}}}).find("distributed.cluster_size"),
             std::string::npos);
+}
+
+// A recipe by name from any folder (`--manifest global`); a path that exists wins; anything
+// else is refused with the list of recipes.
+TEST(Manifest, FindsABundledRecipeByNameAndAFileThatExistsFirst) {
+  testing::TemporaryDir install;
+  testing::TemporaryDir work;
+  SetExecutableDir(install.path() / "bin");
+  const std::filesystem::path recipes = DefaultManifestFile().parent_path();
+  std::filesystem::create_directories(recipes);
+  std::ofstream(recipes / "global.json") << R"({"seed": 5})";
+  std::ofstream(recipes / "fast.json") << R"({"seed": 6})";
+  std::ofstream(recipes / "notes.txt") << "not a recipe";
+  const std::filesystem::path previous = std::filesystem::current_path();
+  std::filesystem::current_path(work.path());
+  EXPECT_EQ(BundledRecipeNames(), (std::vector<std::string>{"fast", "global"}));
+  EXPECT_EQ(FindManifestFile("global"), recipes / "global.json");
+  EXPECT_EQ(FindManifestFile("global.json"), recipes / "global.json");
+  EXPECT_EQ(Manifest::Load("global").seed, 5u);
+  EXPECT_EQ(Manifest::Load("fast.json").file, recipes / "fast.json");
+  std::string refused;
+  try {
+    FindManifestFile("globl");
+  } catch (const InputError& error) {
+    refused = error.what();
+  }
+  EXPECT_EQ(refused,
+            "globl: cannot read the manifest: no such file, nor a recipe (the recipes: fast, "
+            "global)");
+  // A path with a folder is a path: the recipe's name inside it does not count.
+  EXPECT_THROW(FindManifestFile("manifests/global.json"), InputError);
+  EXPECT_THROW(FindManifestFile("notes"), InputError);
+  std::ofstream(work.path() / "global.json") << R"({"seed": 9})";
+  EXPECT_EQ(FindManifestFile("global.json"), "global.json");
+  EXPECT_EQ(Manifest::Load("global.json").seed, 9u);
+  EXPECT_EQ(Manifest::Load("global").seed, 5u);
+  std::filesystem::current_path(previous);
+  SetExecutableDir("");
 }
 
 }  // namespace tessera

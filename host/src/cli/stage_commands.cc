@@ -56,7 +56,8 @@ void AddCommonOptions(CLI::App* sub, StageOptions* options, bool needs_images) {
   sub->add_option("--output", options->output, "Workspace folder (database.db, models)")
       ->required();
   sub->add_option("--manifest", options->arguments.manifest,
-                  "Pipeline manifest (default: default.json)");
+                  "Pipeline manifest: a file, or a bundled recipe by name (global, fast, ...; "
+                  "default: default.json)");
   sub->add_option("--camera-K", options->arguments.camera_K,
                   "Known intrinsics: a text file with the 3x3 matrix K (overrides EXIF)");
   if (needs_images) {

@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "image/known_intrinsics.h"
+#include "manifest/recipes.h"
 #include "tessera/camera.h"
 #include "tessera/camera_models.h"
 #include "tessera/errors.h"
@@ -242,7 +243,8 @@ void ReadKnownIntrinsicsFile(const std::filesystem::path& file, CameraSettings* 
   SetKnownIntrinsics(ReadCalibrationMatrixFile(file), file.string(), camera);
 }
 
-Manifest Manifest::Load(const std::filesystem::path& file) {
+Manifest Manifest::Load(const std::filesystem::path& manifest_file) {
+  const std::filesystem::path file = FindManifestFile(manifest_file);
   std::error_code error_code;
   if (std::filesystem::is_directory(file, error_code)) {
     throw InputError(file.string() + ": cannot read the manifest: it is a folder, not a file");
