@@ -22,9 +22,9 @@
 #include "pipeline/stage_arguments.h"
 #include "stage_process.h"
 #include "tessera/errors.h"
-#include "toolbox/triangulate_known_poses.h"
 #include "toolbox/model_adjustment.h"
 #include "toolbox/model_alignment.h"
+#include "toolbox/triangulate_known_poses.h"
 #include "util/workspace_layout.h"
 
 namespace py = pybind11;

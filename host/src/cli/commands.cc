@@ -6,15 +6,15 @@
 namespace tessera {
 
 std::vector<CommandRegistration> RegisterCommands(CLI::App& app, const GlobalOptions& global) {
-  return {RegisterRunCommand(app, global),    RegisterExtractCommand(app, global),
-          RegisterMatchCommand(app, global),  RegisterMapCommand(app, global),
-          RegisterExportCommand(app, global), RegisterEvalCommand(app, global),
-          RegisterBenchCommand(app, global),  RegisterPluginsCommand(app, global),
-          RegisterVocabCommand(app, global),  RegisterPartitionCommand(app, global),
-          RegisterMergeCommand(app, global),  RegisterSlurmCommand(app, global),
-          RegisterGuiCommand(app, global),    RegisterTriangulateCommand(app, global),
+  return {RegisterRunCommand(app, global),      RegisterExtractCommand(app, global),
+          RegisterMatchCommand(app, global),    RegisterMapCommand(app, global),
+          RegisterExportCommand(app, global),   RegisterEvalCommand(app, global),
+          RegisterBenchCommand(app, global),    RegisterPluginsCommand(app, global),
+          RegisterVocabCommand(app, global),    RegisterPartitionCommand(app, global),
+          RegisterMergeCommand(app, global),    RegisterSlurmCommand(app, global),
+          RegisterGuiCommand(app, global),      RegisterTriangulateCommand(app, global),
           RegisterRegisterCommand(app, global), RegisterAdjustCommand(app, global),
-          RegisterAlignCommand(app, global),  RegisterImportCommand(app, global)};
+          RegisterAlignCommand(app, global),    RegisterImportCommand(app, global)};
 }
 
 CLI::Validator AtLeast(int64_t minimum) {

@@ -43,8 +43,8 @@ struct ClustersFile {
   double cut_weight = 0;              // inliers of the pairs between different cores
   double total_weight = 0;
   // The focal length of each camera without a prior, found once on the whole view graph
-  // (tessera/sfm/first_model_calibration.h), that every cluster maps with; written only when there is
-  // one, so a file without it reads as none.
+  // (tessera/sfm/first_model_calibration.h), that every cluster maps with; written only when there
+  // is one, so a file without it reads as none.
   std::vector<FocalLengthReport> cameras;
 
   nlohmann::json ToJson() const;

@@ -30,9 +30,9 @@ struct PairGraph {
 PairGraph LoadPairGraph(const Database& database);
 
 // Calibrates the cameras without a focal prior once for every cluster
-// (tessera/sfm/first_model_calibration.h, with the context's bundle adjuster), cuts the workspace's view
-// graph by the manifest's `distributed` settings, writes OUTPUT/clusters.json atomically
-// and logs the cut. Throws InputError naming the database when it has no verified pair.
+// (tessera/sfm/first_model_calibration.h, with the context's bundle adjuster), cuts the workspace's
+// view graph by the manifest's `distributed` settings, writes OUTPUT/clusters.json atomically and
+// logs the cut. Throws InputError naming the database when it has no verified pair.
 ClustersFile PartitionWorkspace(const Workspace& workspace, const PipelineContext& context);
 
 // OUTPUT/clusters.json, checked as input: StaleClustersError naming it and what differs
