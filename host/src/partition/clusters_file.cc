@@ -147,9 +147,11 @@ ClustersFile ClustersFile::FromJson(const nlohmann::json& json) {
     camera.method = entry.at("method").get<std::string>();
     camera.num_pairs = IntegerAt<size_t>(entry, "num_pairs", what);
     camera.num_images = IntegerAt<size_t>(entry, "num_images", what);
-    if (camera.method != "view graph" && camera.method != "first model") {
+    // The methods of CalibrateCamerasWithoutPrior (tessera/sfm/first_model_calibration.h).
+    if (camera.method != "view graph" && camera.method != "first model" &&
+        camera.method != "view graph, first model") {
       throw InputError(what + "method = " + entry.at("method").dump() +
-                       ": not \"view graph\" or \"first model\"");
+                       ": not \"view graph\", \"first model\" or \"view graph, first model\"");
     }
     file.cameras.push_back(std::move(camera));
   }

@@ -75,7 +75,7 @@ TEST(ClustersFile, RoundTripsTheCalibrationOfEveryCluster) {
   camera.camera_id = 3;
   camera.initial = 2304;
   camera.estimated = 1379.5;
-  camera.method = "first model";
+  camera.method = "view graph, first model";
   camera.num_images = 16;
   written.cameras.push_back(camera);
   const ClustersFile read = ClustersFile::FromJson(written.ToJson());
@@ -83,7 +83,7 @@ TEST(ClustersFile, RoundTripsTheCalibrationOfEveryCluster) {
   EXPECT_EQ(read.cameras[0].camera_id, 3u);
   EXPECT_EQ(read.cameras[0].estimated, 1379.5);
   EXPECT_EQ(read.cameras[0].initial, 2304);
-  EXPECT_EQ(read.cameras[0].method, "first model");
+  EXPECT_EQ(read.cameras[0].method, "view graph, first model");
   EXPECT_EQ(read.cameras[0].num_images, 16u);
   EXPECT_NE(read.Fingerprint(), TwoClusters().Fingerprint());
 
@@ -125,7 +125,8 @@ TEST(ClustersFile, NumbersOutOfRangeAreRefusedNamingTheEntry) {
   EXPECT_EQ(with(Pointer("/cameras/0/initial_focal_length"), 0),
             "cameras[0].initial_focal_length = 0: not a finite number above 0");
   EXPECT_EQ(with(Pointer("/cameras/0/method"), "guess"),
-            "cameras[0].method = \"guess\": not \"view graph\" or \"first model\"");
+            "cameras[0].method = \"guess\": not \"view graph\", \"first model\" or \"view graph, "
+            "first model\"");
   EXPECT_EQ(with(Pointer("/total_weight"), -5),
             "total_weight = -5: not a finite number of at least 0");
   EXPECT_NE(with(Pointer("/clusters/1/index"), 1e300).find("clusters[1].index = 1e+300"),
