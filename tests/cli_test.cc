@@ -629,7 +629,7 @@ TEST(Cli, VerboseAndQuietAreTakenAfterTheVerb) {
 // the user's where a row would go is refused before any row runs, and left as it was.
 TEST(Cli, BenchReplacesOnlyTheWorkspacesItMade) {
   testing::TemporaryDir dir;
-  const auto theirs = dir.path() / "o" / "default";
+  const auto theirs = dir.path() / "o" / "tessera" / "default";  // the Tessera row's folder
   std::filesystem::create_directories(theirs);
   std::ofstream(theirs / "notes.txt") << "mine";
   const std::string manifest = (testing::SourceDir() / "manifests" / "default.json").string();

@@ -65,10 +65,10 @@ TEST(PluginLoader, RefusesAnotherAbiVersionNamingBothNumbers) {
 }
 
 TEST(PluginLoader, RefusesAPluginBuiltAgainstAbiOne) {
-  ASSERT_EQ(kPluginAbiVersion, 10u);
+  ASSERT_EQ(kPluginAbiVersion, 11u);
   const auto file = File("abi_one", "abi_one");
   EXPECT_EQ(InspectPluginFile(file).refusal,
-            file.string() + ": wrong plugin ABI version: got version 1, supported version is 10");
+            file.string() + ": wrong plugin ABI version: got version 1, supported version is 11");
   const PluginRegistry registry = PluginRegistry::Discover({kRoot / "abi_one"});
   EXPECT_TRUE(registry.NamesOfKind("pair_selector").empty());
 }

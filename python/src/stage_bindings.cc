@@ -183,49 +183,9 @@ void BindWorkspaceStages(py::module_& module) {
           .c_str());
 }
 
-}  // namespace
-
-void BindStages(py::module_& module) {
-  BindImageStages(module);
-  BindWorkspaceStages(module);
-  module.def(
-      "export",
-      [](const std::filesystem::path& model, const std::string& format,
-         const std::filesystem::path& output, const OptionalPath& images, const py::object& options,
-         int model_index, const OptionalPath& masks) {
-        // Refused as the command line refuses --model-index -1, before the child starts.
-        if (model_index < 0) {
-          throw InputError("model_index: Value " + std::to_string(model_index) +
-                           " is not a whole number of at least 0");
-        }
-        ExportArguments arguments;
-        arguments.model = model;
-        arguments.format = format;
-        arguments.output = output;
-        arguments.images = images.value_or(std::filesystem::path());
-        if (!options.is_none()) arguments.options = ToJson(options);
-        arguments.model_index = model_index;
-        arguments.masks = masks.value_or(std::filesystem::path());
-        return ToPython(RunInChildProcess(
-            "export", py::none(),
-            [&](const StageControl&) {
-              const ExportSummary summary = ExportModel(arguments);
-              spdlog::info("export: wrote {} images and {} points with '{}' into {}",
-                           summary.num_images, summary.num_points3D, summary.exporter,
-                           arguments.output.string());
-              return nlohmann::json{{"exporter", summary.exporter},
-                                    {"num_images", summary.num_images},
-                                    {"num_points3D", summary.num_points3D},
-                                    {"num_observations", summary.num_observations},
-                                    {"seconds", summary.seconds}};
-            },
-            /*runs_to_the_end=*/true));
-      },
-      py::arg("model"), py::arg("format"), py::arg("output"), py::arg("images") = py::none(),
-      py::arg("options") = py::none(), py::arg("model_index") = 0, py::arg("masks") = py::none(),
-      "Writes a COLMAP model with an exporter plugin (`tessera export`), in a child process; "
-      "options: a dict.");
-
+// tessera.triangulate, adjust and align: the model toolbox's verbs (toolbox/), each in a
+// child process as the stages.
+void BindToolboxVerbs(py::module_& module) {
   module.def(
       "triangulate",
       [](const std::filesystem::path& output, const OptionalPath& model, const OptionalPath& poses,
@@ -311,6 +271,51 @@ void BindStages(py::module_& module) {
       py::arg("gps_sigma") = py::none(),
       "Moves a COLMAP model onto a reference model, onto its images' GPS or upright "
       "(`tessera align`), in a child process; writes alignment.json beside it.");
+}
+
+}  // namespace
+
+void BindStages(py::module_& module) {
+  BindImageStages(module);
+  BindWorkspaceStages(module);
+  module.def(
+      "export",
+      [](const std::filesystem::path& model, const std::string& format,
+         const std::filesystem::path& output, const OptionalPath& images, const py::object& options,
+         int model_index, const OptionalPath& masks) {
+        // Refused as the command line refuses --model-index -1, before the child starts.
+        if (model_index < 0) {
+          throw InputError("model_index: Value " + std::to_string(model_index) +
+                           " is not a whole number of at least 0");
+        }
+        ExportArguments arguments;
+        arguments.model = model;
+        arguments.format = format;
+        arguments.output = output;
+        arguments.images = images.value_or(std::filesystem::path());
+        if (!options.is_none()) arguments.options = ToJson(options);
+        arguments.model_index = model_index;
+        arguments.masks = masks.value_or(std::filesystem::path());
+        return ToPython(RunInChildProcess(
+            "export", py::none(),
+            [&](const StageControl&) {
+              const ExportSummary summary = ExportModel(arguments);
+              spdlog::info("export: wrote {} images and {} points with '{}' into {}",
+                           summary.num_images, summary.num_points3D, summary.exporter,
+                           arguments.output.string());
+              return nlohmann::json{{"exporter", summary.exporter},
+                                    {"num_images", summary.num_images},
+                                    {"num_points3D", summary.num_points3D},
+                                    {"num_observations", summary.num_observations},
+                                    {"seconds", summary.seconds}};
+            },
+            /*runs_to_the_end=*/true));
+      },
+      py::arg("model"), py::arg("format"), py::arg("output"), py::arg("images") = py::none(),
+      py::arg("options") = py::none(), py::arg("model_index") = 0, py::arg("masks") = py::none(),
+      "Writes a COLMAP model with an exporter plugin (`tessera export`), in a child process; "
+      "options: a dict.");
+  BindToolboxVerbs(module);
 }
 
 }  // namespace tessera::python

@@ -10,7 +10,7 @@ import pytest
 import tessera
 from conftest import MANIFEST
 
-NEW = ("0002.jpg", "0005.jpg", "0008.jpg")
+NEW = ("0008.jpg", "0009.jpg", "0010.jpg")  # 0000 to 0007 a sequence that maps whole
 
 
 def pose_records(model_dir):

@@ -253,7 +253,7 @@ expect_refused not_rotation "not_rotation.json: frames\[1\] \(images/r_1.png\): 
   --output "$work/lego_ws" --poses "$work/not_rotation.json"
 expect_refused zero_quaternion "zero_quaternion/images.txt.*: the rotation of image 4 has length 0" \
   --output "$work/ws" --model "$work/zero_quaternion"
-expect_refused nan_model "nan_model/images.txt: image 4 \(0003.jpg\): the pose holds numbers that are not finite" \
+expect_refused nan_model "nan_model/images.txt line 7: 'nan' is not a finite quaternion component" \
   --output "$work/ws" --model "$work/nan_model"
 expect_refused nan "nan.json is not valid JSON" --output "$work/lego_ws" --poses "$work/nan.json"
 expect_refused nan_focal "nan_focal.json: frames\[0\] \(images/r_[0-9]+.png\): \"fl_y\" is \"NaN\", not a finite number" \

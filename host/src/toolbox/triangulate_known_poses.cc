@@ -259,6 +259,26 @@ nlohmann::json TriangulateSummary::ToJson() const {
           {"seconds", seconds}};
 }
 
+namespace {
+
+// One warning naming the images on one side only (the first few of each, and a count).
+void WarnOfOneSidedImages(const TriangulateSummary& summary) {
+  if (summary.only_in_source.empty() && summary.only_in_workspace.empty()) return;
+  std::string line = "triangulate: images on one side only are left out:";
+  if (!summary.only_in_source.empty()) {
+    line += " " + std::to_string(summary.only_in_source.size()) + " of " + summary.source +
+            " are not in the workspace (" + ListNames(summary.only_in_source) + ")";
+  }
+  if (!summary.only_in_workspace.empty()) {
+    line += std::string(summary.only_in_source.empty() ? "" : ";") + " " +
+            std::to_string(summary.only_in_workspace.size()) + " of the workspace's are not in " +
+            summary.source + " (" + ListNames(summary.only_in_workspace) + ")";
+  }
+  spdlog::warn("{}", line);
+}
+
+}  // namespace
+
 TriangulateSummary TriangulateWorkspace(const TriangulateArguments& arguments) {
   const Timer timer;
   if (arguments.model_index < 0) {
@@ -333,19 +353,7 @@ TriangulateSummary TriangulateWorkspace(const TriangulateArguments& arguments) {
                      arguments.output.string() + " (images are matched by name)");
   }
   summary.num_images_in_common = input.images.size();
-  if (!summary.only_in_source.empty() || !summary.only_in_workspace.empty()) {
-    std::string line = "triangulate: images on one side only are left out:";
-    if (!summary.only_in_source.empty()) {
-      line += " " + std::to_string(summary.only_in_source.size()) + " of " + summary.source +
-              " are not in the workspace (" + ListNames(summary.only_in_source) + ")";
-    }
-    if (!summary.only_in_workspace.empty()) {
-      line += std::string(summary.only_in_source.empty() ? "" : ";") + " " +
-              std::to_string(summary.only_in_workspace.size()) + " of the workspace's are not in " +
-              summary.source + " (" + ListNames(summary.only_in_workspace) + ")";
-    }
-    spdlog::warn("{}", line);
-  }
+  WarnOfOneSidedImages(summary);
 
   std::optional<BundleAdjusterGuard> bundle_adjuster;
   if (context) bundle_adjuster.emplace(context->bundle_adjuster, &workspace->crash_log());
