@@ -216,7 +216,11 @@ bool Database::ExistsMatches(image_t image_id1, image_t image_id2) const {
 
 void Database::WriteMatches(image_t image_id1, image_t image_id2, const FeatureMatches& matches) {
   std::lock_guard<std::recursive_mutex> lock(mutex_);
-  const auto [first, second] = PairIdToImagePair(ImagePairToPairId(image_id1, image_id2));
+  // The pair's images in id order; plain variables, as a lambda may not capture a
+  // structured binding before C++20 (clang refuses it).
+  const std::pair<image_t, image_t> ordered =
+      PairIdToImagePair(ImagePairToPairId(image_id1, image_id2));
+  const image_t first = ordered.first, second = ordered.second;
   impl_->connection.Atomically("write the matches of images " + std::to_string(image_id1) +
                                    " and " + std::to_string(image_id2),
                                [&] {
