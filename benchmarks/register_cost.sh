@@ -43,7 +43,7 @@ measure() {  # measure NAME IMAGES MAPPED GT
     > "$dir/remap.log" 2>&1 || { tail -20 "$dir/remap.log"; echo "$name: the re-map failed"; return 1; }
   t3=$(now)
   local registered
-  registered=$(python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); print(f"{s[\"num_registered\"]}/{s[\"num_new_images\"]}")' "$dir/register.json")
+  registered=$(python3 -c 'import json,sys; s=json.load(open(sys.argv[1])); print("%d/%d" % (s["num_registered"], s["num_new_images"]))' "$dir/register.json")
   read -r reg_n reg_err <<< "$(score "$dir/ws/sparse/0" "$gt")"
   read -r remap_n remap_err <<< "$(score "$dir/remap/sparse/0" "$gt")"
   printf '%s: %d mapped + %d new: register %.2f s (%s new registered; model 0: %s images, mean position error %s), re-map %.2f s (model 0: %s images, %s); register/re-map %.2f\n' \
