@@ -16,6 +16,7 @@
 #include "tessera/io/georeference_io.h"
 #include "tessera/io/model_statistics.h"
 #include "tessera/sfm/global_mapper_options.h"
+#include "tessera/sfm/global_pipeline.h"
 #include "tessera/sfm/incremental_mapper_options.h"
 #include "tessera/sfm/track_filtering.h"
 #include "toolbox/toolbox_outputs.h"
@@ -112,7 +113,8 @@ AdjustmentSettings MakeAdjustmentSettings(const Manifest& manifest) {
       slot.options_path.empty() ? slot.json_path + ".options" : slot.options_path;
   AdjustmentSettings settings;
   if (slot.plugin == "global") {
-    const GlobalMapperOptions options = GlobalMapperOptions::FromJson(slot.options, path);
+    // As the global plugin reads them: its options and the finishing step's six.
+    const GlobalMapperOptions options = GlobalPipelineOptions::FromJson(slot.options).mapper;
     settings.refine_focal_length = options.ba_refine_focal_length;
     settings.refine_principal_point = options.ba_refine_principal_point;
     settings.refine_extra_params = options.ba_refine_extra_params;
