@@ -14,30 +14,23 @@
 #include "outputs/output_transaction.h"
 #include "tessera/errors.h"
 #include "test_support.h"
+#include "text_files.h"
 #include "util/workspace_layout.h"
 
 namespace tessera {
 namespace {
 
+using ::tessera::testing::ReadTextFile;
+using ::tessera::testing::WriteTextFile;
+
 namespace fs = std::filesystem;
-
-void WriteText(const fs::path& path, const std::string& text) {
-  fs::create_directories(path.parent_path());
-  std::ofstream(path, std::ios::binary) << text;
-}
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
 
 void CommitFiles(const fs::path& output, const std::map<std::string, std::string>& files,
                  const std::vector<fs::path>& inputs = {}) {
   OutputTransaction outputs(output);
   for (const fs::path& input : inputs) outputs.Protect(input);
-  for (const auto& [relative, text] : files) WriteText(outputs.StageFor("ply") / relative, text);
+  for (const auto& [relative, text] : files)
+    WriteTextFile(outputs.StageFor("ply") / relative, text);
   outputs.Commit();
 }
 
@@ -45,7 +38,7 @@ void CommitFiles(const fs::path& output, const std::map<std::string, std::string
 // `file`, as a forger would; or, with no file, a folder entry.
 void Forge(const fs::path& output, const std::string& entry, const fs::path& file = {}) {
   const fs::path ledger = output / OutputLedger::kFileName;
-  nlohmann::json json = nlohmann::json::parse(ReadText(ledger));
+  nlohmann::json json = nlohmann::json::parse(ReadTextFile(ledger));
   if (file.empty()) {
     json["folders"].push_back(entry);
   } else {
@@ -77,13 +70,13 @@ struct Workspace {
   fs::path output = dir.path() / "out";
   fs::path victim = dir.path() / "victim.txt";
   Workspace() {
-    WriteText(victim, "precious");
+    WriteTextFile(victim, "precious");
     CommitFiles(output, {{"model.ply", "p"}});
   }
   // Nothing moved: the victim and the earlier output are there, the new set is not.
   void ExpectNothingDone() const {
-    EXPECT_EQ(ReadText(victim), "precious");
-    EXPECT_EQ(ReadText(output / "model.ply"), "p");
+    EXPECT_EQ(ReadTextFile(victim), "precious");
+    EXPECT_EQ(ReadTextFile(output / "model.ply"), "p");
     EXPECT_FALSE(fs::exists(output / "transforms.json"));
   }
 };
@@ -105,12 +98,12 @@ TEST(ForgedLedger, AnEntryOutsideTheOutputFolderIsRefusedAndNothingIsDeleted) {
 TEST(ForgedLedger, AnEntryThatIsNotInNormalFormIsRefused) {
   for (const std::string entry : {"./model.ply", "sparse//x", "sparse/", "a\\..\\x", ""}) {
     Workspace workspace;
-    WriteText(workspace.output / "sparse/x", "mine");
+    WriteTextFile(workspace.output / "sparse/x", "mine");
     Forge(workspace.output, entry, workspace.output / "sparse/x");
     const std::string error = CommitError(workspace.output);
     EXPECT_TRUE(Has(error, OutputLedger::kFileName)) << entry << ": " << error;
     workspace.ExpectNothingDone();
-    EXPECT_EQ(ReadText(workspace.output / "sparse/x"), "mine");
+    EXPECT_EQ(ReadTextFile(workspace.output / "sparse/x"), "mine");
   }
 }
 
@@ -118,13 +111,13 @@ TEST(ForgedLedger, AnEntryThatIsNotInNormalFormIsRefused) {
 // it, and the file stays as it was.
 void ExpectForgedWorkspaceEntryRefused(const std::string& entry) {
   Workspace workspace;
-  WriteText(workspace.output / entry, "workspace");
+  WriteTextFile(workspace.output / entry, "workspace");
   Forge(workspace.output, entry, workspace.output / entry);
   const std::string error = CommitError(workspace.output);
   EXPECT_TRUE(Has(error, "the entry '" + entry + "'")) << error;
   EXPECT_TRUE(Has(error, "the workspace's own")) << error;
   workspace.ExpectNothingDone();
-  EXPECT_EQ(ReadText(workspace.output / entry), "workspace") << entry;
+  EXPECT_EQ(ReadTextFile(workspace.output / entry), "workspace") << entry;
 }
 
 TEST(ForgedLedger, TheWorkspacesOwnFilesAreRefused) {
@@ -173,7 +166,7 @@ TEST(ForgedLedger, InputsAreNeverRemovedOnTheLedgersWord) {
   Workspace workspace;
   const fs::path images = workspace.output / "photos";
   const fs::path masks = workspace.output / "masks";
-  WriteText(images / "a.jpg", "image");
+  WriteTextFile(images / "a.jpg", "image");
   fs::create_directories(masks);
   Forge(workspace.output, "photos/a.jpg", images / "a.jpg");
   Forge(workspace.output, "photos");
@@ -181,9 +174,9 @@ TEST(ForgedLedger, InputsAreNeverRemovedOnTheLedgersWord) {
   OutputTransaction outputs(workspace.output);
   outputs.Protect(images);
   outputs.Protect(masks);
-  WriteText(outputs.StageFor("ply") / "transforms.json", "t");
+  WriteTextFile(outputs.StageFor("ply") / "transforms.json", "t");
   const OutputTransaction::Result result = outputs.Commit();
-  EXPECT_EQ(ReadText(images / "a.jpg"), "image");
+  EXPECT_EQ(ReadTextFile(images / "a.jpg"), "image");
   EXPECT_TRUE(fs::is_directory(masks));
   bool named_image = false, named_masks = false;
   for (const std::string& warning : result.warnings) {
@@ -211,7 +204,7 @@ TEST(ForgedLedger, NothingIsRemovedThroughALinkOnTheWay) {
   const std::string error = CommitError(workspace.output);
   EXPECT_TRUE(Has(error, "the entry 'sparse/0/images.bin'")) << error;
   EXPECT_TRUE(Has(error, (workspace.output / "sparse").string() + ", a symbolic link")) << error;
-  EXPECT_EQ(ReadText(elsewhere / "sparse/0/images.bin"), "model");
+  EXPECT_EQ(ReadTextFile(elsewhere / "sparse/0/images.bin"), "model");
 }
 
 // The link made while the run went on (after the transaction began): checked again
@@ -221,20 +214,20 @@ TEST(ForgedLedger, ALinkMadeDuringTheRunIsCaughtAtCommit) {
   CommitFiles(workspace.output, {{"sparse/0/images.bin", "model"}});
   const fs::path elsewhere = workspace.dir.path() / "elsewhere";
   OutputTransaction outputs(workspace.output);
-  WriteText(outputs.StageFor("ply") / "transforms.json", "t");
+  WriteTextFile(outputs.StageFor("ply") / "transforms.json", "t");
   fs::create_directories(elsewhere);
   fs::rename(workspace.output / "sparse", elsewhere / "sparse");
   fs::create_directory_symlink(elsewhere / "sparse", workspace.output / "sparse");
   EXPECT_THROW(outputs.Commit(), InputError);
-  EXPECT_EQ(ReadText(elsewhere / "sparse/0/images.bin"), "model");
+  EXPECT_EQ(ReadTextFile(elsewhere / "sparse/0/images.bin"), "model");
   EXPECT_FALSE(fs::exists(workspace.output / "transforms.json"));
 }
 
 // A file Tessera wrote and the user edited is called that, not "not in the ledger".
 TEST(ForgedLedger, AnEditedOutputIsToldFromAForeignOne) {
   Workspace workspace;
-  WriteText(workspace.output / "model.ply", "edited");
-  WriteText(workspace.output / "notes.ply", "mine");
+  WriteTextFile(workspace.output / "model.ply", "edited");
+  WriteTextFile(workspace.output / "notes.ply", "mine");
   try {
     CommitFiles(workspace.output, {{"model.ply", "q"}});
     FAIL() << "no error";
@@ -248,8 +241,8 @@ TEST(ForgedLedger, AnEditedOutputIsToldFromAForeignOne) {
   } catch (const InputError& error) {
     EXPECT_TRUE(Has(error.what(), "did not write (not in .tessera_outputs.json)")) << error.what();
   }
-  EXPECT_EQ(ReadText(workspace.output / "model.ply"), "edited");
-  EXPECT_EQ(ReadText(workspace.output / "notes.ply"), "mine");
+  EXPECT_EQ(ReadTextFile(workspace.output / "model.ply"), "edited");
+  EXPECT_EQ(ReadTextFile(workspace.output / "notes.ply"), "mine");
 }
 
 // Tessera never records a path its reader would refuse: an exporter's file named with a

@@ -9,23 +9,15 @@
 
 #include "tessera/errors.h"
 #include "test_support.h"
+#include "text_files.h"
 
 namespace tessera {
 namespace {
 
+using ::tessera::testing::ReadTextFile;
+using ::tessera::testing::WriteTextFile;
+
 namespace fs = std::filesystem;
-
-void WriteText(const fs::path& path, const std::string& text) {
-  fs::create_directories(path.parent_path());
-  std::ofstream(path, std::ios::binary) << text;
-}
-
-std::string ReadText(const fs::path& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::stringstream text;
-  text << file.rdbuf();
-  return text.str();
-}
 
 // One committed set: writer name to {relative path: contents}.
 OutputTransaction::Result CommitSet(
@@ -34,7 +26,7 @@ OutputTransaction::Result CommitSet(
   OutputTransaction outputs(output, mode);
   for (const auto& [writer, files] : set) {
     const fs::path staged = outputs.StageFor(writer);
-    for (const auto& [relative, text] : files) WriteText(staged / relative, text);
+    for (const auto& [relative, text] : files) WriteTextFile(staged / relative, text);
   }
   return outputs.Commit();
 }
@@ -51,8 +43,8 @@ TEST(OutputTransaction, PlacesTheSetAndRecordsIt) {
   const auto result = CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "a"}}},
                                              {"ply", {{"model.ply", "p"}}}});
   EXPECT_EQ(result.files_placed, 2u);
-  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.bin"), "a");
-  EXPECT_EQ(ReadText(dir.path() / "model.ply"), "p");
+  EXPECT_EQ(ReadTextFile(dir.path() / "sparse/0/images.bin"), "a");
+  EXPECT_EQ(ReadTextFile(dir.path() / "model.ply"), "p");
   const OutputLedger ledger = OutputLedger::Read(dir.path());
   EXPECT_TRUE(ledger.Owns(dir.path(), "sparse"));
   EXPECT_TRUE(ledger.Owns(dir.path(), "model.ply"));
@@ -68,7 +60,7 @@ TEST(OutputTransaction, ARerunRemovesWhatItsSetNoLongerHolds) {
              {"ply", {{"model.ply", "p"}}},
              {"transforms_json", {{"transforms_1.json", "t"}}}});
   const auto result = CommitSet(dir.path(), {{"colmap_text", {{"sparse/0/images.txt", "text"}}}});
-  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.txt"), "text");
+  EXPECT_EQ(ReadTextFile(dir.path() / "sparse/0/images.txt"), "text");
   EXPECT_FALSE(fs::exists(dir.path() / "sparse/0/images.bin"));
   EXPECT_FALSE(fs::exists(dir.path() / "sparse/1"));
   EXPECT_FALSE(fs::exists(dir.path() / "model.ply"));
@@ -80,13 +72,13 @@ TEST(OutputTransaction, ARerunRemovesWhatItsSetNoLongerHolds) {
 // reader would take them for Tessera's models.
 TEST(OutputTransaction, WhatTesseraDidNotWriteIsLeftAndNamed) {
   const testing::TemporaryDir dir;
-  WriteText(dir.path() / "sparse/1/notes.txt", "mine");
-  WriteText(dir.path() / "sparse/2/images.bin", "theirs");
+  WriteTextFile(dir.path() / "sparse/1/notes.txt", "mine");
+  WriteTextFile(dir.path() / "sparse/2/images.bin", "theirs");
   CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "a"}}}});
   const auto result = CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "b"}}}});
-  EXPECT_EQ(ReadText(dir.path() / "sparse/1/notes.txt"), "mine");
-  EXPECT_EQ(ReadText(dir.path() / "sparse/2/images.bin"), "theirs");
-  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.bin"), "b");
+  EXPECT_EQ(ReadTextFile(dir.path() / "sparse/1/notes.txt"), "mine");
+  EXPECT_EQ(ReadTextFile(dir.path() / "sparse/2/images.bin"), "theirs");
+  EXPECT_EQ(ReadTextFile(dir.path() / "sparse/0/images.bin"), "b");
   EXPECT_TRUE(Mentions(result.warnings, (dir.path() / "sparse/1").string()));
   EXPECT_TRUE(Mentions(result.warnings, (dir.path() / "sparse/2").string()));
 }
@@ -96,19 +88,19 @@ TEST(OutputTransaction, WhatTesseraDidNotWriteIsLeftAndNamed) {
 TEST(OutputTransaction, AFolderWithAFileOfTheUsersIsReplacedFileByFile) {
   const testing::TemporaryDir dir;
   CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "a"}}}});
-  WriteText(dir.path() / "sparse/0/notes.txt", "mine");
+  WriteTextFile(dir.path() / "sparse/0/notes.txt", "mine");
   CommitSet(dir.path(), {{"colmap_text", {{"sparse/0/images.txt", "b"}}}});
-  EXPECT_EQ(ReadText(dir.path() / "sparse/0/notes.txt"), "mine");
-  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.txt"), "b");
+  EXPECT_EQ(ReadTextFile(dir.path() / "sparse/0/notes.txt"), "mine");
+  EXPECT_EQ(ReadTextFile(dir.path() / "sparse/0/images.txt"), "b");
   EXPECT_FALSE(fs::exists(dir.path() / "sparse/0/images.bin"));
 }
 
 TEST(OutputTransaction, RefusesToReplaceAFileTesseraDidNotWriteAndMovesNothing) {
   const testing::TemporaryDir dir;
-  WriteText(dir.path() / "sparse/0/images.bin", "theirs");
+  WriteTextFile(dir.path() / "sparse/0/images.bin", "theirs");
   OutputTransaction outputs(dir.path());
-  WriteText(outputs.StageFor("colmap_binary") / "sparse/0/images.bin", "ours");
-  WriteText(outputs.StageFor("ply") / "model.ply", "p");
+  WriteTextFile(outputs.StageFor("colmap_binary") / "sparse/0/images.bin", "ours");
+  WriteTextFile(outputs.StageFor("ply") / "model.ply", "p");
   try {
     outputs.Commit();
     FAIL() << "no error";
@@ -118,7 +110,7 @@ TEST(OutputTransaction, RefusesToReplaceAFileTesseraDidNotWriteAndMovesNothing) 
         << error.what();
     EXPECT_NE(std::string(error.what()).find("colmap_binary"), std::string::npos);
   }
-  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.bin"), "theirs");
+  EXPECT_EQ(ReadTextFile(dir.path() / "sparse/0/images.bin"), "theirs");
   EXPECT_FALSE(fs::exists(dir.path() / "model.ply"));  // nothing of the set moved
   EXPECT_TRUE(fs::exists(outputs.staging_folder()));   // kept until the next run
 }
@@ -126,9 +118,9 @@ TEST(OutputTransaction, RefusesToReplaceAFileTesseraDidNotWriteAndMovesNothing) 
 TEST(OutputTransaction, ChangedOutputsOfAnEarlierRunAreLeftWithAWarning) {
   const testing::TemporaryDir dir;
   CommitSet(dir.path(), {{"ply", {{"model.ply", "p"}}}});
-  WriteText(dir.path() / "model.ply", "edited by hand");
+  WriteTextFile(dir.path() / "model.ply", "edited by hand");
   const auto result = CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "a"}}}});
-  EXPECT_EQ(ReadText(dir.path() / "model.ply"), "edited by hand");
+  EXPECT_EQ(ReadTextFile(dir.path() / "model.ply"), "edited by hand");
   EXPECT_TRUE(Mentions(result.warnings, "model.ply"));
   // No longer Tessera's: a later set may not replace it either.
   EXPECT_THROW(CommitSet(dir.path(), {{"ply", {{"model.ply", "q"}}}}), InputError);
@@ -136,12 +128,12 @@ TEST(OutputTransaction, ChangedOutputsOfAnEarlierRunAreLeftWithAWarning) {
 
 TEST(OutputTransaction, AnExporterMayNotWriteTheWorkspacesOwnFiles) {
   const testing::TemporaryDir dir;
-  WriteText(dir.path() / "database.db", "db");
+  WriteTextFile(dir.path() / "database.db", "db");
   for (const std::string name :
        {"database.db", "cache/x", ".tessera.lock", "run_summary.json", "mapping_summary.json"}) {
     EXPECT_THROW(CommitSet(dir.path(), {{"transforms_json", {{name, "{}"}}}}), InputError) << name;
   }
-  EXPECT_EQ(ReadText(dir.path() / "database.db"), "db");
+  EXPECT_EQ(ReadTextFile(dir.path() / "database.db"), "db");
 }
 
 // run_summary.json: the host's, recorded like any output, and removed by the next whole
@@ -176,19 +168,19 @@ TEST(OutputTransaction, TwoWritersOfOneFileAreRefusedNamingBoth) {
 TEST(OutputTransaction, NothingIsWrittenOrDeletedThroughALink) {
   const testing::TemporaryDir dir;
   const fs::path elsewhere = dir.path() / "elsewhere";
-  WriteText(elsewhere / "0/images.bin", "precious");
+  WriteTextFile(elsewhere / "0/images.bin", "precious");
   const fs::path output = dir.path() / "out";
   fs::create_directories(output);
   fs::create_directory_symlink(elsewhere, output / "sparse");
   EXPECT_THROW(CommitSet(output, {{"colmap_binary", {{"sparse/0/images.bin", "a"}}}}), InputError);
-  EXPECT_EQ(ReadText(elsewhere / "0/images.bin"), "precious");
+  EXPECT_EQ(ReadTextFile(elsewhere / "0/images.bin"), "precious");
   // A link where Tessera's file was: not Tessera's any more, not followed.
   const fs::path output2 = dir.path() / "out2";
   CommitSet(output2, {{"ply", {{"model.ply", "p"}}}});
   fs::remove(output2 / "model.ply");
   fs::create_symlink(elsewhere / "0/images.bin", output2 / "model.ply");
   CommitSet(output2, {{"colmap_binary", {{"sparse/0/images.bin", "a"}}}});
-  EXPECT_EQ(ReadText(elsewhere / "0/images.bin"), "precious");
+  EXPECT_EQ(ReadTextFile(elsewhere / "0/images.bin"), "precious");
   EXPECT_TRUE(fs::is_symlink(output2 / "model.ply"));
 }
 
@@ -200,17 +192,17 @@ TEST(OutputTransaction, AProtectedFolderIsNeverReplacedOrWrittenIn) {
   {
     OutputTransaction outputs(dir.path());
     outputs.Protect(dir.path() / "gaussian_splatting/images");
-    WriteText(outputs.StageFor("gaussian_splatting") / "gaussian_splatting/images/b.jpg", "b");
+    WriteTextFile(outputs.StageFor("gaussian_splatting") / "gaussian_splatting/images/b.jpg", "b");
     EXPECT_THROW(outputs.Commit(), InputError);
   }
-  EXPECT_EQ(ReadText(dir.path() / "gaussian_splatting/images/a.jpg"), "a");
+  EXPECT_EQ(ReadTextFile(dir.path() / "gaussian_splatting/images/a.jpg"), "a");
   {
     OutputTransaction outputs(dir.path());  // a set without it would remove it
     outputs.Protect(dir.path() / "gaussian_splatting/images");
-    WriteText(outputs.StageFor("ply") / "model.ply", "p");
+    WriteTextFile(outputs.StageFor("ply") / "model.ply", "p");
     outputs.Commit();
   }
-  EXPECT_EQ(ReadText(dir.path() / "gaussian_splatting/images/a.jpg"), "a");
+  EXPECT_EQ(ReadTextFile(dir.path() / "gaussian_splatting/images/a.jpg"), "a");
 }
 
 // A kill between the ledger's journal and the last rename leaves files that all count
@@ -221,19 +213,19 @@ TEST(OutputTransaction, LeftoversOfAKilledRunAreRemovedAndItsOutputsStayTesseras
   // As a kill leaves it: the journal accepts both versions, one is in place, the
   // staging folder and an atomic write's temporary remain.
   OutputLedger journal = OutputLedger::Read(dir.path());
-  WriteText(dir.path() / "new.bin", "new");
+  WriteTextFile(dir.path() / "new.bin", "new");
   journal.AddFile("sparse/0/images.bin", DigestFile(dir.path() / "new.bin"));
   fs::remove(dir.path() / "new.bin");
   journal.Write(dir.path());
-  WriteText(dir.path() / "sparse/0/images.bin", "new");
+  WriteTextFile(dir.path() / "sparse/0/images.bin", "new");
   const fs::path leftover = dir.path() / OutputTransaction::kStagingFolderName / "1/set/x";
-  WriteText(leftover, "partial");
+  WriteTextFile(leftover, "partial");
   // The ledger's temporary, as a kill during its write leaves it ("." + ".tessera_outputs...").
   const fs::path ledger_temporary =
       dir.path() / "..tessera_outputs.json.tessera-tmp-999999999-0123456789abcdef";
-  WriteText(ledger_temporary, "partial");
+  WriteTextFile(ledger_temporary, "partial");
   CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "newer"}}}});
-  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.bin"), "newer");
+  EXPECT_EQ(ReadTextFile(dir.path() / "sparse/0/images.bin"), "newer");
   EXPECT_FALSE(fs::exists(leftover));
   EXPECT_FALSE(fs::exists(ledger_temporary));
 }
@@ -256,14 +248,14 @@ TEST(OutputTransaction, FilesNamedLikeTemporariesThatAreNotTesserasAreKept) {
       dir.path() / "sparse/0/.images.bin.tessera-tmp-999999-0123456789abcdef",
       dir.path() / "photos/..tessera_outputs.json.tessera-tmp-999999-0123456789abcdef",
   };
-  for (const fs::path& path : users) WriteText(path, "mine");
+  for (const fs::path& path : users) WriteTextFile(path, "mine");
   // A forged ledger naming the user's folder.
   OutputLedger forged = OutputLedger::Read(dir.path());
   forged.AddFolder("photos");
   forged.Write(dir.path());
   CommitSet(dir.path(), {{"colmap_binary", {{"sparse/0/images.bin", "b"}}}},
             OutputTransaction::Mode::kAddToSet);
-  for (const fs::path& path : users) EXPECT_EQ(ReadText(path), "mine") << path;
+  for (const fs::path& path : users) EXPECT_EQ(ReadTextFile(path), "mine") << path;
 }
 
 TEST(OutputTransaction, AddingToTheSetKeepsTheOtherModels) {
@@ -277,8 +269,8 @@ TEST(OutputTransaction, AddingToTheSetKeepsTheOtherModels) {
             {{"colmap_text", {{"sparse/1/images.txt", "1"}}},
              {"gaussian_splatting", {{"gaussian_splatting/images/a.jpg", "a2"}}}},
             OutputTransaction::Mode::kAddToSet);
-  EXPECT_EQ(ReadText(dir.path() / "sparse/0/images.bin"), "0");
-  EXPECT_EQ(ReadText(dir.path() / "sparse/1/images.txt"), "1");
+  EXPECT_EQ(ReadTextFile(dir.path() / "sparse/0/images.bin"), "0");
+  EXPECT_EQ(ReadTextFile(dir.path() / "sparse/1/images.txt"), "1");
   EXPECT_FALSE(fs::exists(dir.path() / "sparse/1/images.bin"));  // the model folder, whole
   EXPECT_FALSE(fs::exists(dir.path() / "gaussian_splatting/images/b.jpg"));
   // The files it kept are still Tessera's: a whole set removes them.
@@ -288,7 +280,7 @@ TEST(OutputTransaction, AddingToTheSetKeepsTheOtherModels) {
 
 TEST(OutputLedger, ARecordThatIsNotALedgerIsAnErrorNamingIt) {
   const testing::TemporaryDir dir;
-  WriteText(dir.path() / OutputLedger::kFileName, "not json");
+  WriteTextFile(dir.path() / OutputLedger::kFileName, "not json");
   try {
     OutputLedger::Read(dir.path());
     FAIL() << "no error";

@@ -9,7 +9,7 @@
 namespace tessera {
 namespace {
 
-MappingSummary Example() {
+MappingSummary ExampleMappingSummary() {
   MappingSummary summary;
   MappingSummary::Model model;
   model.index = 0;
@@ -35,7 +35,7 @@ MappingSummary Example() {
 }
 
 TEST(MappingSummary, JsonKeys) {
-  const nlohmann::json json = Example().ToJson();
+  const nlohmann::json json = ExampleMappingSummary().ToJson();
   const nlohmann::json& model = json.at("models").at(0);
   EXPECT_EQ(model.at("num_points3D").get<size_t>(), 1200u);
   EXPECT_DOUBLE_EQ(model.at("view_graph_check").at("agreement").get<double>(), 0.875);
@@ -53,7 +53,7 @@ TEST(MappingSummary, JsonKeys) {
 
 TEST(MappingSummary, RoundTripThroughAFile) {
   const testing::TemporaryDir dir;
-  const MappingSummary summary = Example();
+  const MappingSummary summary = ExampleMappingSummary();
   summary.Write(dir.path() / "mapping_summary.json");
   const MappingSummary back = MappingSummary::Read(dir.path() / "mapping_summary.json");
   EXPECT_EQ(back.ToJson(), summary.ToJson());
@@ -69,7 +69,7 @@ TEST(MappingSummary, RoundTripThroughAFile) {
 // `rig` is written only with a rig (json.size() above counts without), and read back.
 TEST(MappingSummary, RigSectionRoundTrips) {
   const testing::TemporaryDir dir;
-  MappingSummary summary = Example();
+  MappingSummary summary = ExampleMappingSummary();
   summary.rig = {{"file", "rig.json"}, {"digest", "0123456789abcdef"}, {"poses_known", false}};
   summary.Write(dir.path() / "mapping_summary.json");
   const MappingSummary back = MappingSummary::Read(dir.path() / "mapping_summary.json");

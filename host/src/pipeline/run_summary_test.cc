@@ -7,7 +7,7 @@
 namespace tessera {
 namespace {
 
-RunSummary Example() {
+RunSummary ExampleRunSummary() {
   RunSummary summary;
   summary.extract = {StageStatus::kCompleted, 11, 1, 9, 2, 70000, 0, 3, 4, 1.5, 5};
   summary.match.num_pairs = 55;
@@ -30,7 +30,7 @@ RunSummary Example() {
 }
 
 TEST(RunSummary, JsonHasTheKeysBenchReads) {
-  const nlohmann::json json = Example().ToJson();
+  const nlohmann::json json = ExampleRunSummary().ToJson();
   EXPECT_DOUBLE_EQ(json.at("extract").at("seconds").get<double>(), 1.5);
   EXPECT_EQ(json.at("extract").at("num_images").get<size_t>(), 11u);
   EXPECT_EQ(json.at("match").at("num_pairs").get<size_t>(), 55u);
@@ -55,7 +55,7 @@ TEST(RunSummary, JsonHasTheKeysBenchReads) {
 }
 
 TEST(RunSummary, RoundTrip) {
-  const RunSummary summary = Example();
+  const RunSummary summary = ExampleRunSummary();
   const RunSummary back = RunSummary::FromJson(nlohmann::json::parse(summary.ToJson().dump(2)));
   EXPECT_EQ(back.ToJson(), summary.ToJson());
   EXPECT_EQ(back.extract.num_detected, 9u);
@@ -76,7 +76,7 @@ TEST(RunSummary, RoundTrip) {
 }
 
 TEST(RunSummary, OlderFilesWithoutPairsPerSelectorOrImagesPerModelRead) {
-  nlohmann::json json = Example().ToJson();
+  nlohmann::json json = ExampleRunSummary().ToJson();
   json["match"].erase("pairs_per_selector");
   json["map"].erase("images_per_model");
   json["map"].erase("kept");
@@ -93,10 +93,10 @@ TEST(RunSummary, OlderFilesWithoutPairsPerSelectorOrImagesPerModelRead) {
 }
 
 TEST(RunSummary, MissingOrMistypedFieldThrows) {
-  nlohmann::json json = Example().ToJson();
+  nlohmann::json json = ExampleRunSummary().ToJson();
   json["map"].erase("num_models");
   EXPECT_THROW(RunSummary::FromJson(json), nlohmann::json::exception);
-  json = Example().ToJson();
+  json = ExampleRunSummary().ToJson();
   json["total_seconds"] = "soon";
   EXPECT_THROW(RunSummary::FromJson(json), nlohmann::json::exception);
 }

@@ -25,7 +25,7 @@ namespace tessera {
 namespace {
 
 // Seed streams of the run's random choices.
-constexpr uint64_t kViewGraphStream = 1;
+constexpr uint64_t kGlobalViewGraphStream = 1;
 constexpr uint64_t kPositioningStream = 2;  // + the part's index
 
 // Retriangulation and adjustment again while the last adjustment moved a camera by more
@@ -308,8 +308,9 @@ void GlobalMapper::CalibrateCameras() {
 
 GlobalMapper::Status GlobalMapper::BuildViewGraph() {
   if (Stop()) return Status::kCancelled;
-  view_graph_ = ViewGraph::Build(input_, cameras_, pairs_,
-                                 DeriveSeed(options_.seed, kViewGraphStream), options_.num_threads);
+  view_graph_ =
+      ViewGraph::Build(input_, cameras_, pairs_, DeriveSeed(options_.seed, kGlobalViewGraphStream),
+                       options_.num_threads);
   if (options_.filter_view_graph) {
     result_.num_pairs_dropped_by_cycles =
         view_graph_.FilterByRotationCycles(options_.view_graph_max_cycle_error, 3);

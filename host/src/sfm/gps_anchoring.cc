@@ -14,6 +14,7 @@
 #include "sfm/option_ranges.h"
 #include "tessera/sfm/gps_similarity.h"
 #include "util/random.h"
+#include "util/statistics.h"
 
 namespace tessera {
 namespace {
@@ -41,12 +42,6 @@ Eigen::Matrix3d EnuFromEcefRotation(const Georeference& origin) {
       -std::sin(lat) * std::cos(lon), -std::sin(lat) * std::sin(lon), std::cos(lat),  //
       std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat);
   return rotation;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
 }
 
 }  // namespace
@@ -122,9 +117,9 @@ Georeference MedianPosition(const std::map<image_t, ImageMetadata>& metadata,
     if (gps.altitude_m) altitudes.push_back(*gps.altitude_m);
   }
   Georeference median;
-  median.latitude_deg = Median(latitudes);
-  median.longitude_deg = Median(longitudes);
-  median.altitude_m = Median(altitudes);
+  median.latitude_deg = UpperMedian(latitudes);
+  median.longitude_deg = UpperMedian(longitudes);
+  median.altitude_m = UpperMedian(altitudes);
   return median;
 }
 
@@ -152,13 +147,13 @@ std::vector<image_t> SetAsideImpossibleTags(const std::map<image_t, ImageMetadat
       if (!gps.altitude_m) gps.altitude_m = median.altitude_m;
       distances.push_back(EnuFromWgs84(gps, median).norm());
     }
-    const double median_distance = Median(distances);
+    const double median_distance = UpperMedian(distances);
     std::vector<double> deviations;
     for (const double distance : distances)
       deviations.push_back(std::abs(distance - median_distance));
     const double limit =
         std::max(options.far_tag_floor_m,
-                 median_distance + options.far_tag_mads * 1.4826 * Median(deviations));
+                 median_distance + options.far_tag_mads * 1.4826 * UpperMedian(deviations));
     std::vector<image_t> near;
     for (size_t i = 0; i < plausible.size(); ++i) {
       if (distances[i] <= limit) {
@@ -291,7 +286,7 @@ GpsSimilarity EstimateGpsSimilarity(const std::map<image_t, ImageMetadata>& meta
   for (size_t i = 0; i < geotagged.size(); ++i)
     errors.push_back((sim * centres[i] - enu[i]).norm());
   report.mean_error_m = std::accumulate(errors.begin(), errors.end(), 0.0) / errors.size();
-  report.median_error_m = Median(errors);
+  report.median_error_m = UpperMedian(errors);
   report.anchored = true;
   return result;
 }
@@ -332,7 +327,7 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
         (anchored.images.at(found.images[i]).ProjectionCenter() - found.enu[i]).norm());
   }
   report.mean_error_m = std::accumulate(errors.begin(), errors.end(), 0.0) / errors.size();
-  report.median_error_m = Median(errors);
+  report.median_error_m = UpperMedian(errors);
   if (report.median_error_m > found.threshold_m) {
     report.reason = "its GPS contradicts it: after adjustment the median camera is " +
                     std::to_string(report.median_error_m) + " m from its GPS position";

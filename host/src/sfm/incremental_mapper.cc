@@ -17,12 +17,12 @@
 #include "sfm/rig_poses.h"
 #include "tessera/io/model_statistics.h"
 #include "tessera/sfm/camera_plausibility.h"
+#include "util/angles.h"
 #include "util/random.h"
+#include "util/statistics.h"
 
 namespace tessera {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
 
 // The options, once checked: before any member is built from them.
 const IncrementalMapperOptions& Checked(const IncrementalMapperOptions& options) {
@@ -39,7 +39,7 @@ spdlog::level::level_enum StepLevel(MapperLogging logging) {
   return logging == MapperLogging::kQuiet ? spdlog::level::debug : spdlog::level::info;
 }
 // The view graph's seed stream (see MapperRansacOptions for the estimators').
-constexpr uint64_t kViewGraphStream = 4;
+constexpr uint64_t kIncrementalViewGraphStream = 4;
 // See IncrementalMapper::NextImages. The penalty puts weakly connected images after
 // every strongly connected one in the next-best-view order (scores are below 300).
 constexpr double kMinConnectionStrength = 0.8;
@@ -50,13 +50,6 @@ bool CanInitialize(const TwoViewGeometry& geometry) {
   return geometry.config == TwoViewGeometry::CALIBRATED ||
          geometry.config == TwoViewGeometry::UNCALIBRATED ||
          geometry.config == TwoViewGeometry::PLANAR;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  return values[mid];
 }
 
 double AngleBetweenDeg(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
@@ -138,8 +131,8 @@ const char* StatusName(IncrementalMapper::Status status) {
 
 size_t MapperRunState::Prepare(const IncrementalMapperOptions& options,
                                const std::vector<const MapperInput::Pair*>& pairs) {
-  view_graph = ViewGraph::Build(input, cameras, pairs, DeriveSeed(seed, kViewGraphStream),
-                                options.num_threads);
+  view_graph = ViewGraph::Build(input, cameras, pairs,
+                                DeriveSeed(seed, kIncrementalViewGraphStream), options.num_threads);
   size_t num_dropped = 0;
   if (options.filter_view_graph) {
     constexpr size_t kMinNumCycles = 3;
@@ -242,7 +235,7 @@ bool IncrementalMapper::EvaluateInitialPair(const MapperInput::Pair& pair,
     angles.push_back(angle);
     result->points.push_back({track1, matches[i].point2D_idx1, matches[i].point2D_idx2, xyz});
   }
-  result->median_angle = Median(angles);
+  result->median_angle = UpperMedian(angles);
   if (result->points.size() < static_cast<size_t>(options_.init_min_num_inliers)) return false;
   // Many well-triangulated points, discounted when the median angle is below the goal.
   result->score =

@@ -7,13 +7,10 @@
 
 #include "geometry/triangulation.h"
 #include "sfm/option_ranges.h"
+#include "util/angles.h"
 
 namespace tessera {
-namespace {
-
-constexpr double kDegToRad = M_PI / 180.0;
-
-}  // namespace
+namespace {}  // namespace
 
 IncrementalTriangulator::IncrementalTriangulator(const IncrementalTriangulatorOptions& options,
                                                  ObservationManager* observations)

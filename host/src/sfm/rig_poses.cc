@@ -8,15 +8,10 @@
 #include <string>
 #include <utility>
 
+#include "util/statistics.h"
+
 namespace tessera {
 namespace {
-
-double Median(std::vector<double> values) {
-  const size_t middle = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(middle),
-                   values.end());
-  return values[middle];
-}
 
 // The mean of unit quaternions of nearby rotations: their sum, each on the hemisphere
 // of the first, normalised.
@@ -69,9 +64,9 @@ std::optional<Rigid3d> EstimateCamFromRig(const CameraRig& rig, camera_t camera_
   }
   *num_frames = rotations.size();
   if (rotations.empty()) return std::nullopt;
-  return Rigid3d(
-      MeanRotation(rotations),
-      Eigen::Vector3d(Median(translations[0]), Median(translations[1]), Median(translations[2])));
+  return Rigid3d(MeanRotation(rotations),
+                 Eigen::Vector3d(UpperMedian(translations[0]), UpperMedian(translations[1]),
+                                 UpperMedian(translations[2])));
 }
 
 }  // namespace

@@ -9,11 +9,10 @@
 #include <queue>
 
 #include "sfm/option_ranges.h"
+#include "util/angles.h"
 
 namespace tessera {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180;
 
 Eigen::Vector3d LogRotation(const Eigen::Matrix3d& R) {
   const Eigen::AngleAxisd angle_axis(R);

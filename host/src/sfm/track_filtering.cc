@@ -7,10 +7,10 @@
 #include <limits>
 #include <vector>
 
+#include "util/angles.h"
+
 namespace tessera {
 namespace {
-
-constexpr double kDegToRad = M_PI / 180;
 
 // Removes the observations of every point for which `bad` says so.
 size_t FilterObservations(

@@ -9,13 +9,13 @@
 #include "estimators/essential_matrix.h"
 #include "estimators/ransac.h"
 #include "geometry/essential_matrix.h"
+#include "util/angles.h"
 #include "util/parallel.h"
 #include "util/random.h"
 
 namespace tessera {
 namespace {
 
-constexpr double kRadToDeg = 180.0 / M_PI;
 // Five-point RANSAC on a pair's verified inliers: its threshold, and the share of them
 // the essential matrix must keep (most: they already fit the pair's F or H).
 constexpr double kMaxErrorPx = 4.0;

@@ -9,11 +9,10 @@
 #include "tessera/io/model_statistics.h"
 #include "tessera/testing/synthetic_model.h"
 #include "test_support.h"
+#include "util/angles.h"
 
 namespace tessera {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // The synthetic scene with half a pixel of noise on every keypoint, so that its own
 // poses are not the optimum, and its reprojection error not zero.

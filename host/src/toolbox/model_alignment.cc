@@ -17,20 +17,13 @@
 #include "tessera/io/georeference_io.h"
 #include "tessera/sfm/gps_similarity.h"
 #include "toolbox/toolbox_outputs.h"
+#include "util/angles.h"
 #include "util/random.h"
+#include "util/statistics.h"
 #include "util/timer.h"
 
 namespace tessera {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0;
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
-}
 
 // The median distance of `positions` from their coordinate-wise median: a scale of the
 // scene that outliers do not move.
@@ -39,11 +32,11 @@ double RobustSpread(const std::vector<Eigen::Vector3d>& positions) {
   for (int axis = 0; axis < 3; ++axis) {
     std::vector<double> values;
     for (const Eigen::Vector3d& position : positions) values.push_back(position(axis));
-    median(axis) = Median(values);
+    median(axis) = UpperMedian(values);
   }
   std::vector<double> distances;
   for (const Eigen::Vector3d& position : positions) distances.push_back((position - median).norm());
-  return Median(distances);
+  return UpperMedian(distances);
 }
 
 void SetResiduals(const std::vector<double>& residuals, Alignment* alignment) {
@@ -314,7 +307,7 @@ Alignment AlignUpright(const Reconstruction& model, const std::string& model_nam
       }
       alignment.num_inliers = alignment.inlier_point_ids.size();
       alignment.new_from_old.rotation = level * alignment.new_from_old.rotation;
-      alignment.new_from_old.translation = Eigen::Vector3d(0, 0, -Median(heights));
+      alignment.new_from_old.translation = Eigen::Vector3d(0, 0, -UpperMedian(heights));
       plane_json["found"] = true;
       plane_json["normal_tilt_deg"] = AngleDeg(normal, Eigen::Vector3d::UnitZ());
     }

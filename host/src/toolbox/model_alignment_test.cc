@@ -10,11 +10,10 @@
 #include "tessera/sfm/gps_anchoring.h"
 #include "tessera/testing/synthetic_model.h"
 #include "test_support.h"
+#include "util/angles.h"
 
 namespace tessera {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 Reconstruction Scene() {
   const Camera camera = Camera::Create(1, CameraModelId::kSimpleRadial, 500, 640, 480);
