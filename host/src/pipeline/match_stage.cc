@@ -29,7 +29,10 @@ DescriptorMetric MetricFromName(const std::string& name) {
                                                                   : DescriptorMetric::kL2;
 }
 
-// One image's features as matching and verification need them.
+}  // namespace
+
+// One image's features as matching and verification need them (outside the anonymous
+// namespace, as the cache below that holds them is PairMatchVerifier's).
 struct ImageFeatures {
   FeatureKeypoints keypoints;
   FeatureDescriptors descriptors;
@@ -44,11 +47,10 @@ struct ImageFeatures {
 // selectors' order, which is local for sequential selectors and revisits the first
 // image of a row for exhaustive ones, so most reads hit. Thread-safe; an entry in use
 // outlives its eviction through its shared_ptr.
-class LruFeatureCache {
+class PairMatchVerifier::FeatureCache {
  public:
   // `dimension` > 0: every descriptor row read must have that width.
-  LruFeatureCache(const Database* database, DescriptorMetric metric, int dimension,
-                  size_t max_bytes)
+  FeatureCache(const Database* database, DescriptorMetric metric, int dimension, size_t max_bytes)
       : database_(database),
         metric_(metric),
         dimension_(dimension > 0 ? dimension : -1),
@@ -95,6 +97,8 @@ class LruFeatureCache {
   std::unordered_map<image_t, Entry> entries_;
   size_t bytes_ = 0;
 };
+
+namespace {
 
 // About 800 images of 8192 SIFT features (1.2 MB each); more are read again.
 constexpr size_t kFeatureCacheBytes = size_t{1} << 30;
@@ -282,10 +286,6 @@ MatchPlan PlanMatching(const Workspace& workspace, const MatchSettings& settings
   }
   return plan;
 }
-
-class PairMatchVerifier::FeatureCache : public LruFeatureCache {
-  using LruFeatureCache::LruFeatureCache;
-};
 
 PairMatchVerifier::PairMatchVerifier(const MatchSettings& settings, const MatchPlan& plan,
                                      const WorkspaceDescriptors& descriptors,

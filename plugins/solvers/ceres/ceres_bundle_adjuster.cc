@@ -39,8 +39,6 @@ struct CeresBundleAdjusterOptions {
   bool minimizer_progress = false;
 };
 
-}  // namespace
-
 class CeresBundleAdjuster : public BundleAdjuster {
  public:
   explicit CeresBundleAdjuster(const nlohmann::json& options) {
@@ -111,6 +109,7 @@ class CeresBundleAdjuster : public BundleAdjuster {
   CeresBundleAdjusterOptions options_;
 };
 
+}  // namespace
 }  // namespace tessera
 
 TESSERA_PLUGIN(bundle_adjuster, tessera::CeresBundleAdjuster, "ceres", "1.0.0",
