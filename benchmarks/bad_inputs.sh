@@ -78,7 +78,7 @@ check "misspelt plugin" 2 "pipeline.detector.plugin: no detector plugin 'sfit'; 
 check "missing manifest" 2 "nonexistent.json: cannot read the manifest" "" -- \
   t run --images "$work/all" --output "$work/o5" --manifest "$work/nonexistent.json"
 echo '{"threads": -3}' > "$work/threads.json"
-check "negative threads" 2 "threads.json: threads: = -3 is out of range" "" -- \
+check "negative threads" 2 "threads.json: threads = -3 is out of range" "" -- \
   t run --images "$work/all" --output "$work/o6" --manifest "$work/threads.json"
 
 # Exporter paths.
