@@ -15,8 +15,11 @@
 #include <vector>
 
 #include "bindings.h"
+#include "distributed/shard_plan.h"
+#include "distributed/sharded_stages.h"
 #include "errors.h"
 #include "json_objects.h"
+#include "partition/map_modes.h"
 #include "pipeline/export_model.h"
 #include "pipeline/run_pipeline.h"
 #include "pipeline/stage_arguments.h"
@@ -25,6 +28,7 @@
 #include "toolbox/model_adjustment.h"
 #include "toolbox/model_alignment.h"
 #include "toolbox/triangulate_known_poses.h"
+#include "util/paths.h"
 #include "util/workspace_layout.h"
 
 namespace py = pybind11;
@@ -40,8 +44,9 @@ std::string PathText(const OptionalPath& path) { return path ? path->string() : 
 StageArguments MakeArguments(const py::object& manifest, const OptionalPath& camera_K,
                              const OptionalPath& masks,
                              const std::vector<std::filesystem::path>& videos, int threads,
-                             bool camera_per_folder = false) {
+                             bool camera_per_folder = false, const OptionalPath& rig = {}) {
   StageArguments arguments;
+  arguments.rig = PathText(rig);
   if (py::isinstance<py::dict>(manifest)) {
     arguments.manifest_json = ToJson(manifest);
   } else if (!manifest.is_none()) {
@@ -78,9 +83,15 @@ void CheckModels(const MapStageSummary& summary, const std::filesystem::path& ou
         NoModelMessage(output / workspace_layout::kDatabase, /*warnings_logged=*/true));
 }
 
+// `shard` ("K/N", extract and match): checked before the child starts.
+std::optional<Shard> ShardOf(const std::optional<std::string>& shard) {
+  return shard ? std::optional<Shard>(ParseShard(*shard)) : std::nullopt;
+}
+
 // The keywords the verbs share, in the CLI's terms, and what the docstrings say of them.
 const char* const kCommonDoc =
-    " manifest: a file or a dict (default: default.json); camera_K: a K.txt file; "
+    " manifest: a file, a bundled recipe's name or a dict (default: default.json); camera_K: "
+    "a K.txt file; "
     "camera_per_folder (run, extract): images in different subfolders never share a camera; "
     "threads: "
     "0 for the manifest's; progress(stage, done, total): called with the GIL held, an "
@@ -95,6 +106,9 @@ py::arg_v CameraPerFolderArg() { return py::arg("camera_per_folder") = false; }
 py::arg_v VideosArg() { return py::arg("videos") = std::vector<std::filesystem::path>(); }
 py::arg_v ThreadsArg() { return py::arg("threads") = 0; }
 py::arg_v ProgressArg() { return py::arg("progress") = py::none(); }
+py::arg_v RigArg() { return py::arg("rig") = py::none(); }
+py::arg_v ForceMapArg() { return py::arg("force_map") = false; }
+py::arg_v ShardArg() { return py::arg("shard") = py::none(); }
 
 // `run` and `extract`: images (or videos) in.
 void BindImageStages(py::module_& module) {
@@ -103,10 +117,11 @@ void BindImageStages(py::module_& module) {
       [](const OptionalPath& images, const std::filesystem::path& output,
          const py::object& manifest, const OptionalPath& camera_K, const OptionalPath& masks,
          const std::vector<std::filesystem::path>& videos, int threads, const py::object& progress,
-         bool camera_per_folder) {
-        const RunOptions options = MakeRunOptions(images, output, videos, true);
+         bool camera_per_folder, const OptionalPath& rig, bool force_map) {
+        RunOptions options = MakeRunOptions(images, output, videos, true);
+        options.force_map = force_map;
         const StageArguments arguments =
-            MakeArguments(manifest, camera_K, masks, videos, threads, camera_per_folder);
+            MakeArguments(manifest, camera_K, masks, videos, threads, camera_per_folder, rig);
         return ToPython(RunInChildProcess("run", progress, [&](const StageControl& control) {
           const RunResult run = RunPipeline(LoadPipelineContext(arguments), options, control);
           if (!control.Cancelled()) CheckModels(run.summary.map, output);
@@ -114,7 +129,7 @@ void BindImageStages(py::module_& module) {
         }));
       },
       ImagesArg(), py::arg("output"), ManifestArg(), CameraKArg(), MasksArg(), VideosArg(),
-      ThreadsArg(), ProgressArg(), CameraPerFolderArg(),
+      ThreadsArg(), ProgressArg(), CameraPerFolderArg(), RigArg(), ForceMapArg(),
       (std::string("Every stage, images in, models out (`tessera run`); returns "
                    "run_summary.json as a dict, NoModelError when no model was built.") +
        kCommonDoc)
@@ -125,18 +140,22 @@ void BindImageStages(py::module_& module) {
       [](const OptionalPath& images, const std::filesystem::path& output,
          const py::object& manifest, const OptionalPath& camera_K, const OptionalPath& masks,
          const std::vector<std::filesystem::path>& videos, int threads, const py::object& progress,
-         bool camera_per_folder) {
+         bool camera_per_folder, const std::optional<std::string>& shard_text) {
         const RunOptions options = MakeRunOptions(images, output, videos, true);
+        const std::optional<Shard> shard = ShardOf(shard_text);
+        if (shard && !videos.empty()) throw InputError("shard: extracts images, not videos");
         const StageArguments arguments =
             MakeArguments(manifest, camera_K, masks, videos, threads, camera_per_folder);
         return ToPython(RunInChildProcess("extract", progress, [&](const StageControl& control) {
           RunSummary summary;
-          summary.extract = RunExtract(LoadPipelineContext(arguments), options, control);
+          summary.extract =
+              shard ? RunExtractShard(LoadPipelineContext(arguments), options, *shard, control)
+                    : RunExtract(LoadPipelineContext(arguments), options, control);
           return StageJson("extract", summary);
         }));
       },
       ImagesArg(), py::arg("output"), ManifestArg(), CameraKArg(), MasksArg(), VideosArg(),
-      ThreadsArg(), ProgressArg(), CameraPerFolderArg(),
+      ThreadsArg(), ProgressArg(), CameraPerFolderArg(), ShardArg(),
       (std::string("Ingests images and detects features (`tessera extract`); returns the "
                    "summary's 'extract' part.") +
        kCommonDoc)
@@ -148,15 +167,21 @@ void BindWorkspaceStages(py::module_& module) {
   module.def(
       "match",
       [](const std::filesystem::path& output, const py::object& manifest,
-         const OptionalPath& camera_K, int threads, const py::object& progress) {
+         const OptionalPath& camera_K, int threads, const py::object& progress,
+         const OptionalPath& images, const std::optional<std::string>& shard_text) {
         const StageArguments arguments = MakeArguments(manifest, camera_K, {}, {}, threads);
+        const RunOptions options(images.value_or(std::filesystem::path()), output);
+        const std::optional<Shard> shard = ShardOf(shard_text);
         return ToPython(RunInChildProcess("match", progress, [&](const StageControl& control) {
           RunSummary summary;
-          summary.match = RunMatch(LoadPipelineContext(arguments), RunOptions({}, output), control);
+          summary.match =
+              shard ? RunMatchShard(LoadPipelineContext(arguments), options, *shard, control)
+                    : RunMatch(LoadPipelineContext(arguments), options, control);
           return StageJson("match", summary);
         }));
       },
-      py::arg("output"), ManifestArg(), CameraKArg(), ThreadsArg(), ProgressArg(),
+      py::arg("output"), ManifestArg(), CameraKArg(), ThreadsArg(), ProgressArg(), ImagesArg(),
+      ShardArg(),
       (std::string("Matches and verifies the workspace's pairs (`tessera match`); returns "
                    "the summary's 'match' part.") +
        kCommonDoc)
@@ -166,17 +191,42 @@ void BindWorkspaceStages(py::module_& module) {
       "map",
       [](const std::filesystem::path& output, const OptionalPath& images,
          const py::object& manifest, const OptionalPath& camera_K, int threads,
-         const py::object& progress) {
-        const StageArguments arguments = MakeArguments(manifest, camera_K, {}, {}, threads);
-        const RunOptions options(images.value_or(std::filesystem::path()), output);
+         const py::object& progress, const OptionalPath& rig, bool force_map,
+         const std::optional<int>& cluster, const std::optional<std::string>& cluster_shard,
+         bool hierarchical, int jobs) {
+        const StageArguments arguments =
+            MakeArguments(manifest, camera_K, {}, {}, threads, false, rig);
+        RunOptions options(images.value_or(std::filesystem::path()), output);
+        options.force_map = force_map;
+        MapMode mode;
+        mode.cluster = cluster;
+        mode.cluster_shard = cluster_shard;
+        mode.hierarchical = hierarchical;
+        // The cluster processes are the installed `tessera` beside the module, given the
+        // manifest as a file or recipe: a dict cannot be passed on.
+        if (hierarchical && arguments.manifest_json) {
+          throw InputError(
+              "manifest: hierarchical=True runs each cluster in a `tessera` process, which "
+              "reads a manifest file or recipe, not a dict");
+        }
+        mode.pool.tessera = TesseraExecutable();
+        mode.pool.manifest = arguments.manifest;
+        mode.pool.camera_K = arguments.camera_K;
+        mode.pool.jobs = jobs;
+        mode.pool.threads = arguments.threads;
+        CheckMapMode(mode, rig.has_value());
         return ToPython(RunInChildProcess("map", progress, [&](const StageControl& control) {
           RunSummary summary;
-          summary.map = RunMap(LoadPipelineContext(arguments), options, control);
-          if (!control.Cancelled()) CheckModels(summary.map, output);
+          summary.map = MapWorkspace(LoadPipelineContext(arguments), options, mode, control);
+          if (!control.Cancelled() && summary.map.num_models == 0 && !mode.cluster_shard) {
+            throw NoModelError(MapModeNoModelMessage(mode, options, /*warnings_logged=*/true));
+          }
           return StageJson("map", summary);
         }));
       },
       py::arg("output"), ImagesArg(), ManifestArg(), CameraKArg(), ThreadsArg(), ProgressArg(),
+      RigArg(), ForceMapArg(), py::arg("cluster") = py::none(),
+      py::arg("cluster_shard") = py::none(), py::arg("hierarchical") = false, py::arg("jobs") = 0,
       (std::string("Maps a workspace into models (`tessera map`); returns the summary's "
                    "'map' part, NoModelError when no model was built.") +
        kCommonDoc)
