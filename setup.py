@@ -23,6 +23,18 @@ import sysconfig
 from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
 
+# pip builds the wheel with this Python's own `wheel` package (--no-build-isolation: offline);
+# without it setuptools says only "invalid command 'bdist_wheel'".
+try:
+    import wheel  # noqa: F401
+except ImportError:
+    sys.exit(f"Tessera's setup.py: {sys.executable} has no `wheel` package, so pip cannot build "
+             "a wheel with it (\"invalid command 'bdist_wheel'\"). Install with Debian's "
+             "/usr/bin/python3 (python3-wheel, python3-dev, pybind11-dev, python3-numpy: "
+             "`/usr/bin/python3 -m venv --system-site-packages venv`), or give this Python "
+             "wheel, numpy and pybind11 and its development headers; see docs/python.md, "
+             "'Which Python'.")
+
 ROOT = pathlib.Path(__file__).resolve().parent
 VERSION = re.search(r"project\(Tessera VERSION ([0-9.]+)",
                     (ROOT / "CMakeLists.txt").read_text()).group(1)
@@ -85,7 +97,12 @@ class CMakeBuild(build_ext):
         shutil.rmtree(target, ignore_errors=True)
         shutil.copytree(package, target)
         extension = pathlib.Path(self.get_ext_fullpath("tessera._tessera"))
-        built = next(package.glob("_tessera*.so"))
+        built = next(package.glob("_tessera*.so"), None)
+        if built is None:
+            sys.exit(f"Tessera's setup.py: CMake built no extension for {sys.executable}: it "
+                     "found no pybind11, Python development files or numpy for it (its "
+                     "configure output says which). Use Debian's /usr/bin/python3; see "
+                     "docs/python.md, 'Which Python'.")
         if extension.parent.resolve() != target.resolve():
             extension.parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(built, extension)

@@ -149,6 +149,23 @@ std::string FirstNonFinite(const Reconstruction& model) {
   return "";
 }
 
+// A track element of an image that is not registered, which the writer leaves out (a
+// COLMAP model holds registered images only) and the reader would then refuse; empty when
+// there is none.
+std::string FirstUnwrittenObservation(const Reconstruction& model) {
+  for (const auto& [point3D_id, point] : model.points3D) {
+    for (const TrackElement& element : point.track) {
+      const auto image = model.images.find(element.image_id);
+      if (image != model.images.end() && !image->second.registered) {
+        return "the track of point3D " + std::to_string(point3D_id) + " holds image " +
+               std::to_string(element.image_id) +
+               ", which is not registered; a COLMAP model holds the registered images only";
+      }
+    }
+  }
+  return "";
+}
+
 void BindCamera(py::module_& module) {
   py::class_<Camera>(module, "Camera", "A camera: model, image size and parameters.")
       .def_readonly("camera_id", &Camera::camera_id)
@@ -286,10 +303,19 @@ void BindPoint3D(py::module_& module) {
 
 // A read-only mapping of the model's `what` ("image", ...) by id, whose KeyError names
 // the id and the range of ids there are.
+// pybind11 makes its key, value and item view classes in the scope the map is bound in: a
+// private submodule, so that dir(tessera.Image) lists the model's own names (and Map).
 template <typename Key, typename Value>
 void BindIdMap(py::module_& module, const char* value_class, const char* what) {
   using Map = std::map<Key, Value>;
-  py::class_<Map> map_class = py::bind_map<Map>(module.attr(value_class), "Map");
+  py::module_ views = py::hasattr(module, "_map_views")
+                          ? py::reinterpret_borrow<py::module_>(module.attr("_map_views"))
+                          : module.def_submodule("_map_views", "pybind11's views of the id maps");
+  py::class_<Map> map_class = py::bind_map<Map>(views, std::string(value_class) + "Map");
+  map_class.attr("__name__") = "Map";
+  map_class.attr("__qualname__") = std::string(value_class) + ".Map";
+  map_class.attr("__module__") = module.attr("__name__");
+  module.attr(value_class).attr("Map") = map_class;
   py::delattr(map_class, "__setitem__");
   py::delattr(map_class, "__delitem__");
   py::delattr(map_class, "__getitem__");  // bind_map's KeyError says nothing
@@ -429,6 +455,9 @@ void BindModel(py::module_& module) {
               throw py::value_error("write: " + bad +
                                     ", not a finite number; a COLMAP model holds finite numbers "
                                     "only (nothing was written)");
+            }
+            if (const std::string bad = FirstUnwrittenObservation(handle.model); !bad.empty()) {
+              throw py::value_error("write: " + bad + " (nothing was written)");
             }
             const py::gil_scoped_release release;
             WriteColmapModel(

@@ -8,6 +8,7 @@ signatures (``inspect.signature`` and type checkers read them), checks argument 
 Python calls, and adds pycolmap's names where the meaning is the same (docs/python.md).
 """
 
+import math
 import numbers
 import os
 import typing
@@ -52,18 +53,49 @@ def _optional_path(function: str, name: str, value: object) -> Any:
     return None if value is None else _path(function, name, value)
 
 
+def _json(function: str, name: str, value: object) -> Any:
+    """`value` as JSON would hold it (dicts with str keys, lists, str, finite numbers,
+    bool, None); TypeError or InputError naming the key path of what is not."""
+    if value is None or isinstance(value, (str, bool)):
+        return value
+    if isinstance(value, numbers.Integral):
+        return int(value)
+    if isinstance(value, numbers.Real):
+        number = float(value)
+        if not math.isfinite(number):
+            raise InputError(f"{name}: {number} is not a finite number (JSON has no NaN or "
+                             f"infinity)")
+        return number
+    if isinstance(value, Mapping):
+        result: Dict[str, Any] = {}
+        for key, item in value.items():
+            if not isinstance(key, str):
+                raise TypeError(f"{function}(): {name}: key {key!r} must be a str, not "
+                                f"{_type_name(key)}")
+            result[key] = _json(function, f"{name}.{key}", item)
+        return result
+    if isinstance(value, (list, tuple)):
+        return [_json(function, f"{name}[{index}]", item) for index, item in enumerate(value)]
+    raise TypeError(f"{function}(): {name} must be a JSON value (dict, list, str, number, bool "
+                    f"or None), not {_type_name(value)}")
+
+
 def _manifest(function: str, value: object) -> Any:
     if value is None or isinstance(value, (str, os.PathLike)):
         return value
     if isinstance(value, Mapping):
-        return dict(value)
-    raise TypeError(f"{function}(): manifest must be a path (str or os.PathLike), a dict or "
-                    f"None, not {_type_name(value)}")
+        return _json(function, "manifest", value)
+    raise TypeError(f"{function}(): manifest must be a path or a recipe's name (str or "
+                    f"os.PathLike), a dict or None, not {_type_name(value)}")
 
 
-def _int(function: str, name: str, value: object) -> int:
+def _int(function: str, name: str, value: object, low: int = 0, high: int = 1024) -> int:
+    """An int in low..high: TypeError naming the argument for another type, InputError
+    (as the CLI's exit code 2) for one out of range."""
     if isinstance(value, bool) or not isinstance(value, numbers.Integral):
         raise TypeError(f"{function}(): {name} must be an int, not {_type_name(value)}")
+    if not low <= int(value) <= high:
+        raise InputError(f"{name}: {int(value)} is not in {low}..{high}")
     return int(value)
 
 
@@ -71,6 +103,16 @@ def _number(function: str, name: str, value: object) -> float:
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise TypeError(f"{function}(): {name} must be a number, not {_type_name(value)}")
     return float(value)
+
+
+def _optional_int(function: str, name: str, value: object, high: int) -> Optional[int]:
+    return None if value is None else _int(function, name, value, 0, high)
+
+
+def _optional_str(function: str, name: str, value: object) -> Optional[str]:
+    if value is None or isinstance(value, str):
+        return value
+    raise TypeError(f"{function}(): {name} must be a str or None, not {_type_name(value)}")
 
 
 def _bool(function: str, name: str, value: object) -> bool:
@@ -107,14 +149,19 @@ def _call(function: Callable[..., Any], *arguments: Any, **keywords: Any) -> Any
 def run(images: Optional[PathLike] = None, output: Optional[PathLike] = None,
         manifest: ManifestLike = None, camera_K: Optional[PathLike] = None,
         masks: Optional[PathLike] = None, videos: Sequence[PathLike] = (), threads: int = 0,
-        progress: Progress = None, camera_per_folder: bool = False) -> Dict[str, Any]:
+        progress: Progress = None, camera_per_folder: bool = False,
+        rig: Optional[PathLike] = None, force_map: bool = False) -> Dict[str, Any]:
     """Every stage, images in, models out (`tessera run`); returns run_summary.json as a
-    dict, NoModelError when no model was built. output is required. manifest: a file or a
-    dict (default: default.json); camera_K: a K.txt file; camera_per_folder: images in
-    different subfolders never share a camera; threads: 0 for the manifest's;
-    progress(stage, done, total): an exception from it (KeyboardInterrupt) cancels the
-    stage, keeping what was finished for the same call to resume. Runs in a child process:
-    a plugin that crashes raises PluginCrashError naming it."""
+    dict, NoModelError when no model was built. output is required. manifest: a file, a
+    bundled recipe by name ("global", "fast", ...) or a dict (default: default.json);
+    camera_K: a K.txt file; masks: a folder of IMAGE.png masks; videos: videos to take
+    keyframes from instead of images; camera_per_folder: images in different subfolders
+    never share a camera; rig: a rig file (implies camera_per_folder); force_map: map even
+    when the models in place were made from the same inputs (else they are kept);
+    threads: 0 for the manifest's; progress(stage, done, total): an exception from it
+    (KeyboardInterrupt) cancels the stage, keeping what was finished for the same call to
+    resume. Runs in a child process: a plugin that crashes raises PluginCrashError naming
+    it."""
     name = "run"
     return typing.cast(Dict[str, Any], _call(
         _tessera.run, images=_optional_path(name, "images", images),
@@ -122,17 +169,20 @@ def run(images: Optional[PathLike] = None, output: Optional[PathLike] = None,
         camera_K=_optional_path(name, "camera_K", camera_K),
         masks=_optional_path(name, "masks", masks), videos=_paths(name, "videos", videos),
         threads=_int(name, "threads", threads), progress=_progress(name, progress),
-        camera_per_folder=_bool(name, "camera_per_folder", camera_per_folder)))
+        camera_per_folder=_bool(name, "camera_per_folder", camera_per_folder),
+        rig=_optional_path(name, "rig", rig), force_map=_bool(name, "force_map", force_map)))
 
 
 def extract(images: Optional[PathLike] = None, output: Optional[PathLike] = None,
             manifest: ManifestLike = None, camera_K: Optional[PathLike] = None,
             masks: Optional[PathLike] = None, videos: Sequence[PathLike] = (),
             threads: int = 0, progress: Progress = None,
-            camera_per_folder: bool = False) -> Dict[str, Any]:
+            camera_per_folder: bool = False, shard: Optional[str] = None) -> Dict[str, Any]:
     """Ingests images and detects features (`tessera extract`); returns the summary's
     'extract' part (num_failed: images skipped as unreadable; num_quarantined: images
-    skipped because they crashed the detector twice). Arguments as run()'s."""
+    skipped because they crashed the detector twice). shard: "K/N", only shard K of N,
+    into OUTPUT/shards/ (the CLI's `tessera merge` folds the shards into database.db).
+    Other arguments as run()'s."""
     name = "extract"
     return typing.cast(Dict[str, Any], _call(
         _tessera.extract, images=_optional_path(name, "images", images),
@@ -140,31 +190,48 @@ def extract(images: Optional[PathLike] = None, output: Optional[PathLike] = None
         camera_K=_optional_path(name, "camera_K", camera_K),
         masks=_optional_path(name, "masks", masks), videos=_paths(name, "videos", videos),
         threads=_int(name, "threads", threads), progress=_progress(name, progress),
-        camera_per_folder=_bool(name, "camera_per_folder", camera_per_folder)))
+        camera_per_folder=_bool(name, "camera_per_folder", camera_per_folder),
+        shard=_optional_str(name, "shard", shard)))
 
 
 def match(output: PathLike, manifest: ManifestLike = None, camera_K: Optional[PathLike] = None,
-          threads: int = 0, progress: Progress = None) -> Dict[str, Any]:
+          threads: int = 0, progress: Progress = None, images: Optional[PathLike] = None,
+          shard: Optional[str] = None) -> Dict[str, Any]:
     """Matches and verifies the workspace's pairs (`tessera match`); returns the summary's
-    'match' part. Arguments as run()'s."""
+    'match' part. images: the image folder, where it moved since extract; shard: "K/N",
+    only shard K of N's pairs, into OUTPUT/shards/. Other arguments as run()'s."""
     name = "match"
     return typing.cast(Dict[str, Any], _call(
         _tessera.match, output=_path(name, "output", output),
         manifest=_manifest(name, manifest), camera_K=_optional_path(name, "camera_K", camera_K),
-        threads=_int(name, "threads", threads), progress=_progress(name, progress)))
+        threads=_int(name, "threads", threads), progress=_progress(name, progress),
+        images=_optional_path(name, "images", images),
+        shard=_optional_str(name, "shard", shard)))
 
 
 def map(output: PathLike, images: Optional[PathLike] = None, manifest: ManifestLike = None,
         camera_K: Optional[PathLike] = None, threads: int = 0,
-        progress: Progress = None) -> Dict[str, Any]:
+        progress: Progress = None, rig: Optional[PathLike] = None, force_map: bool = False,
+        cluster: Optional[int] = None, cluster_shard: Optional[str] = None,
+        hierarchical: bool = False, jobs: int = 0) -> Dict[str, Any]:
     """Maps a workspace into models (`tessera map`); returns the summary's 'map' part,
-    NoModelError when no model was built. Arguments as run()'s."""
+    NoModelError when no model was built. At most one of: cluster, only cluster K of
+    OUTPUT/clusters.json (the CLI's `tessera partition`), into OUTPUT/clusters/K/;
+    cluster_shard, "K/N": the clusters c with c mod N = K; hierarchical: partition, map
+    the clusters in a pool of `jobs` processes (0: half the cores; each a `tessera`
+    process, so the manifest must be a file or recipe), merge them. Other arguments as
+    run()'s."""
     name = "map"
     return typing.cast(Dict[str, Any], _call(
         _tessera.map, output=_path(name, "output", output),
         images=_optional_path(name, "images", images), manifest=_manifest(name, manifest),
         camera_K=_optional_path(name, "camera_K", camera_K),
-        threads=_int(name, "threads", threads), progress=_progress(name, progress)))
+        threads=_int(name, "threads", threads), progress=_progress(name, progress),
+        rig=_optional_path(name, "rig", rig), force_map=_bool(name, "force_map", force_map),
+        cluster=_optional_int(name, "cluster", cluster, 2**31 - 1),
+        cluster_shard=_optional_str(name, "cluster_shard", cluster_shard),
+        hierarchical=_bool(name, "hierarchical", hierarchical),
+        jobs=_int(name, "jobs", jobs)))
 
 
 def import_features(output: PathLike,
@@ -238,8 +305,8 @@ def export(model: PathLike, format: str, output: PathLike, images: Optional[Path
     return typing.cast(Dict[str, Any], _call(
         _tessera.export, model=_path(name, "model", model), format=format,
         output=_path(name, "output", output), images=_optional_path(name, "images", images),
-        options=None if options is None else dict(options),
-        model_index=_int(name, "model_index", model_index),
+        options=None if options is None else _json(name, "options", options),
+        model_index=_int(name, "model_index", model_index, -2**31, 2**31 - 1),
         masks=_optional_path(name, "masks", masks)))
 
 
@@ -428,9 +495,22 @@ def _cam_from_world(image: Image) -> Rigid3d:
 
 
 def _compute_mean_reprojection_error(self: Reconstruction) -> float:
-    """COLMAP's (and pycolmap's) mean reprojection error: the mean over points of each
-    point's mean error over its track; 0 for a model without points."""
-    return float(self.statistics()["mean_reprojection_error"])
+    """COLMAP's (and pycolmap's, and `colmap model_analyzer`'s) mean reprojection error:
+    the mean of the points' stored errors (Point3D.error), over the points whose error is
+    known (not -1); 0 when none is. Nothing is projected: after moving points or poses,
+    compute_mean_reprojection_error_from_scratch() gives the current one."""
+    errors = self.points3D_arrays()["errors"]
+    known = errors[errors != -1]
+    return float(known.mean()) if known.size else 0.0
+
+
+def _compute_mean_reprojection_error_from_scratch(self: Reconstruction) -> float:
+    """The mean reprojection error of the model as it is now: each point projected into
+    the images of its track (those in front of their camera), the mean over points of each
+    point's mean error; 0 for a model without points (statistics()'s
+    mean_reprojection_error)."""
+    value = float(self.statistics()["mean_reprojection_error"])
+    return 0.0 if math.isnan(value) else value
 
 
 def _find_image_with_name(self: Reconstruction, name: str) -> Optional[Image]:
@@ -467,7 +547,7 @@ def _summary(self: Reconstruction) -> str:
         f"\tnum_points3D = {statistics['num_points3D']}",
         f"\tnum_observations = {statistics['num_observations']}",
         f"\tmean_track_length = {statistics['mean_track_length']:.6f}",
-        f"\tmean_reprojection_error = {statistics['mean_reprojection_error']:.6f}",
+        f"\tmean_reprojection_error = {_compute_mean_reprojection_error(self):.6f}",
     ])
 
 
@@ -480,13 +560,16 @@ def _attach() -> None:
                              "rotation.quat (x, y, z, w) and matrix() as pycolmap's")
     model_class: Any = Reconstruction
     model_class.compute_mean_reprojection_error = _compute_mean_reprojection_error
+    model_class.compute_mean_reprojection_error_from_scratch = (
+        _compute_mean_reprojection_error_from_scratch)
     model_class.find_image_with_name = _find_image_with_name
     model_class.num_points3D = _num_points3D
     model_class.num_cameras = _num_cameras
     model_class.num_images = _num_images
     model_class.summary = _summary
-    for function in (_compute_mean_reprojection_error, _find_image_with_name, _num_points3D,
-                     _num_cameras, _num_images, _summary):
+    for function in (_compute_mean_reprojection_error,
+                     _compute_mean_reprojection_error_from_scratch, _find_image_with_name,
+                     _num_points3D, _num_cameras, _num_images, _summary):
         function.__name__ = function.__qualname__ = function.__name__.lstrip("_")
         function.__module__ = __name__
 

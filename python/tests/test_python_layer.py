@@ -54,6 +54,15 @@ def test_signatures_name_the_arguments():
     assert run.parameters["threads"].default == 0
 
 
+def test_dir_lists_no_pybind11_helper_classes(model):
+    for cls in CLASSES:
+        assert not [name for name in dir(cls) if "View" in name], dir(cls)
+    assert tessera.Image.Map.__qualname__ == "Image.Map"
+    # The views still work where they are used.
+    assert list(model.images.keys()) == sorted(model.images)
+    assert len(list(model.cameras.items())) == len(model.cameras)
+
+
 def test_version_all_and_stubs():
     assert tessera.__version__.count(".") == 2
     assert set(tessera.__all__) <= set(dir(tessera))
@@ -165,10 +174,13 @@ def test_project_one_point_or_many(model):
 
 def test_pycolmap_names(model):
     statistics = model.statistics()
-    assert model.compute_mean_reprojection_error() == statistics["mean_reprojection_error"]
-    # COLMAP's per-point mean: the mean of the points' own (track) errors.
+    # COLMAP's (pycolmap's, model_analyzer's): the mean of the points' stored errors.
+    errors = model.points3D_arrays()["errors"]
     assert model.compute_mean_reprojection_error() == pytest.approx(
-        np.mean(model.points3D_arrays()["errors"]))
+        np.mean(errors[errors != -1]), rel=1e-12)
+    # The recompute projects each point into its track's images: the host's figure.
+    assert model.compute_mean_reprojection_error_from_scratch() == (
+        statistics["mean_reprojection_error"])
     assert model.num_points3D() == len(model.points3D) == statistics["num_points3D"]
     image = model.images[next(iter(model.images))]
     assert model.find_image_with_name(image.name).image_id == image.image_id
@@ -215,6 +227,20 @@ def test_stages_log_through_logging_and_print_nothing_by_default(sample, tmp_pat
     assert all(record.levelno >= logging.WARNING for record in caplog.records)
 
 
+def test_the_mean_reprojection_error_averages_the_stored_errors(model):
+    copy_ = pickle.loads(pickle.dumps(model))
+    stored = copy_.compute_mean_reprojection_error()
+    recomputed = copy_.compute_mean_reprojection_error_from_scratch()
+    # Moving a point changes the recompute, not the stored errors pycolmap averages.
+    for point in list(copy_.points3D.values())[:20]:
+        point.xyz = point.xyz + 0.5
+    assert copy_.compute_mean_reprojection_error() == stored
+    assert copy_.compute_mean_reprojection_error_from_scratch() > recomputed
+    assert f"mean_reprojection_error = {stored:.6f}" in copy_.summary()
+    assert tessera.Reconstruction().compute_mean_reprojection_error() == 0.0
+    assert tessera.Reconstruction().compute_mean_reprojection_error_from_scratch() == 0.0
+
+
 def test_hints_name_the_python_call(tmp_path):
     from tessera import _hints
     assert _hints.for_python("x: no features; run `tessera extract` (or `tessera run`) "
@@ -223,9 +249,27 @@ def test_hints_name_the_python_call(tmp_path):
     assert _hints.for_python("run `tessera map --cluster 3` again") == (
         "call tessera.map(cluster=3) again")
     assert "logged on 'tessera.map'" in _hints.for_python("no model (see the warnings above)")
+    # Options and steps named as keywords and calls, other CLI commands kept for the shell.
+    assert _hints.for_python("kept the 1 model(s) in x (pass --force-map or change an option "
+                             "to re-map)") == (
+        "kept the 1 model(s) in x (pass force_map=True or change an option to re-map)")
+    assert _hints.for_python("x: no workspace database for map; run extract and match "
+                             "first") == ("x: no workspace database for map; call "
+                                          "tessera.extract(...) and tessera.match(...) first")
+    assert _hints.for_python("extract again with --camera-K FILE") == (
+        "call tessera.extract(...) again with camera_K=FILE")
+    assert _hints.for_python("--rig: partitioned mapping (--cluster, --cluster-shard, "
+                             "--hierarchical)") == (
+        "rig: partitioned mapping (cluster, cluster_shard, hierarchical)")
+    assert _hints.for_python("map --cluster 3: no model") == "tessera.map(cluster=3): no model"
+    assert _hints.for_python("run `tessera merge --output x` first") == (
+        "run `tessera merge --output x` first")
     with pytest.raises(tessera.InputError) as raised:
         tessera.match(output=tmp_path / "empty", manifest=MANIFEST)
     assert "`tessera " not in str(raised.value), str(raised.value)
+    with pytest.raises(tessera.InputError,
+                       match=r"call tessera\.extract\(\.\.\.\) and tessera\.match\(\.\.\.\) first"):
+        tessera.map(output=tmp_path / "empty", manifest=MANIFEST)
 
 
 def test_results_count_quarantined_images_as_their_own(sample, tmp_path):
