@@ -308,9 +308,9 @@ void BindPoint3D(py::module_& module) {
 template <typename Key, typename Value>
 void BindIdMap(py::module_& module, const char* value_class, const char* what) {
   using Map = std::map<Key, Value>;
-  py::module_ views = py::hasattr(module, "_map_views")
-                          ? py::reinterpret_borrow<py::module_>(module.attr("_map_views"))
-                          : module.def_submodule("_map_views", "pybind11's views of the id maps");
+  // One per map: the point ids' key view and the image ids' are both "KeysView[int]".
+  py::module_ views = module.def_submodule(("_" + std::string(value_class) + "_map_views").c_str(),
+                                           "pybind11's views of an id map");
   py::class_<Map> map_class = py::bind_map<Map>(views, std::string(value_class) + "Map");
   map_class.attr("__name__") = "Map";
   map_class.attr("__qualname__") = std::string(value_class) + ".Map";
