@@ -1,5 +1,7 @@
 #include "model_state.h"
 
+#include <pybind11/stl.h>
+
 #include <cmath>
 #include <limits>
 #include <string>
