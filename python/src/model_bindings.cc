@@ -166,7 +166,25 @@ std::string FirstUnwrittenObservation(const Reconstruction& model) {
   return "";
 }
 
+// `__reduce__` of a class whose state `factory` (a private function of this module)
+// validates and makes into a whole object. A pickle then calls that factory, and never
+// the class's bare `__new__`: a pybind11 object that `__new__` made and no `__setstate__`
+// filled has no C++ object behind it, and a call on it would read memory never written.
+// A pickle whose bytes were changed can name only the factory, which checks the state.
+template <typename T, typename State>
+auto ReduceThrough(const char* factory, State (*state)(const T&)) {
+  return [factory, state](const T& value) {
+    return py::make_tuple(py::module_::import("tessera._tessera").attr(factory),
+                          py::make_tuple(state(value)));
+  };
+}
+
 void BindCamera(py::module_& module) {
+  module.def(
+      "_camera_from_state", [](const py::tuple& state) { return CameraFromState(state); },
+      py::arg("state"),
+      "_camera_from_state(state)\n--\n\nA Camera from its pickled state, checked (pickle's "
+      "factory)");
   py::class_<Camera>(module, "Camera", "A camera: model, image size and parameters.")
       .def_readonly("camera_id", &Camera::camera_id)
       .def_property_readonly("model", &Camera::ModelName, "COLMAP's model name, e.g. 'PINHOLE'")
@@ -200,6 +218,7 @@ void BindCamera(py::module_& module) {
           "or (2,) of one (3,) point; NaN for points not in front")
       .def(py::pickle([](const Camera& camera) { return CameraState(camera); },
                       [](const py::tuple& state) { return CameraFromState(state); }))
+      .def("__reduce__", ReduceThrough("_camera_from_state", &CameraState))
       .def("__repr__", [](const Camera& camera) {
         return "Camera(camera_id=" + std::to_string(camera.camera_id) + ", model='" +
                camera.ModelName() + "', width=" + std::to_string(camera.width) +
@@ -208,6 +227,11 @@ void BindCamera(py::module_& module) {
 }
 
 void BindImage(py::module_& module) {
+  module.def(
+      "_image_from_state", [](const py::tuple& state) { return ImageFromState(state); },
+      py::arg("state"),
+      "_image_from_state(state)\n--\n\nAn Image from its pickled state, checked (pickle's "
+      "factory)");
   py::class_<Image>(module, "Image", "An image: its camera, name, pose and keypoints.")
       .def_readonly("image_id", &Image::image_id)
       .def_readonly("camera_id", &Image::camera_id)
@@ -252,6 +276,7 @@ void BindImage(py::module_& module) {
            "num_points3D(self)\n--\n\nHow many keypoints have a 3D point")
       .def(py::pickle([](const Image& image) { return ImageState(image); },
                       [](const py::tuple& state) { return ImageFromState(state); }))
+      .def("__reduce__", ReduceThrough("_image_from_state", &ImageState))
       .def("__repr__", [](const Image& image) {
         return "Image(image_id=" + std::to_string(image.image_id) +
                ", name=" + py::repr(py::str(image.name)).cast<std::string>() +
@@ -261,6 +286,11 @@ void BindImage(py::module_& module) {
 }
 
 void BindPoint3D(py::module_& module) {
+  module.def(
+      "_point3D_from_state", [](const py::tuple& state) { return Point3DFromState(state); },
+      py::arg("state"),
+      "_point3D_from_state(state)\n--\n\nA Point3D from its pickled state, checked (pickle's "
+      "factory)");
   py::class_<Point3D>(module, "Point3D", "A 3D point: position, colour, error and track.")
       .def_property(
           "xyz",
@@ -293,6 +323,7 @@ void BindPoint3D(py::module_& module) {
           "(image_id, point2D_idx) per observation, (K, 2) uint32: a read-only view")
       .def(py::pickle([](const Point3D& point) { return Point3DState(point); },
                       [](const py::tuple& state) { return Point3DFromState(state); }))
+      .def("__reduce__", ReduceThrough("_point3D_from_state", &Point3DState))
       .def("__repr__", [](const Point3D& point) {
         return "Point3D(xyz=[" + std::to_string(point.xyz.x()) + ", " +
                std::to_string(point.xyz.y()) + ", " + std::to_string(point.xyz.z()) +
@@ -424,6 +455,14 @@ void BindModel(py::module_& module) {
   BindIdMap<image_t, Image>(module, "Image", "image");
   BindIdMap<point3D_t, Point3D>(module, "Point3D", "point3D");
 
+  const auto model_from_state = [](const py::tuple& state) {
+    auto handle = std::make_shared<ModelHandle>();
+    handle->model = ReconstructionFromState(state);
+    return handle;
+  };
+  module.def("_reconstruction_from_state", model_from_state, py::arg("state"),
+             "_reconstruction_from_state(state)\n--\n\nA Reconstruction from its pickled "
+             "state, checked (pickle's factory)");
   py::class_<ModelHandle, std::shared_ptr<ModelHandle>> model_class(
       module, "Reconstruction", "A COLMAP sparse model: cameras, images and 3D points.");
   model_class
@@ -439,11 +478,13 @@ void BindModel(py::module_& module) {
            "folder: the .bin files when all three are there, else the .txt files. InputError "
            "names the file on any problem. Without a path: an empty model.")
       .def(py::pickle([](const ModelHandle& handle) { return ReconstructionState(handle.model); },
-                      [](const py::tuple& state) {
-                        auto handle = std::make_shared<ModelHandle>();
-                        handle->model = ReconstructionFromState(state);
-                        return handle;
-                      }))
+                      model_from_state))
+      .def("__reduce__",
+           [](const ModelHandle& handle) {
+             return py::make_tuple(
+                 py::module_::import("tessera._tessera").attr("_reconstruction_from_state"),
+                 py::make_tuple(ReconstructionState(handle.model)));
+           })
       .def(
           "write",
           [](const ModelHandle& handle, const std::filesystem::path& path,

@@ -8,6 +8,7 @@ import copy
 import inspect
 import logging
 import pickle
+import pickletools
 
 import numpy as np
 import pytest
@@ -126,6 +127,21 @@ def test_pickle_copy_and_deepcopy_keep_every_value(model, tmp_path):
     # The unpickled model writes what the original does.
     pickle.loads(pickle.dumps(model)).write(tmp_path / "copy")
     assert tessera.Reconstruction(tmp_path / "copy").num_points3D() == model.num_points3D()
+
+
+def test_pickles_call_a_checking_factory_never_a_bare_new(model):
+    """A pickle that called Camera.__new__ and then failed to reach __setstate__ would leave
+    an object with no C++ value behind it; each pickle names a factory that checks."""
+    image = next(iter(model.images.values()))
+    values = {"_reconstruction_from_state": model, "_image_from_state": image,
+              "_camera_from_state": model.cameras[image.camera_id],
+              "_point3D_from_state": next(iter(model.points3D.values()))}
+    for factory, value in values.items():
+        opcodes = [op.name for op, _, _ in pickletools.genops(pickle.dumps(value))]
+        assert "NEWOBJ" not in opcodes and "NEWOBJ_EX" not in opcodes, (factory, opcodes)
+        assert factory.encode() in pickle.dumps(value)
+    with pytest.raises(tessera.InputError, match="unknown camera model 'NOPE'"):
+        tessera._tessera._camera_from_state((1, "NOPE", 10, 10, []))
 
 
 def test_an_empty_reconstruction():
