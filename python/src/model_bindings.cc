@@ -166,15 +166,16 @@ std::string FirstUnwrittenObservation(const Reconstruction& model) {
   return "";
 }
 
-// `__reduce__` of a class whose state `factory` (a private function of this module)
-// validates and makes into a whole object. A pickle then calls that factory, and never
-// the class's bare `__new__`: a pybind11 object that `__new__` made and no `__setstate__`
-// filled has no C++ object behind it, and a call on it would read memory never written.
-// A pickle whose bytes were changed can name only the factory, which checks the state.
+// `__reduce__` of a class whose state `factory` (a function of tessera/_pickle.py, which
+// calls this module's checking `_NAME_from_state`) makes into a whole object. A pickle
+// then calls that factory, and never the class's bare `__new__`: a pybind11 object that
+// `__new__` made and no `__setstate__` filled has no C++ object behind it, and a call on
+// it would read memory never written. A pickle whose bytes were changed can name only
+// the factory, which checks the state.
 template <typename T, typename State>
 auto ReduceThrough(const char* factory, State (*state)(const T&)) {
   return [factory, state](const T& value) {
-    return py::make_tuple(py::module_::import("tessera._tessera").attr(factory),
+    return py::make_tuple(py::module_::import("tessera._pickle").attr(factory),
                           py::make_tuple(state(value)));
   };
 }
@@ -218,7 +219,7 @@ void BindCamera(py::module_& module) {
           "or (2,) of one (3,) point; NaN for points not in front")
       .def(py::pickle([](const Camera& camera) { return CameraState(camera); },
                       [](const py::tuple& state) { return CameraFromState(state); }))
-      .def("__reduce__", ReduceThrough("_camera_from_state", &CameraState))
+      .def("__reduce__", ReduceThrough("camera_from_state", &CameraState))
       .def("__repr__", [](const Camera& camera) {
         return "Camera(camera_id=" + std::to_string(camera.camera_id) + ", model='" +
                camera.ModelName() + "', width=" + std::to_string(camera.width) +
@@ -276,7 +277,7 @@ void BindImage(py::module_& module) {
            "num_points3D(self)\n--\n\nHow many keypoints have a 3D point")
       .def(py::pickle([](const Image& image) { return ImageState(image); },
                       [](const py::tuple& state) { return ImageFromState(state); }))
-      .def("__reduce__", ReduceThrough("_image_from_state", &ImageState))
+      .def("__reduce__", ReduceThrough("image_from_state", &ImageState))
       .def("__repr__", [](const Image& image) {
         return "Image(image_id=" + std::to_string(image.image_id) +
                ", name=" + py::repr(py::str(image.name)).cast<std::string>() +
@@ -323,7 +324,7 @@ void BindPoint3D(py::module_& module) {
           "(image_id, point2D_idx) per observation, (K, 2) uint32: a read-only view")
       .def(py::pickle([](const Point3D& point) { return Point3DState(point); },
                       [](const py::tuple& state) { return Point3DFromState(state); }))
-      .def("__reduce__", ReduceThrough("_point3D_from_state", &Point3DState))
+      .def("__reduce__", ReduceThrough("point3D_from_state", &Point3DState))
       .def("__repr__", [](const Point3D& point) {
         return "Point3D(xyz=[" + std::to_string(point.xyz.x()) + ", " +
                std::to_string(point.xyz.y()) + ", " + std::to_string(point.xyz.z()) +
@@ -482,7 +483,7 @@ void BindModel(py::module_& module) {
       .def("__reduce__",
            [](const ModelHandle& handle) {
              return py::make_tuple(
-                 py::module_::import("tessera._tessera").attr("_reconstruction_from_state"),
+                 py::module_::import("tessera._pickle").attr("reconstruction_from_state"),
                  py::make_tuple(ReconstructionState(handle.model)));
            })
       .def(

@@ -325,7 +325,7 @@ def triangulate(output: PathLike, model: Optional[PathLike] = None,
     return typing.cast(Dict[str, Any], _call(
         _tessera.triangulate, output=_path(name, "output", output),
         model=_optional_path(name, "model", model), poses=_optional_path(name, "poses", poses),
-        model_index=_int(name, "model_index", model_index),
+        model_index=_int(name, "model_index", model_index, -2**31, 2**31 - 1),
         refine_intrinsics=_bool(name, "refine_intrinsics", refine_intrinsics),
         manifest=_manifest(name, manifest), threads=_int(name, "threads", threads)))
 
@@ -344,7 +344,7 @@ def register(output: PathLike, images: Optional[PathLike] = None, manifest: Mani
     return typing.cast(Dict[str, Any], _call(
         _tessera.register, output=_path(name, "output", output),
         images=_optional_path(name, "images", images), manifest=_manifest(name, manifest),
-        model_index=_int(name, "model_index", model_index),
+        model_index=_int(name, "model_index", model_index, -2**31, 2**31 - 1),
         refine_existing=_bool(name, "refine_existing", refine_existing),
         camera_K=_optional_path(name, "camera_K", camera_K),
         threads=_int(name, "threads", threads), progress=_progress(name, progress)))

@@ -24,6 +24,8 @@ _PHRASES = (
     ("run extract, match and partition first",
      "call tessera.extract(...), tessera.match(...) and the CLI's `tessera partition` first"),
     ("extract again with", "call tessera.extract(...) again with"),
+    ("run extract first", "call tessera.extract(...) first"),
+    ("run match first", "call tessera.match(...) first"),
 )
 
 

@@ -133,13 +133,13 @@ def test_pickles_call_a_checking_factory_never_a_bare_new(model):
     """A pickle that called Camera.__new__ and then failed to reach __setstate__ would leave
     an object with no C++ value behind it; each pickle names a factory that checks."""
     image = next(iter(model.images.values()))
-    values = {"_reconstruction_from_state": model, "_image_from_state": image,
-              "_camera_from_state": model.cameras[image.camera_id],
-              "_point3D_from_state": next(iter(model.points3D.values()))}
+    values = {"reconstruction_from_state": model, "image_from_state": image,
+              "camera_from_state": model.cameras[image.camera_id],
+              "point3D_from_state": next(iter(model.points3D.values()))}
     for factory, value in values.items():
         opcodes = [op.name for op, _, _ in pickletools.genops(pickle.dumps(value))]
         assert "NEWOBJ" not in opcodes and "NEWOBJ_EX" not in opcodes, (factory, opcodes)
-        assert factory.encode() in pickle.dumps(value)
+        assert b"tessera._pickle" in pickle.dumps(value) and factory.encode() in pickle.dumps(value)
     with pytest.raises(tessera.InputError, match="unknown camera model 'NOPE'"):
         tessera._tessera._camera_from_state((1, "NOPE", 10, 10, []))
 
@@ -285,7 +285,14 @@ def test_hints_name_the_python_call(tmp_path):
     assert "`tessera " not in str(raised.value), str(raised.value)
     with pytest.raises(tessera.InputError,
                        match=r"call tessera\.extract\(\.\.\.\) and tessera\.match\(\.\.\.\) first"):
+        tessera.map(output=tmp_path / "none", manifest=MANIFEST)
+    # match made the database of "empty", which holds no images.
+    with pytest.raises(tessera.InputError,
+                       match=r"has no images; call tessera\.extract\(\.\.\.\) first"):
         tessera.map(output=tmp_path / "empty", manifest=MANIFEST)
+    assert _hints.for_python("x: no verified image pairs in the workspace; run match "
+                             "first") == ("x: no verified image pairs in the workspace; call "
+                                          "tessera.match(...) first")
 
 
 def test_results_count_quarantined_images_as_their_own(sample, tmp_path):
