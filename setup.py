@@ -5,12 +5,15 @@ stubs and py.typed) where the environment keeps packages, and the plugins, the r
 (lib/tessera/plugins, share/tessera/manifests, bin/), where the extension finds them from
 its own location (python/src/module.cc).
 
-The CMake build folder is build/pip, configured for the install (no tests, benchmarks or
-GUI) and kept between installs, so a second install rebuilds only what changed; ccache is
-used when it is on PATH. TESSERA_PIP_BUILD_DIR names another: one already configured and built
-(the developer's build/, as the python_pip_install test uses) is installed as it is,
-without a second build of the same sources. TESSERA_PIP_JOBS: parallel jobs
-(default 2)."""
+The CMake build folder is build-pip, configured for the install with the quickstart's
+compile options (Release, warnings as errors; no tests, benchmarks or GUI) and kept between
+installs, so a second install rebuilds only what changed. ccache is used when it is on
+PATH, as scripts/compiler_cache.sh sets it up: with the checkout as base directory, and the
+folder beside build/ at the same depth, so that the compile lines are the quickstart's and
+its objects are reused. TESSERA_PIP_BUILD_DIR names another: one already configured and
+built (the developer's build/, as the python_pip_install test uses) is installed as it is,
+without a second build of the same sources. TESSERA_PIP_JOBS: parallel jobs (default 2).
+CMake's progress shows with `pip install -v`."""
 
 import os
 import pathlib
@@ -48,7 +51,7 @@ def python_subdir():
 
 
 def build_dir():
-    return pathlib.Path(os.environ.get("TESSERA_PIP_BUILD_DIR", ROOT / "build" / "pip"))
+    return pathlib.Path(os.environ.get("TESSERA_PIP_BUILD_DIR", ROOT / "build-pip"))
 
 
 def configured_python_subdir(folder):
@@ -67,8 +70,10 @@ class CMakeBuild(build_ext):
         subdir = configured_python_subdir(folder) if "TESSERA_PIP_BUILD_DIR" in os.environ else None
         if subdir is None:  # else built already, as it is configured
             subdir = self.configure(folder)
+            environment = dict(os.environ, CCACHE_BASEDIR=str(ROOT), CCACHE_NOHASHDIR="1")
             subprocess.run(["cmake", "--build", str(folder), "-j",
-                            os.environ.get("TESSERA_PIP_JOBS", "2")], check=True)
+                            os.environ.get("TESSERA_PIP_JOBS", "2")], check=True,
+                           env=environment)
         shutil.rmtree(stage, ignore_errors=True)
         subprocess.run(["cmake", "--install", str(folder), "--prefix", str(stage)], check=True,
                        stdout=subprocess.DEVNULL)
@@ -79,7 +84,7 @@ class CMakeBuild(build_ext):
         """Configures `folder` for this environment; the package's folder below the prefix."""
         subdir = python_subdir()
         configure = ["cmake", "-S", str(ROOT), "-B", str(folder), "-DCMAKE_BUILD_TYPE=Release",
-                     "-DTESSERA_BUILD_TESTS=OFF", "-DTESSERA_BUILD_BENCHMARKS=OFF",
+                     "-DTESSERA_WERROR=ON", "-DTESSERA_BUILD_TESTS=OFF", "-DTESSERA_BUILD_BENCHMARKS=OFF",
                      "-DTESSERA_BUILD_GUI=OFF", "-DCMAKE_INSTALL_LIBDIR=lib",
                      f"-DPython3_EXECUTABLE={sys.executable}",
                      f"-DTESSERA_PYTHON_SUBDIR={subdir}"]
