@@ -481,11 +481,9 @@ void BindModel(py::module_& module) {
       .def(py::pickle([](const ModelHandle& handle) { return ReconstructionState(handle.model); },
                       model_from_state))
       .def("__reduce__",
-           [](const ModelHandle& handle) {
-             return py::make_tuple(
-                 py::module_::import("tessera._pickle").attr("reconstruction_from_state"),
-                 py::make_tuple(ReconstructionState(handle.model)));
-           })
+           ReduceThrough(
+               "reconstruction_from_state",
+               +[](const ModelHandle& handle) { return ReconstructionState(handle.model); }))
       .def(
           "write",
           [](const ModelHandle& handle, const std::filesystem::path& path,
