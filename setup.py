@@ -85,7 +85,8 @@ class CMakeBuild(build_ext):
         subdir = python_subdir()
         configure = ["cmake", "-S", str(ROOT), "-B", str(folder), "-DCMAKE_BUILD_TYPE=Release",
                      "-DTESSERA_WERROR=ON", "-DTESSERA_BUILD_TESTS=OFF", "-DTESSERA_BUILD_BENCHMARKS=OFF",
-                     "-DTESSERA_BUILD_GUI=OFF", "-DCMAKE_INSTALL_LIBDIR=lib",
+                     "-DTESSERA_BUILD_GUI=OFF", "-DTESSERA_BUILD_PYTHON=ON",
+                     "-DCMAKE_INSTALL_LIBDIR=lib",
                      f"-DPython3_EXECUTABLE={sys.executable}",
                      f"-DTESSERA_PYTHON_SUBDIR={subdir}"]
         if shutil.which("ccache"):

@@ -8,10 +8,10 @@ cd "$(dirname "$0")/.."
 jobs=$(nproc)
 source scripts/compiler_cache.sh
 
-# The quickstart's options (its objects are reused through ccache), with the tests and
-# the benchmarks.
+# The quickstart's options (its objects are reused through ccache), with the tests, the
+# benchmarks and the Python module.
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DTESSERA_WERROR=ON -DTESSERA_BUILD_TESTS=ON \
-      -DTESSERA_BUILD_BENCHMARKS=ON "${launcher[@]}" > /dev/null
+      -DTESSERA_BUILD_BENCHMARKS=ON -DTESSERA_BUILD_PYTHON=ON "${launcher[@]}" > /dev/null
 cmake --build build -j"$jobs"
 ctest --test-dir build --output-on-failure -j"$jobs"
 
