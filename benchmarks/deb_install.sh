@@ -51,14 +51,14 @@ EOF
 cp /etc/resolv.conf "$root/etc/resolv.conf"
 mount -t proc proc "$root/proc"
 trap 'umount "$root/proc" 2> /dev/null || true; [ "${KEEP_ROOT:-0}" = 1 ] || rm -rf "$root"' EXIT
-step "debootstrap bookworm minbase ($(du -sh "$root" | cut -f1))"
+step "debootstrap bookworm minbase ($(du -sxh "$root" | cut -f1))"
 
 cp "$deb" "$root/tmp/"
 cp -r "$root_dir/examples/fountain-P11-small" "$root/tmp/sample"
 chroot "$root" apt-get update -qq
 DEBIAN_FRONTEND=noninteractive chroot "$root" \
   apt-get install -y -qq "/tmp/$(basename "$deb")" > "$out/apt.log"
-step "apt install ./$(basename "$deb") ($(du -sh "$root" | cut -f1) with its dependencies)"
+step "apt install ./$(basename "$deb") ($(du -sxh "$root" | cut -f1) with its dependencies)"
 
 chroot "$root" tessera --version
 chroot "$root" tessera plugins | tail -n +1 | wc -l | sed 's/^/plugins listed (lines): /'
