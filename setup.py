@@ -38,6 +38,16 @@ except ImportError:
              "wheel, numpy and pybind11 and its development headers; see docs/python.md, "
              "'Which Python'.")
 
+# The module's arrays are numpy's; without it CMake would build everything else first and
+# then no extension.
+try:
+    import numpy  # noqa: F401
+except ImportError:
+    sys.exit(f"Tessera's setup.py: {sys.executable} has no `numpy`, which the module needs to "
+             "build and run. Install with Debian's /usr/bin/python3 (python3-numpy: "
+             "`/usr/bin/python3 -m venv --system-site-packages venv`), or `pip install numpy` "
+             "into this environment first; see docs/python.md, 'Which Python'.")
+
 ROOT = pathlib.Path(__file__).resolve().parent
 VERSION = re.search(r"project\(Tessera VERSION ([0-9.]+)",
                     (ROOT / "CMakeLists.txt").read_text()).group(1)

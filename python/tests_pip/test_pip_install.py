@@ -76,3 +76,27 @@ print(json.dumps({{"version": tessera.__version__, "file": tessera.__file__,
                             "import tessera; print(tessera.__version__)"],
                            cwd=elsewhere, env=environment, capture_output=True, text=True)
     assert quick.stdout.strip() == found["version"]
+
+
+def run_setup_without(module):
+    """setup.py run by this Python with `module` made unimportable, as in an environment
+    that lacks it."""
+    script = ("import runpy, sys\n"
+              f"sys.modules[{module!r}] = None\n"
+              "sys.argv = ['setup.py', '--name']\n"
+              "runpy.run_path('setup.py', run_name='__main__')\n")
+    return subprocess.run([sys.executable, "-c", script], cwd=SOURCE, capture_output=True,
+                          text=True, timeout=60)
+
+
+def test_a_python_without_numpy_or_wheel_is_stopped_before_the_build():
+    for module in ("numpy", "wheel"):
+        result = run_setup_without(module)
+        assert result.returncode != 0, module
+        lines = result.stderr.strip().splitlines()
+        assert len(lines) == 1, result.stderr
+        assert f"has no `{module}`" in lines[0] and "docs/python.md" in lines[0]
+    # Both present: setup.py gets as far as answering --name, without building.
+    result = subprocess.run([sys.executable, "setup.py", "--name"], cwd=SOURCE,
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0 and result.stdout.strip().splitlines()[-1] == "tessera"
