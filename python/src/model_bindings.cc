@@ -239,12 +239,10 @@ void BindImage(py::module_& module) {
       .def_readonly("name", &Image::name)
       .def_readonly("registered", &Image::registered)
       .def_property_readonly(
-          "cam_from_world",
-          [](const Image& image) {
-            return py::make_tuple(Eigen::Matrix3d(image.cam_from_world.rotation),
-                                  Eigen::Vector3d(image.cam_from_world.translation));
-          },
-          "(R, t): x_cam = R @ x_world + t, R (3, 3) and t (3,), copies")
+          "_cam_from_world_translation",
+          [](const Image& image) { return Eigen::Vector3d(image.cam_from_world.translation); },
+          "t of cam_from_world (x_cam = R @ x_world + t), (3,), a copy; tessera.Image's "
+          "cam_from_world is the Rigid3d of it and _cam_from_world_quat")
       .def_property_readonly(
           "_cam_from_world_quat",
           [](const Image& image) {

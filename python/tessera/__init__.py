@@ -18,15 +18,16 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _hints, _logging, _tessera
+from ._geometry import Rigid3d, Rotation3d, Sim3d
 from ._tessera import (Camera, Database, Error, Image, InputError, NoModelError, Point3D,
                        PluginCrashError, Reconstruction)
 from ._version import __version__
 
 __all__ = [
     "Camera", "Database", "Error", "Image", "InputError", "NoModelError", "Point3D",
-    "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "__version__", "adjust",
-    "align", "bench", "evaluate", "export", "extract", "import_features", "import_matches",
-    "map", "match", "plugins", "register", "run", "triangulate",
+    "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "Sim3d", "__version__",
+    "adjust", "align", "bench", "evaluate", "export", "extract", "import_features",
+    "import_matches", "map", "match", "plugins", "register", "run", "triangulate",
 ]
 
 PathLike = Union[str, os.PathLike[str]]
@@ -256,10 +257,11 @@ def import_features(output: PathLike,
         if not isinstance(key, str):
             raise TypeError(f"{name}(): features keys must be image names (str), not "
                             f"{_type_name(key)}")
-        if not isinstance(value, Sequence) or len(value) != 2:
+        pair: object = value  # checked as what a caller may pass, not as it is typed
+        if not isinstance(pair, Sequence) or len(pair) != 2:
             raise TypeError(f"{name}(): features[{key!r}] must be a tuple (keypoints, "
-                            f"descriptors), not {_type_name(value)}")
-        arrays[key] = (np.asarray(value[0]), np.asarray(value[1]))
+                            f"descriptors), not {_type_name(pair)}")
+        arrays[key] = (np.asarray(pair[0]), np.asarray(pair[1]))
     return typing.cast(Dict[str, Any], _call(
         _tessera.import_features, output=_path(name, "output", output), features=arrays,
         images=_optional_path(name, "images", images), manifest=_manifest(name, manifest),
@@ -377,14 +379,15 @@ def align(model: PathLike, output: PathLike, reference: Optional[PathLike] = Non
         if not isinstance(value, bool):
             raise TypeError(f"align(): {flag} must be a bool, not {_type_name(value)}")
     sigma = None
-    if isinstance(gps_sigma, numbers.Real) and not isinstance(gps_sigma, bool):
-        sigma = [float(gps_sigma)]
-    elif gps_sigma is not None:
-        if isinstance(gps_sigma, str) or not all(
-                isinstance(v, numbers.Real) and not isinstance(v, bool) for v in gps_sigma):
+    given: object = gps_sigma  # checked as what a caller may pass, not as it is typed
+    if isinstance(given, numbers.Real) and not isinstance(given, bool):
+        sigma = [float(given)]
+    elif given is not None:
+        if not isinstance(given, Sequence) or isinstance(given, str) or not all(
+                isinstance(v, numbers.Real) and not isinstance(v, bool) for v in given):
             raise TypeError(f"align(): gps_sigma must be a number or a sequence of numbers, not "
-                            f"{_type_name(gps_sigma)}")
-        sigma = [float(v) for v in gps_sigma]
+                            f"{_type_name(given)}")
+        sigma = [float(v) for v in given]
     return typing.cast(Dict[str, Any], _call(
         _tessera.align, model=_path(name, "model", model), output=_path(name, "output", output),
         reference=_optional_path(name, "reference", reference), gps=gps, upright=upright,
@@ -442,56 +445,8 @@ def bench(images: PathLike, manifests: Sequence[PathLike], output: PathLike = "b
 
 # ---- pycolmap's names, where the meaning is the same ----
 
-class Rotation3d:
-    """A rotation: quat (x, y, z, w), pycolmap's (and Eigen's) order, and matrix()."""
-
-    def __init__(self, quat: Sequence[float]) -> None:
-        self.quat: npt.NDArray[np.float64] = np.array(quat, dtype=np.float64)
-
-    def matrix(self) -> npt.NDArray[np.float64]:
-        """The 3x3 rotation matrix."""
-        x, y, z, w = (float(value) for value in self.quat)
-        return np.array([
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-
-    def __repr__(self) -> str:
-        return f"Rotation3d(quat=[{', '.join(f'{v:.6g}' for v in self.quat)}])"
-
-
-class Rigid3d(Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]):
-    """A pose x_cam = R @ x_world + t. Unpacks as (R, t), as Image.cam_from_world always
-    did; pycolmap's names beside: rotation (a Rotation3d, quat in (x, y, z, w)),
-    translation, matrix() (3x4)."""
-
-    rotation: Rotation3d
-
-    def __new__(cls, matrix: npt.NDArray[np.float64], translation: npt.NDArray[np.float64],
-                quat: Sequence[float]) -> "Rigid3d":
-        pose = tuple.__new__(cls, (matrix, translation))
-        pose.rotation = Rotation3d(quat)
-        return pose
-
-    def __getnewargs__(self) -> Tuple[Any, ...]:  # pickle and copy
-        return (self[0], self[1], tuple(float(value) for value in self.rotation.quat))
-
-    @property
-    def translation(self) -> npt.NDArray[np.float64]:
-        return self[1]
-
-    def matrix(self) -> npt.NDArray[np.float64]:
-        """[R | t], 3x4."""
-        return np.hstack([self[0], self[1].reshape(3, 1)])
-
-    def __repr__(self) -> str:
-        return (f"Rigid3d(rotation={self.rotation!r}, "
-                f"translation=[{', '.join(f'{v:.6g}' for v in self[1])}])")
-
-
 def _cam_from_world(image: Image) -> Rigid3d:
-    matrix, translation = image._cam_from_world_matrix
-    return Rigid3d(matrix, translation, image._cam_from_world_quat)
+    return Rigid3d(image._cam_from_world_quat, image._cam_from_world_translation)
 
 
 def _compute_mean_reprojection_error(self: Reconstruction) -> float:
@@ -554,22 +509,15 @@ def _summary(self: Reconstruction) -> str:
 def _attach() -> None:
     # Set on the extension's classes: pycolmap's names beside the C++ ones.
     image_class: Any = Image
-    image_class._cam_from_world_matrix = image_class.cam_from_world
     image_class.cam_from_world = property(
-        _cam_from_world, doc="x_cam = R @ x_world + t: a Rigid3d that unpacks as (R, t), with "
-                             "rotation.quat (x, y, z, w) and matrix() as pycolmap's")
+        _cam_from_world, doc="x_cam = R @ x_world + t: a tessera.Rigid3d (a copy; pycolmap's "
+                             "rotation.quat (x, y, z, w), translation, matrix(), inverse(), *)")
     model_class: Any = Reconstruction
-    model_class.compute_mean_reprojection_error = _compute_mean_reprojection_error
-    model_class.compute_mean_reprojection_error_from_scratch = (
-        _compute_mean_reprojection_error_from_scratch)
-    model_class.find_image_with_name = _find_image_with_name
-    model_class.num_points3D = _num_points3D
-    model_class.num_cameras = _num_cameras
-    model_class.num_images = _num_images
-    model_class.summary = _summary
-    for function in (_compute_mean_reprojection_error,
-                     _compute_mean_reprojection_error_from_scratch, _find_image_with_name,
-                     _num_points3D, _num_cameras, _num_images, _summary):
+    methods = (_compute_mean_reprojection_error, _compute_mean_reprojection_error_from_scratch,
+               _find_image_with_name, _num_points3D, _num_cameras, _num_images, _summary)
+    for function in methods:
+        setattr(model_class, function.__name__.lstrip("_"), function)
+    for function in methods:
         function.__name__ = function.__qualname__ = function.__name__.lstrip("_")
         function.__module__ = __name__
 
