@@ -449,6 +449,78 @@ def _cam_from_world(image: Image) -> Rigid3d:
     return Rigid3d(image._cam_from_world_quat, image._cam_from_world_translation)
 
 
+def _viewing_direction(image: Image) -> npt.NDArray[np.float64]:
+    """The camera's optical axis (its +z) in the world, a unit (3,): the third row of R of
+    cam_from_world, as pycolmap's."""
+    return np.array(image.cam_from_world.rotation.matrix()[2])
+
+
+def _reg_image_ids(self: Reconstruction) -> List[int]:
+    """The ids of the registered images, ascending, as pycolmap's (a list of int)."""
+    return [image_id for image_id, image in self.images.items() if image.registered]
+
+
+def _compute_mean_track_length(self: Reconstruction) -> float:
+    """COLMAP's mean track length: the observations of the registered images over the
+    number of points; 0 for a model without points."""
+    return float(self.statistics()["mean_track_length"])
+
+
+def _transform(self: Reconstruction, sim3: Sim3d) -> None:
+    """Moves the model by the similarity new_from_old, in place, as pycolmap's: every point
+    x becomes sim3 * x and every pose cam_from_world becomes
+    sim3.transform_camera_world(cam_from_world). Reprojection errors (in pixels) do not
+    change."""
+    if not isinstance(sim3, Sim3d):
+        raise TypeError(f"transform(): sim3 must be a tessera.Sim3d, not {_type_name(sim3)}")
+    self._transform(sim3.scale, sim3.rotation.matrix(), sim3.translation)
+
+
+def _normalize(self: Reconstruction, fixed_scale: bool = False, extent: float = 10.0,
+               min_percentile: float = 0.1, max_percentile: float = 0.9,
+               use_images: bool = True) -> Sim3d:
+    """Centres and scales the model in place, as pycolmap's (COLMAP 3.9 and later): over the
+    registered images' projection centres (use_images) or the points, the coordinates
+    between min_percentile and max_percentile of each axis give a box and a centroid; the
+    model is moved so that the centroid is the origin and, unless fixed_scale, scaled so
+    that the box's diagonal is `extent`. Returns the Sim3d applied (the identity, nothing
+    moved, with fewer than 2 images or points)."""
+    name = "normalize"
+    fixed_scale = _bool(name, "fixed_scale", fixed_scale)
+    use_images = _bool(name, "use_images", use_images)
+    extent = _number(name, "extent", extent)
+    low = _number(name, "min_percentile", min_percentile)
+    high = _number(name, "max_percentile", max_percentile)
+    if not (math.isfinite(extent) and extent > 0):
+        raise InputError(f"extent: {extent} is not a positive finite number")
+    if not 0 <= low <= high <= 1:
+        raise InputError(f"min_percentile, max_percentile: {low}, {high} are not "
+                         f"0 <= min_percentile <= max_percentile <= 1")
+    if use_images:
+        centres = [image.projection_center() for image in self.images.values()
+                   if image.registered]
+        coordinates = np.array(centres, dtype=np.float64).reshape(-1, 3)
+    else:
+        coordinates = self.points3D_arrays()["xyz"]
+    if len(coordinates) < 2:
+        return Sim3d()
+    # COLMAP's ComputeBoundingBoxAndCentroid: per axis, the sorted values from
+    # floor(low * (n - 1)) to ceil(high * (n - 1)).
+    end = len(coordinates) - 1
+    first = min(end, math.floor(low * end))
+    last = min(end, math.ceil(high * end))
+    kept = np.sort(coordinates, axis=0)[first:last + 1]
+    centroid = kept.mean(axis=0)
+    scale = 1.0
+    if not fixed_scale:
+        diagonal = float(np.linalg.norm(kept[-1] - kept[0]))
+        if diagonal >= np.finfo(np.float64).eps:
+            scale = extent / diagonal
+    sim3 = Sim3d(scale, Rotation3d(), -scale * centroid)
+    _transform(self, sim3)
+    return sim3
+
+
 def _compute_mean_reprojection_error(self: Reconstruction) -> float:
     """COLMAP's (and pycolmap's, and `colmap model_analyzer`'s) mean reprojection error:
     the mean of the points' stored errors (Point3D.error), over the points whose error is
@@ -512,12 +584,14 @@ def _attach() -> None:
     image_class.cam_from_world = property(
         _cam_from_world, doc="x_cam = R @ x_world + t: a tessera.Rigid3d (a copy; pycolmap's "
                              "rotation.quat (x, y, z, w), translation, matrix(), inverse(), *)")
+    image_class.viewing_direction = _viewing_direction
     model_class: Any = Reconstruction
     methods = (_compute_mean_reprojection_error, _compute_mean_reprojection_error_from_scratch,
-               _find_image_with_name, _num_points3D, _num_cameras, _num_images, _summary)
+               _compute_mean_track_length, _find_image_with_name, _normalize, _num_points3D,
+               _num_cameras, _num_images, _reg_image_ids, _summary, _transform)
     for function in methods:
         setattr(model_class, function.__name__.lstrip("_"), function)
-    for function in methods:
+    for function in methods + (_viewing_direction,):
         function.__name__ = function.__qualname__ = function.__name__.lstrip("_")
         function.__module__ = __name__
 

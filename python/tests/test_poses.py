@@ -1,5 +1,7 @@
-"""pycolmap's pose classes (tessera.Rotation3d, Rigid3d, Sim3d), on poses with known
-values and on the sample's model."""
+"""pycolmap's pose classes (tessera.Rotation3d, Rigid3d, Sim3d), the getters beside them
+(reg_image_ids, compute_mean_track_length, cam_from_img, viewing_direction,
+focal_length) and Reconstruction.transform and normalize, on the sample's model and on
+poses with known values."""
 
 import copy
 import math
@@ -166,6 +168,8 @@ def test_image_poses_are_rigid3d_from_the_stored_quaternion(model):
         np.testing.assert_allclose(R @ R.T, np.eye(3), atol=1e-12)
         np.testing.assert_allclose(pose.inverse().translation, image.projection_center(),
                                    atol=1e-9)
+        np.testing.assert_allclose(image.viewing_direction(), R[2], atol=1e-15)
+        assert np.linalg.norm(image.viewing_direction()) == pytest.approx(1, abs=1e-12)
         # pycolmap's own projection: img_from_cam(cam_from_world * xyz).
         point_ids = image.point3D_ids[image.point3D_ids != np.iinfo(np.uint64).max]
         if len(point_ids):
@@ -173,3 +177,117 @@ def test_image_poses_are_rigid3d_from_the_stored_quaternion(model):
             camera = model.cameras[image.camera_id]
             np.testing.assert_allclose(camera.img_from_cam(pose * xyz),
                                        model.project(image.image_id, xyz), atol=1e-9)
+
+
+def test_reg_image_ids_and_mean_track_length(model):
+    ids = model.reg_image_ids()
+    assert ids == sorted(i for i, image in model.images.items() if image.registered)
+    assert all(type(i) is int for i in ids) and len(ids) == model.num_reg_images() > 0
+    tracks = [len(point.track) for point in model.points3D.values()]
+    assert model.compute_mean_track_length() == pytest.approx(np.mean(tracks), rel=1e-12)
+    assert tessera.Reconstruction().compute_mean_track_length() == 0.0
+    assert tessera.Reconstruction().reg_image_ids() == []
+
+
+def test_cam_from_img_inverts_img_from_cam_with_distortion(model):
+    camera = copy.deepcopy(model.cameras[next(iter(model.cameras))])
+    assert camera.model == "SIMPLE_RADIAL"
+    f, cx, cy, _ = camera.params
+    camera.params = [f, cx, cy, -0.08]  # a distortion an undistortion must undo
+    rng = np.random.default_rng(3)
+    points = np.c_[rng.uniform(-0.4, 0.4, (50, 2)), rng.uniform(1, 5, 50)]
+    pixels = camera.img_from_cam(points)
+    # The distortion moves pixels far from the undistorted pinhole's.
+    assert np.max(np.abs(pixels - (points[:, :2] / points[:, 2:] * f + [cx, cy]))) > 1
+    np.testing.assert_allclose(camera.cam_from_img(pixels), points[:, :2] / points[:, 2:],
+                               atol=1e-9)
+    one = camera.cam_from_img(pixels[0])
+    assert one.shape == (2,)
+    np.testing.assert_allclose(one, points[0, :2] / points[0, 2], atol=1e-9)
+    assert camera.cam_from_img(np.zeros((0, 2))).shape == (0, 2)
+    with pytest.raises(TypeError, match=r"\(2,\) pixel or an \(N, 2\) array"):
+        camera.cam_from_img(np.zeros((4, 3)))
+    # What numpy cannot read as numbers: a TypeError naming the function and argument.
+    for function in (camera.cam_from_img, camera.img_from_cam,
+                     lambda points: model.project(1, points)):
+        for bad, name in (("abc", "str"), (None, "NoneType"), ([[1.0, "a"]], "list")):
+            with pytest.raises(TypeError, match=rf"\(\): points must be numbers, not {name}$"):
+                function(bad)
+
+
+def test_focal_lengths_as_pycolmap(model):
+    camera = next(iter(model.cameras.values()))
+    f = float(camera.params[0])
+    assert camera.focal_length == camera.focal_length_x == camera.focal_length_y == f
+    assert camera.mean_focal_length() == f
+    pinhole = tessera._tessera._camera_from_state(
+        (2, "PINHOLE", 640, 480, [500.0, 510.0, 320.0, 240.0]))
+    assert (pinhole.focal_length_x, pinhole.focal_length_y) == (500.0, 510.0)
+    assert pinhole.mean_focal_length() == 505.0
+    with pytest.raises(tessera.InputError, match="PINHOLE has two focal lengths"):
+        pinhole.focal_length
+
+
+def test_transform_moves_every_pose_and_point_as_the_similarity_says(model):
+    moved = copy.deepcopy(model)
+    sim3 = tessera.Sim3d(3.7, R1, T2)
+    error = model.compute_mean_reprojection_error_from_scratch()
+    assert moved.transform(sim3) is None
+    for image_id, image in model.images.items():
+        assert moved.images[image_id].cam_from_world == sim3.transform_camera_world(
+            image.cam_from_world)
+        np.testing.assert_allclose(moved.images[image_id].projection_center(),
+                                   sim3 * image.projection_center(), atol=1e-9)
+    before, after = model.points3D_arrays(), moved.points3D_arrays()
+    np.testing.assert_allclose(after["xyz"], sim3 * before["xyz"], atol=1e-9)
+    np.testing.assert_array_equal(after["errors"], before["errors"])
+    # A similarity moves nothing in the images: the reprojection errors stay.
+    assert moved.compute_mean_reprojection_error_from_scratch() == pytest.approx(error,
+                                                                                 rel=1e-9)
+    moved.transform(sim3.inverse())
+    for image_id, image in model.images.items():
+        assert moved.images[image_id].cam_from_world == image.cam_from_world
+    with pytest.raises(TypeError, match="transform\\(\\): sim3 must be a tessera.Sim3d"):
+        moved.transform(tessera.Rigid3d())
+
+
+def test_normalize_centres_and_scales_the_camera_centres(model):
+    centres = np.array([model.images[i].projection_center() for i in model.reg_image_ids()])
+    error = model.compute_mean_reprojection_error_from_scratch()
+    # The whole range: the centroid is the centres' mean, the box their bounding box.
+    moved = copy.deepcopy(model)
+    sim3 = moved.normalize(extent=4.0, min_percentile=0.0, max_percentile=1.0)
+    scale = 4.0 / np.linalg.norm(centres.max(axis=0) - centres.min(axis=0))
+    assert sim3 == tessera.Sim3d(scale, tessera.Rotation3d(), -scale * centres.mean(axis=0))
+    after = np.array([moved.images[i].projection_center() for i in moved.reg_image_ids()])
+    np.testing.assert_allclose(after.mean(axis=0), 0, atol=1e-9)
+    assert np.linalg.norm(after.max(axis=0) - after.min(axis=0)) == pytest.approx(4.0)
+    for image_id, image in model.images.items():
+        assert moved.images[image_id].cam_from_world == sim3.transform_camera_world(
+            image.cam_from_world)
+    assert moved.compute_mean_reprojection_error_from_scratch() == pytest.approx(error,
+                                                                                 rel=1e-9)
+    # pycolmap's defaults: percentiles 0.1..0.9 of each axis (COLMAP's floor and ceil of
+    # p * (n - 1)), extent 10.
+    moved = copy.deepcopy(model)
+    sim3 = moved.normalize()
+    n = len(centres)
+    kept = np.sort(centres, axis=0)[math.floor(0.1 * (n - 1)):math.ceil(0.9 * (n - 1)) + 1]
+    scale = 10.0 / np.linalg.norm(kept[-1] - kept[0])
+    assert sim3 == tessera.Sim3d(scale, tessera.Rotation3d(), -scale * kept.mean(axis=0))
+    fixed = copy.deepcopy(model).normalize(fixed_scale=True)
+    assert fixed.scale == 1.0
+    np.testing.assert_allclose(fixed.translation, -kept.mean(axis=0), atol=1e-12)
+    # Over the points instead.
+    xyz = model.points3D_arrays()["xyz"]
+    sim3 = copy.deepcopy(model).normalize(use_images=False, min_percentile=0.0,
+                                          max_percentile=1.0)
+    np.testing.assert_allclose(sim3.translation, -sim3.scale * xyz.mean(axis=0), atol=1e-9)
+    # Nothing to normalise: the identity.
+    assert tessera.Reconstruction().normalize() == tessera.Sim3d()
+    with pytest.raises(tessera.InputError, match="extent: -1.0 is not a positive"):
+        model.normalize(extent=-1.0)
+    with pytest.raises(tessera.InputError, match="min_percentile"):
+        model.normalize(min_percentile=0.9, max_percentile=0.1)
+    with pytest.raises(TypeError, match="normalize\\(\\): fixed_scale must be a bool"):
+        model.normalize(fixed_scale=1)
