@@ -29,6 +29,12 @@ def checked_calls(workspace: pathlib.Path) -> List[Tuple[str, str, Callable[[], 
     camera = rec.cameras[image.camera_id]
     point_id, point = next(iter(rec.points3D.items()))
     out = pathlib.Path(tempfile.mkdtemp())
+    pose = image.cam_from_world
+    other = rec.images[rec.reg_image_ids()[-1]].cam_from_world
+    xyz = rec.points3D_arrays()["xyz"]
+    sim3 = tessera.Sim3d(2.0, tessera.Rotation3d([0.0, 0.0, 0.6, 0.8]), np.array([1.0, 0, 0]))
+    moved = copy.deepcopy(rec)
+    pixels = camera.img_from_cam(pose * xyz[:10])
     return [
         ("pycolmap.Reconstruction(path)", SAME, lambda: tessera.Reconstruction(
             workspace / "sparse" / "0")),
@@ -55,7 +61,33 @@ def checked_calls(workspace: pathlib.Path) -> List[Tuple[str, str, Callable[[], 
          lambda: image.cam_from_world.rotation.matrix()),
         ("image.cam_from_world.translation", SAME, lambda: image.cam_from_world.translation),
         ("image.cam_from_world.matrix()", SAME, lambda: image.cam_from_world.matrix()),
+        ("image.cam_from_world.inverse()", SAME, lambda: pose.inverse()),
+        ("cam2_from_world * world_from_cam1", SAME, lambda: other * pose.inverse()),
+        ("image.cam_from_world * point3D.xyz", SAME, lambda: pose * point.xyz),
+        ("image.cam_from_world * points (N, 3)", SAME, lambda: pose * xyz),
+        ("pycolmap.Rigid3d(rotation, translation)", SAME,
+         lambda: tessera.Rigid3d(pose.rotation, pose.translation)),
+        ("pycolmap.Rigid3d(matrix)", SAME, lambda: tessera.Rigid3d(pose.matrix())),
+        ("pycolmap.Rotation3d(quat)", SAME, lambda: tessera.Rotation3d(pose.rotation.quat)),
+        ("rotation.inverse()", SAME, lambda: pose.rotation.inverse()),
+        ("rotation.angle_to(other)", SAME, lambda: pose.rotation.angle_to(other.rotation)),
+        ("pycolmap.Sim3d(scale, rotation, translation)", SAME,
+         lambda: tessera.Sim3d(2.0, pose.rotation, pose.translation)),
+        ("sim3.scale, sim3.rotation, sim3.translation", SAME,
+         lambda: (sim3.scale, sim3.rotation, sim3.translation)),
+        ("sim3.matrix()", SAME, sim3.matrix),
+        ("sim3.inverse()", SAME, sim3.inverse),
+        ("sim3 * sim3", SAME, lambda: sim3 * sim3.inverse()),
+        ("sim3 * points", SAME, lambda: sim3 * xyz),
+        ("sim3.transform_camera_world(cam_from_world)", SAME,
+         lambda: sim3.transform_camera_world(pose)),
+        ("pickle.dumps(image.cam_from_world)", SAME, lambda: pickle.loads(pickle.dumps(pose))),
+        ("rec.transform(sim3)", SAME, lambda: moved.transform(sim3)),
+        ("rec.normalize()", SAME, moved.normalize),
+        ("rec.reg_image_ids()", SAME, rec.reg_image_ids),
+        ("rec.compute_mean_track_length()", SAME, rec.compute_mean_track_length),
         ("image.projection_center()", SAME, image.projection_center),
+        ("image.viewing_direction()", SAME, image.viewing_direction),
         ("image.num_points3D", DIFFERS, image.num_points3D),
         ("image.points2D", DIFFERS, lambda: (image.keypoints, image.point3D_ids)),
         ("camera.model", DIFFERS, lambda: camera.model),
@@ -64,6 +96,11 @@ def checked_calls(workspace: pathlib.Path) -> List[Tuple[str, str, Callable[[], 
         ("camera.calibration_matrix()", SAME, camera.calibration_matrix),
         ("camera.img_from_cam(points)", DIFFERS,
          lambda: camera.img_from_cam(np.array([[0.1, 0.2, 1.0]]))),
+        ("camera.cam_from_img(pixels)", SAME, lambda: camera.cam_from_img(pixels)),
+        ("camera.focal_length", DIFFERS, lambda: camera.focal_length),
+        ("camera.focal_length_x, camera.focal_length_y", SAME,
+         lambda: (camera.focal_length_x, camera.focal_length_y)),
+        ("camera.mean_focal_length()", SAME, camera.mean_focal_length),
         ("point3D.xyz", SAME, lambda: point.xyz),
         ("point3D.color", SAME, lambda: point.color),
         ("point3D.error", SAME, lambda: point.error),

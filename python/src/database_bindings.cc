@@ -8,6 +8,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl/filesystem.h>
 
+#include <cmath>
 #include <memory>
 #include <string>
 
@@ -56,8 +57,22 @@ py::dict GeometryDict(image_t image_id1, image_t image_id2, TwoViewGeometry geom
   result["E"] = geometry.E;
   result["F"] = geometry.F;
   result["H"] = geometry.H;
-  result["cam2_from_cam1"] = py::make_tuple(Eigen::Matrix3d(geometry.cam2_from_cam1.rotation),
-                                            geometry.cam2_from_cam1.translation);
+  // A tessera.Rigid3d, as an image's pose; a database row's quaternion is not normalised
+  // when read, so one that no rotation fits is refused here, naming the pair.
+  const Eigen::Quaterniond& rotation = geometry.cam2_from_cam1.rotation;
+  const Eigen::Vector3d& translation = geometry.cam2_from_cam1.translation;
+  const double norm = rotation.norm();
+  if (!std::isfinite(norm) || std::abs(norm - 1) > 1e-3 || !translation.allFinite()) {
+    throw InputError("two-view geometry of images " + std::to_string(image_id1) + " and " +
+                     std::to_string(image_id2) +
+                     ": cam2_from_cam1 is not a unit quaternion and a finite translation "
+                     "(quaternion norm " +
+                     std::to_string(norm) + ")");
+  }
+  result["cam2_from_cam1"] =
+      py::module_::import("tessera._geometry")
+          .attr("Rigid3d")(py::make_tuple(rotation.x(), rotation.y(), rotation.z(), rotation.w()),
+                           translation);
   result["inlier_matches"] = MatchesArray(std::move(geometry.inlier_matches));
   return result;
 }
@@ -155,7 +170,7 @@ void BindDatabase(py::module_& module) {
           },
           py::arg("image_id1"), py::arg("image_id2"),
           "two_view_geometry(self, image_id1, image_id2)\n--\n\n"
-          "{'config', 'kind' ('E', 'F', 'H' or None), 'E', 'F', 'H', 'cam2_from_cam1': (R, t), "
+          "{'config', 'kind' ('E', 'F', 'H' or None), 'E', 'F', 'H', 'cam2_from_cam1': a Rigid3d, "
           "'inlier_matches': (K, 2)}, relating image_id1 to image_id2")
       .def(
           "two_view_geometries",

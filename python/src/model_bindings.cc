@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "bindings.h"
+#include "geometry/similarity_transform.h"
 #include "model_state.h"
 #include "numpy_views.h"
 #include "tessera/errors.h"
@@ -47,6 +48,17 @@ struct ModelHandle {
 };
 
 using DoubleRows = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// `points` as float64 numbers; TypeError naming the function and argument for what numpy
+// cannot read as numbers (pybind11's own message lists overloads instead).
+DoubleRows Numbers(const py::object& points, const std::string& function) {
+  DoubleRows rows = DoubleRows::ensure(points);  // a null array where numpy cannot convert
+  if (points.is_none() || !rows) {
+    throw py::type_error(function + "(): points must be numbers, not " +
+                         py::str(py::type::of(points).attr("__name__")).cast<std::string>());
+  }
+  return rows;
+}
 
 // Rows of an (N, 3) array of points; ValueError naming the argument otherwise.
 size_t NumPointRows(const DoubleRows& points, const char* name) {
@@ -84,6 +96,36 @@ py::object ImgFromCam(const Camera& camera, const Rigid3d& cam_from_world,
     return ImgFromCamRows(camera, cam_from_world, row).attr("reshape")(2);
   }
   return ImgFromCamRows(camera, cam_from_world, points);
+}
+
+// Normalised image-plane coordinates (x/z, y/z) of pixels, through the model's
+// undistortion: (N, 2) of (N, 2), or (2,) of one (2,) pixel.
+py::object CamFromImg(const Camera& camera, const DoubleRows& pixels) {
+  const bool one = pixels.ndim() == 1 && pixels.shape(0) == 2;
+  if (!one && (pixels.ndim() != 2 || pixels.shape(1) != 2)) {
+    throw py::type_error("cam_from_img(): points must be one (2,) pixel or an (N, 2) array");
+  }
+  const size_t n = one ? 1 : static_cast<size_t>(pixels.shape(0));
+  py::array_t<double> normalized = NewArray<double>(n, 2);
+  auto out = normalized.mutable_unchecked<2>();
+  const double* in = pixels.data();
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d uv = camera.CamFromImg(Eigen::Vector2d(in[2 * i], in[2 * i + 1]));
+    out(i, 0) = uv.x();
+    out(i, 1) = uv.y();
+  }
+  return one ? normalized.attr("reshape")(2) : py::object(normalized);
+}
+
+// A focal length of a camera; InputError naming the camera where its model has no such one.
+double FocalLength(const Camera& camera, const char* which) {
+  const std::vector<int> idx = camera.FocalIdx();
+  const std::string name = which;
+  if (name == "focal_length" && idx.size() != 1) {
+    throw InputError("camera " + std::to_string(camera.camera_id) + ": " + camera.ModelName() +
+                     " has two focal lengths: use focal_length_x and focal_length_y");
+  }
+  return name == "focal_length_y" ? camera.FocalLengthY() : camera.FocalLengthX();
 }
 
 // "Image(image_id=3, name='0003.jpg', camera_id=1, num_points3D=2087)".
@@ -211,12 +253,35 @@ void BindCamera(py::module_& module) {
            "calibration_matrix(self)\n--\n\nK, 3x3, of the pinhole part")
       .def(
           "img_from_cam",
-          [](const Camera& camera, const DoubleRows& points) {
-            return ImgFromCam(camera, Rigid3d(), points);
+          [](const Camera& camera, const py::object& points) {
+            return ImgFromCam(camera, Rigid3d(), Numbers(points, "img_from_cam"));
           },
           py::arg("points"),
           "img_from_cam(self, points)\n--\n\nPixels (N, 2) of camera-frame points (N, 3), "
           "or (2,) of one (3,) point; NaN for points not in front")
+      .def(
+          "cam_from_img",
+          [](const Camera& camera, const py::object& points) {
+            return CamFromImg(camera, Numbers(points, "cam_from_img"));
+          },
+          py::arg("points"),
+          "cam_from_img(self, points)\n--\n\nNormalised image-plane points (x/z, y/z), (N, 2), of "
+          "pixels (N, 2), or (2,) of one (2,) pixel, distortion removed: the inverse of "
+          "img_from_cam")
+      .def_property_readonly(
+          "focal_length", [](const Camera& camera) { return FocalLength(camera, "focal_length"); },
+          "The focal length in pixels of a model with one (InputError for one with fx and fy)")
+      .def_property_readonly(
+          "focal_length_x",
+          [](const Camera& camera) { return FocalLength(camera, "focal_length_x"); },
+          "fx in pixels (the focal length of a model with one)")
+      .def_property_readonly(
+          "focal_length_y",
+          [](const Camera& camera) { return FocalLength(camera, "focal_length_y"); },
+          "fy in pixels (the focal length of a model with one)")
+      .def("mean_focal_length", &Camera::MeanFocalLength,
+           "mean_focal_length(self)\n--\n\n(fx + fy) / 2, or the focal length of a model with "
+           "one")
       .def(py::pickle([](const Camera& camera) { return CameraState(camera); },
                       [](const py::tuple& state) { return CameraFromState(state); }))
       .def("__reduce__", ReduceThrough("camera_from_state", &CameraState))
@@ -239,12 +304,10 @@ void BindImage(py::module_& module) {
       .def_readonly("name", &Image::name)
       .def_readonly("registered", &Image::registered)
       .def_property_readonly(
-          "cam_from_world",
-          [](const Image& image) {
-            return py::make_tuple(Eigen::Matrix3d(image.cam_from_world.rotation),
-                                  Eigen::Vector3d(image.cam_from_world.translation));
-          },
-          "(R, t): x_cam = R @ x_world + t, R (3, 3) and t (3,), copies")
+          "_cam_from_world_translation",
+          [](const Image& image) { return Eigen::Vector3d(image.cam_from_world.translation); },
+          "t of cam_from_world (x_cam = R @ x_world + t), (3,), a copy; tessera.Image's "
+          "cam_from_world is the Rigid3d of it and _cam_from_world_quat")
       .def_property_readonly(
           "_cam_from_world_quat",
           [](const Image& image) {
@@ -404,18 +467,32 @@ void BindModelArrays(py::class_<ModelHandle, std::shared_ptr<ModelHandle>>& mode
           "(N,) float64}, rows by ascending id: one bulk copy each (the points are a map)")
       .def(
           "project",
-          [](const ModelHandle& handle, image_t image_id, const DoubleRows& points) {
+          [](const ModelHandle& handle, image_t image_id, const py::object& points) {
             const auto image = handle.model.images.find(image_id);
             if (image == handle.model.images.end()) {
               throw py::key_error("image_id " + std::to_string(image_id) + ": no such image");
             }
             const Camera& camera = handle.model.cameras.at(image->second.camera_id);
-            return ImgFromCam(camera, image->second.cam_from_world, points);
+            return ImgFromCam(camera, image->second.cam_from_world, Numbers(points, "project"));
           },
           py::arg("image_id"), py::arg("points"),
           "project(self, image_id, points)\n--\n\nPixels (N, 2) of world points (N, 3) in an "
           "image, or (2,) of one (3,) point; NaN for points behind it; KeyError naming an "
           "unknown image_id")
+      .def(
+          "_transform",
+          [](ModelHandle& handle, double scale, const Eigen::Matrix3d& rotation,
+             const Eigen::Vector3d& translation) {
+            // Checked by tessera.Sim3d, which alone calls this.
+            Similarity3d new_from_old;
+            new_from_old.scale = scale;
+            new_from_old.rotation = rotation;
+            new_from_old.translation = translation;
+            TransformModel(new_from_old, &handle.model);
+          },
+          py::arg("scale"), py::arg("rotation"), py::arg("translation"),
+          "_transform(self, scale, rotation, translation)\n--\n\nMoves every pose and point by "
+          "x' = scale * rotation @ x + translation (Reconstruction.transform's step)")
       .def(
           "statistics",
           [](const ModelHandle& handle) {

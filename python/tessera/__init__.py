@@ -18,15 +18,16 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _hints, _logging, _tessera
+from ._geometry import Rigid3d, Rotation3d, Sim3d
 from ._tessera import (Camera, Database, Error, Image, InputError, NoModelError, Point3D,
                        PluginCrashError, Reconstruction)
 from ._version import __version__
 
 __all__ = [
     "Camera", "Database", "Error", "Image", "InputError", "NoModelError", "Point3D",
-    "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "__version__", "adjust",
-    "align", "bench", "evaluate", "export", "extract", "import_features", "import_matches",
-    "map", "match", "plugins", "register", "run", "triangulate",
+    "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "Sim3d", "__version__",
+    "adjust", "align", "bench", "evaluate", "export", "extract", "import_features",
+    "import_matches", "map", "match", "plugins", "register", "run", "triangulate",
 ]
 
 PathLike = Union[str, os.PathLike[str]]
@@ -256,10 +257,11 @@ def import_features(output: PathLike,
         if not isinstance(key, str):
             raise TypeError(f"{name}(): features keys must be image names (str), not "
                             f"{_type_name(key)}")
-        if not isinstance(value, Sequence) or len(value) != 2:
+        pair: object = value  # checked as what a caller may pass, not as it is typed
+        if not isinstance(pair, Sequence) or len(pair) != 2:
             raise TypeError(f"{name}(): features[{key!r}] must be a tuple (keypoints, "
-                            f"descriptors), not {_type_name(value)}")
-        arrays[key] = (np.asarray(value[0]), np.asarray(value[1]))
+                            f"descriptors), not {_type_name(pair)}")
+        arrays[key] = (np.asarray(pair[0]), np.asarray(pair[1]))
     return typing.cast(Dict[str, Any], _call(
         _tessera.import_features, output=_path(name, "output", output), features=arrays,
         images=_optional_path(name, "images", images), manifest=_manifest(name, manifest),
@@ -377,14 +379,15 @@ def align(model: PathLike, output: PathLike, reference: Optional[PathLike] = Non
         if not isinstance(value, bool):
             raise TypeError(f"align(): {flag} must be a bool, not {_type_name(value)}")
     sigma = None
-    if isinstance(gps_sigma, numbers.Real) and not isinstance(gps_sigma, bool):
-        sigma = [float(gps_sigma)]
-    elif gps_sigma is not None:
-        if isinstance(gps_sigma, str) or not all(
-                isinstance(v, numbers.Real) and not isinstance(v, bool) for v in gps_sigma):
+    given: object = gps_sigma  # checked as what a caller may pass, not as it is typed
+    if isinstance(given, numbers.Real) and not isinstance(given, bool):
+        sigma = [float(given)]
+    elif given is not None:
+        if not isinstance(given, Sequence) or isinstance(given, str) or not all(
+                isinstance(v, numbers.Real) and not isinstance(v, bool) for v in given):
             raise TypeError(f"align(): gps_sigma must be a number or a sequence of numbers, not "
-                            f"{_type_name(gps_sigma)}")
-        sigma = [float(v) for v in gps_sigma]
+                            f"{_type_name(given)}")
+        sigma = [float(v) for v in given]
     return typing.cast(Dict[str, Any], _call(
         _tessera.align, model=_path(name, "model", model), output=_path(name, "output", output),
         reference=_optional_path(name, "reference", reference), gps=gps, upright=upright,
@@ -442,56 +445,80 @@ def bench(images: PathLike, manifests: Sequence[PathLike], output: PathLike = "b
 
 # ---- pycolmap's names, where the meaning is the same ----
 
-class Rotation3d:
-    """A rotation: quat (x, y, z, w), pycolmap's (and Eigen's) order, and matrix()."""
-
-    def __init__(self, quat: Sequence[float]) -> None:
-        self.quat: npt.NDArray[np.float64] = np.array(quat, dtype=np.float64)
-
-    def matrix(self) -> npt.NDArray[np.float64]:
-        """The 3x3 rotation matrix."""
-        x, y, z, w = (float(value) for value in self.quat)
-        return np.array([
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-
-    def __repr__(self) -> str:
-        return f"Rotation3d(quat=[{', '.join(f'{v:.6g}' for v in self.quat)}])"
-
-
-class Rigid3d(Tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]):
-    """A pose x_cam = R @ x_world + t. Unpacks as (R, t), as Image.cam_from_world always
-    did; pycolmap's names beside: rotation (a Rotation3d, quat in (x, y, z, w)),
-    translation, matrix() (3x4)."""
-
-    rotation: Rotation3d
-
-    def __new__(cls, matrix: npt.NDArray[np.float64], translation: npt.NDArray[np.float64],
-                quat: Sequence[float]) -> "Rigid3d":
-        pose = tuple.__new__(cls, (matrix, translation))
-        pose.rotation = Rotation3d(quat)
-        return pose
-
-    def __getnewargs__(self) -> Tuple[Any, ...]:  # pickle and copy
-        return (self[0], self[1], tuple(float(value) for value in self.rotation.quat))
-
-    @property
-    def translation(self) -> npt.NDArray[np.float64]:
-        return self[1]
-
-    def matrix(self) -> npt.NDArray[np.float64]:
-        """[R | t], 3x4."""
-        return np.hstack([self[0], self[1].reshape(3, 1)])
-
-    def __repr__(self) -> str:
-        return (f"Rigid3d(rotation={self.rotation!r}, "
-                f"translation=[{', '.join(f'{v:.6g}' for v in self[1])}])")
-
-
 def _cam_from_world(image: Image) -> Rigid3d:
-    matrix, translation = image._cam_from_world_matrix
-    return Rigid3d(matrix, translation, image._cam_from_world_quat)
+    return Rigid3d(image._cam_from_world_quat, image._cam_from_world_translation)
+
+
+def _viewing_direction(image: Image) -> npt.NDArray[np.float64]:
+    """The camera's optical axis (its +z) in the world, a unit (3,): the third row of R of
+    cam_from_world, as pycolmap's."""
+    return np.array(image.cam_from_world.rotation.matrix()[2])
+
+
+def _reg_image_ids(self: Reconstruction) -> List[int]:
+    """The ids of the registered images, ascending, as pycolmap's (a list of int)."""
+    return [image_id for image_id, image in self.images.items() if image.registered]
+
+
+def _compute_mean_track_length(self: Reconstruction) -> float:
+    """COLMAP's mean track length: the observations of the registered images over the
+    number of points; 0 for a model without points."""
+    return float(self.statistics()["mean_track_length"])
+
+
+def _transform(self: Reconstruction, sim3: Sim3d) -> None:
+    """Moves the model by the similarity new_from_old, in place, as pycolmap's: every point
+    x becomes sim3 * x and every pose cam_from_world becomes
+    sim3.transform_camera_world(cam_from_world). Reprojection errors (in pixels) do not
+    change."""
+    if not isinstance(sim3, Sim3d):
+        raise TypeError(f"transform(): sim3 must be a tessera.Sim3d, not {_type_name(sim3)}")
+    self._transform(sim3.scale, sim3.rotation.matrix(), sim3.translation)
+
+
+def _normalize(self: Reconstruction, fixed_scale: bool = False, extent: float = 10.0,
+               min_percentile: float = 0.1, max_percentile: float = 0.9,
+               use_images: bool = True) -> Sim3d:
+    """Centres and scales the model in place, as pycolmap's (COLMAP 3.9 and later): over the
+    registered images' projection centres (use_images) or the points, the coordinates
+    between min_percentile and max_percentile of each axis give a box and a centroid; the
+    model is moved so that the centroid is the origin and, unless fixed_scale, scaled so
+    that the box's diagonal is `extent`. Returns the Sim3d applied (the identity, nothing
+    moved, with fewer than 2 images or points)."""
+    name = "normalize"
+    fixed_scale = _bool(name, "fixed_scale", fixed_scale)
+    use_images = _bool(name, "use_images", use_images)
+    extent = _number(name, "extent", extent)
+    low = _number(name, "min_percentile", min_percentile)
+    high = _number(name, "max_percentile", max_percentile)
+    if not (math.isfinite(extent) and extent > 0):
+        raise InputError(f"extent: {extent} is not a positive finite number")
+    if not 0 <= low <= high <= 1:
+        raise InputError(f"min_percentile, max_percentile: {low}, {high} are not "
+                         f"0 <= min_percentile <= max_percentile <= 1")
+    if use_images:
+        centres = [image.projection_center() for image in self.images.values()
+                   if image.registered]
+        coordinates = np.array(centres, dtype=np.float64).reshape(-1, 3)
+    else:
+        coordinates = self.points3D_arrays()["xyz"]
+    if len(coordinates) < 2:
+        return Sim3d()
+    # COLMAP's ComputeBoundingBoxAndCentroid: per axis, the sorted values from
+    # floor(low * (n - 1)) to ceil(high * (n - 1)).
+    end = len(coordinates) - 1
+    first = min(end, math.floor(low * end))
+    last = min(end, math.ceil(high * end))
+    kept = np.sort(coordinates, axis=0)[first:last + 1]
+    centroid = kept.mean(axis=0)
+    scale = 1.0
+    if not fixed_scale:
+        diagonal = float(np.linalg.norm(kept[-1] - kept[0]))
+        if diagonal >= np.finfo(np.float64).eps:
+            scale = extent / diagonal
+    sim3 = Sim3d(scale, Rotation3d(), -scale * centroid)
+    _transform(self, sim3)
+    return sim3
 
 
 def _compute_mean_reprojection_error(self: Reconstruction) -> float:
@@ -554,22 +581,17 @@ def _summary(self: Reconstruction) -> str:
 def _attach() -> None:
     # Set on the extension's classes: pycolmap's names beside the C++ ones.
     image_class: Any = Image
-    image_class._cam_from_world_matrix = image_class.cam_from_world
     image_class.cam_from_world = property(
-        _cam_from_world, doc="x_cam = R @ x_world + t: a Rigid3d that unpacks as (R, t), with "
-                             "rotation.quat (x, y, z, w) and matrix() as pycolmap's")
+        _cam_from_world, doc="x_cam = R @ x_world + t: a tessera.Rigid3d (a copy; pycolmap's "
+                             "rotation.quat (x, y, z, w), translation, matrix(), inverse(), *)")
+    image_class.viewing_direction = _viewing_direction
     model_class: Any = Reconstruction
-    model_class.compute_mean_reprojection_error = _compute_mean_reprojection_error
-    model_class.compute_mean_reprojection_error_from_scratch = (
-        _compute_mean_reprojection_error_from_scratch)
-    model_class.find_image_with_name = _find_image_with_name
-    model_class.num_points3D = _num_points3D
-    model_class.num_cameras = _num_cameras
-    model_class.num_images = _num_images
-    model_class.summary = _summary
-    for function in (_compute_mean_reprojection_error,
-                     _compute_mean_reprojection_error_from_scratch, _find_image_with_name,
-                     _num_points3D, _num_cameras, _num_images, _summary):
+    methods = (_compute_mean_reprojection_error, _compute_mean_reprojection_error_from_scratch,
+               _compute_mean_track_length, _find_image_with_name, _normalize, _num_points3D,
+               _num_cameras, _num_images, _reg_image_ids, _summary, _transform)
+    for function in methods:
+        setattr(model_class, function.__name__.lstrip("_"), function)
+    for function in methods + (_viewing_direction,):
         function.__name__ = function.__qualname__ = function.__name__.lstrip("_")
         function.__module__ = __name__
 

@@ -39,8 +39,10 @@ def assert_same_model(expected, actual):
     for image_id, image in expected.images.items():
         other = actual.images[image_id]
         assert image.name == other.name
-        for mine, theirs in zip(image.cam_from_world, other.cam_from_world):
-            np.testing.assert_array_equal(mine, theirs)
+        np.testing.assert_array_equal(image.cam_from_world.rotation.quat,
+                                      other.cam_from_world.rotation.quat)
+        np.testing.assert_array_equal(image.cam_from_world.translation,
+                                      other.cam_from_world.translation)
         np.testing.assert_array_equal(image.keypoints, other.keypoints)
         np.testing.assert_array_equal(image.point3D_ids, other.point3D_ids)
     mine, theirs = expected.points3D_arrays(), actual.points3D_arrays()

@@ -1,6 +1,10 @@
 """tessera.Database on the CLI's workspace of the sample: the keypoints the model's
 images hold, matches in the caller's order, inliers among the matches, geometry kinds."""
 
+import shutil
+import sqlite3
+import struct
+
 import numpy as np
 import pytest
 
@@ -45,6 +49,29 @@ def test_matches_and_two_view_geometries(sample):
         assert len(inliers) >= 15 and inliers <= matched
     single = database.two_view_geometry(verified[0]["image_id1"], verified[0]["image_id2"])
     np.testing.assert_array_equal(single["inlier_matches"], verified[0]["inlier_matches"])
+    assert all(isinstance(g["cam2_from_cam1"], tessera.Rigid3d) for g in geometries)
+
+
+def test_a_relative_pose_no_rotation_fits_is_refused_naming_the_pair(sample, tmp_path):
+    copy = tmp_path / "database.db"
+    shutil.copyfile(sample[2] / "database.db", copy)
+    pair_id = 2147483647 * 1 + 2  # COLMAP's pair id of images 1 and 2
+    with sqlite3.connect(copy) as connection:
+        connection.execute("UPDATE two_view_geometries SET qvec = ?, tvec = ? WHERE pair_id = ?",
+                           (struct.pack("4d", 0.5, 0, 0, 0), struct.pack("3d", 1, 2, 3),
+                            pair_id))
+    connection.close()
+    with pytest.raises(tessera.InputError,
+                       match="two-view geometry of images 1 and 2: cam2_from_cam1 is not a "
+                             "unit quaternion"):
+        tessera.Database(copy).two_view_geometry(1, 2)
+    # COLMAP leaves qvec at zero where it has no relative pose: the identity rotation.
+    with sqlite3.connect(copy) as connection:
+        connection.execute("UPDATE two_view_geometries SET qvec = ? WHERE pair_id = ?",
+                           (struct.pack("4d", 0, 0, 0, 0), pair_id))
+    connection.close()
+    pose = tessera.Database(copy).two_view_geometry(1, 2)["cam2_from_cam1"]
+    assert pose == tessera.Rigid3d(tessera.Rotation3d(), [1.0, 2.0, 3.0])
 
 
 def test_a_file_that_is_not_a_database_raises_input_error(sample, tmp_path):

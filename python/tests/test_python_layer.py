@@ -203,7 +203,9 @@ def test_pycolmap_names(model):
     assert model.find_image_with_name("no_such.jpg") is None
     assert f"num_points3D = {len(model.points3D)}" in model.summary()
     pose = image.cam_from_world
-    R, t = pose  # unpacks as before
+    R, t = pose.rotation.matrix(), pose.translation
+    with pytest.raises(TypeError):
+        R, t = pose  # a Rigid3d, as pycolmap's, is no tuple: it does not unpack
     x, y, z, w = pose.rotation.quat
     assert abs(np.linalg.norm([x, y, z, w]) - 1) < 1e-9
     np.testing.assert_allclose(pose.rotation.matrix(), R, atol=1e-12)

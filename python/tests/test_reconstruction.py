@@ -72,7 +72,8 @@ def test_arrays_have_their_shapes_and_views_share_memory(model_dir):
 def test_poses_and_projection_agree_with_the_host(model_dir):
     model = tessera.Reconstruction(model_dir)
     for image in model.images.values():
-        rotation, translation = image.cam_from_world
+        pose = image.cam_from_world
+        rotation, translation = pose.rotation.matrix(), pose.translation
         np.testing.assert_allclose(rotation @ rotation.T, np.eye(3), atol=1e-12)
         np.testing.assert_allclose(image.projection_center(), -rotation.T @ translation,
                                    atol=1e-9)
