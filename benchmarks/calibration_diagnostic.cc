@@ -6,10 +6,12 @@
 //   calibration_diagnostic --manifest M --database DB --true-K K.txt --gt GT [--mm]
 //       a workspace's verified matches (`tessera run` or `tessera match` made DB), K.txt
 //       and the ground-truth poses of the set; --mm: metric ground truth, errors in mm
-//   calibration_diagnostic --manifest M --synthetic N [--scene-seed S]
+//   calibration_diagnostic --manifest M --synthetic N [--scene-seed S] [--given-K]
 //       a synthetic arc of N views with known K (1600x1200 px, f 1200 px, the principal
 //       point 16 px right and 10 px up of the centre, k1 -0.02), no focal-length prior
 //       (the default 1.2 times the larger side), 0.5 px noise and 5% wrong matches
+//       --given-K: the true camera given as a prior (the reference of calibrated.json,
+//       whose mapper holds it)
 //   --threads T: of the mapper and Ceres (1)
 //
 // Exit codes: 0, 2 for bad arguments or input (one line naming the file), 1 otherwise.
@@ -38,11 +40,12 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: calibration_diagnostic --manifest M (--database DB --true-K K.txt --gt GT [--mm] | "
-    "--synthetic N [--scene-seed S]) [--threads T]";
+    "--synthetic N [--scene-seed S] [--given-K]) [--threads T]";
 
 struct Arguments {
   std::map<std::string, std::string> values;
   bool mm = false;
+  bool given_k = false;
   std::string Get(const std::string& key) const {
     const auto it = values.find(key);
     return it == values.end() ? "" : it->second;
@@ -55,6 +58,8 @@ bool Parse(int argc, char** argv, Arguments* arguments) {
     const std::string arg = argv[i];
     if (arg == "--mm") {
       arguments->mm = true;
+    } else if (arg == "--given-K") {
+      arguments->given_k = true;
     } else if ((arg == "--manifest" || arg == "--database" || arg == "--true-K" || arg == "--gt" ||
                 arg == "--synthetic" || arg == "--scene-seed" || arg == "--threads") &&
                i + 1 < argc) {
@@ -66,7 +71,8 @@ bool Parse(int argc, char** argv, Arguments* arguments) {
   const bool real = !arguments->Get("--database").empty() && !arguments->Get("--true-K").empty() &&
                     !arguments->Get("--gt").empty();
   const bool synthetic = !arguments->Get("--synthetic").empty();
-  return !arguments->Get("--manifest").empty() && real != synthetic;
+  return !arguments->Get("--manifest").empty() && real != synthetic &&
+         (synthetic || !arguments->given_k);
 }
 
 int PositiveInt(const std::string& text, const std::string& option) {
@@ -123,6 +129,18 @@ TrueIntrinsics SyntheticTruth(const testing::SyntheticSceneOptions& options) {
           {options.k1}};
 }
 
+// The reference of a K given and held: the true camera as a prior, every pair's
+// geometry calibrated (its essential matrix and pose are the true ones already).
+void GiveTrueCamera(const testing::SyntheticSceneOptions& options, MapperInput* input) {
+  const TrueIntrinsics truth = SyntheticTruth(options);
+  for (auto& [camera_id, camera] : input->cameras) {
+    camera.params = {truth.fx, truth.cx, truth.cy, truth.distortion.at(0)};
+    camera.has_prior_focal_length = true;
+    camera.calibration_source = CalibrationSource::kUser;
+  }
+  for (MapperInput::Pair& pair : input->pairs) pair.geometry.config = TwoViewGeometry::CALIBRATED;
+}
+
 int Run(const Arguments& arguments) {
   const nlohmann::json manifest = ReadManifest(arguments.Get("--manifest"));
   const int threads =
@@ -152,6 +170,7 @@ int Run(const Arguments& arguments) {
     truth_poses = scene.GroundTruth();
     truth = SyntheticTruth(options);
     input = std::move(scene.input);
+    if (arguments.given_k) GiveTrueCamera(options, &input);
   } else {
     const std::string database = arguments.Get("--database");
     if (!std::filesystem::is_regular_file(database)) throw InputError(database + ": not found");

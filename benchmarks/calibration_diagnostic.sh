@@ -5,6 +5,9 @@
 # one Markdown table per set. The mapper, its options, the adjuster's and the seed are the
 # manifest's; the features and matches too (`tessera extract` and `tessera match` into
 # OUT/SET once, reused by later runs on the same set: delete the folder to make them again).
+# A manifest that requires a calibration (calibrated.json: K given and held) gets the true
+# one: the set's K.txt (--camera-K, its own workspace OUT/SET-K), or the synthetic truth
+# (--given-K): the reference self-calibration is to reach.
 # usage: benchmarks/calibration_diagnostic.sh OUT MANIFEST SET [SET ...]
 #   SET: a folder of ../shared/datasets with images/, gt/ (*.camera, metric) and K.txt, or
 #   synthetic:N, a synthetic arc of N views with known K (calibration_diagnostic's header).
@@ -13,7 +16,7 @@
 #   e.g. benchmarks/calibration_diagnostic.sh /tmp/diag manifests/global.json fountain-P11 synthetic:12
 set -uo pipefail
 [ $# -ge 3 ] || { sed -n 's/^# usage: /usage: /p' "$0" >&2; exit 2; }
-command_line="benchmarks/calibration_diagnostic.sh $*"
+command_line="TESSERA_THREADS=${TESSERA_THREADS:-2} benchmarks/calibration_diagnostic.sh $*"
 out=$1
 manifest=$2
 shift 2
@@ -28,25 +31,28 @@ threads=${TESSERA_THREADS:-2}
 for need in "$tessera" "$diagnostic"; do
   [ -x "$need" ] || { echo "calibration_diagnostic: $need: not found (build it)" >&2; exit 2; }
 done
+given_k=""
+grep -q '"require_calibration": *true' "$manifest" && given_k=yes
 tables=$(mktemp)
 table=$(mktemp)
 trap 'rm -f "$tables" "$table"' EXIT
 status=0
 for set_name in "$@"; do
   if [[ "$set_name" == synthetic:* ]]; then
-    arguments=(--synthetic "${set_name#synthetic:}")
+    arguments=(--synthetic "${set_name#synthetic:}" ${given_k:+--given-K})
   else
     data=../shared/datasets/$set_name
     for need in "$data/images" "$data/gt" "$data/K.txt"; do
       [ -e "$need" ] || { echo "calibration_diagnostic: $need: not found" >&2; exit 2; }
     done
-    workspace=$out/$set_name
+    workspace=$out/$set_name${given_k:+-K}
+    camera_k=(${given_k:+--camera-K "$data/K.txt"})
     if [ ! -f "$workspace/database.db" ] || [ ! -f "$workspace/matched" ]; then
       mkdir -p "$workspace"
       { "$tessera" extract --images "$data/images" --output "$workspace" --manifest "$manifest" \
-          --threads "$threads" &&
+          "${camera_k[@]}" --threads "$threads" &&
         "$tessera" match --images "$data/images" --output "$workspace" --manifest "$manifest" \
-          --threads "$threads"; } > "$workspace/match.log" 2>&1 ||
+          "${camera_k[@]}" --threads "$threads"; } > "$workspace/match.log" 2>&1 ||
         { echo "calibration_diagnostic: $set_name: matching failed, see $workspace/match.log" >&2
           exit 1; }
       touch "$workspace/matched"

@@ -296,7 +296,7 @@ std::string DistortionCell(const Camera& camera, const TrueIntrinsics& truth) {
 }
 
 std::string PositionCell(double error, double scale) {
-  return std::isnan(error) ? "-" : Format("%.3f", scale * error);
+  return std::isnan(error) ? "-" : Format("%.4g", scale * error);
 }
 
 }  // namespace
