@@ -24,7 +24,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 [ -f "$manifest" ] || { echo "calibration_diagnostic: $manifest: not found" >&2; exit 2; }
 manifest=$(readlink -f "$manifest")
 out=$(mkdir -p "$out" && cd "$out" && pwd)
-cd "$root"
+cd "$root" || exit 2
 tessera=$(readlink -f "${TESSERA:-build/bin/tessera}")
 diagnostic=$(readlink -f "${DIAGNOSTIC:-build/bin/calibration_diagnostic}")
 threads=${TESSERA_THREADS:-2}
@@ -70,9 +70,9 @@ for set_name in "$@"; do
   echo
 done
 if [ -n "${RECORD:-}" ]; then
-  python3 - "$tables" "$RECORD" "$command_line" <<'EOF'
+  python3 - "$tables" "$RECORD" "$command_line" "$(basename "$manifest")" <<'EOF'
 import datetime, json, os, sys
-tables, record_path, command = sys.argv[1:4]
+tables, record_path, command, manifest = sys.argv[1:5]
 record = {"columns": [], "runs": [], "rows": []}
 if os.path.exists(record_path):
     record = json.load(open(record_path))
@@ -83,11 +83,11 @@ for line in open(tables).read().splitlines():
     if cells[0].startswith("---"):
         continue
     if cells[0].endswith("mapper: stage"):
-        columns = ["set", "mapper"] + ["stage"] + cells[1:]
+        columns = ["set", "manifest (mapper)", "stage"] + cells[1:]
         if record["columns"] and record["columns"] != columns:
             sys.exit("calibration_diagnostic: %s: other columns" % record_path)
         record["columns"] = columns
-        mapper = cells[0].split(" ")[0]
+        mapper = "%s (%s)" % (manifest, cells[0].split(" ")[0])
         continue
     record["rows"].append({"run": run, "cells": [name, mapper] + cells})
 date = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
