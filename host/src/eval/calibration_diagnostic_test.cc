@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -84,6 +86,25 @@ TEST(CalibrationDiagnostic, IncrementalStagesStartAtTheInitialPair) {
       IncrementalPipeline(IncrementalMapperOptions(), adjuster, 3).Reconstruct(scene.input);
   ASSERT_FALSE(mapped.models.empty());
   EXPECT_EQ(diagnosis.stages.back().camera.params, mapped.models[0].cameras.at(1).params);
+}
+
+// A first model for the focal length (min_view_graph_focal_pairs 0) adjusts whole models
+// of its own before the real pass: none of them is a stage.
+TEST(CalibrationDiagnostic, IncrementalStagesLeaveTheFirstModelOut) {
+  const testing::SyntheticScene scene = SmallScene();
+  IncrementalMapperOptions options;
+  options.min_view_graph_focal_pairs = 0;
+  const CalibrationDiagnosis diagnosis = DiagnoseIncrementalMapper(
+      scene.input, testing::CeresAdjusterOnOneThread(), options, 3, scene.GroundTruth());
+  const std::vector<std::string> names = Names(diagnosis);
+  ASSERT_GE(names.size(), 5u);
+  EXPECT_EQ(names[2], "calibration (view graph, first model)");
+  EXPECT_EQ(names[3], "global BA (2 images)");
+  EXPECT_EQ(std::count(names.begin(), names.end(), "global BA (2 images)"), 1);
+  // The real pass only grows: its whole-model adjustments never have fewer images.
+  for (size_t i = 4; i + 1 < diagnosis.stages.size(); ++i) {
+    EXPECT_GE(diagnosis.stages[i].num_images, diagnosis.stages[i - 1].num_images) << names[i];
+  }
 }
 
 TEST(CalibrationDiagnostic, ReadsTheTrueKAndTabulatesTheErrors) {
