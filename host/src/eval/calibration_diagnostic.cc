@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <fstream>
 #include <iterator>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <utility>
@@ -215,7 +216,7 @@ CalibrationDiagnosis DiagnoseIncrementalMapper(
   // model starts; the first image registered after the initial pair marks where the
   // real pass began: its initial pair's adjustment is the one before.
   std::vector<CalibrationStage> whole_model_adjustments;
-  size_t first_grown = whole_model_adjustments.max_size();
+  std::optional<size_t> first_grown;  // adjustments recorded when the first image grew it
   bool second_model = false;
   const ObservedBundleAdjuster observed(
       bundle_adjuster, [&](const BundleAdjustmentConfig& config, const BundleAdjustmentSummary&,
@@ -232,16 +233,14 @@ CalibrationDiagnosis DiagnoseIncrementalMapper(
   MapperControl control;
   control.on_model_changed = [&](size_t model_index, const Reconstruction&) {
     if (model_index > 0) second_model = true;
-    if (first_grown == whole_model_adjustments.max_size()) {
-      first_grown = whole_model_adjustments.size();
-    }
+    if (!first_grown) first_grown = whole_model_adjustments.size();
   };
   const MapperResult result =
       IncrementalPipeline(options, observed, seed).Reconstruct(input, control);
   stages.push_back(CalibratedStage(input, result.focal_lengths, camera_id));
-  if (first_grown != whole_model_adjustments.max_size() && first_grown > 0) {
+  if (first_grown && *first_grown > 0) {
     stages.insert(stages.end(),
-                  whole_model_adjustments.begin() + static_cast<std::ptrdiff_t>(first_grown - 1),
+                  whole_model_adjustments.begin() + static_cast<std::ptrdiff_t>(*first_grown - 1),
                   whole_model_adjustments.end());
   }
   stages.push_back(FinalStage(result, camera_id, truth));
