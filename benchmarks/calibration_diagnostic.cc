@@ -6,10 +6,13 @@
 //   calibration_diagnostic --manifest M --database DB --true-K K.txt --gt GT [--mm]
 //       a workspace's verified matches (`tessera run` or `tessera match` made DB), K.txt
 //       and the ground-truth poses of the set; --mm: metric ground truth, errors in mm
-//   calibration_diagnostic --manifest M --synthetic N [--scene-seed S] [--given-K]
+//   calibration_diagnostic --manifest M --synthetic N [--scene-seed S] [--view-angle A]
+//                          [--given-K]
 //       a synthetic arc of N views with known K (1600x1200 px, f 1200 px, the principal
 //       point 16 px right and 10 px up of the centre, k1 -0.02), no focal-length prior
-//       (the default 1.2 times the larger side), 0.5 px noise and 5% wrong matches
+//       (the default 1.2 times the larger side), 0.5 px noise and 5% wrong matches;
+//       every camera sees the whole cube of points, or with --view-angle A each point
+//       only from within A degrees of its outward normal (an object's surface)
 //       --given-K: the true camera given as a prior (the reference of calibrated.json,
 //       whose mapper holds it)
 //   --threads T: of the mapper and Ceres (1)
@@ -40,7 +43,7 @@ namespace {
 
 constexpr const char* kUsage =
     "usage: calibration_diagnostic --manifest M (--database DB --true-K K.txt --gt GT [--mm] | "
-    "--synthetic N [--scene-seed S] [--given-K]) [--threads T]";
+    "--synthetic N [--scene-seed S] [--view-angle A] [--given-K]) [--threads T]";
 
 struct Arguments {
   std::map<std::string, std::string> values;
@@ -61,7 +64,8 @@ bool Parse(int argc, char** argv, Arguments* arguments) {
     } else if (arg == "--given-K") {
       arguments->given_k = true;
     } else if ((arg == "--manifest" || arg == "--database" || arg == "--true-K" || arg == "--gt" ||
-                arg == "--synthetic" || arg == "--scene-seed" || arg == "--threads") &&
+                arg == "--synthetic" || arg == "--scene-seed" || arg == "--view-angle" ||
+                arg == "--threads") &&
                i + 1 < argc) {
       arguments->values[arg] = argv[++i];
     } else {
@@ -164,8 +168,11 @@ int Run(const Arguments& arguments) {
     const int seed_of_scene = arguments.Get("--scene-seed").empty()
                                   ? 1
                                   : PositiveInt(arguments.Get("--scene-seed"), "--scene-seed");
-    const testing::SyntheticSceneOptions options =
+    testing::SyntheticSceneOptions options =
         SyntheticOptions(PositiveInt(arguments.Get("--synthetic"), "--synthetic"), seed_of_scene);
+    if (!arguments.Get("--view-angle").empty()) {
+      options.max_view_angle_deg = PositiveInt(arguments.Get("--view-angle"), "--view-angle");
+    }
     testing::SyntheticScene scene = testing::MakeSyntheticScene(options);
     truth_poses = scene.GroundTruth();
     truth = SyntheticTruth(options);

@@ -10,7 +10,9 @@
 # (--given-K): the reference self-calibration is to reach.
 # usage: benchmarks/calibration_diagnostic.sh OUT MANIFEST SET [SET ...]
 #   SET: a folder of ../shared/datasets with images/, gt/ (*.camera, metric) and K.txt, or
-#   synthetic:N, a synthetic arc of N views with known K (calibration_diagnostic's header).
+#   synthetic:N, a synthetic arc of N views with known K (calibration_diagnostic's header),
+#   every view seeing the whole scene; synthetic:N:A, each point seen only from within A
+#   degrees of its outward normal (partial overlap, as around an object).
 #   RECORD=benchmarks/results/NAME.json: the tables are also added to that record, as one
 #   run (benchmarks/benchmarks_doc.py).
 #   e.g. benchmarks/calibration_diagnostic.sh /tmp/diag manifests/global.json fountain-P11 synthetic:12
@@ -39,7 +41,9 @@ trap 'rm -f "$tables" "$table"' EXIT
 status=0
 for set_name in "$@"; do
   if [[ "$set_name" == synthetic:* ]]; then
-    arguments=(--synthetic "${set_name#synthetic:}" ${given_k:+--given-K})
+    scene=${set_name#synthetic:}
+    arguments=(--synthetic "${scene%%:*}" ${given_k:+--given-K})
+    [[ "$scene" == *:* ]] && arguments+=(--view-angle "${scene#*:}")
   else
     data=../shared/datasets/$set_name
     for need in "$data/images" "$data/gt" "$data/K.txt"; do
