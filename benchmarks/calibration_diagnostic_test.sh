@@ -19,7 +19,7 @@ expect() {
     failures=$((failures + 1))
   fi
 }
-usage="usage: calibration_diagnostic --manifest M (--database DB --true-K K.txt --gt GT [--mm] | --synthetic N [--scene-seed S] [--given-K]) [--threads T]"
+usage="usage: calibration_diagnostic --manifest M (--database DB --true-K K.txt --gt GT [--mm] | --synthetic N [--scene-seed S] [--view-angle A] [--given-K]) [--threads T]"
 manifest=$root/manifests/global.json
 expect 2 "$usage"
 expect 2 "$usage" --manifest "$manifest" --synthetic 8 --database x --true-K y --gt z
@@ -37,5 +37,7 @@ expect 2 "calibration_diagnostic: $work/K.txt: holds 6 numbers, not the 9 of a 3
   --manifest "$manifest" --database "$work/database.db" --true-K "$work/K.txt" --gt "$work"
 expect 2 "calibration_diagnostic: --synthetic 0: not a whole number from 1 to 100000" \
   --manifest "$manifest" --synthetic 0
+expect 2 "calibration_diagnostic: --view-angle x: not a whole number from 1 to 100000" \
+  --manifest "$manifest" --synthetic 8 --view-angle x
 [ "$failures" = 0 ] && echo "PASS"
 exit $((failures > 0))
