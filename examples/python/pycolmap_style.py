@@ -136,6 +136,8 @@ def estimator_calls(rec: tessera.Reconstruction) -> List[Tuple[str, str, Callabl
          lambda: tessera.estimate_fundamental_matrix(points1, points2)),
         ("pycolmap.estimate_homography_matrix(points1, points2)", DIFFERS,
          lambda: tessera.estimate_homography_matrix(points1, points2)),
+        ("pycolmap.estimate_two_view_geometry(camera1, points1, camera2, points2)", DIFFERS,
+         lambda: tessera.estimate_two_view_geometry(camera1, points1, camera2, points2)),
         ("pycolmap.Camera(model, width, height, params)", SAME,
          lambda: tessera.Camera("SIMPLE_PINHOLE", 640, 480, [500.0, 320.0, 240.0])),
     ]

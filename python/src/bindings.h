@@ -33,7 +33,8 @@ void BindRegister(pybind11::module_& module);
 void BindImport(pybind11::module_& module);
 
 // tessera._estimate_absolute_pose, _estimate_essential_matrix, _estimate_fundamental_matrix,
-// _estimate_homography_matrix (estimator_bindings.cc; tessera/_estimators.py wraps them).
+// _estimate_homography_matrix, _estimate_two_view_geometry (estimator_bindings.cc;
+// tessera/_estimators.py wraps them).
 void BindEstimators(pybind11::module_& module);
 
 }  // namespace tessera::python

@@ -1,8 +1,9 @@
 // The robust estimators on numpy (tessera._estimate_absolute_pose, _estimate_essential_matrix,
 // _estimate_fundamental_matrix, _estimate_homography_matrix): Tessera's own LO-RANSAC and
 // minimal solvers, as the mapper and the verification use them, each returning pycolmap's
-// fields and an inlier mask. The Python layer (tessera/_estimators.py) reads pycolmap's
-// option dicts and passes the RANSAC fields here as one dict of known keys.
+// fields and an inlier mask; and the verification itself (_estimate_two_view_geometry).
+// The Python layer (tessera/_estimators.py) reads pycolmap's option dicts and passes the
+// RANSAC fields here as one dict of known keys.
 
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
@@ -11,6 +12,7 @@
 #include <Eigen/Geometry>
 #include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bindings.h"
@@ -19,8 +21,10 @@
 #include "estimators/fundamental_matrix.h"
 #include "estimators/homography_matrix.h"
 #include "estimators/ransac.h"
+#include "geometry/two_view_geometry_estimation.h"
 #include "tessera/camera.h"
 #include "tessera/errors.h"
+#include "two_view_geometry_dict.h"
 
 namespace py = pybind11;
 
@@ -217,6 +221,94 @@ py::object EstimatePixelMatrix(const char* function, const char* name, const py:
       name, RunLORANSAC<Estimator, LocalEstimator>(options, Seed(ransac), points1, points2));
 }
 
+// Keypoints at `points` (no shape: identity frames), for the verification.
+FeatureKeypoints Keypoints(const std::vector<Eigen::Vector2d>& points) {
+  FeatureKeypoints keypoints;
+  keypoints.reserve(points.size());
+  for (const Eigen::Vector2d& point : points) {
+    keypoints.emplace_back(static_cast<float>(point.x()), static_cast<float>(point.y()));
+  }
+  return keypoints;
+}
+
+// (K, 2) indices into points1 and points2, or row i to row i where `value` is None.
+FeatureMatches Matches(const py::object& value, size_t n1, size_t n2) {
+  const char* function = "estimate_two_view_geometry";
+  FeatureMatches matches;
+  if (value.is_none()) {
+    if (n1 != n2) {
+      throw InputError(std::string(function) + ": points1 has " + std::to_string(n1) +
+                       " rows but points2 has " + std::to_string(n2) +
+                       "; without matches, row i of one matches row i of the other");
+    }
+    for (size_t i = 0; i < n1; ++i) {
+      matches.push_back({static_cast<point2D_t>(i), static_cast<point2D_t>(i)});
+    }
+    return matches;
+  }
+  using IndexRows = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
+  const bool is_array = py::isinstance<py::array>(value) || py::isinstance<py::list>(value) ||
+                        py::isinstance<py::tuple>(value);
+  const IndexRows rows = is_array ? IndexRows::ensure(value) : IndexRows();
+  if (is_array && !rows) PyErr_Clear();
+  if (!is_array || !rows || rows.ndim() != 2 || rows.shape(1) != 2) {
+    throw py::type_error(std::string(function) +
+                         ": matches must be None or a (K, 2) array of indices into points1 "
+                         "and points2");
+  }
+  const auto view = rows.unchecked<2>();
+  for (py::ssize_t k = 0; k < rows.shape(0); ++k) {
+    const int64_t idx1 = view(k, 0), idx2 = view(k, 1);
+    if (idx1 < 0 || static_cast<size_t>(idx1) >= n1 || idx2 < 0 ||
+        static_cast<size_t>(idx2) >= n2) {
+      throw InputError(std::string(function) + ": matches row " + std::to_string(k) + " (" +
+                       std::to_string(idx1) + ", " + std::to_string(idx2) +
+                       ") is not a pair of indices into points1 (" + std::to_string(n1) +
+                       " rows) and points2 (" + std::to_string(n2) + " rows)");
+    }
+    matches.push_back({static_cast<point2D_t>(idx1), static_cast<point2D_t>(idx2)});
+  }
+  return matches;
+}
+
+py::dict EstimateTwoView(const Camera& camera1, const py::object& points1_in, const Camera& camera2,
+                         const py::object& points2_in, const py::object& matches_in,
+                         const py::dict& options) {
+  const char* function = "estimate_two_view_geometry";
+  const auto points1 = Rows<2>(points1_in, function, "points1");
+  const auto points2 = Rows<2>(points2_in, function, "points2");
+  CheckCamera(function, "camera1", camera1);
+  CheckCamera(function, "camera2", camera2);
+  const FeatureMatches matches = Matches(matches_in, points1.size(), points2.size());
+  VerificationSettings settings;
+  settings.max_error_px = MaxErrorPx(options);
+  settings.confidence = options["confidence"].cast<double>();
+  settings.min_num_trials = options["min_num_trials"].cast<int>();
+  settings.max_num_trials = options["max_num_trials"].cast<int>();
+  settings.min_inlier_ratio = options["min_inlier_ratio"].cast<double>();
+  settings.min_num_inliers = options["min_num_inliers"].cast<int>();
+  settings.max_H_inlier_ratio = options["max_H_inlier_ratio"].cast<double>();
+  RANSACOptions checked;  // the fields the verification's RANSAC takes, checked before it runs
+  checked.max_error = settings.max_error_px;
+  checked.confidence = settings.confidence;
+  checked.min_num_trials = settings.min_num_trials;
+  checked.max_num_trials = settings.max_num_trials;
+  checked.min_inlier_ratio = settings.min_inlier_ratio;
+  checked.Check();
+  if (!(settings.max_H_inlier_ratio >= 0 && settings.max_H_inlier_ratio <= 1)) {
+    throw InputError(std::string(function) + ": max_H_inlier_ratio = " +
+                     std::to_string(settings.max_H_inlier_ratio) + " is not in [0, 1]");
+  }
+  const FeatureKeypoints keypoints1 = Keypoints(points1), keypoints2 = Keypoints(points2);
+  TwoViewGeometry geometry;
+  {
+    const py::gil_scoped_release release;
+    geometry = EstimateTwoViewGeometry(camera1, keypoints1, camera2, keypoints2, matches, settings,
+                                       Seed(options));
+  }
+  return TwoViewGeometryDict(std::move(geometry), function);
+}
+
 }  // namespace
 
 void BindEstimators(py::module_& module) {
@@ -245,6 +337,11 @@ void BindEstimators(py::module_& module) {
       },
       py::arg("points1"), py::arg("points2"), py::arg("ransac"),
       "Four-point DLT LO-RANSAC on pixels; use tessera.estimate_homography_matrix");
+  module.def("_estimate_two_view_geometry", &EstimateTwoView, py::arg("camera1"),
+             py::arg("points1"), py::arg("camera2"), py::arg("points2"), py::arg("matches"),
+             py::arg("options"),
+             "The pipeline's geometric verification (EstimateTwoViewGeometry) on numpy; use "
+             "tessera.estimate_two_view_geometry");
 }
 
 }  // namespace tessera::python

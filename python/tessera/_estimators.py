@@ -1,5 +1,6 @@
 """pycolmap's robust estimators on numpy over Tessera's own LO-RANSAC: estimate_absolute_pose,
-estimate_essential_matrix, estimate_fundamental_matrix and estimate_homography_matrix.
+estimate_essential_matrix, estimate_fundamental_matrix, estimate_homography_matrix and
+estimate_two_view_geometry (the pipeline's geometric verification).
 
 Options are dicts with pycolmap's keys: {"ransac": {"max_error": px, "confidence", ...}}
 or the same RANSAC keys flat. A key that is not one of them is an InputError naming it.
@@ -36,6 +37,17 @@ FundamentalMatrixResult = TypedDict("FundamentalMatrixResult",
 HomographyMatrixResult = TypedDict("HomographyMatrixResult",
                                    {"H": _F64, "num_inliers": int, "inlier_mask": _Mask})
 
+
+class TwoViewGeometryResult(TypedDict):
+    """Database.two_view_geometry's fields, without the image ids."""
+    config: int
+    kind: Optional[str]  # "E", "F", "H" or None
+    E: _F64
+    F: _F64
+    H: _F64
+    cam2_from_cam1: Rigid3d
+    inlier_matches: npt.NDArray[np.uint32]
+
 # pycolmap's RANSACOptions fields; the defaults are those of the mapper's registration
 # (absolute pose) and of the pipeline's verification (two-view matrices), in pixels.
 _FLOAT_KEYS = ("max_error", "min_inlier_ratio", "confidence", "dyn_num_trials_multiplier")
@@ -48,6 +60,13 @@ _TWO_VIEW_DEFAULTS: Dict[str, object] = {
     "max_error": 4.0, "min_inlier_ratio": 0.25, "confidence": 0.999,
     "dyn_num_trials_multiplier": 3.0, "min_num_trials": 100, "max_num_trials": 10000,
     "random_seed": 0}
+# The verification's RANSAC (no dyn_num_trials_multiplier: it uses the host's) and the
+# keys of pycolmap's TwoViewGeometryOptions it honours, with the pipeline's defaults.
+_TWO_VIEW_GEOMETRY_DEFAULTS: Dict[str, object] = {
+    key: value for key, value in _TWO_VIEW_DEFAULTS.items()
+    if key != "dyn_num_trials_multiplier"}
+_TWO_VIEW_GEOMETRY_KEYS = ("min_num_inliers", "max_H_inlier_ratio")
+
 # pycolmap's refinement keys Tessera's RefineAbsolutePose honours: it refines the pose only,
 # so the focal length and extra parameters may be asked fixed (False), not refined.
 _FIXED_REFINEMENT_KEYS = ("refine_focal_length", "refine_extra_params")
@@ -91,11 +110,12 @@ def _ransac(function: str, argument: str, options: object,
     """The RANSAC fields of `options` ({"ransac": {...}} or flat), over `defaults`."""
     given = _mapping(function, argument, options)
     ransac = dict(defaults)
-    valid = ("ransac",) + _FLOAT_KEYS + _INT_KEYS + extra_keys
+    ransac_keys = tuple(defaults)
+    valid = ("ransac",) + ransac_keys + extra_keys
     nested = _mapping(function, f"{argument}['ransac']", given.get("ransac"))
     for key, value in nested.items():
         if key not in defaults:
-            raise _unknown(function, f"{argument}['ransac']", key, _FLOAT_KEYS + _INT_KEYS)
+            raise _unknown(function, f"{argument}['ransac']", key, ransac_keys)
         ransac[key] = _ransac_value(function, key, value)
     for key, value in given.items():
         if key == "ransac" or key in extra_keys:
@@ -181,3 +201,33 @@ def estimate_homography_matrix(points1: ArrayLike, points2: ArrayLike,
     else {"H": (3, 3), "num_inliers", "inlier_mask"}."""
     ransac = _ransac("estimate_homography_matrix", "options", options, _TWO_VIEW_DEFAULTS)
     return _tessera._estimate_homography_matrix(points1, points2, ransac)
+
+
+def estimate_two_view_geometry(camera1: Camera, points1: ArrayLike, camera2: Camera,
+                               points2: ArrayLike, matches: Optional[ArrayLike] = None,
+                               options: Options = None) -> TwoViewGeometryResult:
+    """The pipeline's geometric verification of matches between pixels points1 (N1, 2) and
+    points2 (N2, 2): `matches` (K, 2) indices, or row i to row i when None. E when both
+    cameras have a prior focal length (cameras of a Database), else F; H flags planar or
+    panoramic pairs; fewer than min_num_inliers inliers: config 1 (DEGENERATE), no
+    inliers. Returns what Database.two_view_geometry does, without the image ids.
+    options: pycolmap's {"ransac": {...}} (or flat; no dyn_num_trials_multiplier),
+    "min_num_inliers" (default 15) and "max_H_inlier_ratio" (default 0.8)."""
+    function = "estimate_two_view_geometry"
+    _camera(function, "camera1", camera1)
+    _camera(function, "camera2", camera2)
+    given = _mapping(function, "options", options)
+    settings = _ransac(function, "options", given, _TWO_VIEW_GEOMETRY_DEFAULTS,
+                       _TWO_VIEW_GEOMETRY_KEYS)
+    min_num_inliers = given.get("min_num_inliers", 15)
+    if isinstance(min_num_inliers, bool) or not isinstance(min_num_inliers, numbers.Integral):
+        raise TypeError(f"{function}: options min_num_inliers must be a whole number, not "
+                        f"{min_num_inliers!r}")
+    if not 0 <= int(min_num_inliers) <= 2**31 - 1:
+        raise InputError(f"{function}: options min_num_inliers = {min_num_inliers} is not in "
+                         "0..2^31-1")
+    settings["min_num_inliers"] = int(min_num_inliers)
+    settings["max_H_inlier_ratio"] = _ransac_value(function, "max_H_inlier_ratio",
+                                                   given.get("max_H_inlier_ratio", 0.8))
+    return _tessera._estimate_two_view_geometry(camera1, points1, camera2, points2, matches,
+                                                settings)

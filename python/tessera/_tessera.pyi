@@ -7,7 +7,7 @@ import numpy as np
 import numpy.typing as npt
 
 from ._estimators import (AbsolutePoseResult, EssentialMatrixResult, FundamentalMatrixResult,
-                          HomographyMatrixResult)
+                          HomographyMatrixResult, TwoViewGeometryResult)
 from ._geometry import Rigid3d, Sim3d
 
 _Path = Union[str, os.PathLike[str]]
@@ -194,3 +194,6 @@ def _estimate_fundamental_matrix(points1: npt.ArrayLike, points2: npt.ArrayLike,
                                  ransac: Mapping[str, object]) -> Optional[FundamentalMatrixResult]: ...
 def _estimate_homography_matrix(points1: npt.ArrayLike, points2: npt.ArrayLike,
                                 ransac: Mapping[str, object]) -> Optional[HomographyMatrixResult]: ...
+def _estimate_two_view_geometry(camera1: Camera, points1: npt.ArrayLike, camera2: Camera,
+                                points2: npt.ArrayLike, matches: Optional[npt.ArrayLike],
+                                options: Mapping[str, object]) -> TwoViewGeometryResult: ...

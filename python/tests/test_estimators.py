@@ -244,3 +244,60 @@ def test_bad_input_is_refused_naming_the_argument(pose_scene):
         tessera.estimate_homography_matrix(x, x.ravel())
     with pytest.raises(tessera.InputError, match="unknown camera model 'PINHOLE_X'"):
         tessera.Camera("PINHOLE_X", 640, 480, [500.0, 320.0, 240.0])
+
+
+def test_two_view_geometry_verifies_the_matches(two_view_scene):
+    cam, _, F_true, x1, x2, outlier = two_view_scene
+    geometry = tessera.estimate_two_view_geometry(cam, x1, cam, x2)
+    # A camera without a prior focal length: F, as the pipeline verifies such pairs.
+    assert geometry["config"] == 3 and geometry["kind"] == "F"
+    assert isinstance(geometry["cam2_from_cam1"], tessera.Rigid3d)
+    inliers = geometry["inlier_matches"]
+    assert inliers.dtype == np.uint32 and inliers.shape[1] == 2
+    np.testing.assert_array_equal(inliers[:, 0], inliers[:, 1])  # row i matches row i
+    kept = np.zeros(len(x1), dtype=bool)
+    kept[inliers[:, 0]] = True
+    assert kept[outlier].mean() < 0.03 and kept[~outlier].mean() > 0.97
+    assert np.median(epipolar_distance_px(geometry["F"], x1[kept], x2[kept])) < 1.0
+    # The same through explicit, shuffled matches into shuffled rows of points2.
+    order = np.random.default_rng(2).permutation(len(x2))
+    matches = np.c_[np.arange(len(x1)), np.argsort(order)]
+    shuffled = tessera.estimate_two_view_geometry(cam, x1, cam, x2[order], matches)
+    assert shuffled["config"] == 3
+    assert abs(len(shuffled["inlier_matches"]) - len(inliers)) <= 2
+    np.testing.assert_array_equal(order[shuffled["inlier_matches"][:, 1]],
+                                  shuffled["inlier_matches"][:, 0])
+    # Too few inliers for min_num_inliers: degenerate, no inliers.
+    degenerate = tessera.estimate_two_view_geometry(cam, x1, cam, x2,
+                                                    options={"min_num_inliers": 1000})
+    assert degenerate["config"] == 1 and degenerate["kind"] is None
+    assert degenerate["inlier_matches"].shape == (0, 2)
+
+
+def test_two_view_geometry_flags_a_planar_pair_and_refuses_bad_input():
+    rng = np.random.default_rng(9)
+    cam = camera()
+    H_true = np.array([[0.9, 0.02, 30.0], [0.01, 1.05, -20.0], [5e-5, 1e-5, 1.0]])
+    x1 = rng.uniform([50, 50], [590, 430], (120, 2))
+    h = np.c_[x1, np.ones(len(x1))] @ H_true.T
+    x2 = h[:, :2] / h[:, 2:] + rng.normal(0, NOISE_PX, (120, 2))
+    geometry = tessera.estimate_two_view_geometry(cam, x1, cam, x2, options={"random_seed": 4})
+    assert geometry["kind"] == "H" and geometry["config"] == 6  # PLANAR_OR_PANORAMIC
+    np.testing.assert_allclose(geometry["H"] / geometry["H"][2, 2], H_true, rtol=0.02, atol=0.5)
+    with pytest.raises(tessera.InputError, match=r"matches row 1 \(5, 120\) is not a pair"):
+        tessera.estimate_two_view_geometry(cam, x1, cam, x2, np.array([[0, 0], [5, 120]]))
+    with pytest.raises(tessera.InputError, match="matches row 0 .-1, 0. is not a pair"):
+        tessera.estimate_two_view_geometry(cam, x1, cam, x2, [[-1, 0]])
+    with pytest.raises(TypeError, match=r"matches must be None or a \(K, 2\) array"):
+        tessera.estimate_two_view_geometry(cam, x1, cam, x2, np.arange(6))
+    with pytest.raises(tessera.InputError, match="points1 has 119 rows but points2 has 120"):
+        tessera.estimate_two_view_geometry(cam, x1[1:], cam, x2)
+    with pytest.raises(tessera.InputError, match="has no key 'dyn_num_trials_multiplier'"):
+        tessera.estimate_two_view_geometry(cam, x1, cam, x2,
+                                           options={"dyn_num_trials_multiplier": 2.0})
+    with pytest.raises(tessera.InputError, match="max_H_inlier_ratio = 1.5"):
+        tessera.estimate_two_view_geometry(cam, x1, cam, x2, options={"max_H_inlier_ratio": 1.5})
+    with pytest.raises(TypeError, match="min_num_inliers must be a whole number"):
+        tessera.estimate_two_view_geometry(cam, x1, cam, x2, options={"min_num_inliers": 1.5})
+    with pytest.raises(TypeError, match="camera1 must be a tessera.Camera"):
+        tessera.estimate_two_view_geometry(x1, x1, cam, x2)
