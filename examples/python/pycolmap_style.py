@@ -35,7 +35,7 @@ def checked_calls(workspace: pathlib.Path) -> List[Tuple[str, str, Callable[[], 
     sim3 = tessera.Sim3d(2.0, tessera.Rotation3d([0.0, 0.0, 0.6, 0.8]), np.array([1.0, 0, 0]))
     moved = copy.deepcopy(rec)
     pixels = camera.img_from_cam(pose * xyz[:10])
-    return [
+    calls: List[Tuple[str, str, Callable[[], Any]]] = [
         ("pycolmap.Reconstruction(path)", SAME, lambda: tessera.Reconstruction(
             workspace / "sparse" / "0")),
         ("pycolmap.Reconstruction()", SAME, lambda: tessera.Reconstruction()),
@@ -105,6 +105,41 @@ def checked_calls(workspace: pathlib.Path) -> List[Tuple[str, str, Callable[[], 
         ("point3D.color", SAME, lambda: point.color),
         ("point3D.error", SAME, lambda: point.error),
         ("point3D.track", DIFFERS, lambda: point.track),
+    ]
+    return calls + estimator_calls(rec)
+
+
+def estimator_calls(rec: tessera.Reconstruction) -> List[Tuple[str, str, Callable[[], Any]]]:
+    """The robust estimators on a registered image's 2D-3D correspondences and on the
+    matches of two images that see the same points."""
+    none = np.iinfo(np.uint64).max
+    image_ids = rec.reg_image_ids()
+    image1 = rec.images[image_ids[0]]
+    seen = image1.point3D_ids != none
+    points2D = image1.keypoints[seen]
+    points3D = np.array([rec.points3D[int(i)].xyz for i in image1.point3D_ids[seen]])
+    # The image that sees most of image1's points; keypoints of one point: putative matches.
+    ids1 = set(int(i) for i in image1.point3D_ids[seen])
+    image2 = max((rec.images[i] for i in image_ids[1:]),
+                 key=lambda other: len(ids1 & set(int(i) for i in other.point3D_ids)))
+    camera1, camera2 = rec.cameras[image1.camera_id], rec.cameras[image2.camera_id]
+    index2 = {int(p): k for k, p in enumerate(image2.point3D_ids) if p != none}
+    pairs = [(k, index2[int(p)]) for k, p in enumerate(image1.point3D_ids) if int(p) in index2]
+    points1 = image1.keypoints[[k for k, _ in pairs]]
+    points2 = image2.keypoints[[k for _, k in pairs]]
+    return [
+        ("pycolmap.estimate_absolute_pose(points2D, points3D, camera)", DIFFERS,
+         lambda: tessera.estimate_absolute_pose(points2D, points3D, camera1)),
+        ("pycolmap.estimate_essential_matrix(points1, points2, camera1, camera2)", DIFFERS,
+         lambda: tessera.estimate_essential_matrix(points1, points2, camera1, camera2)),
+        ("pycolmap.estimate_fundamental_matrix(points1, points2)", DIFFERS,
+         lambda: tessera.estimate_fundamental_matrix(points1, points2)),
+        ("pycolmap.estimate_homography_matrix(points1, points2)", DIFFERS,
+         lambda: tessera.estimate_homography_matrix(points1, points2)),
+        ("pycolmap.estimate_two_view_geometry(camera1, points1, camera2, points2)", DIFFERS,
+         lambda: tessera.estimate_two_view_geometry(camera1, points1, camera2, points2)),
+        ("pycolmap.Camera(model, width, height, params)", SAME,
+         lambda: tessera.Camera("SIMPLE_PINHOLE", 640, 480, [500.0, 320.0, 240.0])),
     ]
 
 

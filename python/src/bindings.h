@@ -32,4 +32,9 @@ void BindRegister(pybind11::module_& module);
 // tessera.import_features, import_matches (import_bindings.cc).
 void BindImport(pybind11::module_& module);
 
+// tessera._estimate_absolute_pose, _estimate_essential_matrix, _estimate_fundamental_matrix,
+// _estimate_homography_matrix, _estimate_two_view_geometry (estimator_bindings.cc;
+// tessera/_estimators.py wraps them).
+void BindEstimators(pybind11::module_& module);
+
 }  // namespace tessera::python

@@ -15,6 +15,7 @@
 #include "bindings.h"
 #include "database/database.h"
 #include "numpy_views.h"
+#include "two_view_geometry_dict.h"
 
 namespace py = pybind11;
 
@@ -48,10 +49,10 @@ py::array_t<point2D_t> MatchesArray(FeatureMatches matches) {
       [](const FeatureMatches& m) { return m.empty() ? nullptr : &m[0].point2D_idx1; });
 }
 
-py::dict GeometryDict(image_t image_id1, image_t image_id2, TwoViewGeometry geometry) {
+}  // namespace
+
+py::dict TwoViewGeometryDict(TwoViewGeometry geometry, const std::string& what) {
   py::dict result;
-  result["image_id1"] = image_id1;
-  result["image_id2"] = image_id2;
   result["config"] = geometry.config;
   result["kind"] = GeometryKind(geometry.config);
   result["E"] = geometry.E;
@@ -63,8 +64,7 @@ py::dict GeometryDict(image_t image_id1, image_t image_id2, TwoViewGeometry geom
   const Eigen::Vector3d& translation = geometry.cam2_from_cam1.translation;
   const double norm = rotation.norm();
   if (!std::isfinite(norm) || std::abs(norm - 1) > 1e-3 || !translation.allFinite()) {
-    throw InputError("two-view geometry of images " + std::to_string(image_id1) + " and " +
-                     std::to_string(image_id2) +
+    throw InputError(what +
                      ": cam2_from_cam1 is not a unit quaternion and a finite translation "
                      "(quaternion norm " +
                      std::to_string(norm) + ")");
@@ -74,6 +74,20 @@ py::dict GeometryDict(image_t image_id1, image_t image_id2, TwoViewGeometry geom
           .attr("Rigid3d")(py::make_tuple(rotation.x(), rotation.y(), rotation.z(), rotation.w()),
                            translation);
   result["inlier_matches"] = MatchesArray(std::move(geometry.inlier_matches));
+  return result;
+}
+
+namespace {
+
+py::dict GeometryDict(image_t image_id1, image_t image_id2, TwoViewGeometry geometry) {
+  py::dict result;
+  result["image_id1"] = image_id1;
+  result["image_id2"] = image_id2;
+  for (const auto& [key, value] : TwoViewGeometryDict(
+           std::move(geometry), "two-view geometry of images " + std::to_string(image_id1) +
+                                    " and " + std::to_string(image_id2))) {
+    result[key] = value;
+  }
   return result;
 }
 

@@ -229,6 +229,16 @@ void BindCamera(py::module_& module) {
       "_camera_from_state(state)\n--\n\nA Camera from its pickled state, checked (pickle's "
       "factory)");
   py::class_<Camera>(module, "Camera", "A camera: model, image size and parameters.")
+      .def(py::init([](const py::object& model, const py::object& width, const py::object& height,
+                       const py::object& params, const py::object& camera_id) {
+             // Checked as an unpickled camera is (model_state.cc): InputError naming the field.
+             return CameraFromState(py::make_tuple(camera_id, model, width, height, params));
+           }),
+           py::arg("model"), py::arg("width"), py::arg("height"), py::arg("params"),
+           py::arg("camera_id") = 1,
+           "__init__(self, model, width, height, params, camera_id=1)\n--\n\npycolmap's "
+           "constructor: a COLMAP model name ('SIMPLE_PINHOLE', 'PINHOLE', ...), the image size "
+           "and the model's parameters; InputError naming what does not fit")
       .def_readonly("camera_id", &Camera::camera_id)
       .def_property_readonly("model", &Camera::ModelName, "COLMAP's model name, e.g. 'PINHOLE'")
       .def_readonly("width", &Camera::width)

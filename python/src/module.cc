@@ -41,4 +41,5 @@ PYBIND11_MODULE(_tessera, module) {
   tessera::python::BindBench(module);
   tessera::python::BindRegister(module);
   tessera::python::BindImport(module);
+  tessera::python::BindEstimators(module);
 }

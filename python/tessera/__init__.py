@@ -18,6 +18,9 @@ import numpy as np
 import numpy.typing as npt
 
 from . import _hints, _logging, _tessera
+from ._estimators import (estimate_absolute_pose, estimate_essential_matrix,
+                          estimate_fundamental_matrix, estimate_homography_matrix,
+                          estimate_two_view_geometry)
 from ._geometry import Rigid3d, Rotation3d, Sim3d
 from ._tessera import (Camera, Database, Error, Image, InputError, NoModelError, Point3D,
                        PluginCrashError, Reconstruction)
@@ -26,7 +29,10 @@ from ._version import __version__
 __all__ = [
     "Camera", "Database", "Error", "Image", "InputError", "NoModelError", "Point3D",
     "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "Sim3d", "__version__",
-    "adjust", "align", "bench", "evaluate", "export", "extract", "import_features",
+    "adjust", "align", "bench", "estimate_absolute_pose", "estimate_essential_matrix",
+    "estimate_fundamental_matrix", "estimate_homography_matrix", "estimate_two_view_geometry",
+    "evaluate", "export", "extract",
+    "import_features",
     "import_matches", "map", "match", "plugins", "register", "run", "triangulate",
 ]
 
