@@ -103,11 +103,16 @@ class BoundedOutput {
     if (tail_.size() > 2 * kChildOutputTail) tail_.erase(0, tail_.size() - kChildOutputTail);
   }
   size_t total() const { return total_; }
+  // Whether bytes were left out is what was read against what is kept: the tail, once
+  // cut back, can be exactly kChildOutputTail long with bytes left out before it.
   std::string Text() const {
-    if (tail_.size() <= kChildOutputTail) return head_ + tail_;
-    const size_t left_out = total_ - head_.size() - kChildOutputTail;
+    if (tail_.size() <= kChildOutputTail && total_ == head_.size() + tail_.size()) {
+      return head_ + tail_;
+    }
+    const size_t kept_tail = std::min(tail_.size(), kChildOutputTail);
+    const size_t left_out = total_ - head_.size() - kept_tail;
     return head_ + "\n[... " + std::to_string(left_out) + " bytes left out ...]\n" +
-           tail_.substr(tail_.size() - kChildOutputTail);
+           tail_.substr(tail_.size() - kept_tail);
   }
 
  private:
