@@ -101,12 +101,11 @@ def ratio_matches(queries: F32, train: F32, ratio: float) -> npt.NDArray[np.int6
     pairs = []
     for start in range(0, len(queries), 1024):  # a block of dot products at a time
         similarity = queries[start:start + 1024] @ train.T
+        # Column 0: the most similar row; column 1: the second (argpartition at kth=1).
         best_two = np.argpartition(-similarity, 1, axis=1)[:, :2]
         rows = np.arange(len(best_two))
-        first, second = similarity[rows, best_two[:, 0]], similarity[rows, best_two[:, 1]]
-        swap = second > first
-        nearest = np.where(swap, best_two[:, 1], best_two[:, 0])
-        first, second = np.maximum(first, second), np.minimum(first, second)
+        nearest = best_two[:, 0]
+        first, second = similarity[rows, nearest], similarity[rows, best_two[:, 1]]
         distance1 = np.sqrt(np.maximum(2.0 - 2.0 * first, 0.0))
         distance2 = np.sqrt(np.maximum(2.0 - 2.0 * second, 0.0))
         keep = distance1 < ratio * distance2
@@ -179,8 +178,10 @@ def main() -> int:
         keypoints = query_db.keypoints(image_id)[:, :2].astype(np.float64)
         matches = ratio_matches(normalised(query_db.descriptors(image_id)), train,
                                 arguments.ratio)
-        answer = tessera.estimate_absolute_pose(keypoints[matches[:, 0]],
-                                                points3D[matches[:, 1]], camera)
+        answer = None
+        if len(matches) >= 4:
+            answer = tessera.estimate_absolute_pose(keypoints[matches[:, 0]],
+                                                    points3D[matches[:, 1]], camera)
         if answer is None:
             print(f"{image.name}: not localised ({len(matches)} matches)")
             failed += 1
