@@ -22,8 +22,11 @@
 #include "estimators/homography_matrix.h"
 #include "estimators/ransac.h"
 #include "geometry/two_view_geometry_estimation.h"
+#include "geometry/verification_settings.h"
 #include "tessera/camera.h"
 #include "tessera/errors.h"
+#include "tessera/sfm/incremental_mapper.h"
+#include "tessera/sfm/incremental_mapper_options.h"
 #include "two_view_geometry_dict.h"
 
 namespace py = pybind11;
@@ -309,9 +312,38 @@ py::dict EstimateTwoView(const Camera& camera1, const py::object& points1_in, co
   return TwoViewGeometryDict(std::move(geometry), function);
 }
 
+// The defaults of the estimators' options, read from their owners so that they are stated
+// once: the pipeline's verification (VerificationSettings: the two-view matrices and
+// geometry), the mapper's registration (IncrementalMapperOptions' abs_pose_max_error,
+// MapperRansacOptions' abs_pose_confidence) and RANSACOptions' dyn_num_trials_multiplier.
+py::dict EstimatorDefaults() {
+  const VerificationSettings verification;
+  py::dict two_view;
+  two_view["max_error"] = verification.max_error_px;
+  two_view["min_inlier_ratio"] = verification.min_inlier_ratio;
+  two_view["confidence"] = verification.confidence;
+  two_view["dyn_num_trials_multiplier"] = RANSACOptions().dyn_num_trials_multiplier;
+  two_view["min_num_trials"] = verification.min_num_trials;
+  two_view["max_num_trials"] = verification.max_num_trials;
+  py::dict geometry;
+  geometry["min_num_inliers"] = verification.min_num_inliers;
+  geometry["max_H_inlier_ratio"] = verification.max_H_inlier_ratio;
+  py::dict absolute_pose;
+  absolute_pose["max_error"] = IncrementalMapperOptions().abs_pose_max_error;
+  absolute_pose["confidence"] = MapperRansacOptions().abs_pose_confidence;
+  absolute_pose["dyn_num_trials_multiplier"] = RANSACOptions().dyn_num_trials_multiplier;
+  py::dict defaults;
+  defaults["two_view"] = two_view;
+  defaults["two_view_geometry"] = geometry;
+  defaults["absolute_pose"] = absolute_pose;
+  return defaults;
+}
+
 }  // namespace
 
 void BindEstimators(py::module_& module) {
+  module.def("_estimator_defaults", &EstimatorDefaults,
+             "The option defaults that tessera/_estimators.py reads from their owners");
   module.def("_estimate_absolute_pose", &EstimateAbsolutePose, py::arg("points2D"),
              py::arg("points3D"), py::arg("camera"), py::arg("ransac"), py::arg("refine"),
              "P3P + EPnP LO-RANSAC on normalised points, then RefineAbsolutePose on the "

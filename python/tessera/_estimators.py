@@ -48,18 +48,17 @@ class TwoViewGeometryResult(TypedDict):
     cam2_from_cam1: Rigid3d
     inlier_matches: npt.NDArray[np.uint32]
 
-# pycolmap's RANSACOptions fields; the defaults are those of the mapper's registration
-# (absolute pose) and of the pipeline's verification (two-view matrices), in pixels.
+# pycolmap's RANSACOptions fields. The defaults come from their owners in the host
+# (_tessera._estimator_defaults: the pipeline's verification for the two-view matrices and
+# geometry; the mapper's registration for the absolute pose's threshold and confidence);
+# the absolute pose's inlier ratio and trial counts, and the seed, are this module's.
 _FLOAT_KEYS = ("max_error", "min_inlier_ratio", "confidence", "dyn_num_trials_multiplier")
 _INT_KEYS = ("min_num_trials", "max_num_trials", "random_seed")
+_HOST_DEFAULTS = _tessera._estimator_defaults()
 _ABSOLUTE_POSE_DEFAULTS: Dict[str, object] = {
-    "max_error": 12.0, "min_inlier_ratio": 0.1, "confidence": 0.9999,
-    "dyn_num_trials_multiplier": 3.0, "min_num_trials": 100, "max_num_trials": 10000,
-    "random_seed": 0}
-_TWO_VIEW_DEFAULTS: Dict[str, object] = {
-    "max_error": 4.0, "min_inlier_ratio": 0.25, "confidence": 0.999,
-    "dyn_num_trials_multiplier": 3.0, "min_num_trials": 100, "max_num_trials": 10000,
-    "random_seed": 0}
+    **_HOST_DEFAULTS["absolute_pose"], "min_inlier_ratio": 0.1, "min_num_trials": 100,
+    "max_num_trials": 10000, "random_seed": 0}
+_TWO_VIEW_DEFAULTS: Dict[str, object] = {**_HOST_DEFAULTS["two_view"], "random_seed": 0}
 # The verification's RANSAC (no dyn_num_trials_multiplier: it uses the host's) and the
 # keys of pycolmap's TwoViewGeometryOptions it honours, with the pipeline's defaults.
 _TWO_VIEW_GEOMETRY_DEFAULTS: Dict[str, object] = {
@@ -219,7 +218,8 @@ def estimate_two_view_geometry(camera1: Camera, points1: ArrayLike, camera2: Cam
     given = _mapping(function, "options", options)
     settings = _ransac(function, "options", given, _TWO_VIEW_GEOMETRY_DEFAULTS,
                        _TWO_VIEW_GEOMETRY_KEYS)
-    min_num_inliers = given.get("min_num_inliers", 15)
+    geometry_defaults = _HOST_DEFAULTS["two_view_geometry"]
+    min_num_inliers = given.get("min_num_inliers", geometry_defaults["min_num_inliers"])
     if isinstance(min_num_inliers, bool) or not isinstance(min_num_inliers, numbers.Integral):
         raise TypeError(f"{function}: options min_num_inliers must be a whole number, not "
                         f"{min_num_inliers!r}")
@@ -227,7 +227,8 @@ def estimate_two_view_geometry(camera1: Camera, points1: ArrayLike, camera2: Cam
         raise InputError(f"{function}: options min_num_inliers = {min_num_inliers} is not in "
                          "0..2^31-1")
     settings["min_num_inliers"] = int(min_num_inliers)
-    settings["max_H_inlier_ratio"] = _ransac_value(function, "max_H_inlier_ratio",
-                                                   given.get("max_H_inlier_ratio", 0.8))
+    settings["max_H_inlier_ratio"] = _ransac_value(
+        function, "max_H_inlier_ratio",
+        given.get("max_H_inlier_ratio", geometry_defaults["max_H_inlier_ratio"]))
     return _tessera._estimate_two_view_geometry(camera1, points1, camera2, points2, matches,
                                                 settings)
