@@ -11,10 +11,10 @@ Strecha ground truth (gt/*.camera) after a similarity fitted to the mapped image
 Prints one line per held-out photo, "NAME: inliers N/M, position error X cm", and exits 1
 when one could not be localised.
 
-Written with pycolmap's names; the calls Tessera spells differently are marked
-"pycolmap:" beside them (docs/python.md, "pycolmap and Tessera"). The features of every
-image are Tessera's (tessera.extract, with the mapping's recipe), so the held-out photos'
-descriptors are of the same kind as the model's.
+Written against pycolmap 4's API: the only line that differs from a pycolmap script is
+`import tessera as pycolmap`. The features of every image are Tessera's (extract_features
+runs Tessera's default recipe), so the held-out photos' descriptors are of the same kind as
+the model's.
 """
 
 import argparse
@@ -26,7 +26,7 @@ from typing import Dict, List, Tuple
 import numpy as np
 import numpy.typing as npt
 
-import tessera
+import tessera as pycolmap  # the one line that differs from a pycolmap script
 
 F64 = npt.NDArray[np.float64]
 F32 = npt.NDArray[np.float32]
@@ -42,9 +42,7 @@ def parse_arguments() -> argparse.Namespace:
     parser.add_argument("--max-size", type=int, default=0,
                         help="downscale the copies to at most this many pixels a side "
                              "(0: full size)")
-    parser.add_argument("--manifest", default="default", help="a recipe's name or a file")
     parser.add_argument("--ratio", type=float, default=0.8, help="Lowe's ratio test")
-    parser.add_argument("--threads", type=int, default=0)
     return parser.parse_args()
 
 
@@ -113,29 +111,31 @@ def ratio_matches(queries: F32, train: F32, ratio: float) -> npt.NDArray[np.int6
     return np.concatenate(pairs) if pairs else np.zeros((0, 2), np.int64)
 
 
-def point_descriptors(rec: tessera.Reconstruction,
-                      db: tessera.Database) -> Tuple[F64, F32]:
-    """The model's points (N, 3) and a descriptor of each: that of its first observation,
-    from the workspace database's features of the image that sees it."""
-    # pycolmap: {image.name: image.image_id for image in db.read_all_images()}
-    db_ids = {image.name: image_id for image_id, image in db.images.items()}
-    descriptors_of: Dict[int, npt.NDArray[np.uint8]] = {}
-    xyz, descriptors = [], []
-    for point3D in rec.points3D.values():
-        # pycolmap: point3D.track.elements[0].image_id, .point2D_idx
-        image_id, point2D_idx = (int(value) for value in point3D.track[0])
-        if image_id not in descriptors_of:
-            # pycolmap: db.read_descriptors(image_id)
-            descriptors_of[image_id] = db.descriptors(db_ids[rec.images[image_id].name])
-        xyz.append(point3D.xyz)
-        descriptors.append(descriptors_of[image_id][point2D_idx])
-    return np.array(xyz), normalised(np.array(descriptors))
+def point_descriptors(rec: pycolmap.Reconstruction,
+                      db: pycolmap.Database) -> Tuple[F64, F32]:
+    """The model's points (N, 3) and a descriptor of each: that of the first keypoint that
+    observes it, from the database's features of that keypoint's image."""
+    db_ids = {image.name: image.image_id for image in db.read_all_images()}
+    xyz: Dict[int, F64] = {}
+    descriptors: Dict[int, npt.NDArray[np.uint8]] = {}
+    for image_id in rec.reg_image_ids():
+        image = rec.images[image_id]
+        image_descriptors = db.read_descriptors(db_ids[image.name]).data
+        for point2D_idx, point2D in enumerate(image.points2D):
+            if point2D.has_point3D() and point2D.point3D_id not in xyz:
+                xyz[point2D.point3D_id] = rec.points3D[point2D.point3D_id].xyz
+                descriptors[point2D.point3D_id] = image_descriptors[point2D_idx]
+    ids = sorted(xyz)
+    return (np.array([xyz[i] for i in ids]),
+            normalised(np.array([descriptors[i] for i in ids])))
 
 
 def main() -> int:
     arguments = parse_arguments()
     images = arguments.dataset / "images"
     held_out = arguments.held_out.split(",")
+    if not images.is_dir():
+        sys.exit(f"{images}: no such folder (DATASET must hold images/ and gt/)")
     names = sorted(path.name for path in images.iterdir() if path.is_file())
     if not set(held_out) <= set(names):
         sys.exit(f"{images}: has no {sorted(set(held_out) - set(names))}")
@@ -144,18 +144,16 @@ def main() -> int:
     copy_images(mapped, images, out / "images" / "mapped", arguments.max_size)
     copy_images(held_out, images, out / "images" / "held_out", arguments.max_size)
 
-    # The model of the others. pycolmap: extract_features(database_path, image_path),
-    # match_exhaustive(database_path), incremental_mapping(database_path, image_path,
-    # output_path); Tessera's stages take a workspace folder and a recipe.
-    workspace = out / "map"
-    tessera.extract(images=out / "images" / "mapped", output=workspace,
-                    manifest=arguments.manifest, threads=arguments.threads)
-    tessera.match(output=workspace, manifest=arguments.manifest, threads=arguments.threads)
-    tessera.map(output=workspace, manifest=arguments.manifest, threads=arguments.threads)
-    rec = tessera.Reconstruction(workspace / "sparse" / "0")
+    # The model of the others.
+    database_path = out / "map" / "database.db"
+    pycolmap.extract_features(database_path, out / "images" / "mapped")
+    pycolmap.match_exhaustive(database_path)
+    reconstructions = pycolmap.incremental_mapping(database_path, out / "images" / "mapped",
+                                                   out / "map" / "models")
+    rec = reconstructions[0]
     print(f"model: {rec.num_reg_images()} of {len(mapped)} images, "
           f"{rec.num_points3D()} points")
-    points3D, train = point_descriptors(rec, tessera.Database(workspace / "database.db"))
+    points3D, train = point_descriptors(rec, pycolmap.Database.open(database_path))
 
     # The similarity from the model's frame to the ground truth's, by the camera centres.
     registered = [rec.images[image_id] for image_id in rec.reg_image_ids()]
@@ -166,21 +164,19 @@ def main() -> int:
         np.array([ground_truth_centre(arguments.dataset / "gt" / f"{image.name}.camera")
                   for image in registered]))
 
-    # The held-out photos' features, with the same recipe.
-    query_workspace = out / "held_out"
-    tessera.extract(images=out / "images" / "held_out", output=query_workspace,
-                    manifest=arguments.manifest, threads=arguments.threads)
-    query_db = tessera.Database(query_workspace / "database.db")
+    # The held-out photos' features, as the model's.
+    query_database_path = out / "held_out" / "database.db"
+    pycolmap.extract_features(query_database_path, out / "images" / "held_out")
+    query_db = pycolmap.Database.open(query_database_path)
     camera = rec.cameras[registered[0].camera_id]  # the mapped photos' camera, refined
     failed = 0
-    for image_id, image in sorted(query_db.images.items(), key=lambda item: item[1].name):
-        # pycolmap: db.read_keypoints(image_id), db.read_descriptors(image_id)
-        keypoints = query_db.keypoints(image_id)[:, :2].astype(np.float64)
-        matches = ratio_matches(normalised(query_db.descriptors(image_id)), train,
-                                arguments.ratio)
+    for image in sorted(query_db.read_all_images(), key=lambda image: image.name):
+        keypoints = query_db.read_keypoints(image.image_id)[:, :2].astype(np.float64)
+        descriptors = query_db.read_descriptors(image.image_id).data
+        matches = ratio_matches(normalised(descriptors), train, arguments.ratio)
         answer = None
         if len(matches) >= 4:
-            answer = tessera.estimate_absolute_pose(keypoints[matches[:, 0]],
+            answer = pycolmap.estimate_absolute_pose(keypoints[matches[:, 0]],
                                                     points3D[matches[:, 1]], camera)
         if answer is None:
             print(f"{image.name}: not localised ({len(matches)} matches)")

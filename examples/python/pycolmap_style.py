@@ -89,7 +89,6 @@ def checked_calls(workspace: pathlib.Path) -> List[Tuple[str, str, Callable[[], 
         ("image.projection_center()", SAME, image.projection_center),
         ("image.viewing_direction()", SAME, image.viewing_direction),
         ("image.num_points3D", DIFFERS, image.num_points3D),
-        ("image.points2D", DIFFERS, lambda: (image.keypoints, image.point3D_ids)),
         ("camera.model", DIFFERS, lambda: camera.model),
         ("camera.width, camera.height", SAME, lambda: (camera.width, camera.height)),
         ("camera.params", SAME, lambda: camera.params),
@@ -105,8 +104,45 @@ def checked_calls(workspace: pathlib.Path) -> List[Tuple[str, str, Callable[[], 
         ("point3D.color", SAME, lambda: point.color),
         ("point3D.error", SAME, lambda: point.error),
         ("point3D.track", DIFFERS, lambda: point.track),
+        ("image.points2D", SAME, lambda: image.points2D),
+        ("point2D.has_point3D()", SAME, lambda: [p.has_point3D() for p in image.points2D]),
+        ("rec.exists_point3D(point3D_id)", SAME, lambda: rec.exists_point3D(point_id)),
+        ("rec.exists_image(image_id)", SAME, lambda: rec.exists_image(image.image_id)),
+        ("pycolmap.bundle_adjustment(rec)", SAME, lambda: tessera.bundle_adjustment(moved)),
+        ("pycolmap.align_reconstructions_via_proj_centers(src, tgt, max_proj_center_error)",
+         SAME, lambda: tessera.align_reconstructions_via_proj_centers(rec, moved, 0.1)),
     ]
-    return calls + estimator_calls(rec)
+    return calls + edit_calls(copy.deepcopy(rec)) + estimator_calls(rec)
+
+
+def edit_calls(rec: tessera.Reconstruction) -> List[Tuple[str, str, Callable[[], Any]]]:
+    """Adding a camera, an image and a point, and deleting observations and points, in order
+    on one model."""
+    camera = tessera.Camera("PINHOLE", 640, 480, [500.0, 500.0, 320.0, 240.0], camera_id=99)
+    image = tessera.Image(name="added.jpg", points2D=np.array([[10.0, 20.0], [30.0, 40.0]]),
+                          cam_from_world=tessera.Rigid3d(), camera_id=99, image_id=999)
+    first = rec.images[rec.reg_image_ids()[0]]
+    free = int(np.flatnonzero(first.point3D_ids == np.iinfo(np.uint64).max)[0])
+    track = tessera.Track()
+    ids: List[int] = []
+    some_point = next(iter(rec.points3D))
+    return [
+        ("pycolmap.Image(name=..., points2D=..., cam_from_world=..., camera_id=..., "
+         "image_id=...)", SAME, lambda: image),
+        ("rec.add_camera(camera)", SAME, lambda: rec.add_camera(camera)),
+        ("rec.add_image(image)", SAME, lambda: rec.add_image(image)),
+        ("rec.register_image(image_id)", SAME, lambda: rec.register_image(999)),
+        ("pycolmap.Track(); track.add_elements(elements)", SAME,
+         lambda: track.add_elements([(999, 0), (first.image_id, free)])),
+        ("rec.add_point3D(xyz, track, color)", SAME,
+         lambda: ids.append(rec.add_point3D(np.zeros(3), track, np.array([255, 0, 0])))),
+        ("rec.add_observation(point3D_id, track_element)", SAME,
+         lambda: rec.add_observation(ids[0], tessera.TrackElement(999, 1))),
+        ("rec.delete_observation(image_id, point2D_idx)", SAME,
+         lambda: rec.delete_observation(999, 1)),
+        ("rec.delete_point3D(point3D_id)", SAME, lambda: rec.delete_point3D(some_point)),
+        ("rec.deregister_image(image_id)", SAME, lambda: rec.deregister_image(999)),
+    ]
 
 
 def estimator_calls(rec: tessera.Reconstruction) -> List[Tuple[str, str, Callable[[], Any]]]:
@@ -145,15 +181,33 @@ def estimator_calls(rec: tessera.Reconstruction) -> List[Tuple[str, str, Callabl
 
 def stage_calls(images: pathlib.Path,
                 manifest: Optional[pathlib.Path]) -> List[Tuple[str, str, Callable[[], Any]]]:
-    """pycolmap's pipeline functions take a database path; Tessera's a workspace folder."""
-    workspace = pathlib.Path(tempfile.mkdtemp())
+    """pycolmap's pipeline functions on WORKSPACE/database.db. `manifest` (Tessera's keyword,
+    for CI's fast recipe) replaces the default recipe; without it each call is pycolmap's
+    as written."""
+    database_path = pathlib.Path(tempfile.mkdtemp()) / "database.db"
+    models = {}
     return [
-        ("pycolmap.extract_features(database_path, image_path)", DIFFERS,
-         lambda: tessera.extract(images=images, output=workspace, manifest=manifest)),
-        ("pycolmap.match_exhaustive(database_path)", DIFFERS,
-         lambda: tessera.match(output=workspace, manifest=manifest)),
-        ("pycolmap.incremental_mapping(database_path, image_path, output_path)", DIFFERS,
-         lambda: tessera.map(output=workspace, manifest=manifest)),
+        ("pycolmap.extract_features(database_path, image_path)", SAME,
+         lambda: tessera.extract_features(database_path, images, manifest=manifest)),
+        ("pycolmap.match_exhaustive(database_path)", SAME,
+         lambda: tessera.match_exhaustive(database_path, manifest=manifest)),
+        ("pycolmap.incremental_mapping(database_path, image_path, output_path)", SAME,
+         lambda: models.update(tessera.incremental_mapping(database_path, images,
+                                                           database_path.parent / "models",
+                                                           manifest=manifest))),
+        ("pycolmap.triangulate_points(rec, database_path, image_path, output_path)", SAME,
+         lambda: tessera.triangulate_points(models[0], database_path, images,
+                                            database_path.parent / "triangulated",
+                                            manifest=manifest)),
+        ("pycolmap.Database.open(path)", SAME, lambda: tessera.Database.open(database_path)),
+        ("db.read_all_images()", SAME,
+         lambda: tessera.Database.open(database_path).read_all_images()),
+        ("db.read_keypoints(image_id)", SAME,
+         lambda: tessera.Database.open(database_path).read_keypoints(1)),
+        ("db.read_descriptors(image_id).data", SAME,
+         lambda: tessera.Database.open(database_path).read_descriptors(1).data),
+        ("db.read_matches(image_id1, image_id2)", SAME,
+         lambda: tessera.Database.open(database_path).read_matches(1, 2)),
     ]
 
 

@@ -21,6 +21,7 @@
 
 #include "bindings.h"
 #include "geometry/similarity_transform.h"
+#include "model_handle.h"
 #include "model_state.h"
 #include "numpy_views.h"
 #include "tessera/errors.h"
@@ -39,13 +40,6 @@ namespace tessera::python {
 namespace {
 
 static_assert(sizeof(TrackElement) == 2 * sizeof(uint32_t), "track elements are (image, point2D)");
-
-// A model and the order of its records in the files it was read from, which writing
-// keeps so that a read and a write reproduce the files byte for byte.
-struct ModelHandle {
-  Reconstruction model;
-  ColmapModelFileOrder order;
-};
 
 using DoubleRows = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
@@ -309,6 +303,20 @@ void BindImage(py::module_& module) {
       "_image_from_state(state)\n--\n\nAn Image from its pickled state, checked (pickle's "
       "factory)");
   py::class_<Image>(module, "Image", "An image: its camera, name, pose and keypoints.")
+      .def(py::init([](const py::object& name, const py::object& points2D,
+                       const py::object& quat_xyzw, const py::object& translation,
+                       const py::object& camera_id, const py::object& image_id) {
+             // Checked as an unpickled image is (model_state.cc); unregistered until
+             // Reconstruction.register_image. tessera/__init__.py gives the signature.
+             py::list points;
+             for (const py::handle row : points2D) {
+               points.append(py::make_tuple(row[py::int_(0)], row[py::int_(1)], kInvalidPoint3DId));
+             }
+             return ImageFromState(
+                 py::make_tuple(image_id, camera_id, name, false, quat_xyzw, translation, points));
+           }),
+           py::arg("name"), py::arg("points2D"), py::arg("quat_xyzw"), py::arg("translation"),
+           py::arg("camera_id"), py::arg("image_id"))
       .def_readonly("image_id", &Image::image_id)
       .def_readonly("camera_id", &Image::camera_id)
       .def_readonly("name", &Image::name)
@@ -387,14 +395,20 @@ void BindPoint3D(py::module_& module) {
       .def_readonly("error", &Point3D::error, "Mean reprojection error in pixels, -1 if unknown")
       .def_property_readonly(
           "track",
-          [](py::object self) {
-            const Track& track = self.cast<const Point3D&>().track;
-            const auto n = static_cast<py::ssize_t>(track.size());
-            const uint32_t* data = n > 0 ? &track[0].image_id : nullptr;
-            return ArrayView<uint32_t>(data, {n, 2}, {sizeof(TrackElement), sizeof(uint32_t)},
-                                       self);
+          [](const Point3D& point) {
+            // A copy (add_observation may move the track's storage), read-only as the views.
+            std::vector<uint32_t> pairs;
+            pairs.reserve(2 * point.track.size());
+            for (const TrackElement& element : point.track) {
+              pairs.push_back(element.image_id);
+              pairs.push_back(element.point2D_idx);
+            }
+            const auto n = static_cast<py::ssize_t>(point.track.size());
+            return MoveIntoArray<uint32_t>(
+                std::move(pairs), {n, 2}, {2 * sizeof(uint32_t), sizeof(uint32_t)},
+                [](const std::vector<uint32_t>& v) { return v.empty() ? nullptr : v.data(); });
           },
-          "(image_id, point2D_idx) per observation, (K, 2) uint32: a read-only view")
+          "(image_id, point2D_idx) per observation, (K, 2) uint32: a read-only copy")
       .def(py::pickle([](const Point3D& point) { return Point3DState(point); },
                       [](const py::tuple& state) { return Point3DFromState(state); }))
       .def("__reduce__", ReduceThrough("point3D_from_state", &Point3DState))
@@ -615,6 +629,8 @@ void BindModel(py::module_& module) {
                ", points3D=" + std::to_string(handle.model.points3D.size()) + ")";
       });
   BindModelArrays(model_class);
+  BindModelEdits(model_class);
+  BindModelAlignment(module);
 }
 
 }  // namespace tessera::python

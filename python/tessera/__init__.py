@@ -17,23 +17,28 @@ from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 import numpy as np
 import numpy.typing as npt
 
-from . import _hints, _logging, _tessera
+from . import _hints, _logging, _model_edits, _pycolmap_stages, _tessera
 from ._estimators import (estimate_absolute_pose, estimate_essential_matrix,
                           estimate_fundamental_matrix, estimate_homography_matrix,
                           estimate_two_view_geometry)
 from ._geometry import Rigid3d, Rotation3d, Sim3d
+from ._model_edits import (Point2D, Track, TrackElement, align_reconstructions_via_proj_centers,
+                           bundle_adjustment, triangulate_points)
+from ._pycolmap_stages import (extract_features, global_mapping, incremental_mapping,
+                               match_exhaustive, match_sequential)
 from ._tessera import (Camera, Database, Error, Image, InputError, NoModelError, Point3D,
                        PluginCrashError, Reconstruction)
 from ._version import __version__
 
 __all__ = [
     "Camera", "Database", "Error", "Image", "InputError", "NoModelError", "Point3D",
-    "PluginCrashError", "Reconstruction", "Rigid3d", "Rotation3d", "Sim3d", "__version__",
-    "adjust", "align", "bench", "estimate_absolute_pose", "estimate_essential_matrix",
+    "PluginCrashError", "Point2D", "Reconstruction", "Rigid3d", "Rotation3d", "Sim3d", "Track",
+    "TrackElement", "__version__", "adjust", "align", "align_reconstructions_via_proj_centers",
+    "bench", "bundle_adjustment", "estimate_absolute_pose", "estimate_essential_matrix",
     "estimate_fundamental_matrix", "estimate_homography_matrix", "estimate_two_view_geometry",
-    "evaluate", "export", "extract",
-    "import_features",
-    "import_matches", "map", "match", "plugins", "register", "run", "triangulate",
+    "evaluate", "export", "extract", "extract_features", "global_mapping", "import_features",
+    "import_matches", "incremental_mapping", "map", "match", "match_exhaustive",
+    "match_sequential", "plugins", "register", "run", "triangulate", "triangulate_points",
 ]
 
 PathLike = Union[str, os.PathLike[str]]
@@ -600,6 +605,8 @@ def _attach() -> None:
     for function in methods + (_viewing_direction,):
         function.__name__ = function.__qualname__ = function.__name__.lstrip("_")
         function.__module__ = __name__
+    _model_edits.attach()
+    _pycolmap_stages.attach()
 
 
 _attach()

@@ -3,7 +3,8 @@ fails the test instead of ending pytest): mutated pickles and states of a small
 Reconstruction and its Camera, Image and Point3D, each loaded; only InputError, TypeError,
 ValueError and the unpickler's own errors may come out. What loads is then used
 (calibration_matrix, img_from_cam, project, statistics, write and a read back), and the
-setters are given random values. Prints the counts as JSON.
+setters and the model's edits (add_point3D, delete_observation, ...) are given random
+values. Prints the counts as JSON.
 
 usage: fuzz_pickle_states.py SEED MUTATIONS FOLDER"""
 
@@ -134,8 +135,44 @@ def use(value, folder, counts, write):
         tessera.Reconstruction(target)  # Tessera's reader takes what it wrote
 
 
-def set_randomly(rng, value):
+def an_id(rng):
+    """Mostly an id or index the small model has, sometimes any value."""
+    return rng.randrange(6) if rng.random() < 0.8 else random_value(rng)
+
+
+def edit_randomly(rng, rec, counts):
+    """One of pycolmap's edits with random arguments: it keeps the model's invariants or
+    raises a bad value's error (the model then unchanged)."""
+    camera = tessera.Camera("PINHOLE", 640, 480, [500.0, 500.0, 320.0, 240.0],
+                            camera_id=rng.choice([1, 5]))
+    edits = [
+        lambda: rec.add_camera(camera),
+        lambda: rec.add_image(tessera.Image(name=rng.choice(["a.jpg", "new.jpg"]),
+                                            points2D=np.zeros((rng.randrange(3), 2)),
+                                            camera_id=an_id(rng), image_id=an_id(rng))),
+        lambda: rec.register_image(an_id(rng)),
+        lambda: rec.deregister_image(an_id(rng)),
+        lambda: rec.add_point3D(random_value(rng) if rng.random() < 0.2 else [0.0, 0.0, 1.0],
+                                [(an_id(rng), an_id(rng)) for _ in range(rng.randrange(4))]),
+        lambda: rec.add_observation(an_id(rng), (an_id(rng), an_id(rng))),
+        lambda: rec.delete_observation(an_id(rng), an_id(rng)),
+        lambda: rec.delete_point3D(an_id(rng)),
+    ]
+    held = list(rec.points3D.values())  # objects a deletion must leave valid
+    try:
+        rng.choice(edits)()
+        counts["edited"] += 1
+    except STATE_ERRORS:
+        pass
+    for point in held:
+        _ = point.xyz, point.track
+
+
+def set_randomly(rng, value, counts):
     """A setter given a random value: it takes it or raises a bad value's error."""
+    if isinstance(value, tessera.Reconstruction) and rng.random() < 0.5:
+        edit_randomly(rng, value, counts)
+        return
     target = None
     if isinstance(value, tessera.Reconstruction) and value.cameras and rng.random() < 0.5:
         target, name = next(iter(value.cameras.values())), "params"
@@ -161,7 +198,7 @@ def main():
     states = [value.__getstate__() for value in originals]
     pickles = [pickle.dumps(value) for value in originals]
     counts = {"loaded": 0, "refused": 0, "unpickler": 0, "written": 0,
-              "not_written": 0}
+              "not_written": 0, "edited": 0}
     for k in range(mutations):
         which = rng.randrange(len(originals))
         cls = type(originals[which])
@@ -189,8 +226,11 @@ def main():
         counts["loaded"] += 1
         # Writing every survivor would take long: a few hundred are written.
         use(value, folder, counts, write=counts["written"] < 300)
-        set_randomly(rng, value)
-        use(value, folder, counts, write=False)
+        set_randomly(rng, value, counts)
+        # An edited model is written and read back too (the reader refuses what breaks
+        # an invariant).
+        use(value, folder, counts, write=isinstance(value, tessera.Reconstruction) and
+            counts["written"] < 400)
     # A state set again on a live object, a camera of a model included.
     for value in (rec.cameras[1], rec.images[1], rec.points3D[0], rec):
         try:

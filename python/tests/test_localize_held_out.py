@@ -30,7 +30,7 @@ def test_three_held_out_photos_land_within_5_cm_of_the_ground_truth(tmp_path):
     package_parent = pathlib.Path(tessera.__file__).resolve().parent.parent
     result = subprocess.run(
         [sys.executable, SOURCE / "examples/python/localize_held_out.py", DATASET,
-         tmp_path / "out", "--max-size", "1024", "--threads", "2",
+         tmp_path / "out", "--max-size", "1024",
          "--held-out", ",".join(HELD_OUT)],
         env=dict(os.environ, PYTHONPATH=str(package_parent)), cwd=tmp_path,
         capture_output=True, text=True)

@@ -1,6 +1,7 @@
 """No pickle takes the interpreter down: 10,000 mutated pickles and states of a model and
 its parts (tests/fuzz_pickle_states.py) in a child process, seeded, where a crash fails
-the test; what loads is then used and written."""
+the test; what loads is then used, edited (add_point3D, delete_observation, ...) and
+written."""
 
 import json
 import os
@@ -19,3 +20,4 @@ def test_mutated_pickles_and_states_never_crash(tmp_path):
     counts = json.loads(result.stdout.strip().splitlines()[-1])
     # Each kind of outcome happened: the test reaches the checks and the calls.
     assert counts["refused"] > 1000 and counts["loaded"] > 100 and counts["written"] > 50, counts
+    assert counts["edited"] > 20, counts  # the model's edits succeeded, not only refused
