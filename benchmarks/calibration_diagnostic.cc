@@ -32,6 +32,7 @@
 #include <string>
 
 #include "database/database.h"
+#include "eval/calibration_uncertainty.h"
 #include "eval/ground_truth.h"
 #include "pipeline/load_mapper_input.h"
 #include "synthetic_scene.h"
@@ -198,6 +199,21 @@ int Run(const Arguments& arguments) {
         DiagnoseIncrementalMapper(input, testing::Unguarded(adjuster), options, seed, truth_poses);
   }
   std::cout << CalibrationTable(diagnosis, truth, arguments.mm ? 1000.0 : 1.0);
+  // What the final model says of its own calibration (what `tessera map` writes into
+  // mapping_summary.json), beside the truth above.
+  const CalibrationUncertainty assessed = AssessCalibration(
+      diagnosis.final_model, RefinedIntrinsics::FromMapperOptions(mapper_options));
+  std::cout << "\nFinal calibration, as the model assesses it";
+  if (!assessed.assessed) {
+    std::cout << ": not assessed (" << assessed.reason << ")\n";
+    return 0;
+  }
+  std::cout << " (observations' sigma " << assessed.observation_sigma_px << " px):\n";
+  for (const IntrinsicUncertainty& parameter : assessed.parameters) {
+    std::cout << "- " << parameter.parameter << " = " << parameter.value << ", sigma "
+              << parameter.sigma << ", corner shift " << parameter.corner_shift_px << " px"
+              << (parameter.weak ? ", weak" : "") << "\n";
+  }
   return 0;
 }
 

@@ -278,3 +278,28 @@ def test_other_python_threads_run_while_a_stage_runs(sample, tmp_path):
         counter["stop"] = True
         thread.join()
     assert ticks_at[max(ticks_at)] - ticks_at[0] >= 10, ticks_at
+
+
+def test_mapping_summary_says_how_well_the_calibration_is_pinned(sample, tmp_path):
+    """Issue 62: each model's calibration, assessed from its final adjustment (sigma and
+    corner shift per refined intrinsic); none assessed where the recipe holds them."""
+    images, _, cli_output = sample
+    written = json.loads((cli_output / "mapping_summary.json").read_text())
+    calibration = written["models"][0]["calibration"]
+    assert calibration["assessed"], calibration["reason"]
+    assert 0.05 < calibration["observation_sigma_px"] < 2.0
+    # The sample's recipe refines the focal length and distortion (SIMPLE_RADIAL's f, k).
+    assert [p["parameter"] for p in calibration["parameters"]] == ["f", "k"]
+    for parameter in calibration["parameters"]:
+        assert parameter["sigma"] > 0 and parameter["corner_shift_px"] > 0
+        assert parameter["weak"] == (parameter["corner_shift_px"] > 1.0)
+    assert calibration["weak"] == [f"{p['parameter']} of camera {p['camera_id']}"
+                                   for p in calibration["parameters"] if p["weak"]]
+    held = json.loads(json.dumps(MANIFEST))
+    held["pipeline"]["mapper"] = {"plugin": "incremental", "options": {
+        "ba_refine_focal_length": False, "ba_refine_extra_params": False}}
+    output = tmp_path / "held"
+    tessera.run(images=images, output=output, manifest=held, threads=2)
+    calibration = json.loads((output / "mapping_summary.json").read_text())["models"][0][
+        "calibration"]
+    assert not calibration["assessed"] and calibration["reason"] == "no intrinsic was refined"

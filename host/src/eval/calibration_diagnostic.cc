@@ -198,6 +198,7 @@ CalibrationDiagnosis DiagnoseGlobalMapper(const MapperInput& input,
   result.num_global_ba = mapped.num_bundle_adjustments;
   FinishModels(input, observed, run.finishing, seed, &result);
   stages.push_back(FinalStage(result, camera_id, truth));
+  if (!result.models.empty()) diagnosis.final_model = result.models.front();
   return diagnosis;
 }
 
@@ -244,6 +245,7 @@ CalibrationDiagnosis DiagnoseIncrementalMapper(
                   whole_model_adjustments.end());
   }
   stages.push_back(FinalStage(result, camera_id, truth));
+  if (!result.models.empty()) diagnosis.final_model = result.models.front();
   return diagnosis;
 }
 

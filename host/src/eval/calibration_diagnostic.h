@@ -54,6 +54,7 @@ struct CalibrationStage {
 struct CalibrationDiagnosis {
   std::string mapper;  // "global" or "incremental"
   std::vector<CalibrationStage> stages;
+  Reconstruction final_model;  // the largest model (empty when none was built)
 };
 
 // A bundle adjuster that runs `inner` and then shows each adjusted model (usable or not)

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "database/database_feature_reader.h"
+#include "eval/calibration_uncertainty.h"
 #include "image/camera_assignment.h"
 #include "io/keypoint_color_sampler.h"
 #include "outputs/output_transaction.h"
@@ -28,6 +29,31 @@
 #include "util/workspace_layout.h"
 
 namespace tessera {
+
+namespace {
+
+nlohmann::json CalibrationJson(const CalibrationUncertainty& assessment) {
+  nlohmann::json json = {{"assessed", assessment.assessed},
+                         {"reason", assessment.reason},
+                         {"observation_sigma_px", assessment.observation_sigma_px},
+                         {"parameters", nlohmann::json::array()},
+                         {"weak", nlohmann::json::array()}};
+  for (const IntrinsicUncertainty& parameter : assessment.parameters) {
+    json["parameters"].push_back({{"camera_id", parameter.camera_id},
+                                  {"parameter", parameter.parameter},
+                                  {"value", parameter.value},
+                                  {"sigma", parameter.sigma},
+                                  {"corner_shift_px", parameter.corner_shift_px},
+                                  {"weak", parameter.weak}});
+    if (parameter.weak) {
+      json["weak"].push_back(parameter.parameter + " of camera " +
+                             std::to_string(parameter.camera_id));
+    }
+  }
+  return json;
+}
+
+}  // namespace
 
 MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& input,
                                 const std::filesystem::path& sparse_dir, const std::string& mapper,
@@ -59,6 +85,16 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
                             {"longitude", georeference.longitude_deg},
                             {"altitude", georeference.altitude_m},
                             {"frame", georeference.frame}};
+    }
+    const CalibrationUncertainty calibration =
+        AssessCalibration(model, RefinedIntrinsics::FromMapperOptions(mapper_options));
+    entry.calibration = CalibrationJson(calibration);
+    for (const IntrinsicUncertainty* weak : calibration.Weak()) {
+      spdlog::warn(
+          "map: model {}: the observations leave {} of camera {} open: one standard deviation "
+          "({:.3g}) moves the image's corners {:.2f} px; where the camera was calibrated "
+          "beforehand, pass its K (--camera-K)",
+          index, weak->parameter, weak->camera_id, weak->sigma, weak->corner_shift_px);
     }
     summary.models.push_back(std::move(entry));
   }

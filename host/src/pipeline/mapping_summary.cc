@@ -25,7 +25,8 @@ nlohmann::json MappingSummary::ToJson() const {
          {"mean_observation_reprojection_error", model.mean_observation_reprojection_error},
          {"view_graph_check", self_check},
          {"images", model.images},
-         {"georeference", model.georeference}});
+         {"georeference", model.georeference},
+         {"calibration", model.calibration}});
   }
   for (const Unregistered& image : unregistered) {
     json["unregistered"].push_back({{"image", image.image}, {"reason", image.reason}});
@@ -77,6 +78,10 @@ MappingSummary MappingSummary::FromJson(const nlohmann::json& json) {
     model.images = entry.at("images").get<std::vector<std::string>>();
     // Absent in summaries written before models could be georeferenced.
     model.georeference = entry.value("georeference", nlohmann::json());
+    // Absent in summaries written before the calibration was assessed; an object (a
+    // type_error otherwise, which Read reports naming the file).
+    model.calibration =
+        entry.value("calibration", nlohmann::json::object()).get<nlohmann::json::object_t>();
     summary.models.push_back(std::move(model));
   }
   for (const nlohmann::json& entry : json.at("unregistered")) {

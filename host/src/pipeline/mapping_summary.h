@@ -36,6 +36,11 @@ struct MappingSummary {
     // The frame's WGS84 origin ({"latitude", "longitude", "altitude", "frame": "ENU"})
     // of a model anchored to GPS; null otherwise.
     nlohmann::json georeference;
+    // How well the observations pin down each refined intrinsic (CalibrationJson of
+    // eval/calibration_uncertainty.h): {"assessed", "reason", "observation_sigma_px",
+    // "parameters": [...], "weak": ["f of camera 1", ...]}; empty in summaries written
+    // before it.
+    nlohmann::json calibration = nlohmann::json::object();
   };
   struct Unregistered {
     std::string image;

@@ -21,6 +21,9 @@ MappingSummary ExampleMappingSummary() {
   model.mean_observation_reprojection_error = 0.75;
   model.view_graph_check = {3, 2, 0.875, true, {"c.jpg"}};
   model.images = {"a.jpg", "b.jpg", "c.jpg"};
+  model.calibration = {{"assessed", true},
+                       {"parameters", {{{"parameter", "f"}, {"sigma", 0.5}, {"weak", false}}}},
+                       {"weak", nlohmann::json::array()}};
   summary.models.push_back(model);
   summary.unregistered = {{"d.jpg", "no verified pair"}};
   summary.focal_lengths_estimated = {{1, 1200.0, 1150.5, "view graph", 6, 0}};
@@ -64,6 +67,31 @@ TEST(MappingSummary, RoundTripThroughAFile) {
   EXPECT_DOUBLE_EQ(back.focal_lengths_estimated.at(0).estimated, 1150.5);
   EXPECT_EQ(back.merges, summary.merges);
   EXPECT_EQ(back.quarantined, summary.quarantined);
+  EXPECT_EQ(back.models[0].calibration.at("parameters").at(0).at("parameter"), "f");
+}
+
+// A summary from before the calibration was assessed reads with none; one whose
+// calibration is no object is refused naming the file.
+TEST(MappingSummary, TheCalibrationIsOptionalAndAnObject) {
+  const testing::TemporaryDir dir;
+  const std::filesystem::path file = dir.path() / "mapping_summary.json";
+  nlohmann::json json = ExampleMappingSummary().ToJson();
+  json["models"][0].erase("calibration");
+  WriteFileAtomically(file, json.dump());
+  EXPECT_TRUE(MappingSummary::Read(file).models.at(0).calibration.empty());
+  json["models"][0]["calibration"] = "weak";
+  WriteFileAtomically(file, json.dump());
+  EXPECT_THROW(
+      {
+        try {
+          MappingSummary::Read(file);
+        } catch (const InputError& error) {
+          EXPECT_NE(std::string(error.what()).find(file.string() + ": not a mapping summary"),
+                    std::string::npos);
+          throw;
+        }
+      },
+      InputError);
 }
 
 // `rig` is written only with a rig (json.size() above counts without), and read back.
