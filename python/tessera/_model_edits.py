@@ -336,12 +336,42 @@ def triangulate_points(reconstruction: Reconstruction, database_path: Union[str,
         _copy_database(os.fspath(database_path), os.path.join(scratch, "database.db"))
         triangulate(scratch, model=os.path.join(folder, "in"),
                     refine_intrinsics=refine_intrinsics, manifest=manifest)
-        reconstruction._update_from(Reconstruction(os.path.join(scratch, "sparse", "0")))
+        triangulated = Reconstruction(os.path.join(scratch, "sparse", "0"))
+        reconstruction._update_from(_with_ids_of(reconstruction, triangulated, name))
     finally:
         shutil.rmtree(folder, ignore_errors=True)
     os.makedirs(output_path, exist_ok=True)
     reconstruction.write(output_path)
     return reconstruction
+
+
+def _with_ids_of(model: Reconstruction, result: Reconstruction,
+                 function: str) -> Reconstruction:
+    """`result` (triangulate's model: the workspace's image ids and keypoints) with the
+    image ids of `model`'s images of the same names. InputError where an image's keypoints
+    are not the workspace's: the points would observe keypoints the model does not have."""
+    own = {image.name: image for image in model.images.values()}
+    cameras, images, points = result.__getstate__()
+    image_ids = {}
+    renamed = []
+    for image_state in images:
+        image_id, camera_id, name, registered, quat, translation, points2D = image_state
+        mine = own[name]
+        keypoints = np.array([point[:2] for point in points2D], dtype=np.float64).reshape(-1, 2)
+        if keypoints.shape != mine.keypoints.shape or not np.allclose(keypoints, mine.keypoints,
+                                                                      atol=1e-6):
+            raise InputError(
+                f"{function}: image {mine.image_id} ({name}) has {len(mine.keypoints)} "
+                f"keypoints that are not the workspace's {len(keypoints)}: the model must be "
+                f"made from this workspace (tessera.triangulate takes a model from elsewhere "
+                f"and writes a new one)")
+        image_ids[image_id] = mine.image_id
+        renamed.append((mine.image_id, camera_id, name, registered, quat, translation,
+                        points2D))
+    moved_points = [(point3D_id, (xyz, color, error,
+                                  [(image_ids[image_id], idx) for image_id, idx in track]))
+                    for point3D_id, (xyz, color, error, track) in points]
+    return _tessera._reconstruction_from_state((cameras, renamed, moved_points))
 
 
 def _copy_database(source: str, target: str) -> None:

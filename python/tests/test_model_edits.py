@@ -189,6 +189,29 @@ def test_triangulate_points_replaces_the_points(sample, model, tmp_path):
     assert {p.name for p in workspace.iterdir()} <= {"database.db", "database.db-wal",
                                                      "database.db-shm"}
     _ = held.xyz  # an object of the old points stays valid
+    # A model whose image ids are not the workspace's (as one read from elsewhere): the
+    # images are matched by name and keep their own ids.
+    state = list(pickle.loads(pickle.dumps(model)).__getstate__())
+    state[1] = [(image_id + 100,) + tuple(rest) for image_id, *rest in state[1]]
+    state[2] = [(point3D_id, (xyz, color, error, [(i + 100, k) for i, k in track]))
+                for point3D_id, (xyz, color, error, track) in state[2]]
+    renumbered = tessera._tessera._reconstruction_from_state(tuple(state))
+    tessera.triangulate_points(renumbered, workspace / "database.db", images, tmp_path / "o1",
+                               manifest=manifest)
+    assert sorted(renumbered.images) == sorted(image_id + 100 for image_id in model.images)
+    for image in renumbered.images.values():
+        assert image.cam_from_world == poses[image.name]
+    check_invariants(renumbered)
+    assert len(renumbered.points3D) == len(model.points3D)
+    # Keypoints that are not the workspace's: refused, the model left as it was.
+    state[1] = [(image_id, *rest[:5], [(x, y, 2**64 - 1) for x, y, _ in rest[5][1:]])
+                for image_id, *rest in state[1]]
+    state[2] = []
+    foreign = tessera._tessera._reconstruction_from_state(tuple(state))
+    with pytest.raises(tessera.InputError, match="keypoints that are not the workspace's"):
+        tessera.triangulate_points(foreign, workspace / "database.db", images, tmp_path / "o3",
+                                   manifest=manifest)
+    assert len(foreign.points3D) == 0
     with pytest.raises(tessera.InputError, match="database.db in a workspace folder"):
         tessera.triangulate_points(model, workspace / "colmap.db", images, tmp_path / "o2")
     with pytest.raises(tessera.InputError, match="clear_points=False"):
