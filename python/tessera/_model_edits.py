@@ -7,12 +7,14 @@ adjuster), and align_reconstructions_via_proj_centers through `align --reference
 An edit never frees what Python holds: a Point3D object of a deleted point stays valid,
 detached from the model. A point's track is a copy, (K, 2) uint32."""
 
+import collections.abc
 import logging
 import numbers
 import os
 import shutil
 import sqlite3
 import tempfile
+import typing
 import urllib.parse
 from typing import Any, Iterable, Iterator, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -21,7 +23,7 @@ import numpy.typing as npt
 
 from . import _tessera
 from ._geometry import Rigid3d, Rotation3d, Sim3d
-from ._tessera import Camera, Image, InputError, Reconstruction
+from ._tessera import Camera, Image, InputError, Point3D, Reconstruction
 
 INVALID_ID = 2**32 - 1  # camera_t, image_t and point2D_t's "none"
 INVALID_POINT3D_ID = 2**64 - 1
@@ -423,7 +425,27 @@ def align_reconstructions_via_proj_centers(src_reconstruction: Reconstruction,
     return Sim3d(fit["scale"], Rotation3d(fit["rotation"]), fit["translation"])
 
 
+def _safe_iteration(map_class: Any) -> None:
+    """The id maps iterate over a snapshot of their ids, skipping those deleted meanwhile:
+    `for point3D_id, point in rec.points3D.items(): rec.delete_point3D(...)` visits every
+    point that is still there once (pybind11's own iterators walk the C++ map, which an
+    edit changes under them). Ids added during the loop are not visited."""
+    walk = map_class.__iter__  # pybind11's, over the C++ map: run through at once
+
+    def iterate(self: Any) -> Iterator[Any]:
+        for key in list(walk(self)):
+            if key in self:
+                yield key
+
+    map_class.__iter__ = iterate
+    map_class.keys = lambda self: collections.abc.KeysView(self)
+    map_class.values = lambda self: collections.abc.ValuesView(self)
+    map_class.items = lambda self: collections.abc.ItemsView(self)
+
+
 def attach() -> None:
+    for value_class in (Camera, Image, Point3D):
+        _safe_iteration(typing.cast(Any, value_class).Map)
     image_class: Any = Image
     image_class.__init__ = _image_new
     image_class.points2D = property(_points2D, doc=_points2D.__doc__)

@@ -233,3 +233,26 @@ def test_align_reconstructions_via_proj_centers(model):
     assert tessera.align_reconstructions_via_proj_centers(model, empty, 0.05) is None
     with pytest.raises(tessera.InputError, match="max_proj_center_error"):
         tessera.align_reconstructions_via_proj_centers(model, moved, 0)
+
+
+def test_deleting_while_iterating_visits_each_remaining_id_once(model):
+    """The id maps iterate over a snapshot of their ids: deleting during a loop (the
+    everyday filter) neither crashes nor skips, and ids deleted meanwhile are not given."""
+    seen = []
+    for point3D_id, point in model.points3D.items():
+        seen.append(point3D_id)
+        if point.error > 0.5 or len(point.track) < 3:
+            model.delete_point3D(point3D_id)
+    assert len(seen) == len(set(seen))
+    assert all(point.error <= 0.5 and len(point.track) >= 3 for point in model.points3D.values())
+    # Deleting an observation can delete a point not yet visited: it is skipped.
+    visited = []
+    for point3D_id in model.points3D:
+        visited.append(point3D_id)
+        image_id, idx = (int(v) for v in model.points3D[point3D_id].track[0])
+        model.delete_observation(image_id, idx)
+    assert set(visited) >= set(model.points3D.keys())
+    for image_id in model.images:  # deregistering while iterating the images
+        model.deregister_image(image_id)
+    assert len(model.points3D) == 0 and model.num_reg_images() == 0
+    check_invariants(model)
