@@ -325,9 +325,10 @@ def triangulate_points(reconstruction: Reconstruction, database_path: Union[str,
     if options is not None:
         raise InputError(f"{name}: options: Tessera's thresholds are the mapper's; pass "
                          f"manifest=")
-    workspace = workspace_of(name, database_path)
+    workspace_of(name, database_path)
     if not os.path.isdir(image_path):
         raise InputError(f"{name}: image_path: {os.fspath(image_path)}: no such folder")
+    output_folder(name, output_path)
     folder = _work_folder("triangulate")
     try:
         reconstruction.write(os.path.join(folder, "in"))
@@ -382,6 +383,20 @@ def _copy_database(source: str, target: str) -> None:
     with sqlite3.connect(f"file:{urllib.parse.quote(source)}?mode=ro", uri=True) as reader, \
             sqlite3.connect(target) as writer:
         reader.backup(writer)
+
+
+def output_folder(function: str, output_path: Union[str, "os.PathLike[str]"]) -> str:
+    """output_path as a folder to write into, checked before any work: InputError naming it
+    when it is a file (or lies under one)."""
+    if not isinstance(output_path, (str, os.PathLike)):
+        raise TypeError(f"{function}(): output_path must be a path, not {_type_name(output_path)}")
+    path = os.fspath(output_path)
+    probe = path
+    while probe and not os.path.exists(probe):
+        probe = os.path.dirname(probe)
+    if probe and not os.path.isdir(probe):
+        raise InputError(f"{function}: output_path: {path}: {probe} is a file, not a folder")
+    return path
 
 
 def workspace_of(function: str, database_path: Union[str, "os.PathLike[str]"]) -> str:

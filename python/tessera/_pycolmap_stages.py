@@ -14,7 +14,7 @@ output_path/<index> (COLMAP binary), as COLMAP's mapper does."""
 import os
 from typing import Any, Dict, List, Sequence, Union
 
-from ._model_edits import workspace_of
+from ._model_edits import output_folder, workspace_of
 from ._tessera import Database, Image, InputError, Reconstruction
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -66,6 +66,7 @@ def _mapping(function: str, database_path: PathLike, image_path: PathLike,
     workspace = workspace_of(function, database_path)
     if not os.path.isdir(image_path):
         raise InputError(f"{function}: image_path: {os.fspath(image_path)}: no such folder")
+    output_folder(function, output_path)
     summary = map_stage(output=workspace, images=image_path, manifest=manifest, threads=threads)
     models: Dict[int, Reconstruction] = {}
     sparse = os.path.join(workspace, "sparse")

@@ -214,6 +214,14 @@ def test_triangulate_points_replaces_the_points(sample, model, tmp_path):
     assert len(foreign.points3D) == 0
     with pytest.raises(tessera.InputError, match="database.db in a workspace folder"):
         tessera.triangulate_points(model, workspace / "colmap.db", images, tmp_path / "o2")
+    (tmp_path / "a_file").write_text("not a folder")
+    with pytest.raises(tessera.InputError, match="output_path: .*a_file is a file, not a folder"):
+        tessera.triangulate_points(model, workspace / "database.db", images,
+                                   tmp_path / "a_file" / "out")
+    with pytest.raises(tessera.InputError, match="output_path: .*a_file is a file"):
+        tessera.incremental_mapping(workspace / "database.db", images, tmp_path / "a_file")
+    with pytest.raises(tessera.InputError, match="image_path: .*: no such folder"):
+        tessera.global_mapping(workspace / "database.db", tmp_path / "none", tmp_path / "o4")
     with pytest.raises(tessera.InputError, match="clear_points=False"):
         tessera.triangulate_points(model, workspace / "database.db", images, tmp_path / "o2",
                                    clear_points=False)
