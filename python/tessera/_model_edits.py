@@ -25,6 +25,8 @@ from . import _tessera
 from ._geometry import Rigid3d, Rotation3d, Sim3d
 from ._tessera import Camera, Image, InputError, Point3D, Reconstruction
 
+# A manifest file, a bundled recipe's name, a dict, or None for default.json.
+ManifestLike = Union[str, "os.PathLike[str]", Mapping[str, Any], None]
 INVALID_ID = 2**32 - 1  # camera_t, image_t and point2D_t's "none"
 INVALID_POINT3D_ID = 2**64 - 1
 
@@ -276,7 +278,7 @@ def _work_folder(prefix: str) -> str:
 
 
 def bundle_adjustment(reconstruction: Reconstruction, options: Optional[Mapping[str, Any]] = None,
-                      manifest: Any = None, hold: Sequence[str] = ()) -> Mapping[str, Any]:
+                      manifest: ManifestLike = None, hold: Sequence[str] = ()) -> Mapping[str, Any]:
     """Bundle-adjusts the model in place with the manifest's bundle adjuster (pycolmap's
     bundle_adjustment), then filters its points as the mappers do: tessera.adjust on a
     copy, whose result replaces the model's cameras, poses and points (the objects Python
@@ -305,7 +307,7 @@ def bundle_adjustment(reconstruction: Reconstruction, options: Optional[Mapping[
 def triangulate_points(reconstruction: Reconstruction, database_path: Union[str, "os.PathLike[str]"],
                        image_path: Union[str, "os.PathLike[str]"], output_path: Union[str, "os.PathLike[str]"],
                        clear_points: bool = True, options: Optional[Mapping[str, Any]] = None,
-                       refine_intrinsics: bool = False, manifest: Any = None) -> Reconstruction:
+                       refine_intrinsics: bool = False, manifest: ManifestLike = None) -> Reconstruction:
     """Triangulates the workspace's verified matches for the model's registered images,
     every pose held (pycolmap's triangulate_points, COLMAP's point_triangulator), through
     tessera.triangulate. database_path is a workspace's database.db; the new points replace

@@ -14,7 +14,7 @@ output_path/<index> (COLMAP binary), as COLMAP's mapper does."""
 import os
 from typing import Any, Dict, List, Sequence, Union
 
-from ._model_edits import output_folder, workspace_of
+from ._model_edits import ManifestLike, output_folder, workspace_of
 from ._tessera import Database, Image, InputError, Reconstruction
 
 PathLike = Union[str, "os.PathLike[str]"]
@@ -27,7 +27,7 @@ def _no_subset(function: str, image_names: Sequence[str]) -> None:
 
 
 def extract_features(database_path: PathLike, image_path: PathLike,
-                     image_names: Sequence[str] = (), manifest: Any = None,
+                     image_names: Sequence[str] = (), manifest: ManifestLike = None,
                      threads: int = 0) -> None:
     """Ingests image_path's images and detects their features into database_path's
     workspace (tessera.extract; manifest None: default.json)."""
@@ -39,7 +39,7 @@ def extract_features(database_path: PathLike, image_path: PathLike,
             threads=threads)
 
 
-def match_exhaustive(database_path: PathLike, manifest: Any = None,
+def match_exhaustive(database_path: PathLike, manifest: ManifestLike = None,
                      threads: int = 0) -> None:
     """Matches and verifies every pair of the workspace's images (tessera.match with a
     recipe whose pair selector is "exhaustive")."""
@@ -49,7 +49,7 @@ def match_exhaustive(database_path: PathLike, manifest: Any = None,
           threads=threads)
 
 
-def match_sequential(database_path: PathLike, manifest: Any = None,
+def match_sequential(database_path: PathLike, manifest: ManifestLike = None,
                      threads: int = 0) -> None:
     """Matches and verifies the pairs of images near in name order (tessera.match with
     sequential.json)."""
@@ -60,7 +60,7 @@ def match_sequential(database_path: PathLike, manifest: Any = None,
 
 
 def _mapping(function: str, database_path: PathLike, image_path: PathLike,
-             output_path: PathLike, manifest: Any, threads: int) -> Dict[int, Reconstruction]:
+             output_path: PathLike, manifest: ManifestLike, threads: int) -> Dict[int, Reconstruction]:
     from . import map as map_stage
 
     workspace = workspace_of(function, database_path)
@@ -85,7 +85,7 @@ def _same_folder(a: str, b: str) -> bool:
 
 
 def incremental_mapping(database_path: PathLike, image_path: PathLike, output_path: PathLike,
-                        manifest: Any = None, threads: int = 0) -> Dict[int, Reconstruction]:
+                        manifest: ManifestLike = None, threads: int = 0) -> Dict[int, Reconstruction]:
     """Maps the workspace with the incremental mapper (tessera.map with default.json);
     {index: Reconstruction}, each also written to output_path/<index>. NoModelError when no
     model was built (pycolmap returns {})."""
@@ -94,7 +94,7 @@ def incremental_mapping(database_path: PathLike, image_path: PathLike, output_pa
 
 
 def global_mapping(database_path: PathLike, image_path: PathLike, output_path: PathLike,
-                   manifest: Any = None, threads: int = 0) -> Dict[int, Reconstruction]:
+                   manifest: ManifestLike = None, threads: int = 0) -> Dict[int, Reconstruction]:
     """As incremental_mapping, with the global mapper (global.json)."""
     return _mapping("global_mapping", database_path, image_path, output_path,
                     "global" if manifest is None else manifest, threads)
