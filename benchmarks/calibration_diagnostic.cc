@@ -187,22 +187,26 @@ int Run(const Arguments& arguments) {
     input = LoadMapperInput(Database(database, Database::Mode::kReadOnly));
   }
   CalibrationDiagnosis diagnosis;
+  RefinedIntrinsics refined;  // what the mapper's final adjustment refines
   if (pipeline.at("mapper").at("plugin") == "global") {
     GlobalPipelineOptions options = GlobalPipelineOptions::FromJson(mapper_options);
     options.mapper.num_threads = options.finishing.num_threads = threads;
+    refined = {options.mapper.ba_refine_focal_length, options.mapper.ba_refine_principal_point,
+               options.mapper.ba_refine_extra_params};
     diagnosis =
         DiagnoseGlobalMapper(input, testing::Unguarded(adjuster), options, seed, truth_poses);
   } else {
     IncrementalMapperOptions options = IncrementalMapperOptions::FromJson(mapper_options);
     options.num_threads = threads;
+    refined = {options.ba_refine_focal_length, options.ba_refine_principal_point,
+               options.ba_refine_extra_params};
     diagnosis =
         DiagnoseIncrementalMapper(input, testing::Unguarded(adjuster), options, seed, truth_poses);
   }
   std::cout << CalibrationTable(diagnosis, truth, arguments.mm ? 1000.0 : 1.0);
   // What the final model says of its own calibration (what `tessera map` writes into
   // mapping_summary.json), beside the truth above.
-  const CalibrationUncertainty assessed = AssessCalibration(
-      diagnosis.final_model, RefinedIntrinsics::FromMapperOptions(mapper_options));
+  const CalibrationUncertainty assessed = AssessCalibration(diagnosis.final_model, refined);
   std::cout << "\nFinal calibration, as the model assesses it";
   if (!assessed.assessed) {
     std::cout << ": not assessed (" << assessed.reason << ")\n";

@@ -10,12 +10,15 @@
 
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "bindings.h"
 #include "database/database.h"
 #include "numpy_views.h"
+#include "tessera/errors.h"
 #include "two_view_geometry_dict.h"
+#include "util/workspace_layout.h"
 
 namespace py = pybind11;
 
@@ -79,6 +82,59 @@ py::dict TwoViewGeometryDict(TwoViewGeometry geometry, const std::string& what) 
 
 namespace {
 
+// `image` with its keypoints as points2D (no 3D points).
+Image WithKeypoints(const Database& database, Image image) {
+  for (const FeatureKeypoint& keypoint : database.ReadKeypoints(image.image_id)) {
+    Point2D point;
+    point.xy = Eigen::Vector2d(keypoint.x, keypoint.y);
+    image.points2D.push_back(point);
+  }
+  return image;
+}
+
+// pycolmap's reads of one image and of the count, each reading only what it gives (the
+// image list without keypoints, one image's keypoints); tessera/_pycolmap_stages.py adds
+// the reads that are Database's own calls under pycolmap's names.
+void BindPycolmapImageReads(py::class_<Database, std::shared_ptr<Database>>& database_class) {
+  database_class
+      .def(
+          "read_image",
+          [](const Database& database, image_t image_id) {
+            for (Image& image : database.ReadAllImages()) {
+              if (image.image_id == image_id) return WithKeypoints(database, std::move(image));
+            }
+            throw InputError("read_image: image_id " + std::to_string(image_id) +
+                             ": the database has no such image");
+          },
+          py::arg("image_id"),
+          "read_image(self, image_id)\n--\n\nThe image, as `images` gives it; InputError for "
+          "an id the database lacks")
+      .def(
+          "read_image_with_name",
+          [](const Database& database, const std::string& name) {
+            std::optional<Image> image = database.ReadImageWithName(name);
+            if (!image) {
+              throw InputError(
+                  "read_image_with_name: " + py::repr(py::str(name)).cast<std::string>() +
+                  ": the database has no such image");
+            }
+            return WithKeypoints(database, std::move(*image));
+          },
+          py::arg("name"),
+          "read_image_with_name(self, name)\n--\n\nThe image of that name, as `images` gives "
+          "it; InputError for a name the database lacks")
+      .def(
+          "exists_image",
+          [](const Database& database, image_t image_id) {
+            for (const Image& image : database.ReadAllImages()) {
+              if (image.image_id == image_id) return true;
+            }
+            return false;
+          },
+          py::arg("image_id"), "exists_image(self, image_id)\n--\n\nWhether the image is there")
+      .def("num_images", &Database::NumImages, "num_images(self)\n--\n\nHow many images");
+}
+
 py::dict GeometryDict(image_t image_id1, image_t image_id2, TwoViewGeometry geometry) {
   py::dict result;
   result["image_id1"] = image_id1;
@@ -96,8 +152,9 @@ py::dict GeometryDict(image_t image_id1, image_t image_id2, TwoViewGeometry geom
 void BindDatabase(py::module_& module) {
   py::options options;  // signatures in the docstrings, as Python writes them (model_bindings.cc)
   options.disable_function_signatures();
-  py::class_<Database, std::shared_ptr<Database>>(
-      module, "Database", "A workspace's database.db, read-only; results are numpy where arrays")
+  py::class_<Database, std::shared_ptr<Database>> database_class(
+      module, "Database", "A workspace's database.db, read-only; results are numpy where arrays");
+  database_class
       .def(py::init([](const std::filesystem::path& path) {
              return std::make_shared<Database>(path, Database::Mode::kReadOnly);
            }),
@@ -118,12 +175,8 @@ void BindDatabase(py::module_& module) {
           [](const Database& database) {
             py::dict images;
             for (Image& image : database.ReadAllImages()) {
-              for (const FeatureKeypoint& keypoint : database.ReadKeypoints(image.image_id)) {
-                Point2D point;
-                point.xy = Eigen::Vector2d(keypoint.x, keypoint.y);
-                image.points2D.push_back(point);
-              }
-              images[py::int_(image.image_id)] = std::move(image);
+              const image_t image_id = image.image_id;
+              images[py::int_(image_id)] = WithKeypoints(database, std::move(image));
             }
             return images;
           },
@@ -198,6 +251,10 @@ void BindDatabase(py::module_& module) {
           },
           "two_view_geometries(self)\n--\n\nEvery stored geometry as two_view_geometry gives it, "
           "image_id1 < image_id2");
+  BindPycolmapImageReads(database_class);
+  // The workspace's names, for the pycolmap calls that take a database path.
+  module.attr("_DATABASE_FILE") = workspace_layout::kDatabase;
+  module.attr("_MODELS_FOLDER") = workspace_layout::kModelsFolder;
 }
 
 }  // namespace tessera::python

@@ -338,10 +338,10 @@ def triangulate_points(reconstruction: Reconstruction, database_path: Union[str,
         # another process reads it): nothing is written into the caller's workspace.
         scratch = os.path.join(folder, "workspace")
         os.mkdir(scratch)
-        _copy_database(os.fspath(database_path), os.path.join(scratch, "database.db"))
+        _copy_database(os.fspath(database_path), os.path.join(scratch, _tessera._DATABASE_FILE))
         triangulate(scratch, model=os.path.join(folder, "in"),
                     refine_intrinsics=refine_intrinsics, manifest=manifest)
-        triangulated = Reconstruction(os.path.join(scratch, "sparse", "0"))
+        triangulated = Reconstruction(os.path.join(scratch, _tessera._MODELS_FOLDER, "0"))
         reconstruction._update_from(_with_ids_of(reconstruction, triangulated, name))
     finally:
         shutil.rmtree(folder, ignore_errors=True)
@@ -408,9 +408,10 @@ def workspace_of(function: str, database_path: Union[str, "os.PathLike[str]"]) -
         raise TypeError(f"{function}(): database_path must be a path, not "
                         f"{_type_name(database_path)}")
     path = os.fspath(database_path)
-    if os.path.basename(path) != "database.db":
+    name = _tessera._DATABASE_FILE
+    if os.path.basename(path) != name:
         raise InputError(f"{function}: database_path: {path}: Tessera keeps its database as "
-                         f"database.db in a workspace folder; name it WORKSPACE/database.db")
+                         f"{name} in a workspace folder; name it WORKSPACE/{name}")
     return os.path.dirname(os.path.abspath(path))
 
 

@@ -14,6 +14,7 @@ output_path/<index> (COLMAP binary), as COLMAP's mapper does."""
 import os
 from typing import Any, Dict, List, Sequence, Union
 
+from . import _tessera
 from ._model_edits import ManifestLike, output_folder, workspace_of
 from ._tessera import Database, Image, InputError, Reconstruction
 
@@ -69,7 +70,7 @@ def _mapping(function: str, database_path: PathLike, image_path: PathLike,
     output_folder(function, output_path)
     summary = map_stage(output=workspace, images=image_path, manifest=manifest, threads=threads)
     models: Dict[int, Reconstruction] = {}
-    sparse = os.path.join(workspace, "sparse")
+    sparse = os.path.join(workspace, _tessera._MODELS_FOLDER)
     for index in range(int(summary["num_models"])):
         model = Reconstruction(os.path.join(sparse, str(index)))
         target = os.path.join(output_path, str(index))
@@ -112,20 +113,6 @@ def _read_all_images(self: Database) -> List[Image]:
     return [image for _, image in sorted(self.images.items())]
 
 
-def _read_image(self: Database, image_id: int) -> Image:
-    images = self.images
-    if image_id not in images:
-        raise InputError(f"read_image: image_id {image_id}: the database has no such image")
-    return images[image_id]
-
-
-def _read_image_with_name(self: Database, name: str) -> Image:
-    for image in self.images.values():
-        if image.name == name:
-            return image
-    raise InputError(f"read_image_with_name: {name!r}: the database has no such image")
-
-
 class FeatureDescriptors:
     """What pycolmap 4's Database.read_descriptors returns: the (M, D) uint8 rows in .data."""
 
@@ -144,14 +131,6 @@ def _read_descriptors(self: Database, image_id: int) -> FeatureDescriptors:
     return FeatureDescriptors(self.descriptors(image_id))
 
 
-def _num_images(self: Database) -> int:
-    return len(self.images)
-
-
-def _exists_image(self: Database, image_id: int) -> bool:
-    return image_id in self.images
-
-
 def _close(self: Database) -> None:
     """Nothing to release early: the file is closed when the object is freed."""
 
@@ -168,14 +147,10 @@ def attach() -> None:
     database_class: Any = Database
     database_class.open = staticmethod(_open)
     database_class.read_all_images = _read_all_images
-    database_class.read_image = _read_image
-    database_class.read_image_with_name = _read_image_with_name
     database_class.read_keypoints = database_class.keypoints
     database_class.read_descriptors = _read_descriptors
     database_class.read_matches = database_class.matches
     database_class.read_two_view_geometry = database_class.two_view_geometry
-    database_class.num_images = _num_images
-    database_class.exists_image = _exists_image
     database_class.close = _close
     database_class.__enter__ = _enter
     database_class.__exit__ = _exit

@@ -92,3 +92,31 @@ def test_database_arrays_are_read_only(sample):
         assert not array.flags.writeable, name
         with pytest.raises(ValueError, match="read-only"):
             array[0] = 0
+
+
+def test_pycolmap_reads_give_what_the_database_holds(sample):
+    """pycolmap's read_* names: each gives what Tessera's own call gives; unknown ids and
+    names are InputErrors naming them."""
+    _, _, output = sample
+    with tessera.Database.open(output / "database.db") as database:
+        images = database.images
+        assert database.num_images() == len(images) == 11
+        assert [image.image_id for image in database.read_all_images()] == sorted(images)
+        for image_id, image in images.items():
+            assert database.exists_image(image_id)
+            for read in (database.read_image(image_id),
+                         database.read_image_with_name(image.name)):
+                assert (read.image_id, read.name, read.camera_id) == (
+                    image_id, image.name, image.camera_id)
+                np.testing.assert_array_equal(read.keypoints, image.keypoints)
+            np.testing.assert_array_equal(database.read_keypoints(image_id),
+                                          database.keypoints(image_id))
+            np.testing.assert_array_equal(database.read_descriptors(image_id).data,
+                                          database.descriptors(image_id))
+        assert not database.exists_image(999)
+        with pytest.raises(tessera.InputError, match="read_image: image_id 999: the database "
+                                                     "has no such image"):
+            database.read_image(999)
+        with pytest.raises(tessera.InputError, match="read_image_with_name: 'none.jpg': the "
+                                                     "database has no such image"):
+            database.read_image_with_name("none.jpg")

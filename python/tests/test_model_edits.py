@@ -19,7 +19,7 @@ def model(sample):
 
 def check_invariants(rec):
     """Each keypoint's point has it in its track and the other way round; tracks hold
-    registered images only. Then write and read back."""
+    registered images only."""
     for point3D_id, point in rec.points3D.items():
         for image_id, idx in point.track:
             assert rec.images[int(image_id)].registered

@@ -201,19 +201,6 @@ bool AddPoint(const Reconstruction& model, const Layout& layout, const Point3D& 
 
 }  // namespace
 
-RefinedIntrinsics RefinedIntrinsics::FromMapperOptions(const nlohmann::json& mapper_options) {
-  RefinedIntrinsics refined;
-  if (!mapper_options.is_object()) return refined;
-  const auto flag = [&](const char* name, bool fallback) {
-    const auto it = mapper_options.find(name);
-    return it != mapper_options.end() && it->is_boolean() ? it->get<bool>() : fallback;
-  };
-  refined.focal_length = flag("ba_refine_focal_length", refined.focal_length);
-  refined.principal_point = flag("ba_refine_principal_point", refined.principal_point);
-  refined.extra_params = flag("ba_refine_extra_params", refined.extra_params);
-  return refined;
-}
-
 std::vector<const IntrinsicUncertainty*> CalibrationUncertainty::Weak() const {
   std::vector<const IntrinsicUncertainty*> weak;
   for (const IntrinsicUncertainty& parameter : parameters) {

@@ -11,7 +11,6 @@
 // max_corner_shift_px is weak: the data leave it open, and a K given beforehand would
 // hold it.
 
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -20,25 +19,21 @@
 
 namespace tessera {
 
-// The intrinsics the final adjustment refined (the mappers' ba_refine_* options).
+// The intrinsics the final adjustment refined: the mapper's ba_refine_focal_length,
+// ba_refine_principal_point and ba_refine_extra_params, as the caller read them.
 struct RefinedIntrinsics {
-  bool focal_length = true;
+  bool focal_length = false;
   bool principal_point = false;
-  bool extra_params = true;
+  bool extra_params = false;
 
   bool Any() const { return focal_length || principal_point || extra_params; }
-  // From a mapper's options: ba_refine_focal_length, ba_refine_principal_point and
-  // ba_refine_extra_params (the incremental and global mappers' names); what is absent
-  // or not a bool keeps the default above.
-  static RefinedIntrinsics FromMapperOptions(const nlohmann::json& mapper_options);
 };
 
 struct CalibrationUncertaintyOptions {
   // A parameter is weak when a one-sigma change moves a corner's pixel farther than this.
   double max_corner_shift_px = 1.0;
-  // Above this many registered images the dense reduced system is not built (the
-  // calibration of so many views is assessed as not weak by no one: the figure is left
-  // out and `assessed` says why).
+  // Above this many registered images the dense reduced system (6 unknowns per image) is
+  // not built: the model is left unassessed, and `reason` says so.
   size_t max_num_images = 500;
 };
 

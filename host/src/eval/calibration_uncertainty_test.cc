@@ -11,6 +11,9 @@
 namespace tessera {
 namespace {
 
+// What the mappers refine by default: the focal length and the distortion.
+constexpr RefinedIntrinsics kMappersDefault{true, false, true};
+
 Camera MakeCamera() {
   Camera camera;
   camera.camera_id = 1;
@@ -134,7 +137,7 @@ TEST(CalibrationUncertainty, EqualsTheInverseOfTheFullNormalEquationsUnderAnothe
 
 TEST(CalibrationUncertainty, TheObservationSigmaIsTheNoise) {
   const Reconstruction model = NoisyScene(8, 400, 0.7, 5);
-  const CalibrationUncertainty assessed = AssessCalibration(model, RefinedIntrinsics{});
+  const CalibrationUncertainty assessed = AssessCalibration(model, kMappersDefault);
   ASSERT_TRUE(assessed.assessed) << assessed.reason;
   EXPECT_EQ(assessed.parameters.size(), 2u);  // f and k: the principal point was held
   // At the true model (not the least-squares one) the residuals are the noise itself, so
@@ -148,13 +151,12 @@ TEST(CalibrationUncertainty, TheObservationSigmaIsTheNoise) {
 TEST(CalibrationUncertainty, FewViewsAndPointsLeaveTheFocalLengthOpenManyPinItDown) {
   // The mappers' default: focal length and distortion refined, the principal point held.
   const Reconstruction scene = NoisyScene(30, 2000, 0.3, 7);
-  const CalibrationUncertainty many = AssessCalibration(scene, RefinedIntrinsics{});
+  const CalibrationUncertainty many = AssessCalibration(scene, kMappersDefault);
   ASSERT_TRUE(many.assessed) << many.reason;
   ASSERT_EQ(many.parameters.size(), 2u);
   EXPECT_TRUE(many.Weak().empty())
       << many.parameters[0].corner_shift_px << " " << many.parameters[1].corner_shift_px;
-  const CalibrationUncertainty few =
-      AssessCalibration(NoisyScene(3, 30, 2.0, 7), RefinedIntrinsics{});
+  const CalibrationUncertainty few = AssessCalibration(NoisyScene(3, 30, 2.0, 7), kMappersDefault);
   ASSERT_TRUE(few.assessed) << few.reason;
   ASSERT_FALSE(few.Weak().empty());
   EXPECT_EQ(few.Weak().front()->parameter, "f");
@@ -184,11 +186,11 @@ TEST(CalibrationUncertainty, SaysWhyItWasNotAssessed) {
             "no intrinsic was refined");
   CalibrationUncertaintyOptions options;
   options.max_num_images = 3;
-  EXPECT_EQ(AssessCalibration(model, RefinedIntrinsics{}, options).reason,
+  EXPECT_EQ(AssessCalibration(model, kMappersDefault, options).reason,
             "4 registered images, over the 3 assessed");
   Reconstruction one = model;
   for (auto& [image_id, image] : one.images) image.registered = image_id == 1;
-  EXPECT_EQ(AssessCalibration(one, RefinedIntrinsics{}).reason, "fewer than 2 registered images");
+  EXPECT_EQ(AssessCalibration(one, kMappersDefault).reason, "fewer than 2 registered images");
 }
 
 }  // namespace

@@ -25,12 +25,29 @@
 #include "tessera/io/georeference_io.h"
 #include "tessera/io/model_statistics.h"
 #include "tessera/io/point_colors.h"
+#include "tessera/sfm/incremental_mapper_options.h"
 #include "util/timer.h"
 #include "util/workspace_layout.h"
 
 namespace tessera {
 
 namespace {
+
+// The intrinsics the mapper's final adjustment refined, from its effective options
+// (ba_refine_*, the incremental and global mappers' names); a mapper that does not name
+// them is taken to refine as the incremental mapper does by default.
+RefinedIntrinsics RefinedByMapper(const nlohmann::json& mapper_options) {
+  const IncrementalMapperOptions defaults;
+  const auto flag = [&](const char* name, bool fallback) {
+    const auto it = mapper_options.is_object() ? mapper_options.find(name) : mapper_options.end();
+    return it != mapper_options.end() && it->is_boolean() ? it->get<bool>() : fallback;
+  };
+  RefinedIntrinsics refined;
+  refined.focal_length = flag("ba_refine_focal_length", defaults.ba_refine_focal_length);
+  refined.principal_point = flag("ba_refine_principal_point", defaults.ba_refine_principal_point);
+  refined.extra_params = flag("ba_refine_extra_params", defaults.ba_refine_extra_params);
+  return refined;
+}
 
 nlohmann::json CalibrationJson(const CalibrationUncertainty& assessment) {
   nlohmann::json json = {{"assessed", assessment.assessed},
@@ -87,7 +104,7 @@ MappingSummary SummarizeMapping(const MapperResult& result, const MapperInput& i
                             {"frame", georeference.frame}};
     }
     const CalibrationUncertainty calibration =
-        AssessCalibration(model, RefinedIntrinsics::FromMapperOptions(mapper_options));
+        AssessCalibration(model, RefinedByMapper(mapper_options));
     entry.calibration = CalibrationJson(calibration);
     for (const IntrinsicUncertainty* weak : calibration.Weak()) {
       spdlog::warn(
