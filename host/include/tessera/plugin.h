@@ -5,7 +5,11 @@
 //   tessera_plugin_info    -> const TesseraPluginInfo  (what the plugin is)
 //   tessera_plugin_create  -> tessera::PluginFactory   (makes it from JSON options and
 //                                                       the host's services)
-// TESSERA_PLUGIN() below defines both. Host and plugins must be built with the same
+// TESSERA_PLUGIN() below defines both. A third, which every bundled plugin exports:
+//   tessera_plugin_options -> tessera::PluginOptionsDescriber (its options described:
+//                                                       `tessera plugins NAME`)
+// TESSERA_PLUGIN_OPTIONS() defines it; a plugin without it is listed as not describing
+// its options. Host and plugins must be built with the same
 // compiler and standard library, since C++ objects cross the boundary.
 
 #include <cstdint>
@@ -18,6 +22,7 @@
 
 #include "tessera/export.h"
 #include "tessera/log.h"
+#include "tessera/option_list.h"
 #include "tessera/plugin_services.h"
 
 // Bumped whenever TesseraPluginInfo, a plugin interface, a type that crosses the
@@ -27,7 +32,7 @@
 // abi_headers.sha256 records it with a hash of every header here, comments and whitespace
 // excluded: the test sdk_abi_check fails when a header changes without a bump (bump it,
 // then run scripts/sdk_abi_check.py --update).
-#define TESSERA_PLUGIN_ABI_VERSION 11
+#define TESSERA_PLUGIN_ABI_VERSION 12
 
 extern "C" {
 // How a binary was built, as far as the C++ objects that cross the plugin boundary
@@ -128,6 +133,11 @@ class TESSERA_API Plugin {
 using PluginFactory = std::unique_ptr<Plugin>(const nlohmann::json& options,
                                               std::shared_ptr<const PluginServices> services);
 
+// Describes a plugin's options: a JSON array of OptionDescription::ToJson()
+// (tessera/option_list.h), each default being what the plugin uses when the option is
+// not given. Called without constructing the plugin; must not throw.
+using PluginOptionsDescriber = nlohmann::json();
+
 }  // namespace tessera
 
 // Defines the info record and the factory of a plugin. KIND is one of detector,
@@ -149,3 +159,22 @@ using PluginFactory = std::unique_ptr<Plugin>(const nlohmann::json& options,
   }                                                                                               \
   BOOST_DLL_ALIAS(tessera_plugin_info_record, tessera_plugin_info)                                \
   BOOST_DLL_ALIAS(tessera_plugin_create_impl, tessera_plugin_create)
+
+// Exports the description of a plugin's options (symbol tessera_plugin_options), from the
+// option list that its constructor reads them with (tessera/option_list.h): OPTIONS is the
+// options struct, whose default-constructed values are the defaults, and VISIT the
+// function template that lists its fields.
+//
+//   TESSERA_PLUGIN_OPTIONS(tessera::SiftOptions, tessera::VisitSiftOptions)
+#define TESSERA_PLUGIN_OPTIONS(OPTIONS, VISIT)                               \
+  static nlohmann::json tessera_plugin_options_impl() {                      \
+    return ::tessera::option_list::DescribeAsJson<OPTIONS>(                  \
+        [](OPTIONS& options, const auto& visit) { VISIT(options, visit); }); \
+  }                                                                          \
+  BOOST_DLL_ALIAS(tessera_plugin_options_impl, tessera_plugin_options)
+
+// The same, for a plugin whose options another function describes (a host options
+// struct's Describe(), as the mappers' are): FUNCTION returns the JSON array.
+#define TESSERA_PLUGIN_OPTIONS_FROM(FUNCTION)                                \
+  static nlohmann::json tessera_plugin_options_impl() { return FUNCTION(); } \
+  BOOST_DLL_ALIAS(tessera_plugin_options_impl, tessera_plugin_options)

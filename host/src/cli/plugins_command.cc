@@ -1,5 +1,7 @@
 // `tessera plugins [--json] [--manifest FILE]`: every plugin found on the search path,
-// with the ones the host would refuse marked and why. `tessera plugins --forget-crashes
+// with the ones the host would refuse marked and why. `tessera plugins NAME [--json |
+// --markdown]`: one plugin, with its options described (name, type, default, range or
+// choices, help), for any plugin on the path. `tessera plugins --forget-crashes
 // OUTPUT`: forgets the workspace's plugin crash records, and so its quarantine.
 
 #include <iostream>
@@ -7,6 +9,7 @@
 
 #include "cli/commands.h"
 #include "manifest/manifest.h"
+#include "plugin/option_descriptions.h"
 #include "plugin/plugin_crash_log.h"
 #include "plugin/plugin_registry.h"
 #include "util/exit_codes.h"
@@ -14,15 +17,59 @@
 
 namespace tessera {
 
+namespace {
+
+// `tessera plugins NAME`: the record and the options of one plugin.
+template <typename Options>
+int DescribePlugin(const PluginRegistry& registry, const std::string& name,
+                   const Options& options) {
+  if (options.json && options.markdown) throw InputError("--json and --markdown: give one");
+  const PluginRecord& record = registry.Find(name);
+  const std::optional<std::vector<OptionDescription>> described = registry.DescribeOptions(record);
+  if (options.json) {
+    nlohmann::json json = record.ToJson();
+    json["options"] = nlohmann::json();
+    if (described) {
+      json["options"] = nlohmann::json::array();
+      for (const OptionDescription& option : *described) json["options"].push_back(option.ToJson());
+    }
+    std::cout << json.dump(2) << std::endl;
+    return static_cast<int>(kExitSuccess);
+  }
+  if (options.markdown) {
+    if (!described) throw InputError(PluginDoesNotDescribe(record));
+    std::cout << OptionDescriptionsMarkdown(*described);
+    return static_cast<int>(kExitSuccess);
+  }
+  std::cout << record.kind << " '" << record.name << "' " << record.version << ": "
+            << record.description << "\n  " << record.file.string() << "\n";
+  if (!described) {
+    std::cout << PluginDoesNotDescribe(record) << "\n";
+  } else if (described->empty()) {
+    std::cout << "It takes no options.\n";
+  } else {
+    std::cout << "Options (\"options\": {...} in its manifest slot):\n"
+              << OptionDescriptionsText(*described);
+  }
+  return static_cast<int>(kExitSuccess);
+}
+
+}  // namespace
+
 CommandRegistration RegisterPluginsCommand(CLI::App& app, const GlobalOptions&) {
   struct Options {
     bool json = false;
+    bool markdown = false;
+    std::string name;
     std::string manifest;
     std::string forget_crashes;
   };
   auto options = std::make_shared<Options>();
   CLI::App* sub = app.add_subcommand("plugins", "List the plugins found and the ones refused");
+  sub->add_option("name", options->name, "Describe this plugin and its options");
   sub->add_flag("--json", options->json, "Print JSON instead of a table");
+  sub->add_flag("--markdown", options->markdown,
+                "With NAME: print the options as the Markdown table of the plugin's page");
   sub->add_option("--manifest", options->manifest, "Also search the plugin_paths of this manifest");
   sub->add_option("--forget-crashes", options->forget_crashes,
                   "Forget the plugin crashes recorded in this output folder (plugin_crashes.tsv), "
@@ -38,6 +85,8 @@ CommandRegistration RegisterPluginsCommand(CLI::App& app, const GlobalOptions&) 
     std::vector<std::filesystem::path> manifest_paths;
     if (!options->manifest.empty()) manifest_paths = Manifest::Load(options->manifest).plugin_paths;
     const PluginRegistry registry = PluginRegistry::Discover(PluginSearchPath(manifest_paths));
+    if (!options->name.empty()) return DescribePlugin(registry, options->name, *options);
+    if (options->markdown) throw InputError("--markdown: give the plugin's NAME too");
 
     if (options->json) {
       std::cout << registry.ToJson().dump(2) << std::endl;

@@ -85,6 +85,7 @@ std::optional<PluginRecord> RecordFromJson(const std::filesystem::path& file,
   record.name = json.value("name", "");
   record.version = json.value("version", "");
   record.description = json.value("description", "");
+  record.describes_options = json.value("describes_options", false);
   record.refusal = json.value("refused", "");
   if (!json.value("usable", false) && record.refusal.empty()) return std::nullopt;
   return record;

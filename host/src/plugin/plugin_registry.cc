@@ -9,6 +9,7 @@
 #include <set>
 
 #include "plugin/host_plugin_services.h"
+#include "plugin/option_descriptions.h"
 #include "plugin/plugin_crash_log.h"
 #include "plugin/plugin_probe.h"
 
@@ -17,6 +18,7 @@ namespace {
 
 constexpr const char* kInfoSymbol = "tessera_plugin_info";
 constexpr const char* kFactorySymbol = "tessera_plugin_create";
+constexpr const char* kOptionsSymbol = "tessera_plugin_options";
 
 bool IsSharedObject(const std::filesystem::path& path) { return path.extension() == ".so"; }
 
@@ -83,6 +85,7 @@ nlohmann::json PluginRecord::ToJson() const {
                          {"version", version},
                          {"description", description},
                          {"abi_version", abi_version},
+                         {"describes_options", describes_options},
                          {"usable", usable()}};
   if (!usable()) json["refused"] = refusal;
   return json;
@@ -155,6 +158,7 @@ PluginRecord InspectPluginFile(const std::filesystem::path& file) {
         where + "plugin " + Quote(record.name) + " exports no '" + kFactorySymbol + "' factory";
     return record;
   }
+  record.describes_options = library->has(kOptionsSymbol);
   record.library = std::move(library);
   return record;
 }
@@ -361,6 +365,48 @@ void AnnounceShadowing(const PluginRecord& record, const std::vector<PluginRecor
 
 }  // namespace
 
+void PluginRegistry::EnsureLoaded(const PluginRecord& record, const std::string& json_path) const {
+  if (record.library) return;
+  // Inspected in a child process only: open it here now.
+  PluginRecord loaded = InspectPluginFile(record.file);
+  if (!loaded.usable()) throw InputError(json_path + ".plugin: " + loaded.refusal);
+  if (loaded.name != record.name || loaded.kind != record.kind ||
+      loaded.describes_options != record.describes_options) {
+    throw InputError(record.file.string() + ": the file changed while Tessera was running");
+  }
+  record.library = std::move(loaded.library);
+}
+
+std::optional<std::vector<OptionDescription>> PluginRegistry::DescribeOptions(
+    const PluginRecord& record) const {
+  if (!record.describes_options) return std::nullopt;
+  EnsureLoaded(record, record.kind);
+  const auto& describe = record.library->get_alias<PluginOptionsDescriber>(kOptionsSymbol);
+  const std::string who = "plugin " + Quote(record.name) + " (" + record.file.string() + ")";
+  nlohmann::json described;
+  try {
+    const PluginCallScope scope(record.name, PluginStage::kOptions, "describing its options");
+    described = describe();
+  } catch (const std::exception& error) {
+    throw InputError(who + ": describing its options failed: " + error.what());
+  }
+  return ParseOptionDescriptions(described, who);
+}
+
+const PluginRecord& PluginRegistry::Find(const std::string& name) const {
+  std::vector<std::string> names;
+  for (const auto& record : records_) {
+    if (record.usable() && record.name == name) return record;
+    if (record.usable()) names.push_back(record.name);
+  }
+  for (const auto& record : records_) {
+    if (!record.usable() && record.name == name) {
+      throw InputError("plugin " + Quote(name) + " is refused: " + record.refusal);
+    }
+  }
+  throw InputError("no plugin " + Quote(name) + " on the plugin path" + DidYouMean(name, names));
+}
+
 std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
                                                      const nlohmann::json& options,
                                                      const std::string& json_path,
@@ -368,15 +414,7 @@ std::unique_ptr<Plugin> PluginRegistry::CreateObject(const PluginRecord& record,
   // Made for another plugin (Plugin::host()) while that one is being made or called.
   const bool nested = !ActivePluginCalls().empty();
   if (nested) CheckPluginChain(record.kind, record.name, record.file);
-  if (!record.library) {
-    // Inspected in a child process only: open it here now.
-    PluginRecord loaded = InspectPluginFile(record.file);
-    if (!loaded.usable()) throw InputError(json_path + ".plugin: " + loaded.refusal);
-    if (loaded.name != record.name || loaded.kind != record.kind) {
-      throw InputError(record.file.string() + ": the file changed while Tessera was running");
-    }
-    record.library = std::move(loaded.library);
-  }
+  EnsureLoaded(record, json_path);
   // Its crash records carry this build: a rebuilt plugin, or other options, run again.
   SetCurrentPluginBuild(record.name, MakePluginBuild(record.version, record.file, options.dump()));
   AnnounceShadowing(record, records_, json_path);

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,8 @@ struct PluginRecord {
   std::string name;
   std::string version;
   std::string description;
+  // Whether it exports the description of its options (TESSERA_PLUGIN_OPTIONS).
+  bool describes_options = false;
   // Why the host refuses this plugin; empty when it is usable.
   std::string refusal;
   // Opened when the host first makes an object of a usable record (discovery inspects
@@ -125,6 +128,15 @@ class PluginRegistry {
   // refuses that (a plugin with a required option).
   nlohmann::json DefaultOptions(const PluginRecord& record) const;
 
+  // The description of a usable plugin's options (tessera/option_list.h), checked as
+  // input: nullopt when the plugin does not describe them. Loads the plugin, without
+  // making it. Throws InputError naming the file when the description is malformed.
+  std::optional<std::vector<OptionDescription>> DescribeOptions(const PluginRecord& record) const;
+
+  // The usable plugin named `name`, of any kind; InputError naming the closest name
+  // when there is none.
+  const PluginRecord& Find(const std::string& name) const;
+
   // Usable plugin names of a kind, sorted.
   std::vector<std::string> NamesOfKind(const std::string& kind) const;
 
@@ -153,6 +165,8 @@ class PluginRegistry {
 
   const PluginRecord& Resolve(const std::string& kind, const std::string& name,
                               const std::string& json_path) const;
+  // Opens a record's library when discovery inspected it in a child process only.
+  void EnsureLoaded(const PluginRecord& record, const std::string& json_path) const;
   std::unique_ptr<Plugin> CreateObject(const PluginRecord& record, const nlohmann::json& options,
                                        const std::string& json_path,
                                        const std::string& options_path) const;

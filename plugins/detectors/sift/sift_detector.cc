@@ -50,26 +50,39 @@ struct SiftOptions {
   double min_contrast_threshold = 0.0025;
 };
 
+// The options, listed once: read, checked and described (`tessera plugins sift`) from here.
+template <typename Visit>
+void VisitSiftOptions(SiftOptions& o, const Visit& visit) {
+  visit("max_num_features", o.max_num_features, 1, 1000000,
+        "keep at most this many keypoints, the strongest by DoG response");
+  visit("max_image_size", o.max_image_size, 16, 100000,
+        "if the longer side is larger, detect on a copy downscaled with area averaging to this "
+        "size; keypoints are still reported in full-resolution pixels");
+  visit("contrast_threshold", o.contrast_threshold, 0.0, 1.0,
+        "OpenCV's contrast threshold: a DoG extremum is kept when |D| >= contrast_threshold / "
+        "num_octave_layers, with D on the [0, 1] grey scale");
+  visit("edge_threshold", o.edge_threshold, 1.0, 1000.0,
+        "largest ratio of principal curvatures of a kept extremum; smaller rejects more edge "
+        "responses");
+  visit("num_octave_layers", o.num_octave_layers, 1, 10,
+        "DoG layers per octave, COLMAP's octave_resolution");
+  visit("sigma", o.sigma, 0.5, 10.0, "Gaussian blur of the base of the first octave");
+  visit("root_sift", o.root_sift,
+        "RootSIFT descriptors (COLMAP's default, L1_ROOT normalisation); false gives "
+        "L2-normalised SIFT");
+  visit("min_num_features", o.min_num_features, 0, 1000000,
+        "detection that adapts to weak texture: an image with fewer keypoints than this is "
+        "detected again with the contrast threshold halved, until it has enough or the "
+        "threshold reaches min_contrast_threshold; 0: off");
+  visit("min_contrast_threshold", o.min_contrast_threshold, 1e-6, 1.0,
+        "the floor of that adaptation; only with min_num_features above 0");
+}
+
 class SiftDetector : public Detector {
  public:
   explicit SiftDetector(const nlohmann::json& options) {
     OptionReader reader(options);
-    options_.max_num_features =
-        reader.Get<int>("max_num_features", options_.max_num_features, 1, 1000000);
-    options_.max_image_size =
-        reader.Get<int>("max_image_size", options_.max_image_size, 16, 100000);
-    options_.contrast_threshold =
-        reader.Get<double>("contrast_threshold", options_.contrast_threshold, 0.0, 1.0);
-    options_.edge_threshold =
-        reader.Get<double>("edge_threshold", options_.edge_threshold, 1.0, 1000.0);
-    options_.num_octave_layers =
-        reader.Get<int>("num_octave_layers", options_.num_octave_layers, 1, 10);
-    options_.sigma = reader.Get<double>("sigma", options_.sigma, 0.5, 10.0);
-    options_.root_sift = reader.GetBool("root_sift", options_.root_sift);
-    options_.min_num_features =
-        reader.Get<int>("min_num_features", options_.min_num_features, 0, 1000000);
-    options_.min_contrast_threshold =
-        reader.Get<double>("min_contrast_threshold", options_.min_contrast_threshold, 1e-6, 1.0);
+    VisitSiftOptions(options_, option_list::Reader(&reader));
     reader.Finish();
     effective_options_ = reader.Effective();
     if (options_.min_num_features == 0) {
@@ -159,5 +172,6 @@ class SiftDetector : public Detector {
 }  // namespace
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::SiftOptions, tessera::VisitSiftOptions)
 TESSERA_PLUGIN(detector, tessera::SiftDetector, "sift", "1.0.0",
                "SIFT keypoints and (Root)SIFT descriptors from OpenCV, in COLMAP's conventions")
