@@ -1,5 +1,6 @@
 // tessera.plugins(): what `tessera plugins --json` prints, and each usable plugin's
-// default options.
+// default options. tessera.plugin_options(name): what `tessera plugins NAME --json`
+// prints, the plugin's options described.
 
 #include <pybind11/pybind11.h>
 #include <pybind11/stl/filesystem.h>
@@ -11,6 +12,7 @@
 #include "bindings.h"
 #include "json_objects.h"
 #include "manifest/manifest.h"
+#include "plugin/option_descriptions.h"
 #include "plugin/plugin_registry.h"
 #include "stage_process.h"
 #include "tessera/errors.h"
@@ -20,28 +22,67 @@ namespace py = pybind11;
 
 namespace tessera::python {
 
+namespace {
+
+// The plugin search path of a manifest given as None, a file or a dict (its JSON, relative
+// paths from the working folder), as the CLI's --manifest gives it.
+class ManifestPluginPaths {
+ public:
+  explicit ManifestPluginPaths(const py::object& manifest)
+      : json_(py::isinstance<py::dict>(manifest) ? std::optional(ToJson(manifest)) : std::nullopt),
+        file_(manifest.is_none() || json_ ? std::nullopt
+                                          : std::optional(manifest.cast<std::filesystem::path>())) {
+  }
+
+  // Reads the manifest: call in the child process.
+  std::vector<std::filesystem::path> SearchPath() const {
+    std::vector<std::filesystem::path> manifest_paths;
+    if (file_) manifest_paths = Manifest::Load(*file_).plugin_paths;
+    if (json_) {
+      manifest_paths =
+          Manifest::FromJson(*json_, std::filesystem::current_path(), "manifest").plugin_paths;
+    }
+    return PluginSearchPath(manifest_paths);
+  }
+
+ private:
+  std::optional<nlohmann::json> json_;
+  std::optional<std::filesystem::path> file_;
+};
+
+}  // namespace
+
 void BindPlugins(py::module_& module) {
+  module.def(
+      "plugin_options",
+      [](const std::string& name, const py::object& manifest) {
+        const ManifestPluginPaths paths(manifest);
+        // In a child process: a plugin that crashes when loaded must not end the interpreter.
+        return ToPython(RunInChildProcess("plugin_options", py::none(), [&](const StageControl&) {
+          const PluginRegistry registry = PluginRegistry::Discover(paths.SearchPath());
+          const PluginRecord& record = registry.Find(name);
+          nlohmann::json json = record.ToJson();
+          json["options"] = nullptr;
+          if (const auto described = registry.DescribeOptions(record)) {
+            json["options"] = nlohmann::json::array();
+            for (const OptionDescription& option : *described) {
+              json["options"].push_back(option.ToJson());
+            }
+          }
+          return json;
+        }));
+      },
+      py::arg("name"), py::arg("manifest") = py::none(),
+      "One plugin as `tessera plugins NAME --json` prints it: its record and 'options', a list "
+      "of {name, type, default, min, max, choices, help}, or None when it does not describe "
+      "them.");
   module.def(
       "plugins",
       [](const py::object& manifest) {
-        // A dict is the manifest's JSON, relative paths from the working folder.
-        const std::optional<nlohmann::json> manifest_json =
-            py::isinstance<py::dict>(manifest) ? std::optional(ToJson(manifest)) : std::nullopt;
-        const std::optional<std::filesystem::path> manifest_file =
-            manifest.is_none() || manifest_json
-                ? std::nullopt
-                : std::optional(manifest.cast<std::filesystem::path>());
+        const ManifestPluginPaths paths(manifest);
         // In a child process: a plugin whose factory crashes must not end the interpreter.
         return ToPython(RunInChildProcess("plugins", py::none(), [&](const StageControl&) {
-          std::vector<std::filesystem::path> manifest_paths;
-          if (manifest_file) manifest_paths = Manifest::Load(*manifest_file).plugin_paths;
-          if (manifest_json) {
-            manifest_paths =
-                Manifest::FromJson(*manifest_json, std::filesystem::current_path(), "manifest")
-                    .plugin_paths;
-          }
-          const PluginRegistry registry =
-              PluginRegistry::Discover(PluginSearchPath(manifest_paths));
+          const PluginRegistry registry = PluginRegistry::Discover(paths.SearchPath());
           nlohmann::json json = registry.ToJson();
           for (size_t i = 0; i < registry.records().size(); ++i) {
             const PluginRecord& record = registry.records()[i];

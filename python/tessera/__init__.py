@@ -38,7 +38,7 @@ __all__ = [
     "estimate_fundamental_matrix", "estimate_homography_matrix", "estimate_two_view_geometry",
     "evaluate", "export", "extract", "extract_features", "global_mapping", "import_features",
     "import_matches", "incremental_mapping", "map", "match", "match_exhaustive",
-    "match_sequential", "plugins", "register", "run", "triangulate", "triangulate_points",
+    "match_sequential", "plugin_options", "plugins", "register", "run", "triangulate", "triangulate_points",
 ]
 
 PathLike = Union[str, os.PathLike[str]]
@@ -411,6 +411,17 @@ def plugins(manifest: ManifestLike = None) -> Dict[str, Any]:
     default 'options'."""
     return typing.cast(Dict[str, Any],
                        _call(_tessera.plugins, manifest=_manifest("plugins", manifest)))
+
+
+def plugin_options(name: str, manifest: ManifestLike = None) -> Dict[str, Any]:
+    """One plugin as `tessera plugins NAME --json` prints it: kind, name, version, file, and
+    'options', a list of dicts (name, type, default, min and max for numbers, choices for
+    strings, help), or None when the plugin does not describe its options. InputError
+    when no plugin on the path (manifest: also its plugin_paths) has that name."""
+    if not isinstance(name, str):
+        raise TypeError(f"plugin_options(): name must be a str, not {_type_name(name)}")
+    return typing.cast(Dict[str, Any], _call(
+        _tessera.plugin_options, name=name, manifest=_manifest("plugin_options", manifest)))
 
 
 def evaluate(model: PathLike, ground_truth: PathLike) -> Dict[str, Any]:

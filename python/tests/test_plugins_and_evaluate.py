@@ -30,6 +30,25 @@ def test_plugins_lists_what_the_cli_lists_with_default_options():
     assert by_name["brute_force"]["options"]["ratio"] == pytest.approx(0.8)
 
 
+def test_plugin_options_is_what_tessera_plugins_name_prints():
+    for name in ("sift", "incremental", "ply"):
+        described = tessera.plugin_options(name)
+        assert described == cli_json("plugins", name, "--json")
+        assert described["name"] == name
+        assert described["options"], name
+    sift = {option["name"]: option for option in tessera.plugin_options("sift")["options"]}
+    assert sift["max_num_features"]["type"] == "integer"
+    assert sift["max_num_features"]["default"] == tessera.plugins()["plugins"][
+        [p["name"] for p in tessera.plugins()["plugins"]].index("sift")]["options"][
+            "max_num_features"]
+    assert sift["root_sift"]["type"] == "boolean" and sift["root_sift"]["help"]
+    with pytest.raises(tessera.InputError, match="no plugin 'sfit' on the plugin path; did you "
+                                                 "mean 'sift'"):
+        tessera.plugin_options("sfit")
+    with pytest.raises(TypeError, match="name must be a str"):
+        tessera.plugin_options(3)  # type: ignore[arg-type]
+
+
 def test_evaluate_gives_the_figures_of_tessera_eval(sample, tmp_path):
     _, _, output = sample
     model = output / "sparse" / "0"

@@ -402,6 +402,26 @@ TESSERA_PLUGIN(bundle_adjuster, WrappingBundleAdjuster, "wrapping_b", "1.0.0",
                "Wraps the bundle adjuster its options name")
 #endif
 
+#elif defined(TESSERA_TEST_CASE_BAD_DESCRIPTION)
+// Usable, but describes its options wrongly: a default outside the range it states.
+static nlohmann::json DescribeWrongly() {
+  return nlohmann::json::array({{{"name", "step"},
+                                 {"type", "integer"},
+                                 {"default", 0},
+                                 {"min", 1},
+                                 {"max", 9},
+                                 {"help", "images apart"}}});
+}
+TESSERA_PLUGIN_OPTIONS_FROM(DescribeWrongly)
+TESSERA_PLUGIN(pair_selector, TestPairSelector, "bad_description", "1.0.0",
+               "Describes its options wrongly")
+
+#elif defined(TESSERA_TEST_CASE_DESCRIBER_THROWS)
+static nlohmann::json DescribeByThrowing() { throw std::runtime_error("no description today"); }
+TESSERA_PLUGIN_OPTIONS_FROM(DescribeByThrowing)
+TESSERA_PLUGIN(pair_selector, TestPairSelector, "describer_throws", "1.0.0",
+               "Its option description throws")
+
 #elif defined(TESSERA_TEST_CASE_GOOD)
 TESSERA_PLUGIN(pair_selector, TestPairSelector, "consecutive", "1.2.3",
                "Each image with the next one")
