@@ -21,6 +21,7 @@
 
 #include "tessera/errors.h"
 #include "tessera/features.h"
+#include "tessera/option_list.h"
 #include "tessera/options.h"
 
 namespace tessera {
@@ -35,19 +36,33 @@ struct MatchFilterOptions {
   double max_distance = 0;
 };
 
+// The options, listed once: read by ReadMatchFilterOptions and described by every matcher
+// that visits this list inside its own (`tessera plugins NAME`). ratio's range is open at
+// 0, which a list cannot say: ReadMatchFilterOptions checks it first.
+template <typename Visit>
+void VisitMatchFilterOptions(MatchFilterOptions& o, const Visit& visit) {
+  visit("ratio", o.ratio, 0.0, 1.0,
+        "Lowe's ratio threshold on distances (not squared), above 0: keep a match if the best "
+        "distance < ratio * the second-best");
+  visit("cross_check", o.cross_check, "keep only mutual nearest neighbours");
+  visit("max_distance", o.max_distance, 0.0, 1e9,
+        "largest distance kept: Euclidean in uint8 descriptor units for l2 (SIFT rows have norm "
+        "about 512), bits for hamming; 0 turns it off");
+}
+
 // Reads "ratio" (in (0, 1]), "cross_check" and "max_distance" (in [0, 1e9]), in that
 // order, with `defaults` for the absent ones; an out-of-range value is an OptionError
 // naming the key.
 inline MatchFilterOptions ReadMatchFilterOptions(OptionReader& reader,
                                                  const MatchFilterOptions& defaults = {}) {
-  MatchFilterOptions options;
-  options.ratio = reader.Get<double>("ratio", defaults.ratio);
-  if (!(options.ratio > 0 && options.ratio <= 1)) {
+  MatchFilterOptions options = defaults;
+  // (0, 1], which the list's [0, 1] does not say; read again by the list, unchanged.
+  const double ratio = reader.Get<double>("ratio", defaults.ratio);
+  if (!(ratio > 0 && ratio <= 1)) {
     throw OptionError(reader.KeyPath("ratio"),
-                      "= " + nlohmann::json(options.ratio).dump() + " is out of range (0, 1]");
+                      "= " + nlohmann::json(ratio).dump() + " is out of range (0, 1]");
   }
-  options.cross_check = reader.GetBool("cross_check", defaults.cross_check);
-  options.max_distance = reader.Get<double>("max_distance", defaults.max_distance, 0.0, 1e9);
+  VisitMatchFilterOptions(options, option_list::Reader(&reader));
   return options;
 }
 
