@@ -17,6 +17,7 @@
 #include <cstddef>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "tessera/errors.h"
@@ -38,7 +39,8 @@ struct MatchFilterOptions {
 
 // The options, listed once: read by ReadMatchFilterOptions and described by every matcher
 // that visits this list inside its own (`tessera plugins NAME`). ratio's range is open at
-// 0, which a list cannot say: ReadMatchFilterOptions checks it first.
+// 0, which a list's closed range cannot say: read a list that visits this one with
+// MatchFilterOptionReader.
 template <typename Visit>
 void VisitMatchFilterOptions(MatchFilterOptions& o, const Visit& visit) {
   visit("ratio", o.ratio, 0.0, 1.0,
@@ -50,19 +52,41 @@ void VisitMatchFilterOptions(MatchFilterOptions& o, const Visit& visit) {
         "about 512), bits for hamming; 0 turns it off");
 }
 
+// option_list::Reader for a list that visits VisitMatchFilterOptions: the same, except that
+// "ratio" must be in (0, 1], and an OptionError says so.
+class MatchFilterOptionReader {
+ public:
+  explicit MatchFilterOptionReader(OptionReader* reader) : reader_(reader), read_(reader) {}
+
+  template <typename... Args>
+  void operator()(const char* key, Args&&... args) const {
+    read_(key, std::forward<Args>(args)...);
+  }
+  void operator()(const char* key, double& value, double min_value, double max_value,
+                  const char* help) const {
+    if (std::string(key) != "ratio") {
+      read_(key, value, min_value, max_value, help);
+      return;
+    }
+    value = reader_->Get<double>(key, value);
+    if (!(value > 0 && value <= 1)) {
+      throw OptionError(reader_->KeyPath(key),
+                        "= " + nlohmann::json(value).dump() + " is out of range (0, 1]");
+    }
+  }
+
+ private:
+  OptionReader* reader_;
+  option_list::Reader read_;
+};
+
 // Reads "ratio" (in (0, 1]), "cross_check" and "max_distance" (in [0, 1e9]), in that
 // order, with `defaults` for the absent ones; an out-of-range value is an OptionError
 // naming the key.
 inline MatchFilterOptions ReadMatchFilterOptions(OptionReader& reader,
                                                  const MatchFilterOptions& defaults = {}) {
   MatchFilterOptions options = defaults;
-  // (0, 1], which the list's [0, 1] does not say; read again by the list, unchanged.
-  const double ratio = reader.Get<double>("ratio", defaults.ratio);
-  if (!(ratio > 0 && ratio <= 1)) {
-    throw OptionError(reader.KeyPath("ratio"),
-                      "= " + nlohmann::json(ratio).dump() + " is out of range (0, 1]");
-  }
-  VisitMatchFilterOptions(options, option_list::Reader(&reader));
+  VisitMatchFilterOptions(options, MatchFilterOptionReader(&reader));
   return options;
 }
 

@@ -172,9 +172,7 @@ class FlannMatcher : public Matcher {
  public:
   explicit FlannMatcher(const nlohmann::json& options) {
     OptionReader reader(options);
-    // First for ratio's range, open at 0; the list reads the filter again, unchanged.
-    options_.filter = ReadMatchFilterOptions(reader);
-    VisitFlannMatchOptions(options_, option_list::Reader(&reader));
+    VisitFlannMatchOptions(options_, MatchFilterOptionReader(&reader));
     reader.Finish();
     const size_t cache_bytes = static_cast<size_t>(options_.index_cache_mb) << 20;
     const auto warn = [this](const std::string& text) { log().Warn(text); };
