@@ -132,6 +132,27 @@ TEST(ReadMatchFilterOptions, ReadsDefaultsValuesAndRefusesOutOfRange) {
             "pipeline.matcher.options.cross_check: expected true or false, got a number");
 }
 
+// Read through its option list once per key: an unknown key's message lists each once, and
+// a matcher's own list that visits the filter's reads ratio's open range the same way.
+TEST(ReadMatchFilterOptions, ReadsEachKeyOnceThroughItsList) {
+  OptionReader reader(nlohmann::json{{"xyzzy_plugh", 1}}, "options");
+  ReadMatchFilterOptions(reader);
+  try {
+    reader.Finish();
+    ADD_FAILURE() << "no error";
+  } catch (const OptionError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "options.xyzzy_plugh: unknown key (known: ratio, cross_check, max_distance)");
+  }
+  MatchFilterOptions options;
+  OptionReader zero(nlohmann::json{{"ratio", 0}, {"max_distance", 8}}, "options");
+  EXPECT_THROW(VisitMatchFilterOptions(options, MatchFilterOptionReader(&zero)), OptionError);
+  OptionReader given(nlohmann::json{{"ratio", 0.5}, {"max_distance", 8}}, "options");
+  VisitMatchFilterOptions(options, MatchFilterOptionReader(&given));
+  EXPECT_EQ(options.ratio, 0.5);
+  EXPECT_EQ(options.max_distance, 8);
+}
+
 TEST(CheckDescriptorsMatchable, NamesTheMetricsOrTheWidths) {
   FeatureDescriptors l2;
   l2.data.setZero(2, 128);

@@ -1,5 +1,6 @@
 // AKAZE keypoints with binary MLDB descriptors (OpenCV), as a third party would write
-// a Tessera detector: one file, the SDK headers, and TESSERA_PLUGIN at the end.
+// a Tessera detector: one file, the SDK headers, its options listed once
+// (tessera/option_list.h), and TESSERA_PLUGIN_OPTIONS and TESSERA_PLUGIN at the end.
 
 #include <algorithm>
 #include <opencv2/features2d.hpp>
@@ -9,13 +10,35 @@
 
 namespace {
 
+struct AkazeOptions {
+  // OpenCV's detector response threshold: larger keeps fewer, stronger keypoints.
+  double threshold = 0.001;
+  int max_num_features = 8192;
+  // Detect on a copy downscaled (area averaging) so that its longer side is at most this.
+  int max_image_size = 2000;
+};
+
+// The options, listed once: read by the constructor and described by
+// TESSERA_PLUGIN_OPTIONS below (`tessera plugins akaze`).
+template <typename Visit>
+void VisitAkazeOptions(AkazeOptions& o, const Visit& visit) {
+  visit("threshold", o.threshold, 1e-6, 1.0,
+        "detector response threshold; larger keeps fewer, stronger keypoints");
+  visit("max_num_features", o.max_num_features, 1, 1000000,
+        "keep at most this many keypoints, the strongest");
+  visit("max_image_size", o.max_image_size, 16, 100000,
+        "detect on a copy downscaled so that its longer side is at most this");
+}
+
 class AkazeDetector : public tessera::Detector {
  public:
   explicit AkazeDetector(const nlohmann::json& options) {
     tessera::OptionReader reader(options);
-    threshold_ = reader.Get<double>("threshold", 0.001, 1e-6, 1.0);
-    max_num_features_ = reader.Get<int>("max_num_features", 8192, 1, 1000000);
-    max_image_size_ = reader.Get<int>("max_image_size", 2000, 16, 100000);
+    AkazeOptions parsed;
+    VisitAkazeOptions(parsed, tessera::option_list::Reader(&reader));
+    threshold_ = parsed.threshold;
+    max_num_features_ = parsed.max_num_features;
+    max_image_size_ = parsed.max_image_size;
     reader.Finish();
     effective_options_ = reader.Effective();
   }
@@ -68,5 +91,6 @@ class AkazeDetector : public tessera::Detector {
 
 }  // namespace
 
+TESSERA_PLUGIN_OPTIONS(AkazeOptions, VisitAkazeOptions)
 TESSERA_PLUGIN(detector, AkazeDetector, "akaze", "1.0.0",
                "AKAZE keypoints with binary MLDB descriptors (OpenCV), an out-of-tree example")

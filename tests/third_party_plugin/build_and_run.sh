@@ -88,6 +88,20 @@ for kind, name in [("detector", "akaze"), ("matcher", "symmetric_ratio"),
 print("plugins --json lists the nine out-of-tree plugins")
 PY
 
+# Out-of-tree plugins describe their options as the bundled ones do (TESSERA_PLUGIN_OPTIONS).
+for described in "akaze threshold,max_num_features,max_image_size" "bundler folder"; do
+  read -r name keys <<< "$described"
+  "$tessera" plugins "$name" --json --manifest "$work/manifest.json" > "$work/$name.json"
+  python3 - "$work/$name.json" "$keys" <<'PY' || { cat "$work/$name.json"; exit 1; }
+import json, sys
+options = json.load(open(sys.argv[1]))["options"]
+names = [option["name"] for option in options or []]
+assert names == sys.argv[2].split(","), names
+assert all(option["help"] for option in options), "an option without help"
+PY
+done
+echo "plugins NAME --json describes the options of akaze and bundler"
+
 mkdir -p "$work/images"
 examples="$source_dir/../../examples/fountain-P11-small/images"
 cp "$examples/0004.jpg" "$examples/0005.jpg" "$examples/0006.jpg" "$work/images/"

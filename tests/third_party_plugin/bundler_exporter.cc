@@ -86,11 +86,26 @@ std::string ImageAsDetected(const fs::path& path, const tessera::Camera& camera)
   return std::string(encoded.begin(), encoded.end());
 }
 
+struct BundlerOptions {
+  // The folder written, inside the output folder.
+  std::string folder = "bundler";
+};
+
+// The options, listed once: read by the constructor and described by
+// TESSERA_PLUGIN_OPTIONS below (`tessera plugins bundler`).
+template <typename Visit>
+void VisitBundlerOptions(BundlerOptions& o, const Visit& visit) {
+  visit("folder", tessera::option_list::RelativePath{o.folder},
+        "the folder written for model 0 (model k: FOLDER_k), inside the output folder");
+}
+
 class BundlerExporter : public tessera::Exporter {
  public:
   explicit BundlerExporter(const nlohmann::json& options) {
     tessera::OptionReader reader(options);
-    folder_ = reader.GetRelativePath("folder", "bundler");
+    BundlerOptions parsed;
+    VisitBundlerOptions(parsed, tessera::option_list::Reader(&reader));
+    folder_ = parsed.folder;
     reader.Finish();
     effective_options_ = reader.Effective();
   }
@@ -155,5 +170,6 @@ class BundlerExporter : public tessera::Exporter {
 
 }  // namespace
 
+TESSERA_PLUGIN_OPTIONS(BundlerOptions, VisitBundlerOptions)
 TESSERA_PLUGIN(exporter, BundlerExporter, "bundler", "1.0.0",
                "Bundler v0.3 bundle.out + list.txt, with the images as detected")

@@ -40,6 +40,31 @@ struct OrbOptions {
   int min_fast_threshold = 2;
 };
 
+// The options, listed once: read, checked and described (`tessera plugins orb`) from here.
+template <typename Visit>
+void VisitOrbOptions(OrbOptions& o, const Visit& visit) {
+  visit("max_num_features", o.max_num_features, 1, 1000000,
+        "keep at most this many keypoints; ORB shares this quota among pyramid levels, then the "
+        "strongest are kept");
+  visit("max_image_size", o.max_image_size, 16, 100000,
+        "if the longer side is larger, detect on a copy downscaled with area averaging to this "
+        "size; keypoints are still reported in full-resolution pixels");
+  visit("scale_factor", o.scale_factor, 1.01, 4.0,
+        "size ratio between neighbouring pyramid levels");
+  visit("num_levels", o.num_levels, 1, 32, "number of pyramid levels");
+  visit("fast_threshold", o.fast_threshold, 1, 255,
+        "FAST threshold: least grey-level difference between a corner and its ring of pixels");
+  visit("edge_threshold", o.edge_threshold, 0, 256,
+        "border in pixels, at each level, where no keypoint is detected; should be about the "
+        "patch size, 31");
+  visit("min_num_features", o.min_num_features, 0, 1000000,
+        "detection that adapts to weak texture: an image with fewer keypoints than this is "
+        "detected again with the FAST threshold halved, until it has enough or the threshold "
+        "reaches min_fast_threshold; 0: off");
+  visit("min_fast_threshold", o.min_fast_threshold, 1, 255,
+        "the floor of that adaptation; only with min_num_features above 0");
+}
+
 // Where a keypoint of OpenCV's ORB lies, in pixels of the image ORB was given, in
 // COLMAP's convention. ORB finds corners at whole pixels x_l of a pyramid level made by
 // cv::resize, whose pixel centres sit at (x_l + 0.5) * width / level_width - 0.5 in the
@@ -61,18 +86,7 @@ class OrbDetector : public Detector {
  public:
   explicit OrbDetector(const nlohmann::json& options) {
     OptionReader reader(options);
-    options_.max_num_features =
-        reader.Get<int>("max_num_features", options_.max_num_features, 1, 1000000);
-    options_.max_image_size =
-        reader.Get<int>("max_image_size", options_.max_image_size, 16, 100000);
-    options_.scale_factor = reader.Get<double>("scale_factor", options_.scale_factor, 1.01, 4.0);
-    options_.num_levels = reader.Get<int>("num_levels", options_.num_levels, 1, 32);
-    options_.fast_threshold = reader.Get<int>("fast_threshold", options_.fast_threshold, 1, 255);
-    options_.edge_threshold = reader.Get<int>("edge_threshold", options_.edge_threshold, 0, 256);
-    options_.min_num_features =
-        reader.Get<int>("min_num_features", options_.min_num_features, 0, 1000000);
-    options_.min_fast_threshold =
-        reader.Get<int>("min_fast_threshold", options_.min_fast_threshold, 1, 255);
+    VisitOrbOptions(options_, option_list::Reader(&reader));
     reader.Finish();
     effective_options_ = reader.Effective();
     if (options_.min_num_features == 0) {
@@ -142,5 +156,6 @@ class OrbDetector : public Detector {
 }  // namespace
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::OrbOptions, tessera::VisitOrbOptions)
 TESSERA_PLUGIN(detector, tessera::OrbDetector, "orb", "1.0.0",
                "ORB keypoints and 256-bit binary descriptors from OpenCV")

@@ -13,5 +13,7 @@ class ColmapBinaryExporter : public ColmapModelExporter {
 
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::ColmapModelExporterOptions,
+                       tessera::VisitColmapModelExporterOptions)
 TESSERA_PLUGIN(exporter, tessera::ColmapBinaryExporter, "colmap_binary", "1.0.0",
                "COLMAP 3.8 binary model: sparse/N/{cameras,images,points3D}.bin")

@@ -13,5 +13,7 @@ class ColmapTextExporter : public ColmapModelExporter {
 
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::ColmapModelExporterOptions,
+                       tessera::VisitColmapModelExporterOptions)
 TESSERA_PLUGIN(exporter, tessera::ColmapTextExporter, "colmap_text", "1.0.0",
                "COLMAP 3.8 text model: sparse/N/{cameras,images,points3D}.txt")

@@ -14,11 +14,28 @@
 
 namespace tessera {
 
+struct ColmapModelExporterOptions {
+  // A COLMAP model folder whose record order the written files follow; empty: ascending
+  // ids.
+  std::string record_order_from;
+};
+
+// The options of colmap_text and colmap_binary, listed once: read, checked and described
+// (`tessera plugins colmap_text`) from here.
+template <typename Visit>
+void VisitColmapModelExporterOptions(ColmapModelExporterOptions& o, const Visit& visit) {
+  visit("record_order_from", o.record_order_from,
+        "a COLMAP model folder (binary or text) whose record order to follow: records it lists "
+        "come in its order, the others by ascending id; empty: ascending ids");
+}
+
 class ColmapModelExporter : public Exporter {
  public:
   ColmapModelExporter(const nlohmann::json& options, ColmapModelFormat format) : format_(format) {
     OptionReader reader(options);
-    record_order_from_ = reader.GetString("record_order_from", "");
+    ColmapModelExporterOptions parsed;
+    VisitColmapModelExporterOptions(parsed, option_list::Reader(&reader));
+    record_order_from_ = parsed.record_order_from;
     reader.Finish();
     if (!record_order_from_.empty() && !ExistsColmapModel(record_order_from_)) {
       throw OptionError("record_order_from", "'" + record_order_from_ +

@@ -283,16 +283,50 @@ void CheckImageNames(const Reconstruction& reconstruction, const std::filesystem
 
 }  // namespace
 
+struct GaussianSplattingOptions {
+  // The scene folder written for model 0, inside the output folder.
+  std::string folder = "gaussian_splatting";
+  int jpeg_quality = 95;
+  // A folder of image masks; empty: the run's masks.
+  std::string mask_path;
+  // "crop" (the original's size and focal lengths) or "full" (the whole field).
+  std::string field_of_view = "crop";
+  // With "full" only: the largest output size, in times the original's, and the largest
+  // ray angle off the optical axis, in degrees.
+  double max_scale = 2.0;
+  double max_ray_angle = 80.0;
+};
+
+// The options, listed once: read, checked and described (`tessera plugins
+// gaussian_splatting`) from here.
+template <typename Visit>
+void VisitGaussianSplattingOptions(GaussianSplattingOptions& o, const Visit& visit) {
+  visit("folder", option_list::RelativePath{o.folder},
+        "output folder, a relative path inside the output folder");
+  visit("jpeg_quality", o.jpeg_quality, 1, 100, "JPEG quality of the written images");
+  visit("mask_path", o.mask_path,
+        "a folder of image masks for this exporter; empty: the run's masks");
+  visit("field_of_view", o.field_of_view, option_list::Choices{"crop", "full"},
+        "crop: the original's size and focal lengths, the periphery of a wide lens cut off; "
+        "full: a larger image holding the whole field, its blank border masked");
+  visit("max_scale", o.max_scale, 1.0, 10.0,
+        "with full only: the largest output width and height, in times the original's");
+  visit("max_ray_angle", o.max_ray_angle, 1.0, 89.0,
+        "with full only: rays further off the optical axis, in degrees, are not kept");
+}
+
 class GaussianSplattingExporter : public Exporter {
  public:
   explicit GaussianSplattingExporter(const nlohmann::json& options) {
     OptionReader reader(options);
-    folder_ = reader.GetRelativePath("folder", "gaussian_splatting");
-    jpeg_quality_ = reader.Get<int>("jpeg_quality", 95, 1, 100);
-    mask_path_ = reader.GetString("mask_path", "");
-    full_field_ = reader.GetString("field_of_view", "crop", {"crop", "full"}) == "full";
-    max_scale_ = reader.Get<double>("max_scale", 2.0, 1.0, 10.0);
-    max_ray_angle_degrees_ = reader.Get<double>("max_ray_angle", 80.0, 1.0, 89.0);
+    GaussianSplattingOptions parsed;
+    VisitGaussianSplattingOptions(parsed, option_list::Reader(&reader));
+    folder_ = parsed.folder;
+    jpeg_quality_ = parsed.jpeg_quality;
+    mask_path_ = parsed.mask_path;
+    full_field_ = parsed.field_of_view == "full";
+    max_scale_ = parsed.max_scale;
+    max_ray_angle_degrees_ = parsed.max_ray_angle;
     reader.Finish();
     nlohmann::json effective = reader.Effective();
     for (const char* key : {"max_scale", "max_ray_angle"}) {
@@ -415,6 +449,7 @@ class GaussianSplattingExporter : public Exporter {
 
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::GaussianSplattingOptions, tessera::VisitGaussianSplattingOptions)
 TESSERA_PLUGIN(exporter, tessera::GaussianSplattingExporter, "gaussian_splatting", "1.0.0",
                "Undistorted images and a PINHOLE COLMAP model for 3D Gaussian Splatting "
                "trainers: gaussian_splatting/{images,sparse/0}")

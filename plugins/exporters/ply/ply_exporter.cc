@@ -57,14 +57,39 @@ std::string FrameComment(const tessera::ExportContext& context) {
   return line;
 }
 
+struct PlyOptions {
+  // Coordinates as "float" or "double".
+  std::string precision = "float";
+  // Point colours: "auto", "model" or "images".
+  std::string colors = "auto";
+  // Add the camera centres as extra vertices, in camera_center_color ([r, g, b]).
+  bool camera_centers = false;
+  nlohmann::json camera_center_color = nlohmann::json::array({255, 0, 0});
+};
+
+// The options, listed once: read, checked and described (`tessera plugins ply`) from here.
+template <typename Visit>
+void VisitPlyOptions(PlyOptions& o, const Visit& visit) {
+  visit("precision", o.precision, option_list::Choices{"float", "double"},
+        "float or double coordinates");
+  visit("colors", o.colors, option_list::Choices{"auto", "model", "images"},
+        "point colours: auto (the model's, sampled from the images when all are unset), model or "
+        "images");
+  visit("camera_centers", o.camera_centers, "add the camera centres as extra vertices");
+  visit("camera_center_color", o.camera_center_color,
+        "their colour, [red, green, blue], each an integer in [0, 255]");
+}
+
 class PlyExporter : public Exporter {
  public:
   explicit PlyExporter(const nlohmann::json& options) {
     OptionReader reader(options);
-    double_precision_ = reader.GetString("precision", "float", {"float", "double"}) == "double";
-    colors_ = reader.GetString("colors", "auto", {"auto", "model", "images"});
-    camera_centers_ = reader.GetBool("camera_centers", false);
-    const nlohmann::json color = reader.GetJson("camera_center_color", {255, 0, 0});
+    PlyOptions parsed;
+    VisitPlyOptions(parsed, option_list::Reader(&reader));
+    double_precision_ = parsed.precision == "double";
+    colors_ = parsed.colors;
+    camera_centers_ = parsed.camera_centers;
+    const nlohmann::json& color = parsed.camera_center_color;
     bool valid = color.is_array() && color.size() == 3;
     for (size_t i = 0; valid && i < 3; ++i) {
       valid =
@@ -147,6 +172,7 @@ class PlyExporter : public Exporter {
 
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::PlyOptions, tessera::VisitPlyOptions)
 TESSERA_PLUGIN(exporter, tessera::PlyExporter, "ply", "1.0.0",
                "3D points (and optionally camera centres) as a coloured binary PLY: "
                "sparse/N/points3D.ply")

@@ -119,11 +119,25 @@ std::string FilePath(const fs::path& json_dir, const fs::path& image_dir, const 
 
 }  // namespace
 
+struct TransformsJsonOptions {
+  // The JSON file written, inside the output folder.
+  std::string file = "transforms.json";
+};
+
+// The options, listed once: read, checked and described (`tessera plugins transforms_json`).
+template <typename Visit>
+void VisitTransformsJsonOptions(TransformsJsonOptions& o, const Visit& visit) {
+  visit("file", option_list::RelativePath{o.file},
+        "the JSON file, a relative path inside the output folder");
+}
+
 class TransformsJsonExporter : public Exporter {
  public:
   explicit TransformsJsonExporter(const nlohmann::json& options) {
     OptionReader reader(options);
-    file_ = reader.GetRelativePath("file", "transforms.json");
+    TransformsJsonOptions parsed;
+    VisitTransformsJsonOptions(parsed, option_list::Reader(&reader));
+    file_ = parsed.file;
     reader.Finish();
     effective_options_ = reader.Effective();
   }
@@ -191,6 +205,7 @@ class TransformsJsonExporter : public Exporter {
 
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::TransformsJsonOptions, tessera::VisitTransformsJsonOptions)
 TESSERA_PLUGIN(exporter, tessera::TransformsJsonExporter, "transforms_json", "1.0.0",
                "Poses and OPENCV intrinsics as the transforms.json of instant-ngp and "
                "nerfstudio (camera-to-world, OpenGL axes)")

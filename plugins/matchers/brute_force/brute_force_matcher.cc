@@ -82,5 +82,7 @@ class BruteForceMatcher : public Matcher {
 
 }  // namespace tessera
 
+// Its options are the match filter's alone.
+TESSERA_PLUGIN_OPTIONS(tessera::MatchFilterOptions, tessera::VisitMatchFilterOptions)
 TESSERA_PLUGIN(matcher, tessera::BruteForceMatcher, "brute_force", "1.0.0",
                "Exact nearest neighbours (OpenCV BFMatcher) with ratio test and cross check")

@@ -67,6 +67,36 @@ struct FlannMatchOptions {
   int index_cache_mb = 1024;
 };
 
+// The options, listed once: read, checked and described (`tessera plugins flann`) from here.
+template <typename Visit>
+void VisitFlannMatchOptions(FlannMatchOptions& o, const Visit& visit) {
+  VisitMatchFilterOptions(o.filter, visit);
+  visit("l2_index", o.l2_index, option_list::Choices{"kmeans", "kdtree"},
+        "index for l2 descriptors: kmeans (deterministic) or kdtree (not repeatable)");
+  visit("hamming_index", o.hamming_index, option_list::Choices{"hierarchical", "lsh"},
+        "index for binary descriptors: hierarchical (deterministic) or lsh (not repeatable)");
+  visit("checks", o.checks, 1, 100000000,
+        "descriptors examined per query by kmeans, kdtree and hierarchical; more is slower and "
+        "closer to exact");
+  visit("branching", o.branching, 2, 1024,
+        "children per node of the kmeans and hierarchical trees");
+  visit("kmeans_iterations", o.kmeans_iterations, 1, 100,
+        "Lloyd iterations per node of the kmeans tree");
+  visit("trees", o.trees, 1, 64, "number of kdtree / hierarchical trees searched together");
+  visit("leaf_max_size", o.leaf_max_size, 1, 100000,
+        "most descriptors in a leaf of the hierarchical trees");
+  visit("lsh_tables", o.lsh_tables, 1, 64, "LSH hash tables");
+  visit("lsh_key_size", o.lsh_key_size, 1, 32, "LSH key bits, at most the descriptor's bits");
+  visit("lsh_multi_probe_level", o.lsh_multi_probe_level, 0, 4,
+        "LSH: also probe buckets whose keys differ in this many bits");
+  visit("random_seed", o.random_seed, 0, std::numeric_limits<int>::max(),
+        "seed of std::rand() for kmeans and hierarchical builds");
+  visit("index_cache_size", o.index_cache_size, 0, 1000000,
+        "most deterministic indexes kept for reuse across pairs; 0: off");
+  visit("index_cache_mb", o.index_cache_mb, 1, 1000000,
+        "most MiB those indexes hold, descriptors and trees together");
+}
+
 namespace {
 
 // std::rand() is process-wide: builds that must replay one seeded sequence take turns.
@@ -142,26 +172,7 @@ class FlannMatcher : public Matcher {
  public:
   explicit FlannMatcher(const nlohmann::json& options) {
     OptionReader reader(options);
-    options_.filter = ReadMatchFilterOptions(reader);
-    options_.l2_index = reader.GetString("l2_index", options_.l2_index, {"kmeans", "kdtree"});
-    options_.hamming_index =
-        reader.GetString("hamming_index", options_.hamming_index, {"hierarchical", "lsh"});
-    options_.checks = reader.Get<int>("checks", options_.checks, 1, 100000000);
-    options_.branching = reader.Get<int>("branching", options_.branching, 2, 1024);
-    options_.kmeans_iterations =
-        reader.Get<int>("kmeans_iterations", options_.kmeans_iterations, 1, 100);
-    options_.trees = reader.Get<int>("trees", options_.trees, 1, 64);
-    options_.leaf_max_size = reader.Get<int>("leaf_max_size", options_.leaf_max_size, 1, 100000);
-    options_.lsh_tables = reader.Get<int>("lsh_tables", options_.lsh_tables, 1, 64);
-    options_.lsh_key_size = reader.Get<int>("lsh_key_size", options_.lsh_key_size, 1, 32);
-    options_.lsh_multi_probe_level =
-        reader.Get<int>("lsh_multi_probe_level", options_.lsh_multi_probe_level, 0, 4);
-    options_.random_seed =
-        reader.Get<int>("random_seed", options_.random_seed, 0, std::numeric_limits<int>::max());
-    options_.index_cache_size =
-        reader.Get<int>("index_cache_size", options_.index_cache_size, 0, 1000000);
-    options_.index_cache_mb =
-        reader.Get<int>("index_cache_mb", options_.index_cache_mb, 1, 1000000);
+    VisitFlannMatchOptions(options_, MatchFilterOptionReader(&reader));
     reader.Finish();
     const size_t cache_bytes = static_cast<size_t>(options_.index_cache_mb) << 20;
     const auto warn = [this](const std::string& text) { log().Warn(text); };
@@ -370,6 +381,7 @@ class FlannMatcher : public Matcher {
 
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::FlannMatchOptions, tessera::VisitFlannMatchOptions)
 TESSERA_PLUGIN(matcher, tessera::FlannMatcher, "flann", "1.0.0",
                "Approximate nearest neighbours (FLANN k-means / hierarchical clustering trees) "
                "with ratio test and cross check")

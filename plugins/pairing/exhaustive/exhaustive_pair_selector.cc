@@ -5,10 +5,18 @@
 
 namespace tessera {
 
+// No options: the list is empty, so that `tessera plugins exhaustive` says so.
+struct ExhaustivePairOptions {};
+
+template <typename Visit>
+void VisitExhaustivePairOptions(ExhaustivePairOptions& /*o*/, const Visit& /*visit*/) {}
+
 class ExhaustivePairSelector : public PairSelector {
  public:
   explicit ExhaustivePairSelector(const nlohmann::json& options) {
     OptionReader reader(options);
+    ExhaustivePairOptions none;
+    VisitExhaustivePairOptions(none, option_list::Reader(&reader));
     reader.Finish();
     effective_options_ = reader.Effective();
   }
@@ -26,5 +34,6 @@ class ExhaustivePairSelector : public PairSelector {
 
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::ExhaustivePairOptions, tessera::VisitExhaustivePairOptions)
 TESSERA_PLUGIN(pair_selector, tessera::ExhaustivePairSelector, "exhaustive", "1.0.0",
                "Every pair of images (n(n-1)/2 pairs)")

@@ -76,15 +76,8 @@ std::vector<ImageIndexPair> AllPairs(size_t n) {
 
 RetrievalPairSelector::RetrievalPairSelector(const nlohmann::json& options) {
   OptionReader reader(options);
-  options_.num_neighbors = reader.Get<int>("num_neighbors", options_.num_neighbors, 1, 1000000);
-  options_.codebook = reader.GetString("codebook", options_.codebook);
+  VisitRetrievalOptions(options_, option_list::Reader(&reader));
   const bool size_given = reader.Has("codebook_size");
-  options_.codebook_size = reader.Get<int>("codebook_size", options_.codebook_size, 1, 65536);
-  options_.max_features_per_image =
-      reader.Get<int>("max_features_per_image", options_.max_features_per_image, 1, 1000000);
-  options_.training_descriptors =
-      reader.Get<int>("training_descriptors", options_.training_descriptors, 1, 100000000);
-  options_.seed = reader.Get<int>("seed", options_.seed, 0, 1 << 30);
   reader.Finish();
   if (!options_.codebook.empty()) {
     if (size_given) {

@@ -28,6 +28,22 @@ struct RetrievalOptions {
   int seed = 1;
 };
 
+// The options, listed once: read, checked and described (`tessera plugins retrieval`).
+template <typename Visit>
+void VisitRetrievalOptions(RetrievalOptions& o, const Visit& visit) {
+  visit("num_neighbors", o.num_neighbors, 1, 1000000, "nearest images each image is paired with");
+  visit("codebook", o.codebook,
+        "codebook file from tessera vocab (path relative to the working folder); empty: train "
+        "on the run");
+  visit("codebook_size", o.codebook_size, 1, 65536,
+        "centres of a codebook trained on the run; not with codebook");
+  visit("max_features_per_image", o.max_features_per_image, 1, 1000000,
+        "features of largest scale per image that feed its VLAD vector and the training sample");
+  visit("training_descriptors", o.training_descriptors, 1, 100000000,
+        "descriptors sampled over all images to train a codebook");
+  visit("seed", o.seed, 0, 1 << 30, "seed of the training sample and of k-means");
+}
+
 class RetrievalPairSelector : public PairSelector {
  public:
   explicit RetrievalPairSelector(const nlohmann::json& options);

@@ -14,12 +14,19 @@ struct SequentialPairOptions {
   bool quadratic_overlap = true;
 };
 
+// The options, listed once: read, checked and described (`tessera plugins sequential`).
+template <typename Visit>
+void VisitSequentialPairOptions(SequentialPairOptions& o, const Visit& visit) {
+  visit("overlap", o.overlap, 1, 1000000, "number of following images each image is paired with");
+  visit("quadratic_overlap", o.quadratic_overlap,
+        "also pair each image with the images 2^k after it, k in [0, overlap)");
+}
+
 class SequentialPairSelector : public PairSelector {
  public:
   explicit SequentialPairSelector(const nlohmann::json& options) {
     OptionReader reader(options);
-    options_.overlap = reader.Get<int>("overlap", options_.overlap, 1, 1000000);
-    options_.quadratic_overlap = reader.GetBool("quadratic_overlap", options_.quadratic_overlap);
+    VisitSequentialPairOptions(options_, option_list::Reader(&reader));
     reader.Finish();
     effective_options_ = reader.Effective();
   }
@@ -62,6 +69,7 @@ class SequentialPairSelector : public PairSelector {
 
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::SequentialPairOptions, tessera::VisitSequentialPairOptions)
 TESSERA_PLUGIN(pair_selector, tessera::SequentialPairSelector, "sequential", "1.0.0",
                "Each image with its next `overlap` images and, optionally, the images 2^k after it "
                "(COLMAP's sequential matching)")

@@ -30,6 +30,17 @@ struct SpatialPairOptions {
   int fallback_window = 5;
 };
 
+// The options, listed once: read, checked and described (`tessera plugins spatial`).
+template <typename Visit>
+void VisitSpatialPairOptions(SpatialPairOptions& o, const Visit& visit) {
+  visit("num_neighbors", o.num_neighbors, 1, 1000000,
+        "nearest geotagged images each geotagged image is paired with");
+  visit("max_distance", o.max_distance, 0.0, 1e8, "metres; farther neighbours are not paired");
+  visit("ignore_altitude", o.ignore_altitude, "horizontal distance only (east, north)");
+  visit("fallback_window", o.fallback_window, 0, 1000000,
+        "neighbours on each side in capture order for images without GPS");
+}
+
 namespace {
 
 // WGS84 latitude/longitude (degrees) and height above the ellipsoid (metres) to ECEF.
@@ -69,11 +80,7 @@ class SpatialPairSelector : public PairSelector {
  public:
   explicit SpatialPairSelector(const nlohmann::json& options) {
     OptionReader reader(options);
-    options_.num_neighbors = reader.Get<int>("num_neighbors", options_.num_neighbors, 1, 1000000);
-    options_.max_distance = reader.Get<double>("max_distance", options_.max_distance, 0, 1e8);
-    options_.ignore_altitude = reader.GetBool("ignore_altitude", options_.ignore_altitude);
-    options_.fallback_window =
-        reader.Get<int>("fallback_window", options_.fallback_window, 0, 1000000);
+    VisitSpatialPairOptions(options_, option_list::Reader(&reader));
     reader.Finish();
     effective_options_ = reader.Effective();
   }
@@ -168,6 +175,7 @@ class SpatialPairSelector : public PairSelector {
 
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::SpatialPairOptions, tessera::VisitSpatialPairOptions)
 TESSERA_PLUGIN(pair_selector, tessera::SpatialPairSelector, "spatial", "1.0.0",
                "Each geotagged image with its nearest geotagged images within a distance (EXIF "
                "GPS); images without GPS by a window in capture order")

@@ -15,12 +15,18 @@ struct WindowPairOptions {
   bool loop = false;
 };
 
+// The options, listed once: read, checked and described (`tessera plugins window`).
+template <typename Visit>
+void VisitWindowPairOptions(WindowPairOptions& o, const Visit& visit) {
+  visit("window", o.window, 1, 1000000, "neighbours on each side each image is paired with");
+  visit("loop", o.loop, "treat the capture order as circular and pair across the end");
+}
+
 class WindowPairSelector : public PairSelector {
  public:
   explicit WindowPairSelector(const nlohmann::json& options) {
     OptionReader reader(options);
-    options_.window = reader.Get<int>("window", options_.window, 1, 1000000);
-    options_.loop = reader.GetBool("loop", options_.loop);
+    VisitWindowPairOptions(options_, option_list::Reader(&reader));
     reader.Finish();
     effective_options_ = reader.Effective();
   }
@@ -48,6 +54,7 @@ class WindowPairSelector : public PairSelector {
 
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::WindowPairOptions, tessera::VisitWindowPairOptions)
 TESSERA_PLUGIN(pair_selector, tessera::WindowPairSelector, "window", "1.0.0",
                "Each image with its `window` neighbours on each side in capture order, optionally "
                "circular")

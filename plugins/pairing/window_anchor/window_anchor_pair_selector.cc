@@ -22,14 +22,22 @@ struct WindowAnchorPairOptions {
   bool anchors_all_pairs = true;
 };
 
+// The options, listed once: read, checked and described (`tessera plugins window_anchor`).
+template <typename Visit>
+void VisitWindowAnchorPairOptions(WindowAnchorPairOptions& o, const Visit& visit) {
+  visit("window", o.window, 1, 1000000, "neighbours on each side each image is paired with");
+  visit("anchor_every", o.anchor_every, 1, 1000000,
+        "every anchor_every-th image, starting with the first, is an anchor");
+  visit("anchor_window", o.anchor_window, 0, 1000000,
+        "neighbours on each side each anchor is paired with");
+  visit("anchors_all_pairs", o.anchors_all_pairs, "also pair every anchor with every other anchor");
+}
+
 class WindowAnchorPairSelector : public PairSelector {
  public:
   explicit WindowAnchorPairSelector(const nlohmann::json& options) {
     OptionReader reader(options);
-    options_.window = reader.Get<int>("window", options_.window, 1, 1000000);
-    options_.anchor_every = reader.Get<int>("anchor_every", options_.anchor_every, 1, 1000000);
-    options_.anchor_window = reader.Get<int>("anchor_window", options_.anchor_window, 0, 1000000);
-    options_.anchors_all_pairs = reader.GetBool("anchors_all_pairs", options_.anchors_all_pairs);
+    VisitWindowAnchorPairOptions(options_, option_list::Reader(&reader));
     reader.Finish();
     effective_options_ = reader.Effective();
   }
@@ -69,5 +77,6 @@ class WindowAnchorPairSelector : public PairSelector {
 
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::WindowAnchorPairOptions, tessera::VisitWindowAnchorPairOptions)
 TESSERA_PLUGIN(pair_selector, tessera::WindowAnchorPairSelector, "window_anchor", "1.0.0",
                "Window pairs plus anchor images matched over a wider window and with each other")

@@ -39,25 +39,36 @@ struct CeresBundleAdjusterOptions {
   bool minimizer_progress = false;
 };
 
+// The options, listed once: read, checked and described (`tessera plugins ceres`) from here.
+template <typename Visit>
+void VisitCeresBundleAdjusterOptions(CeresBundleAdjusterOptions& o, const Visit& visit) {
+  visit("loss", o.loss, option_list::Choices{"huber", "cauchy", "trivial"},
+        "robust loss per observation; trivial: plain squares");
+  visit("loss_scale", o.loss_scale, 1e-6, 1e6,
+        "residual norm in pixels where the loss starts to down-weight");
+  visit("max_num_iterations", o.max_num_iterations, 0, 1000000,
+        "Levenberg-Marquardt iterations at most");
+  visit("function_tolerance", o.function_tolerance, 0.0, 1.0,
+        "stop when the relative cost change is below this");
+  visit("gradient_tolerance", o.gradient_tolerance, 0.0, 1.0,
+        "stop when the max-norm of the projected gradient is below this");
+  visit("parameter_tolerance", o.parameter_tolerance, 0.0, 1.0,
+        "stop when the relative step size is below this");
+  visit("num_threads", o.num_threads, 0, 1024,
+        "threads for Ceres; 0 means one per hardware thread; one (the default) is "
+        "bit-reproducible");
+  visit("linear_solver", o.linear_solver,
+        option_list::Choices{"auto", "dense_schur", "sparse_schur", "iterative_schur"},
+        "the linear solver of each iteration");
+  visit("minimizer_progress", o.minimizer_progress,
+        "print Ceres' per-iteration progress to stdout");
+}
+
 class CeresBundleAdjuster : public BundleAdjuster {
  public:
   explicit CeresBundleAdjuster(const nlohmann::json& options) {
     OptionReader reader(options);
-    options_.loss = reader.GetString("loss", options_.loss, {"huber", "cauchy", "trivial"});
-    options_.loss_scale = reader.Get<double>("loss_scale", options_.loss_scale, 1e-6, 1e6);
-    options_.max_num_iterations =
-        reader.Get<int>("max_num_iterations", options_.max_num_iterations, 0, 1000000);
-    options_.function_tolerance =
-        reader.Get<double>("function_tolerance", options_.function_tolerance, 0, 1);
-    options_.gradient_tolerance =
-        reader.Get<double>("gradient_tolerance", options_.gradient_tolerance, 0, 1);
-    options_.parameter_tolerance =
-        reader.Get<double>("parameter_tolerance", options_.parameter_tolerance, 0, 1);
-    options_.num_threads = reader.Get<int>("num_threads", options_.num_threads, 0, 1024);
-    options_.linear_solver =
-        reader.GetString("linear_solver", options_.linear_solver,
-                         {"auto", "dense_schur", "sparse_schur", "iterative_schur"});
-    options_.minimizer_progress = reader.GetBool("minimizer_progress", options_.minimizer_progress);
+    VisitCeresBundleAdjusterOptions(options_, option_list::Reader(&reader));
     reader.Finish();
     effective_options_ = reader.Effective();
   }
@@ -112,5 +123,7 @@ class CeresBundleAdjuster : public BundleAdjuster {
 }  // namespace
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS(tessera::CeresBundleAdjusterOptions,
+                       tessera::VisitCeresBundleAdjusterOptions)
 TESSERA_PLUGIN(bundle_adjuster, tessera::CeresBundleAdjuster, "ceres", "1.0.0",
                "Bundle adjustment with Ceres Solver (robust reprojection error)")
