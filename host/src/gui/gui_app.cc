@@ -331,13 +331,13 @@ void GuiApp::DrawWindows(const RunStatus& status) {
     CheckImageFolderOfModel(images);
     DrawSetupWindow(status);
     picking_->DrawDetails(view, images, MaskDir(), &widgets_);
-    // The match matrix beside the camera window (top right) when the view has room for
-    // both: opened after it, the matrix hid it whole at 1600x1000. Else below the camera
-    // window's title bar, which stays in sight to be clicked to the front.
     // The matrix is the model's: it follows the model shown to its workspace.
     const fs::path workspace = model_panel_->Workspace();
     match_matrix_->FollowModel(workspace,
                                controller_->Running() && SameFolder(workspace, status.output_dir));
+    // The match matrix beside the camera window (top right) when the view has room for
+    // both: opened after it, the matrix hid it whole at 1600x1000. Else below the camera
+    // window's title bar, which stays in sight to be clicked to the front.
     WidgetRect matrix_room = view;
     const std::optional<WidgetRect> camera = widgets_.Find("camera window");
     if (camera && camera->min_x - view.min_x >= 0.5f * (view.max_x - view.min_x)) {
