@@ -357,3 +357,39 @@ TEST_F(GuiOneModelTest, AnExportsMessageGoesWithItsModel) {
 
 }  // namespace
 }  // namespace tessera::gui
+
+namespace tessera::gui {
+namespace {
+
+// Item 10 in the window: between the last registration and the export the map bar names
+// the stage's tail (the final bundle adjustment alone takes a few tenths of a second on
+// the sample), and reads finished once the export starts.
+TEST_F(GuiOneModelTest, TheMapBarNamesItsTailAfterTheLastRegistration) {
+  GuiApp app(SampleOptions());
+  app.Frame();
+  ASSERT_TRUE(app.Run()) << app.SetupError();
+  std::string tail;  // the map bar's text while finishing
+  ASSERT_TRUE(WaitFor(
+      &app,
+      [&] {
+        const RunStatus status = app.controller().Status();
+        for (const StageProgress& stage : status.stages) {
+          if (stage.stage == "map" && stage.finishing && !stage.finished && tail.empty()) {
+            tail = StageOverlay(stage);
+            Review(&app, "item10_map_bar_tail.png");
+          }
+        }
+        return !app.controller().Running();
+      },
+      120));
+  const RunStatus status = app.controller().Status();
+  ASSERT_EQ(status.state, RunState::kCompleted) << status.error;
+  EXPECT_TRUE(Contains(tail, std::string("images registered (") + kMapFinishingSteps + ")"))
+      << tail;
+  const StageProgress& map = status.stages.at(2);
+  EXPECT_TRUE(map.finished);
+  EXPECT_EQ(StageOverlay(map), std::to_string(map.done) + "/8 images registered");
+}
+
+}  // namespace
+}  // namespace tessera::gui

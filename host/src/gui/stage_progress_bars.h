@@ -22,7 +22,7 @@ std::string FormatSeconds(double seconds);
 
 // What the map bar names after its last registration (StageProgress::finishing), when
 // the mapper named no later step of its own.
-inline constexpr const char* kMapFinishingSteps = "final adjustment, colours, writing the model";
+inline constexpr const char* kMapFinishingSteps = "final adjustment, colours, writing";
 
 // The rows kept for a run's bars before their stages start: extract, match, map, export.
 inline constexpr size_t kStageRows = 4;
