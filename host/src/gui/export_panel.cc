@@ -29,6 +29,7 @@ void ExportPanel::FindExporters() {
 bool ExportPanel::Export(const fs::path& model, const std::string& format, const fs::path& output,
                          const fs::path& images, int model_index) {
   failed_ = true;
+  message_model_ = model;
   if (model.empty()) {
     message_ =
         "export: the model shown is not written yet (a run's model): export it once "
@@ -61,10 +62,17 @@ bool ExportPanel::Export(const fs::path& model, const std::string& format, const
 
 void ExportPanel::Draw(const fs::path& model, int model_index, const fs::path& images,
                        WidgetRects* widgets) {
+  // A message is about the model exported: another model shown, and it goes.
+  if (!message_.empty() && model != message_model_) {
+    ForgetResult();
+  }
   const bool open = ImGui::CollapsingHeader("Export the model");
   widgets->RecordLastItem("export section");
   if (!open) return;
-  if (!searched_) FindExporters();
+  if (!searched_) {
+    FindExporters();
+    message_model_ = model;
+  }
   ImGui::SetNextItemWidth(ImGui::GetFontSize() * 10);
   if (ImGui::BeginCombo("##exporter", format_.empty() ? "(no exporter found)" : format_.c_str())) {
     for (const std::string& name : exporters_) {

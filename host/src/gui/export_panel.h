@@ -26,6 +26,11 @@ class ExportPanel {
   // "exporter NAME"), the output folder ("export output") and Export ("export").
   void Draw(const std::filesystem::path& model, int model_index,
             const std::filesystem::path& images, WidgetRects* widgets);
+  // Forgets the last export's message (a run replaces the model it was about).
+  void ForgetResult() {
+    message_.clear();
+    failed_ = false;
+  }
   const std::string& Message() const { return message_; }
   bool failed() const { return failed_; }
   const std::string& format() const { return format_; }
@@ -39,6 +44,7 @@ class ExportPanel {
   PathField output_{};
   std::string message_;
   bool failed_ = false;
+  std::filesystem::path message_model_;  // the model message_ is about
 };
 
 }  // namespace tessera::gui

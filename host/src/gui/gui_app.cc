@@ -98,6 +98,19 @@ GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
   }
   asked_scale_ = std::clamp(scale, 0.5f, 4.0f);
   ImGui_ImplGlfw_InitForOpenGL(window_, true);
+  // Keys and characters go through the queue, not straight to ImGui's state (replacing
+  // the back end's callbacks for them; its Shutdown puts the ones above back).
+  key_queue_ = std::make_unique<KeyQueue>(
+      KeyQueue::ModifierKeys{{GLFW_KEY_LEFT_CONTROL, GLFW_KEY_RIGHT_CONTROL},
+                             {GLFW_KEY_LEFT_SHIFT, GLFW_KEY_RIGHT_SHIFT},
+                             {GLFW_KEY_LEFT_ALT, GLFW_KEY_RIGHT_ALT},
+                             {GLFW_KEY_LEFT_SUPER, GLFW_KEY_RIGHT_SUPER}});
+  glfwSetKeyCallback(window_, [](GLFWwindow* w, int key, int, int action, int) {
+    if (GuiApp* app = AppOf(w)) app->QueueKey(key, action);
+  });
+  glfwSetCharCallback(window_, [](GLFWwindow* w, unsigned int codepoint) {
+    if (GuiApp* app = AppOf(w)) app->QueueChar(codepoint);
+  });
   ImGui_ImplOpenGL3_Init("#version 330 core");
   renderer_ = std::make_unique<Renderer>();
 
@@ -114,14 +127,20 @@ GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
   view_ = std::make_unique<SceneView>(renderer_.get(), [this]() { changed_.store(true); });
   model_panel_ = std::make_unique<ModelPanel>(view_.get(), options.model);
   // A run's models replace the ones opened: the view is cleared as it starts (when it
-  // follows the run), not to be taken for the run's model.
+  // follows the run), not to be taken for the run's model; what was about the old model
+  // (picks, its folder warning, the last export's message, a match matrix of the
+  // workspace the run rewrites) goes with it.
   setup_ =
       std::make_unique<SetupPanel>(RunRequest{options.images, options.output, options.manifest, {}},
                                    options.follow_run, controller_.get(), [this]() {
+                                     const fs::path output(setup_->OutputField());
                                      view_->ForgetPicks();
+                                     match_matrix_->RunStarted(output);
                                      if (!setup_->follow_run()) return;
-                                     model_panel_->RunStarted(setup_->OutputField());
+                                     model_panel_->RunStarted(output);
                                      view_->Show(nullptr, false);
+                                     folder_check_ = ImageFolderCheck{};
+                                     export_panel_->ForgetResult();
                                    });
   // "Keep it" (a run that would replace the output folder's model, not run): the model
   // kept is what the view shows, rather than an empty view.
@@ -165,6 +184,8 @@ GuiApp::~GuiApp() {
 bool GuiApp::ShouldClose() const { return glfwWindowShouldClose(window_) != 0; }
 
 bool GuiApp::Step(double max_wait_s) {
+  // Keys still queued: a frame for them now.
+  if (!key_queue_->empty()) frames_pending_ = std::max(frames_pending_, 1);
   if (frames_pending_ == 0) {
     // While a run goes on, the progress bars' times move: a frame every 0.25 s at least.
     glfwWaitEventsTimeout(controller_->Running() ? std::min(max_wait_s, 0.25) : max_wait_s);
@@ -180,6 +201,16 @@ bool GuiApp::Step(double max_wait_s) {
 }
 
 void GuiApp::MarkChangedFromInput() { changed_.store(true); }
+
+void GuiApp::QueueKey(int key, int action) {
+  if (action != GLFW_REPEAT) key_queue_->PushKey(key, action == GLFW_PRESS);
+  MarkChangedFromInput();
+}
+
+void GuiApp::QueueChar(unsigned int codepoint) {
+  key_queue_->PushChar(codepoint);
+  MarkChangedFromInput();
+}
 
 float GuiApp::UiScale() const { return ImGui::GetIO().FontGlobalScale; }
 
@@ -237,13 +268,17 @@ const std::string& GuiApp::OverwriteQuestion() const { return setup_->OverwriteQ
 
 RunStatus GuiApp::FollowRun() {
   if (auto scene = controller_->TakeScene(&scene_version_)) {
-    if (setup_->follow_run()) view_->Show(std::move(scene), !view_->user_moved_camera);
+    // Not over a model opened during the run: it would show under that model's name.
+    if (setup_->follow_run() && model_panel_->FollowsRun()) {
+      view_->Show(std::move(scene), !view_->user_moved_camera);
+    }
   }
   const RunStatus status = controller_->Status();
   if (status.state != last_state_) {
+    if (status.state != RunState::kRunning) match_matrix_->RunEnded();
     last_state_ = status.state;
-    if (status.state == RunState::kCompleted && setup_->follow_run()) {
-      model_panel_->ShowRunModels(status.output_dir);
+    if (status.state == RunState::kCompleted) {
+      model_panel_->RunCompleted(status.output_dir, setup_->follow_run());
     }
     if (status.state == RunState::kFailed) setup_->ShowRunError(status.error);
     if (status.state == RunState::kFailed || status.state == RunState::kCancelled) {
@@ -259,6 +294,7 @@ void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
   ImGui_ImplOpenGL3_NewFrame();
   ImGui_ImplGlfw_NewFrame();
   ImGuiIO& io = ImGui::GetIO();
+  key_queue_->ApplyFrame(&io);
   if (input != nullptr) {
     io.MousePos = ImVec2(input->x, input->y);
     io.MouseDown[0] = input->left_down;
@@ -295,6 +331,10 @@ void GuiApp::DrawWindows(const RunStatus& status) {
     CheckImageFolderOfModel(images);
     DrawSetupWindow(status);
     picking_->DrawDetails(view, images, MaskDir(), &widgets_);
+    // The matrix is the model's: it follows the model shown to its workspace.
+    const fs::path workspace = model_panel_->Workspace();
+    match_matrix_->FollowModel(workspace,
+                               controller_->Running() && SameFolder(workspace, status.output_dir));
     // The match matrix beside the camera window (top right) when the view has room for
     // both: opened after it, the matrix hid it whole at 1600x1000. Else below the camera
     // window's title bar, which stays in sight to be clicked to the front.
@@ -352,8 +392,12 @@ void GuiApp::DrawSetupWindow(const RunStatus& status) {
     ImGui::PopTextWrapPos();
     widgets_.RecordLastItem("image folder warning");
   }
+  // The matrix of the model shown; with none, the output folder's (else the field's).
+  const fs::path shown = model_panel_->Workspace();
   const std::string output = setup_->OutputField();
-  match_matrix_->DrawOpenButton(output.empty() ? model_panel_->ModelField() : output, &widgets_);
+  match_matrix_->DrawOpenButton(
+      !shown.empty() ? shown : fs::path(output.empty() ? model_panel_->ModelField() : output),
+      &widgets_);
   export_panel_->Draw(model_panel_->WrittenModel(), model_panel_->model_index(),
                       fs::path(setup_->ImagesField()), &widgets_);
   ImGui::Separator();
@@ -367,13 +411,17 @@ void GuiApp::DrawSetupWindow(const RunStatus& status) {
 }
 
 void GuiApp::CheckImageFolderOfModel(const fs::path& images) {
-  // Not while a run grows its model: its images are the Images field's by construction.
-  if (controller_->Running()) return;
+  const Scene* scene = view_->scene();
+  std::shared_ptr<const Reconstruction> model = scene == nullptr ? nullptr : scene->model;
+  // Not while a run grows its model: its images are the Images field's by construction;
+  // a warning about the model shown before goes with it.
+  if (controller_->Running()) {
+    if (model != folder_check_.model) folder_check_ = ImageFolderCheck{};
+    return;
+  }
   // Nor while the field is being typed in: one check (and one warning in the log) for
   // the path typed, not one per keystroke.
   if (setup_->ImagesFieldActive()) return;
-  const Scene* scene = view_->scene();
-  std::shared_ptr<const Reconstruction> model = scene == nullptr ? nullptr : scene->model;
   if (model == folder_check_.model && images == folder_check_.image_dir) return;
   folder_check_ = CheckImageFolder(std::move(model), images);
 }
@@ -434,6 +482,7 @@ const std::string& GuiApp::FieldError(const std::string& field) const {
   return setup_->FieldError(field);
 }
 std::string GuiApp::ImagesField() const { return setup_->ImagesField(); }
+bool GuiApp::ImagesFieldActive() const { return setup_->ImagesFieldActive(); }
 std::string GuiApp::OutputField() const { return setup_->OutputField(); }
 std::string GuiApp::ManifestField() const { return setup_->ManifestField(); }
 bool GuiApp::ChooseRecipe(const std::string& name) { return setup_->ChooseRecipe(name); }
@@ -444,6 +493,9 @@ bool GuiApp::SaveEditedManifest(const fs::path& file) { return setup_->editor().
 void GuiApp::SetEditorText(const std::string& text) { setup_->editor().SetText(text); }
 const std::string& GuiApp::EditorQuestion() const { return setup_->editor().Question(); }
 const std::string& GuiApp::RecipeShown() const { return setup_->RecipeShown(); }
+const std::string& GuiApp::RecipeDescriptionShown() const {
+  return setup_->RecipeDescriptionShown();
+}
 std::string GuiApp::EditorText() const { return setup_->editor().Text(); }
 const std::string& GuiApp::EditorError() const { return setup_->editor().Error(); }
 bool GuiApp::SetEditorPlugin(const std::string& slot, const std::string& plugin) {
@@ -457,6 +509,10 @@ std::string GuiApp::EditorPluginDescription(const std::string& slot) const {
 }
 
 bool GuiApp::OpenMatchMatrix(const fs::path& path) { return match_matrix_->Open(path); }
+const MatchMatrix* GuiApp::MatrixShown() const { return match_matrix_->matrix(); }
+const fs::path& GuiApp::MatrixWorkspace() const { return match_matrix_->workspace(); }
+const fs::path& GuiApp::OfferedRun() const { return model_panel_->OfferedRun(); }
+const std::string& GuiApp::RunStateShown() const { return setup_->StateShown(); }
 const std::string& GuiApp::MatchError() const { return match_matrix_->Error(); }
 std::pair<int, int> GuiApp::SelectedPair() const { return match_matrix_->SelectedPair(); }
 size_t GuiApp::PairLinesDrawn() const { return match_matrix_->pair_view().lines_drawn(); }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "gui/image_folder_check.h"
+#include "gui/key_queue.h"
 #include "gui/log_sink.h"
 #include "gui/match_matrix.h"
 #include "gui/run_controller.h"
@@ -125,9 +126,13 @@ class GuiApp {
   const std::string& EditorQuestion() const;
   // The Recipe box's text in the last frame ("default", "default (edited)", ...).
   const std::string& RecipeShown() const;
+  // The description under the Recipe box in the last frame.
+  const std::string& RecipeDescriptionShown() const;
   std::string EditorText() const;
   const std::string& EditorError() const;
   std::string ImagesField() const;
+  // Whether the Images field was being typed in during the last frame.
+  bool ImagesFieldActive() const;
   std::string OutputField() const;
   std::string ManifestField() const;
   // Chooses the recipe `name` (manifests/<name>.json) as the recipe list does: the
@@ -146,6 +151,15 @@ class GuiApp {
   // message in MatchError when it cannot.
   bool OpenMatchMatrix(const std::filesystem::path& path);
   const std::string& MatchError() const;
+  // The match matrix open (nullptr: none) and its workspace: the model shown's.
+  const MatchMatrix* MatrixShown() const;
+  const std::filesystem::path& MatrixWorkspace() const;
+  // A completed run's workspace offered beside a model opened during it ("Show the run's
+  // model"); empty when none.
+  const std::filesystem::path& OfferedRun() const;
+  // The run's state as the set-up window wrote it in the last frame ("running",
+  // "cancelling...", ...).
+  const std::string& RunStateShown() const;
   // The pair (row, column) clicked in the match matrix and its inlier matches.
   std::pair<int, int> SelectedPair() const;
   const PairInliers& SelectedPairInliers() const;
@@ -204,6 +218,12 @@ class GuiApp {
   const std::string& FrameError() const { return frame_error_; }
   // For the window system's callbacks.
   void MarkChangedFromInput();
+  // A key event (GLFW's key code and action) and a typed character, queued for the frames
+  // to come (KeyQueue: none is lost while the window is busy).
+  void QueueKey(int key, int action);
+  void QueueChar(unsigned int codepoint);
+  // The key and character events not yet given to ImGui.
+  size_t KeysQueued() const { return key_queue_->size(); }
 
  private:
   // Before a frame: the run's new model and state (a completed run's model opened, a
@@ -226,6 +246,7 @@ class GuiApp {
   GuiOptions options_;
   GLFWwindow* window_ = nullptr;
   std::unique_ptr<Renderer> renderer_;
+  std::unique_ptr<KeyQueue> key_queue_;
   std::shared_ptr<LogSink> log_sink_;
   std::unique_ptr<RunController> controller_;
   std::atomic<bool> changed_{true};

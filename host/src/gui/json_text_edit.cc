@@ -164,4 +164,13 @@ std::optional<std::string> RemoveOptionsInText(const std::string& text, const st
   return edited;
 }
 
+std::string MarkDescriptionEditedInText(const std::string& text) {
+  const size_t root = SkipSpace(text, 0);
+  if (root >= text.size() || text[root] != '{') return text;
+  const size_t value = FindMember(text, root, "description");
+  if (value == kNone || text[value] != '"') return text;
+  if (text.compare(value + 1, kEditedDescription.size(), kEditedDescription) == 0) return text;
+  return text.substr(0, value + 1) + std::string(kEditedDescription) + text.substr(value + 1);
+}
+
 }  // namespace tessera::gui

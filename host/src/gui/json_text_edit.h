@@ -6,6 +6,7 @@
 
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace tessera::gui {
@@ -23,5 +24,14 @@ std::optional<std::string> SetPluginInText(const std::string& text, const std::s
 // no such options object to edit (or is not JSON as far as the edit reads it).
 std::optional<std::string> RemoveOptionsInText(const std::string& text, const std::string& slot,
                                                const std::vector<std::string>& keys);
+
+// What an edited manifest's "description" starts with: the recipe's words describe the
+// plugins it was written with, not those chosen since.
+inline constexpr std::string_view kEditedDescription =
+    "(edited: its plugins were changed since this description was written) ";
+
+// `text` with its top-level "description" (a string) starting with kEditedDescription,
+// in place; `text` itself when it has none or it says so already.
+std::string MarkDescriptionEditedInText(const std::string& text);
 
 }  // namespace tessera::gui

@@ -249,7 +249,8 @@ bool ManifestEditorPanel::SetPlugin(const std::string& slot, const std::string& 
     // (Check names any the new plugin does not take).
     if (slot != "mapper" || !json.contains("mapper")) {
       if (const std::optional<std::string> edited = SetPluginInText(text_.data(), slot, plugin)) {
-        SetText(*edited);
+        // The recipe's description named the plugins it was written with: it says so.
+        SetText(*edited == text_.data() ? *edited : MarkDescriptionEditedInText(*edited));
         return true;
       }
     }
@@ -257,7 +258,7 @@ bool ManifestEditorPanel::SetPlugin(const std::string& slot, const std::string& 
     // A top-level "mapper" (the incremental mapper's options before mappers were plugins)
     // next to pipeline.mapper is refused; the plugin is set with no options anyway.
     if (slot == "mapper") json.erase("mapper");
-    SetText(json.dump(2));
+    SetText(MarkDescriptionEditedInText(json.dump(2)));
     return true;
   } catch (const nlohmann::json::exception& error) {
     error_ = std::string("the manifest editor: ") + error.what();

@@ -37,25 +37,81 @@ size_t MatrixLabelStep(float cell, float label_extent) {
   }
 }
 
+bool SameFolder(const fs::path& a, const fs::path& b) {
+  if (a.empty() || b.empty()) return a.empty() && b.empty();
+  std::error_code error;
+  const bool same = fs::equivalent(a, b, error);
+  if (!error) return same;
+  const auto normal = [](const fs::path& path) {
+    const fs::path lexical = path.lexically_normal();
+    return lexical.has_filename() ? lexical : lexical.parent_path();
+  };
+  return normal(a) == normal(b);
+}
+
 bool MatchMatrixPanel::Open(const fs::path& path) {
   error_.clear();
   pair_row_ = pair_column_ = -1;
   pair_view_.Clear();
+  reopen_after_run_.clear();
   if (CheckedRead(
           path, [&] { matrix_ = ReadMatchMatrix(path); }, &error_)) {
     show_ = true;
+    workspace_ = path;
     return true;
   }
   spdlog::error("{}", error_);
   matrix_.reset();
+  workspace_.clear();
   return false;
+}
+
+void MatchMatrixPanel::Close() {
+  show_ = false;
+  matrix_.reset();
+  workspace_.clear();
+  pair_row_ = pair_column_ = -1;
+  pair_view_.Clear();
+}
+
+void MatchMatrixPanel::FollowModel(const fs::path& workspace, bool being_written) {
+  if (SameFolder(workspace, model_workspace_)) return;
+  model_workspace_ = workspace;
+  if (!show_ || !matrix_ || SameFolder(workspace, workspace_)) return;
+  if (workspace.empty()) {
+    spdlog::info("gui: the match matrix of {} closed: the model shown has no workspace",
+                 workspace_.string());
+    Close();
+  } else if (being_written) {
+    Close();
+    reopen_after_run_ = workspace;
+  } else {
+    spdlog::info("gui: the match matrix follows the model shown: {}", workspace.string());
+    Open(workspace);
+  }
+}
+
+void MatchMatrixPanel::RunStarted(const fs::path& workspace) {
+  if (!show_ || !matrix_ || !SameFolder(workspace_, workspace)) return;
+  spdlog::info(
+      "gui: the match matrix of {} closed while the run rewrites its matches; it "
+      "reopens when the run ends",
+      workspace.string());
+  Close();
+  reopen_after_run_ = workspace;
+}
+
+void MatchMatrixPanel::RunEnded() {
+  if (reopen_after_run_.empty()) return;
+  const fs::path workspace = reopen_after_run_;
+  Open(workspace);
 }
 
 void MatchMatrixPanel::DrawOpenButton(const fs::path& workspace, WidgetRects* widgets) {
   if (ImGui::Button("Match matrix")) Open(workspace);
   widgets->RecordLastItem("match matrix");
   ImGui::SameLine();
-  FitText("of the output folder (else the model's workspace)", widgets, /*disabled=*/true);
+  FitText("of the model's workspace (else the output folder)", widgets, /*disabled=*/true);
   ErrorText(error_, widgets);
 }
 

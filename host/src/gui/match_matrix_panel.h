@@ -23,6 +23,10 @@ namespace tessera::gui {
 // its width and a gap for the columns).
 size_t MatrixLabelStep(float cell, float label_extent);
 
+// Whether `a` and `b` name the same folder (the same file when both exist, else the same
+// path once normal: "out/" is "out"); two empty paths are the same.
+bool SameFolder(const std::filesystem::path& a, const std::filesystem::path& b);
+
 class MatchMatrixPanel {
  public:
   // Where the column numbers were drawn in the last frame (they never overlap).
@@ -30,9 +34,25 @@ class MatchMatrixPanel {
   // Opens the match matrix of the workspace `path` (its database.db); false with the
   // message in Error() (also logged) when it cannot.
   bool Open(const std::filesystem::path& path);
+  // Closes the window and forgets the matrix.
+  void Close();
+  // Called each frame with the workspace of the model shown (empty: none) and whether a
+  // run is writing it: when that workspace changes, an open matrix of another one is
+  // replaced by its (or closed: no workspace, or one being written, reopened once the
+  // run ends). The matrix and the 3D view never show two workspaces.
+  void FollowModel(const std::filesystem::path& workspace, bool being_written);
+  // A run starts into `workspace`: an open matrix of it is closed (its matches are
+  // rewritten) and reopened, read anew, when the run ends (RunEnded).
+  void RunStarted(const std::filesystem::path& workspace);
+  void RunEnded();
+  // The workspace of the matrix open; empty when none.
+  const std::filesystem::path& workspace() const { return workspace_; }
+  // The matrix open; nullptr when none.
+  const MatchMatrix* matrix() const { return show_ && matrix_ ? &*matrix_ : nullptr; }
 
-  // The "Match matrix" button of the set-up window (opens the matrix of `workspace`),
-  // recorded as "match matrix", and the message of the last failure.
+  // The "Match matrix" button of the set-up window (opens the matrix of `workspace`, the
+  // model's, else the output folder), recorded as "match matrix", and the message of the
+  // last failure.
   void DrawOpenButton(const std::filesystem::path& workspace, WidgetRects* widgets);
   // The window, while open, at the top left of `view_rect`; the photographs of a pair are
   // read from `image_dir`. Records "match cells".
@@ -61,6 +81,9 @@ class MatchMatrixPanel {
 
   bool show_ = false;
   std::optional<MatchMatrix> matrix_;
+  std::filesystem::path workspace_;        // of matrix_
+  std::filesystem::path model_workspace_;  // FollowModel's last
+  std::filesystem::path reopen_after_run_;
   std::string error_;
   int pair_row_ = -1, pair_column_ = -1;
   PairView pair_view_;

@@ -28,11 +28,40 @@ bool ModelPanel::Open(const fs::path& path) {
     return false;
   }
   SetPathField(path, &path_);
+  if (follows_run_) {
+    // The view no longer follows the run: its models would show under this one's name.
+    follows_run_ = false;
+    spdlog::info(
+        "gui: the view shows {}; the run goes on into {} (its model is offered when "
+        "it completes)",
+        path.string(), run_workspace_.string());
+  }
   LoadFolder(0);
   return error_.empty();
 }
 
+void ModelPanel::RunCompleted(const fs::path& output_dir, bool show) {
+  const bool followed = follows_run_;
+  follows_run_ = false;
+  if (followed && show) {
+    ShowRunModels(output_dir);
+    return;
+  }
+  offered_run_ = output_dir;
+  spdlog::info(
+      "gui: the run wrote its model to {}; the view keeps {} (\"Show the run's model\" "
+      "shows the run's)",
+      output_dir.string(), path_.data());
+}
+
+fs::path ModelPanel::Workspace() const {
+  if (showing_.empty()) return {};
+  return showing_written_ ? written_workspace_ : run_workspace_;
+}
+
 void ModelPanel::ShowRunModels(const fs::path& output_dir) {
+  offered_run_.clear();
+  run_workspace_ = output_dir;
   // The written model has the points' colours; show it (and offer any others).
   try {
     folders_ = FindModelFolders(output_dir);
@@ -52,12 +81,16 @@ void ModelPanel::RunStarted(const fs::path& output_dir) {
   folders_.clear();
   image_counts_.clear();
   error_.clear();
+  offered_run_.clear();
+  follows_run_ = true;
+  run_workspace_ = output_dir;
   SetPathField(output_dir, &path_);
   showing_ = "the run's model as it grows, not yet written to " + output_dir.string();
   showing_written_ = false;
 }
 
 void ModelPanel::RunStopped(bool failed, bool has_model) {
+  follows_run_ = false;
   if (showing_written_) return;  // a model opened since the run started
   const std::string workspace = path_.data();
   if (has_model) {
@@ -105,6 +138,13 @@ void ModelPanel::LoadFolder(size_t index) {
   }
   index_ = static_cast<int>(index);
   view_->ForgetPicks();
+  written_workspace_.clear();
+  const fs::path workspace = folders_[index].parent_path().parent_path();
+  std::error_code exists_error;
+  if (folders_[index].parent_path().filename() == workspace_layout::kModelsFolder &&
+      fs::is_regular_file(workspace / workspace_layout::kDatabase, exists_error)) {
+    written_workspace_ = workspace;
+  }
   showing_ = folders_[index].string() + " (" + std::to_string(model->NumRegisteredImages()) +
              " images, as written)";
   showing_written_ = true;
@@ -129,7 +169,14 @@ void ModelPanel::Draw(WidgetRects* widgets) {
   ImGui::SameLine();
   if (ImGui::Button("Open")) Open(fs::path(path_.data()));
   widgets->RecordLastItem("open");
-  ErrorText(error_, widgets);
+  ErrorLine(error_, widgets);
+  if (!offered_run_.empty()) {
+    // A model opened during the run stayed; the run's is one click away.
+    if (ImGui::Button("Show the run's model")) ShowRunModels(fs::path(offered_run_));
+    widgets->RecordLastItem("show run model");
+    ImGui::SameLine();
+    FitText("the run completed into " + offered_run_.string(), widgets, /*disabled=*/true);
+  }
   DrawModelChoice();
   // What the view shows, after its counts: a written model, or a run's (growing,
   // cancelled, failed); one line always, so that what is below never moves.

@@ -24,16 +24,31 @@ class ModelPanel {
   // Opens a model folder, workspace or database.db (its first model); false with the
   // message in Error() (also logged) when it cannot.
   bool Open(const std::filesystem::path& path);
-  // A run completed: shows the first model it wrote in `output_dir` (the model field then
-  // names `output_dir`, not a model opened before), the camera left where the user moved
-  // it; keeps the model shown when it wrote no COLMAP model.
+  // Shows the first model a run wrote in `output_dir` (the model field then names
+  // `output_dir`, not a model opened before), the camera left where the user moved it;
+  // keeps the model shown when it wrote no COLMAP model.
   void ShowRunModels(const std::filesystem::path& output_dir);
-  // A run starts: the models opened are no longer the ones shown; the field names the
-  // run's workspace and the line under it says its model is growing, not yet written.
+  // A run starts and the view follows it: the models opened are no longer the ones shown;
+  // the field names the run's workspace and the line under it says its model is growing,
+  // not yet written.
   void RunStarted(const std::filesystem::path& output_dir);
+  // Whether the view shows the run going on (its growing model): from RunStarted until a
+  // model is opened (Open) or the run ends. The run's models go to the view only then:
+  // a model opened during a run stays, under its own name.
+  bool FollowsRun() const { return follows_run_; }
+  // A run completed: its model is shown (ShowRunModels) when the view followed it and
+  // `show` (the "show the model growing" box); else what the view shows stays (a model
+  // opened during the run) and the panel offers the run's ("Show the run's model",
+  // recorded as "show run model").
+  void RunCompleted(const std::filesystem::path& output_dir, bool show);
+  // The completed run's workspace offered beside the model opened; empty when none.
+  const std::filesystem::path& OfferedRun() const { return offered_run_; }
   // A run was cancelled or failed: the line says what the view shows now (the partial
   // model, not written; or nothing). `has_model`: whether the view shows one.
   void RunStopped(bool failed, bool has_model);
+  // The workspace (its database.db) of the model shown: a written model's sparse/N's, or
+  // the run's; empty when the view shows nothing or a model folder outside a workspace.
+  std::filesystem::path Workspace() const;
   // What the view shows, as the line under the field says it ("sparse/0 of W (8 images)",
   // "the run's model as it grows, not yet written to W", ...); empty before anything.
   const std::string& Showing() const { return showing_; }
@@ -73,6 +88,10 @@ class ModelPanel {
   bool showing_written_ = false;
   std::vector<std::string> image_counts_;
   std::string stale_;  // per folder of folders_, for the picker
+  bool follows_run_ = false;
+  std::filesystem::path run_workspace_;  // of the run shown (growing, stopped or completed)
+  std::filesystem::path offered_run_;
+  std::filesystem::path written_workspace_;  // of the written model shown, if in one
 };
 
 }  // namespace tessera::gui

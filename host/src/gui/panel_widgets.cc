@@ -21,6 +21,17 @@ void ErrorText(const std::string& text, WidgetRects* widgets) {
   ImGui::PopStyleColor();
 }
 
+void ErrorLine(const std::string& text, WidgetRects* widgets) {
+  if (text.empty()) {
+    ImGui::Dummy(ImVec2(0, ImGui::GetTextLineHeight()));
+    return;
+  }
+  if (widgets != nullptr) widgets->AddError(text);
+  ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.35f, 0.3f, 1.0f));
+  FitText(text, widgets);
+  ImGui::PopStyleColor();
+}
+
 void HintText(const std::string& text) {
   if (text.empty()) return;
   ImGui::PushStyleColor(ImGuiCol_Text, ImGui::GetStyle().Colors[ImGuiCol_TextDisabled]);

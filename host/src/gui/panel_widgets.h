@@ -20,6 +20,12 @@ void SetPathField(const std::filesystem::path& path, PathField* field);
 // Draws `text` wrapped, in red; nothing when it is empty.
 void ErrorText(const std::string& text, WidgetRects* widgets = nullptr);
 
+// Draws `text` in red on one line, the line taken even when `text` is empty: a message
+// appearing or going never moves what is below it (a click aimed at it lands on it). A
+// longer message is cut with "..." and shown whole in a tooltip (as FitText); the log
+// holds it whole too.
+void ErrorLine(const std::string& text, WidgetRects* widgets);
+
 // Draws `text` wrapped, greyed (a description or hint); nothing when it is empty.
 void HintText(const std::string& text);
 

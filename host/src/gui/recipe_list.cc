@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "gui/checked_read.h"
+#include "gui/json_text_edit.h"
 #include "gui/panel_widgets.h"
 #include "tessera/errors.h"
 #include "util/paths.h"
@@ -117,7 +118,13 @@ const Recipe* RecipeList::Draw(const std::string& manifest_field, WidgetRects* w
     }
     ImGui::EndCombo();
   }
-  if (current != nullptr) HintText(current->description);
+  // An edited recipe's description describes the recipe, not the editor's text.
+  description_shown_.clear();
+  if (current != nullptr) {
+    description_shown_ =
+        edited ? std::string(kEditedDescription) + current->description : current->description;
+  }
+  HintText(description_shown_);
   return chosen;
 }
 

@@ -39,12 +39,16 @@ class RecipeList {
   // The box's text in the last frame: the recipe the field names (" (edited)" when the
   // editor's text differs from its file), "(another file)" or "(no recipes found)".
   const std::string& preview() const { return preview_; }
+  // The description drawn under the box in the last frame: the recipe's, said to be
+  // edited (kEditedDescription first) when the editor's text differs from its file.
+  const std::string& description_shown() const { return description_shown_; }
   // The recipe whose file the manifest field names (or a copy of it: the same name and
   // bytes); nullptr for another file.
   const Recipe* Current(const std::string& manifest_field);
 
  private:
   std::string preview_;
+  std::string description_shown_;
   const std::vector<Recipe>& recipes();
 
   std::filesystem::path folder_;

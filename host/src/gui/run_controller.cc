@@ -131,6 +131,11 @@ void RunController::Cancel() {
 
 bool RunController::Running() const { return running_.load(); }
 
+bool RunController::Cancelling() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return running_.load() && cancel_ != nullptr && cancel_->IsCancelled();
+}
+
 void RunController::Join() {
   if (worker_.joinable()) worker_.join();
 }
@@ -195,6 +200,12 @@ void RunController::OnProgress(const std::string& stage, size_t done, size_t tot
   {
     std::lock_guard<std::mutex> lock(mutex_);
     const bool is_new = status_.stages.empty() || status_.stages.back().stage != stage;
+    if (is_new && !status_.stages.empty() && status_.stages.back().finishing) {
+      // The stage before this one ended as this one started.
+      StageProgress& before = status_.stages.back();
+      before.finished = true;
+      before.rate_per_s = before.remaining_s = -1;
+    }
     if (is_new) {
       StageProgress started;
       started.stage = stage;
@@ -203,8 +214,13 @@ void RunController::OnProgress(const std::string& stage, size_t done, size_t tot
     }
     StageProgress& progress = status_.stages.back();
     if (stage == "map" && !progress.unit.empty()) {
-      // The end, (1, 1): done stays what the models registered.
-      if (done == total) progress.finished = true;
+      // Every image registered, or the mapper returned: done stays what the models
+      // registered; the stage goes on (final adjustment, colours, writing) until the
+      // next starts or the run ends.
+      if (done == total) {
+        progress.finishing = true;
+        progress.rate_per_s = progress.remaining_s = -1;
+      }
     } else if (stage == "map" && view_graph_images > 0) {
       progress.unit = "images registered";
       registered_.clear();
@@ -325,6 +341,7 @@ void RunController::Work(RunRequest request) {
     status_.error = error;
     // A stopped stage has no rate nor time left.
     for (StageProgress& stage : status_.stages) {
+      if (state == RunState::kCompleted && stage.finishing) stage.finished = true;
       if (!stage.finished) stage.rate_per_s = stage.remaining_s = -1;
     }
     status_.num_models = num_models;

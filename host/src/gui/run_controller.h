@@ -50,6 +50,10 @@ struct StageProgress {
   // graph, those with a verified pair).
   std::string unit;
   bool finished = false;  // the stage ended (map: done stays what its models registered)
+  // The map stage: every image registered, or the mapper done, and the stage still going
+  // (the final bundle adjustment, the points' colours, the model written): its bar says
+  // so until the next stage starts or the run completes.
+  bool finishing = false;
   // The map stage: the mapper's step last reported (MapperControl::on_progress, e.g.
   // "rotation averaging"); empty before its first.
   std::string step;
@@ -85,6 +89,8 @@ class RunController {
   bool Start(const RunRequest& request);
   void Cancel();
   bool Running() const;
+  // Cancel was asked and the worker has not ended yet (the stage stops at its next check).
+  bool Cancelling() const;
   // Waits for the worker to end (tests and the screenshot mode).
   void Join();
 

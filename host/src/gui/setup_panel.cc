@@ -65,6 +65,10 @@ bool SetupPanel::CheckFields() {
   std::error_code error;
   if (images.empty()) {
     images_error_ = "choose the folder of images";
+  } else if (fs::exists(images, error) && !fs::is_directory(images, error)) {
+    // A file typed or pasted as the folder (README.md, one photograph): not "no such".
+    images_error_ =
+        images.string() + ": a file, not a folder; choose the folder that holds the images";
   } else if (!fs::is_directory(images, error)) {
     images_error_ = images.string() + ": no such folder";
   } else if (!HasImageFile(images)) {
@@ -72,6 +76,9 @@ bool SetupPanel::CheckFields() {
   }
   if (output_[0] == '\0') {
     error_ = "choose an output folder (the workspace)";
+    error_field_ = ErrorField::kOutput;
+  } else if (fs::exists(output_.data(), error) && !fs::is_directory(output_.data(), error)) {
+    error_ = std::string(output_.data()) + ": a file, not a folder; choose the workspace folder";
     error_field_ = ErrorField::kOutput;
   }
   if (!editor_.LoadError().empty()) {
@@ -242,7 +249,7 @@ void SetupPanel::DrawFields(WidgetRects* widgets) {
   images_active_ = ImGui::IsItemActive();
   ImGui::SameLine();
   browser_.Draw("images", &images_, widgets);
-  ErrorText(images_error_, widgets);
+  ErrorLine(images_error_, widgets);
   if (ImGui::InputTextWithHint("Output", "workspace folder", output_.data(), output_.size())) {
     error_.clear();
   }
@@ -262,7 +269,7 @@ void SetupPanel::DrawFields(WidgetRects* widgets) {
   }
   editor_.FollowManifestField();
   // Shown once: the open editor shows its own message about the same text.
-  ErrorText(editor_.open() && manifest_error_ == editor_.Error() ? "" : manifest_error_, widgets);
+  ErrorLine(editor_.open() && manifest_error_ == editor_.Error() ? "" : manifest_error_, widgets);
   ImGui::PopItemWidth();
 }
 
@@ -272,12 +279,15 @@ void SetupPanel::DrawRunButtons(const RunStatus& status, bool running, WidgetRec
   ImGui::EndDisabled();
   widgets->RecordLastItem("run");
   ImGui::SameLine();
-  ImGui::BeginDisabled(!running);
+  ImGui::BeginDisabled(!running || controller_->Cancelling());
   if (ImGui::Button("Cancel")) controller_->Cancel();
   ImGui::EndDisabled();
   widgets->RecordLastItem("cancel");
   ImGui::SameLine();
-  ImGui::Text("%s", RunStateName(status.state));
+  // Read after the button: a click says so in its own frame, not when the stage stops.
+  state_shown_ = controller_->Cancelling() ? "cancelling..." : RunStateName(status.state);
+  ImGui::TextUnformatted(state_shown_.c_str());
+  widgets->RecordLastItem("run state");
   ImGui::Checkbox("show the model growing", &follow_run_);
   ImGui::SameLine();
   ImGui::BeginDisabled(running);
@@ -296,9 +306,8 @@ void SetupPanel::DrawRunButtons(const RunStatus& status, bool running, WidgetRec
   // A field's message is beside its field (the output folder's has none): not again here.
   const bool beside_field =
       error_field_ == ErrorField::kImages || error_field_ == ErrorField::kManifest;
-  if (status.state == RunState::kFailed || (!error_.empty() && !beside_field)) {
-    ErrorText(error_.empty() ? status.error : error_, widgets);
-  }
+  const bool shown = status.state == RunState::kFailed || (!error_.empty() && !beside_field);
+  ErrorLine(!shown ? "" : error_.empty() ? status.error : error_, widgets);
 }
 
 }  // namespace tessera::gui

@@ -67,8 +67,11 @@ class SetupPanel {
   bool hierarchical() const { return hierarchical_; }
   void set_hierarchical(bool hierarchical) { hierarchical_ = hierarchical; }
   ManifestEditorPanel& editor() { return editor_; }
+  // The run's state as written beside Cancel in the last frame.
+  const std::string& StateShown() const { return state_shown_; }
   // The Recipe box's text in the last frame (RecipeList::preview).
   const std::string& RecipeShown() const { return recipes_.preview(); }
+  const std::string& RecipeDescriptionShown() const { return recipes_.description_shown(); }
 
  private:
   // Sets the fields' messages; true when all are empty.
@@ -93,6 +96,7 @@ class SetupPanel {
   // What the last CheckFields read: the fields and, when loaded, the editor's text.
   std::string checked_images_, checked_output_, checked_manifest_, checked_editor_text_;
   std::string overwrite_question_;
+  std::string state_shown_;
   bool overwrite_popup_open_ = false;
   bool follow_run_ = true;
   bool hierarchical_ = false;

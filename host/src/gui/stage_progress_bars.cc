@@ -29,6 +29,12 @@ std::string StageOverlay(const StageProgress& stage, bool with_rate) {
   std::string overlay = std::to_string(stage.done) + "/" + std::to_string(stage.total);
   if (!stage.unit.empty()) overlay += " " + stage.unit;
   if (stage.finished) return overlay;
+  if (stage.finishing) {
+    // The long tail after the last registration: named, as the mapper's last step when it
+    // named one after its registrations.
+    const bool named = !stage.step.empty() && stage.step != "registration";
+    return overlay + " (" + (named ? stage.step : std::string(kMapFinishingSteps)) + ")";
+  }
   if (!stage.step.empty() && stage.step != "registration") overlay += " (" + stage.step + ")";
   if (stage.rate_per_s > 0) {
     char rate[64];

@@ -20,6 +20,10 @@ float StageFraction(const StageProgress& stage);
 // "45 s", "2 min 5 s"; "?" for a negative time.
 std::string FormatSeconds(double seconds);
 
+// What the map bar names after its last registration (StageProgress::finishing), when
+// the mapper named no later step of its own.
+inline constexpr const char* kMapFinishingSteps = "final adjustment, colours, writing";
+
 // The rows kept for a run's bars before their stages start: extract, match, map, export.
 inline constexpr size_t kStageRows = 4;
 
