@@ -65,7 +65,7 @@ TEST(PluginLoader, RefusesAnotherAbiVersionNamingBothNumbers) {
 }
 
 TEST(PluginLoader, RefusesAPluginBuiltAgainstAbiOne) {
-  ASSERT_EQ(kPluginAbiVersion, 11u);
+  ASSERT_EQ(kPluginAbiVersion, 12u);
   const auto file = File("abi_one", "abi_one");
   EXPECT_EQ(InspectPluginFile(file).refusal,
             file.string() + ": wrong plugin ABI version: got version 1, supported version is 11");

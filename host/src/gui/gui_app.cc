@@ -507,6 +507,7 @@ std::string GuiApp::EditorPlugin(const std::string& slot) const {
 std::string GuiApp::EditorPluginDescription(const std::string& slot) const {
   return setup_->editor().DescriptionShown(slot);
 }
+ManifestEditorPanel& GuiApp::Editor() { return setup_->editor(); }
 
 bool GuiApp::OpenMatchMatrix(const fs::path& path) { return match_matrix_->Open(path); }
 const MatchMatrix* GuiApp::MatrixShown() const { return match_matrix_->matrix(); }

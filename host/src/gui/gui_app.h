@@ -31,6 +31,7 @@ namespace tessera::gui {
 
 class ExportPanel;
 class LogPane;
+class ManifestEditorPanel;
 class MatchMatrixPanel;
 class ModelPanel;
 class Picking;
@@ -147,6 +148,8 @@ class GuiApp {
   std::string EditorPlugin(const std::string& slot) const;
   // The description drawn under a slot's dropdown in the last frame; empty when none.
   std::string EditorPluginDescription(const std::string& slot) const;
+  // The manifest editor itself (its form view: ShowForm, form()).
+  ManifestEditorPanel& Editor();
   // Opens the match matrix of the workspace `path` (its database.db); false with the
   // message in MatchError when it cannot.
   bool OpenMatchMatrix(const std::filesystem::path& path);

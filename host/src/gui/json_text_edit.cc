@@ -105,6 +105,76 @@ std::string InsertFirst(const std::string& text, size_t open, const std::string&
   return text.substr(0, open + 1) + member + (empty ? "" : ", ") + text.substr(open + 1);
 }
 
+// The starts of the elements of the array whose '[' is at `open`, as far as they read.
+std::vector<size_t> Elements(const std::string& text, size_t open) {
+  std::vector<size_t> elements;
+  size_t at = SkipSpace(text, open + 1);
+  while (at < text.size() && text[at] != ']') {
+    elements.push_back(at);
+    const size_t end = ValueEnd(text, at);
+    if (end == kNone) break;
+    at = SkipSpace(text, end);
+    if (at >= text.size() || text[at] != ',') break;
+    at = SkipSpace(text, at + 1);
+  }
+  return elements;
+}
+
+// Where the value at `steps` (object keys, or an array's index in decimal) starts; kNone
+// when the text has none.
+size_t FindPath(const std::string& text, const std::vector<std::string>& steps) {
+  size_t at = SkipSpace(text, 0);
+  for (const std::string& step : steps) {
+    if (at >= text.size()) return kNone;
+    if (text[at] == '{') {
+      at = FindMember(text, at, step);
+    } else if (text[at] == '[' && !step.empty() && step.size() < 10 &&
+               std::all_of(step.begin(), step.end(),
+                           [](char c) { return std::isdigit(static_cast<unsigned char>(c)); })) {
+      const std::vector<size_t> elements = Elements(text, at);
+      const size_t index = std::stoul(step);
+      at = index < elements.size() ? elements[index] : kNone;
+    } else {
+      return kNone;
+    }
+    if (at == kNone) return kNone;
+  }
+  return at;
+}
+
+// `member` ("KEY": VALUE) put after the last member of the object whose '{' is at `open`.
+std::optional<std::string> InsertLast(const std::string& text, size_t open,
+                                      const std::string& member) {
+  bool complete = false;
+  const std::vector<Member> members = Members(text, open, &complete);
+  if (!complete) return std::nullopt;
+  if (members.empty()) return InsertFirst(text, open, member);
+  const size_t end = members.back().end;
+  return text.substr(0, end) + ", " + member + text.substr(end);
+}
+
+// `text` without the member `key` of the object whose '{' is at `open` (its comma goes
+// with it); the text as it is when the object has no such key.
+std::optional<std::string> RemoveMember(const std::string& text, size_t open,
+                                        const std::string& key) {
+  bool complete = false;
+  const std::vector<Member> members = Members(text, open, &complete);
+  if (!complete) return std::nullopt;
+  const auto found = std::find_if(members.begin(), members.end(),
+                                  [&](const Member& member) { return member.name == key; });
+  if (found == members.end()) return text;
+  const size_t index = static_cast<size_t>(found - members.begin());
+  if (index + 1 < members.size()) {
+    // Up to the next key: the next member takes this one's place and indentation.
+    return text.substr(0, found->key) + text.substr(members[index + 1].key);
+  }
+  if (index > 0) {
+    // The last: from the end of the member before it (its comma goes too).
+    return text.substr(0, members[index - 1].end) + text.substr(found->end);
+  }
+  return text.substr(0, open + 1) + text.substr(found->end);
+}
+
 }  // namespace
 
 std::optional<std::string> SetPluginInText(const std::string& text, const std::string& slot,
@@ -136,30 +206,11 @@ std::optional<std::string> RemoveOptionsInText(const std::string& text, const st
   std::string edited = text;
   for (const std::string& key : keys) {
     // Found anew for each key: the text before it has changed.
-    const size_t root = SkipSpace(edited, 0);
-    if (root >= edited.size() || edited[root] != '{') return std::nullopt;
-    const size_t pipeline = FindMember(edited, root, "pipeline");
-    if (pipeline == kNone || edited[pipeline] != '{') return std::nullopt;
-    const size_t value = FindMember(edited, pipeline, slot);
-    if (value == kNone || edited[value] != '{') return std::nullopt;
-    const size_t options = FindMember(edited, value, "options");
+    const size_t options = FindPath(edited, {"pipeline", slot, "options"});
     if (options == kNone || edited[options] != '{') return std::nullopt;
-    bool complete = false;
-    const std::vector<Member> members = Members(edited, options, &complete);
-    if (!complete) return std::nullopt;
-    const auto found = std::find_if(members.begin(), members.end(),
-                                    [&](const Member& member) { return member.name == key; });
-    if (found == members.end()) continue;
-    const size_t index = static_cast<size_t>(found - members.begin());
-    if (index + 1 < members.size()) {
-      // Up to the next key: the next member takes this one's place and indentation.
-      edited = edited.substr(0, found->key) + edited.substr(members[index + 1].key);
-    } else if (index > 0) {
-      // The last: from the end of the member before it (its comma goes too).
-      edited = edited.substr(0, members[index - 1].end) + edited.substr(found->end);
-    } else {
-      edited = edited.substr(0, options + 1) + edited.substr(found->end);
-    }
+    const std::optional<std::string> removed = RemoveMember(edited, options, key);
+    if (!removed) return std::nullopt;
+    edited = *removed;
   }
   return edited;
 }
@@ -171,6 +222,34 @@ std::string MarkDescriptionEditedInText(const std::string& text) {
   if (value == kNone || text[value] != '"') return text;
   if (text.compare(value + 1, kEditedDescription.size(), kEditedDescription) == 0) return text;
   return text.substr(0, value + 1) + std::string(kEditedDescription) + text.substr(value + 1);
+}
+
+std::optional<std::string> SetOptionInText(const std::string& text,
+                                           const std::vector<std::string>& slot_steps,
+                                           const std::string& key,
+                                           const std::optional<nlohmann::json>& value) {
+  const size_t slot = FindPath(text, slot_steps);
+  if (slot == kNone || text[slot] != '{') return std::nullopt;
+  const size_t options = FindMember(text, slot, "options");
+  if (options != kNone && text[options] != '{') return std::nullopt;
+  if (value) {
+    const std::string member = nlohmann::json(key).dump() + ": " + value->dump();
+    if (options == kNone) return InsertLast(text, slot, "\"options\": {" + member + "}");
+    const size_t current = FindMember(text, options, key);
+    if (current == kNone) return InsertLast(text, options, member);
+    const size_t current_end = ValueEnd(text, current);
+    if (current_end == kNone) return std::nullopt;
+    return text.substr(0, current) + value->dump() + text.substr(current_end);
+  }
+  if (options == kNone) return text;
+  const std::optional<std::string> removed = RemoveMember(text, options, key);
+  if (!removed) return std::nullopt;
+  // The edit was after the slot's '{' and the options' '{': both are where they were.
+  bool complete = false;
+  if (Members(*removed, options, &complete).empty() && complete) {
+    return RemoveMember(*removed, slot, "options");
+  }
+  return removed;
 }
 
 }  // namespace tessera::gui

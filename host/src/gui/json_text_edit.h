@@ -4,6 +4,7 @@
 // where it is written, every other character kept (the user's order, spacing and the
 // other slots' options), instead of the whole text parsed and dumped again.
 
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -33,5 +34,17 @@ inline constexpr std::string_view kEditedDescription =
 // `text` with its top-level "description" (a string) starting with kEditedDescription,
 // in place; `text` itself when it has none or it says so already.
 std::string MarkDescriptionEditedInText(const std::string& text);
+
+// `text` with the option `key` of the slot object at `slot_steps` (from the root: object
+// keys, or an array's index in decimal, e.g. {"pipeline", "exporters", "1"}) set to
+// `value`: replaced where it is written, else added after the slot's last option (an
+// "options" object added after the slot's last member when it has none). With no
+// `value`, the option is removed, and the "options" object with it once empty. Every
+// other character kept. Nothing when the text has no such slot object (or options that
+// are not an object) to edit, or is not JSON as far as the edit reads it.
+std::optional<std::string> SetOptionInText(const std::string& text,
+                                           const std::vector<std::string>& slot_steps,
+                                           const std::string& key,
+                                           const std::optional<nlohmann::json>& value);
 
 }  // namespace tessera::gui

@@ -38,6 +38,12 @@ std::string PluginNamed(const nlohmann::json& slot) {
   return "?";
 }
 
+// " (and 2 more invalid options)" after the first of `count`; empty for one.
+std::string MoreProblems(size_t count) {
+  if (count <= 1) return "";
+  return " (and " + std::to_string(count - 1) + " more invalid option" + (count > 2 ? "s)" : ")");
+}
+
 }  // namespace
 
 std::string JsonErrorMessage(const std::string& text, const nlohmann::json::parse_error& error) {
@@ -197,6 +203,7 @@ void ManifestEditorPanel::DrawQuestion(WidgetRects* widgets) {
 }
 
 bool ManifestEditorPanel::Check() {
+  if (plugins_by_kind_.empty()) FindPlugins();  // the descriptions' registry
   error_.clear();
   status_.clear();
   const PathField& manifest = *manifest_field_;
@@ -204,6 +211,12 @@ bool ManifestEditorPanel::Check() {
                                                 : DefaultManifestFile().parent_path();
   try {
     const nlohmann::json json = nlohmann::json::parse(std::string(text_.data()));
+    // Each option against its plugin's description first: the form marks the same.
+    form_.Update(text_.data(), registry_.get());
+    if (const std::vector<std::string>& problems = form_.Problems(); !problems.empty()) {
+      error_ = "the manifest editor: " + problems.front() + MoreProblems(problems.size());
+      return false;
+    }
     PipelineContext::Create(Manifest::FromJson(json, base_dir, "the manifest editor"));
     status_ = "valid: every plugin was created with its options";
     return true;
@@ -414,6 +427,45 @@ void ManifestEditorPanel::DrawSlot(const std::string& kind, WidgetRects* widgets
   HintText(shown);
 }
 
+void ManifestEditorPanel::DrawViews(WidgetRects* widgets) {
+  // The switch; the two views are the same height, so that nothing below moves.
+  if (ImGui::RadioButton("Form", form_view_)) form_view_ = true;
+  widgets->RecordLastItem("form view");
+  ImGui::SameLine();
+  if (ImGui::RadioButton("JSON", !form_view_)) form_view_ = false;
+  widgets->RecordLastItem("json view");
+  const ImVec2 size(-1, ImGui::GetTextLineHeight() * 12);
+  form_.Update(text_.data(), registry_.get());
+  if (form_view_) {
+    // Taller than the text: an option takes two rows.
+    if (const std::optional<std::string> edited = form_.Draw(size.y * 2, widgets)) {
+      SetText(*edited);  // clears the messages, as typing does
+      form_.Update(text_.data(), registry_.get());
+    }
+  } else if (ImGui::InputTextMultiline("##manifest json", text_.data(), text_.size(), size)) {
+    status_.clear();  // a "valid" or "saved" no longer describes the text
+    error_.clear();
+    form_.Update(text_.data(), registry_.get());
+  }
+  widgets->RecordLastItem(form_view_ ? "option form" : "manifest json");
+  // One line either way, so that the buttons stay: the first invalid option (before Run
+  // refuses it; once Check has named it below, not twice), else the hint. A click on it
+  // shows that option in the form.
+  const std::vector<std::string>& problems = form_.Problems();
+  if (!problems.empty() && error_.find(problems.front()) == std::string::npos) {
+    ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(1.0f, 0.35f, 0.3f, 1.0f));
+    FitText(problems.front() + MoreProblems(problems.size()), widgets);
+    ImGui::PopStyleColor();
+    widgets->RecordLastItem("first problem");
+    if (ImGui::IsItemClicked()) {
+      form_view_ = true;
+      form_.ScrollToFirstProblem();
+    }
+  } else {
+    FitText("Run uses this text; saving is optional", widgets, /*disabled=*/true);
+  }
+}
+
 void ManifestEditorPanel::Draw(WidgetRects* widgets) {
   const bool open = ImGui::CollapsingHeader("Pipeline: plugins and options (manifest editor)");
   widgets->RecordLastItem("manifest editor");  // recorded closed too, to be clicked open
@@ -430,12 +482,7 @@ void ManifestEditorPanel::Draw(WidgetRects* widgets) {
       -(ImGui::CalcTextSize("bundle_adjuster").x + ImGui::GetStyle().ItemInnerSpacing.x));
   for (const char* kind : kSlots) DrawSlot(kind, widgets);
   ImGui::PopItemWidth();
-  if (ImGui::InputTextMultiline("##manifest json", text_.data(), text_.size(),
-                                ImVec2(-1, ImGui::GetTextLineHeight() * 12))) {
-    status_.clear();  // a "valid" or "saved" no longer describes the text
-    error_.clear();
-  }
-  HintText("Run uses this text; saving is optional");
+  DrawViews(widgets);
   if (ImGui::Button("Check")) Check();
   ImGui::SameLine();
   if (ImGui::Button("Reload")) RequestLoad();

@@ -1,11 +1,14 @@
 #pragma once
 
 // The manifest editor, a collapsing section of the set-up window: the manifest's JSON in
-// a text box (loaded from the manifest field's file, or the default manifest), one plugin
-// per slot chosen from the plugins found on the plugin path, Check (as `tessera run`
-// does: parsed, every plugin created with its options), Reload, and Save as, which makes
-// the saved file the manifest field's. Once loaded, the editor's text is what Run runs;
-// it is reloaded when the manifest field names another file.
+// a text box (loaded from the manifest field's file, or the default manifest) or, with
+// the Form / JSON switch, each slot's options as a form built from its plugin's
+// description (option_form_view.h; edits rewrite the text), one plugin per slot chosen
+// from the plugins found on the plugin path, Check (as `tessera run` does: parsed, every
+// plugin created with its options; first, every option against its plugin's
+// description), Reload, and Save as, which makes the saved file the manifest field's.
+// Once loaded, the editor's text is what Run runs; it is reloaded when the manifest field
+// names another file.
 
 #include <filesystem>
 #include <map>
@@ -17,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "gui/option_form_view.h"
 #include "gui/panel_widgets.h"
 #include "gui/widget_rects.h"
 
@@ -40,7 +44,9 @@ class ManifestEditorPanel {
   // Each is false with the message in Error().
   // Loads the manifest field's file (empty: the default manifest) into the editor.
   bool Load();
-  // Checks the editor's JSON as `tessera run` does.
+  // Checks the editor's JSON as `tessera run` does, after its options against their
+  // plugins' descriptions (the form's problems, the first named with its JSON path): an
+  // invalid option refuses Run with its reason.
   bool Check();
   // Saves the editor's JSON to `file` (after checking) and sets the manifest field to it.
   bool Save(const std::filesystem::path& file);
@@ -97,6 +103,13 @@ class ManifestEditorPanel {
   // Whether the editor holds a manifest (it is loaded when first opened).
   bool Loaded() const { return text_[0] != '\0'; }
 
+  // Shows the options as a form (true) or the JSON text (false), as the switch does.
+  void ShowForm(bool form) { form_view_ = form; }
+  bool FormShown() const { return form_view_; }
+  // The form of the editor's text as last drawn or checked.
+  const OptionFormView& form() const { return form_; }
+  OptionFormView& form() { return form_; }
+
   // Replaces the text; as typing does, a new text clears the messages about the old.
   void SetText(const std::string& text);
   std::string Text() const { return text_.data(); }
@@ -114,6 +127,10 @@ class ManifestEditorPanel {
   // A slot's dropdown (recorded as "slot KIND", its entries as "plugin KIND NAME"), its
   // preview the plugin the text names, and that plugin's description beneath it.
   void DrawSlot(const std::string& kind, WidgetRects* widgets);
+  // The Form / JSON switch (recorded as "form view" and "json view"), the view chosen
+  // ("option form" or "manifest json") and a line beneath: the first invalid option, or
+  // a hint.
+  void DrawViews(WidgetRects* widgets);
 
   PathField* manifest_field_;
   std::vector<char> text_ = std::vector<char>(1 << 16, '\0');
@@ -145,6 +162,8 @@ class ManifestEditorPanel {
   // Per kind: each plugin's name and description.
   std::map<std::string, std::vector<std::pair<std::string, std::string>>> plugins_by_kind_;
   std::map<std::string, std::string> descriptions_shown_;  // per slot, DescriptionShown
+  bool form_view_ = false;                                 // the switch: Form (true) or JSON
+  OptionFormView form_;
 };
 
 }  // namespace tessera::gui
