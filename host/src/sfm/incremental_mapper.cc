@@ -13,9 +13,9 @@
 #include "estimators/ransac.h"
 #include "geometry/essential_matrix.h"
 #include "geometry/triangulation.h"
-#include "sfm/option_ranges.h"
 #include "sfm/rig_poses.h"
 #include "tessera/io/model_statistics.h"
+#include "tessera/option_list.h"
 #include "tessera/sfm/camera_plausibility.h"
 #include "util/angles.h"
 #include "util/random.h"
@@ -875,7 +875,7 @@ void IncrementalMapper::BeginFinalRounds() {
 }
 
 void MapperRansacOptions::Check() const {
-  const option_ranges::Checker check("MapperRansacOptions");
+  const option_list::Checker check("MapperRansacOptions");
   check("init_confidence", init_confidence, 0.01, 1 - 1e-12);
   check("init_min_inlier_ratio", init_min_inlier_ratio, 1e-6, 1.0);
   check("init_max_num_trials", init_max_num_trials, 1, 100000000);
