@@ -9,8 +9,8 @@ namespace tessera {
 
 namespace {
 
-// Every field, with its range and its one line of help (tessera/option_list.h): FromJson
-// and Check() read the same list.
+// Every field, with its range and its one line of help (tessera/option_list.h): FromJson,
+// Check() and Describe() read the same list.
 template <typename Options, typename Visitor>
 void VisitGlobalMapperOptions(Options& o, const Visitor& visit) {
   visit("min_num_matches", o.min_num_matches, 5, 100000,
@@ -96,6 +96,11 @@ void GlobalMapperOptions::Check() const {
   const option_list::Checker check("GlobalMapperOptions");
   VisitGlobalMapperOptions(*this, check);
   check("num_threads", num_threads, 1, 1024);
+}
+
+nlohmann::json GlobalMapperOptions::Describe() {
+  return option_list::DescribeAsJson<GlobalMapperOptions>(
+      [](GlobalMapperOptions& o, const auto& visit) { VisitGlobalMapperOptions(o, visit); });
 }
 
 nlohmann::json GlobalMapperOptions::ToJson() const {

@@ -7,8 +7,8 @@ namespace tessera {
 
 namespace {
 
-// Every field, with its range and its one line of help (tessera/option_list.h): FromJson
-// and Check() read the same list.
+// Every field, with its range and its one line of help (tessera/option_list.h): FromJson,
+// Check() and Describe() read the same list.
 template <typename Options, typename Visitor>
 void VisitIncrementalMapperOptions(Options& o, const Visitor& visit) {
   visit("min_num_matches", o.min_num_matches, 5, 100000,
@@ -129,6 +129,13 @@ void IncrementalMapperOptions::Check() const {
   const option_list::Checker check("IncrementalMapperOptions");
   VisitIncrementalMapperOptions(*this, check);
   check("num_threads", num_threads, 1, 1024);
+}
+
+nlohmann::json IncrementalMapperOptions::Describe() {
+  return option_list::DescribeAsJson<IncrementalMapperOptions>(
+      [](IncrementalMapperOptions& o, const auto& visit) {
+        VisitIncrementalMapperOptions(o, visit);
+      });
 }
 
 nlohmann::json IncrementalMapperOptions::ToJson() const {

@@ -82,8 +82,8 @@ std::optional<Georeference> Anchor(const MapperInput& input, const BundleAdjuste
 
 namespace {
 
-// Every field, with its range and its one line of help (tessera/option_list.h): FromJson
-// and Check() read the same list.
+// Every field, with its range and its one line of help (tessera/option_list.h): FromJson,
+// Check() and Describe() read the same list.
 template <typename Options, typename Visitor>
 void VisitModelFinishingOptions(Options& o, const Visitor& visit) {
   visit("reg_max_rotation_error", "max_rotation_error_deg", o.max_rotation_error_deg, 0.01, 180.0,
@@ -126,6 +126,11 @@ const std::vector<std::string>& ModelFinishingOptions::JsonKeys() {
                                                 "use_gps_prior",          "gps_horizontal_sigma",
                                                 "gps_vertical_sigma",     "gps_min_images"};
   return keys;
+}
+
+nlohmann::json ModelFinishingOptions::Describe() {
+  return option_list::DescribeAsJson<ModelFinishingOptions>(
+      [](ModelFinishingOptions& o, const auto& visit) { VisitModelFinishingOptions(o, visit); });
 }
 
 nlohmann::json ModelFinishingOptions::ToJson() const {
