@@ -16,8 +16,8 @@ void VisitGlobalMapperOptions(Options& o, const Visitor& visit) {
   visit("min_num_matches", o.min_num_matches, 5, 100000,
         "pairs with fewer verified inliers take no part");
   visit("min_relative_pair_strength", o.min_relative_pair_strength, 0.0, 1.0,
-        "nor pairs with fewer inliers than this share of the strongest pair of either of their "
-        "images (each image keeps its strongest pair); 0: every pair");
+        "pairs with fewer inliers than this share of the strongest pair of either of their "
+        "images take no part either (each image keeps its strongest pair); 0: every pair");
   visit("estimate_focal_length", o.estimate_focal_length,
         "focal lengths of cameras without a prior from the view graph, where the pairs "
         "determine them");
