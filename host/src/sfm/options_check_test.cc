@@ -72,9 +72,9 @@ TEST(OptionsCheck, IncrementalMapperOptionsNamesTheFieldAndThePipelineChecks) {
   EXPECT_EQ(ErrorOf([&] { IncrementalPipeline(options, adjuster, 0); }),
             "IncrementalMapperOptions: num_threads = 0 is out of range [1, 1024]");
   MapperRansacOptions ransac;
-  ransac.init_max_num_trials = 0;
+  ransac.init_ransac_max_num_trials = 0;
   EXPECT_EQ(ErrorOf([&] { IncrementalPipeline({}, adjuster, 0, ransac); }),
-            "MapperRansacOptions: init_max_num_trials = 0 is out of range [1, 100000000]");
+            "MapperRansacOptions: init_ransac_max_num_trials = 0 is out of range [1, 100000000]");
 }
 
 TEST(OptionsCheck, IncrementalMapperChecksItsOptions) {
