@@ -321,6 +321,26 @@ TEST(Manifest, ADuplicateKeyIsRefusedNamingItsPathAndTheFile) {
             "no error");
 }
 
+// The settings a manifest reads by one list (tessera/option_list.h) are checked with it
+// where they are used: a value out of its range names the struct and the field.
+TEST(Manifest, SettingsChecksNameTheStructAndTheField) {
+  EXPECT_NO_THROW(DistributedSettings().Check());
+  DistributedSettings distributed;
+  distributed.cluster_overlap = 0;
+  try {
+    distributed.Check();
+    ADD_FAILURE() << "cluster_overlap = 0 passed";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(),
+                 "DistributedSettings: cluster_overlap = 0 is out of range [1, 1000000]");
+  }
+  distributed = DistributedSettings();
+  distributed.cluster_max_images = 100;
+  EXPECT_THROW(distributed.Check(), InputError);
+  EXPECT_EQ(ErrorOf({{"distributed", {{"cluster_overlap", 0}}}}),
+            "m.json: distributed.cluster_overlap = 0 is out of range [1, 1000000]");
+}
+
 }  // namespace
 TEST(Manifest, DistributedClusterSizesDefaultAndAreChecked) {
   const Manifest plain = Manifest::FromJson(nlohmann::json::object(), "/base", "m.json");

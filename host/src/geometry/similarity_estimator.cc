@@ -62,8 +62,13 @@ std::vector<Eigen::Vector3d> Positions(const std::vector<SimilaritySample>& samp
 
 }  // namespace
 
+void SimilarityEstimatorOptions::Check() const {
+  VisitSimilarityEstimatorOptions(*this, option_list::Checker("SimilarityEstimatorOptions"));
+}
+
 SimilarityEstimator::SimilarityEstimator(SimilarityEstimatorOptions options)
     : options_(std::move(options)) {
+  options_.Check();
   if (options_.residual == SimilarityEstimatorOptions::Residual::kCustom &&
       !options_.custom_residual) {
     throw std::invalid_argument("SimilarityEstimator: a kCustom residual needs custom_residual");

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "geometry/similarity_transform.h"
+#include "tessera/option_list.h"
 
 namespace tessera {
 
@@ -46,7 +47,19 @@ struct SimilarityEstimatorOptions {
   double max_rotation_error_deg = 5.0;
   std::function<double(const SimilaritySample& target, const Eigen::Vector3d& moved_source)>
       custom_residual;
+
+  // Throws InputError naming the first numeric field out of its range
+  // (VisitSimilarityEstimatorOptions); SimilarityEstimator's constructor calls it.
+  void Check() const;
 };
+
+// Its numeric fields, with their ranges and one line of help (tessera/option_list.h).
+template <typename Options, typename Visit>
+void VisitSimilarityEstimatorOptions(Options& o, const Visit& visit) {
+  visit("max_rotation_error_deg", o.max_rotation_error_deg, 0.01, 180.0,
+        "degrees: kPositionAndOrientation refuses a sample whose orientations imply a rotation "
+        "this far from the model's");
+}
 
 class SimilarityEstimator {
  public:

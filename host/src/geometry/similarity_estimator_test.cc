@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "estimators/ransac.h"
+#include "tessera/errors.h"
 
 namespace tessera {
 namespace {
@@ -155,6 +156,20 @@ TEST(SimilarityEstimator, CustomResidualMustBeGiven) {
   SimilarityEstimatorOptions options;
   options.residual = SimilarityEstimatorOptions::Residual::kCustom;
   EXPECT_THROW(SimilarityEstimator{options}, std::invalid_argument);
+}
+
+TEST(SimilarityEstimator, OptionsOutOfRangeAreRefusedNamingTheField) {
+  SimilarityEstimatorOptions options;
+  options.max_rotation_error_deg = 0;
+  try {
+    SimilarityEstimator estimator(options);
+    ADD_FAILURE() << "max_rotation_error_deg = 0 passed";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(),
+                 "SimilarityEstimatorOptions: max_rotation_error_deg = 0 is out of range [0.01, "
+                 "180]");
+  }
+  EXPECT_NO_THROW(SimilarityEstimatorOptions().Check());
 }
 
 TEST(SimilarityEstimator, SameSeedSameReport) {

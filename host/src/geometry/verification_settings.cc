@@ -17,4 +17,10 @@ nlohmann::json VerificationSettings::ToJson() const {
           {"max_H_inlier_ratio", max_H_inlier_ratio}};
 }
 
+void VerificationSettings::Check() const {
+  const option_list::Checker check("VerificationSettings");
+  VisitVerificationSettings(*this, check);
+  check("min_num_trials", min_num_trials, 1, max_num_trials);
+}
+
 }  // namespace tessera

@@ -4,6 +4,8 @@
 
 #include <vector>
 
+#include "tessera/errors.h"
+
 namespace tessera {
 namespace {
 
@@ -30,6 +32,24 @@ TEST(VerificationSettings, EveryFieldChangesTheJson) {
   changed[5].min_num_inliers = 30;
   changed[6].max_H_inlier_ratio = 0.7;
   for (const VerificationSettings& settings : changed) EXPECT_NE(settings.ToJson(), defaults);
+}
+
+// Check() refuses a field out of the range the manifest reads it with, naming the struct
+// and the field, and min_num_trials above max_num_trials.
+TEST(VerificationSettings, CheckNamesTheStructAndTheField) {
+  EXPECT_NO_THROW(VerificationSettings().Check());
+  VerificationSettings settings;
+  settings.confidence = 1;
+  try {
+    settings.Check();
+    ADD_FAILURE() << "confidence = 1 passed";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(),
+                 "VerificationSettings: confidence = 1 is out of range [0.5, 0.999999]");
+  }
+  settings = VerificationSettings();
+  settings.min_num_trials = 20000;
+  EXPECT_THROW(settings.Check(), InputError);
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 #include "tessera/camera_models.h"
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
+#include "tessera/option_list.h"
 #include "tessera/options.h"
 
 namespace tessera {
@@ -180,13 +181,7 @@ class DuplicateKeyCheck {
 VerificationSettings ParseVerification(const nlohmann::json& json) {
   OptionReader reader(json, "verification");
   VerificationSettings s;
-  s.max_error_px = reader.Get<double>("max_error_px", s.max_error_px, 0.1, 100);
-  s.confidence = reader.Get<double>("confidence", s.confidence, 0.5, 0.999999);
-  s.min_num_trials = reader.Get<int>("min_num_trials", s.min_num_trials, 1, 1000000);
-  s.max_num_trials = reader.Get<int>("max_num_trials", s.max_num_trials, 1, 1000000);
-  s.min_inlier_ratio = reader.Get<double>("min_inlier_ratio", s.min_inlier_ratio, 0.01, 1);
-  s.min_num_inliers = reader.Get<int>("min_num_inliers", s.min_num_inliers, 8, 100000);
-  s.max_H_inlier_ratio = reader.Get<double>("max_H_inlier_ratio", s.max_H_inlier_ratio, 0, 1);
+  VisitVerificationSettings(s, option_list::Reader(&reader));
   reader.Finish();
   if (s.min_num_trials > s.max_num_trials) {
     throw OptionError("verification.min_num_trials",
@@ -198,8 +193,7 @@ VerificationSettings ParseVerification(const nlohmann::json& json) {
 DistributedSettings ParseDistributed(const nlohmann::json& json) {
   OptionReader reader(json, "distributed");
   DistributedSettings s;
-  s.cluster_max_images = reader.Get<int>("cluster_max_images", s.cluster_max_images, 2, 1000000);
-  s.cluster_overlap = reader.Get<int>("cluster_overlap", s.cluster_overlap, 1, 1000000);
+  VisitDistributedSettings(s, option_list::Reader(&reader));
   reader.Finish();
   // A cluster must hold more than the overlaps with its neighbours on either side.
   if (s.cluster_max_images < 3 * s.cluster_overlap) {
@@ -212,6 +206,16 @@ DistributedSettings ParseDistributed(const nlohmann::json& json) {
 }
 
 }  // namespace
+
+void DistributedSettings::Check() const {
+  const option_list::Checker check("DistributedSettings");
+  VisitDistributedSettings(*this, check);
+  if (cluster_max_images < 3 * cluster_overlap) {
+    throw InputError(
+        "DistributedSettings: cluster_max_images = " + std::to_string(cluster_max_images) +
+        " is less than 3 times cluster_overlap (" + std::to_string(cluster_overlap) + ")");
+  }
+}
 
 Eigen::Matrix3d ReadCalibrationMatrixFile(const std::filesystem::path& file) {
   // Names a folder as such; a BOM (as Windows editors write) is not part of a number.

@@ -31,7 +31,21 @@ struct DistributedSettings {
   int cluster_max_images = 300;
   // Images a cluster shares with each neighbour (the strongest edges across the cut).
   int cluster_overlap = 40;
+
+  // Throws InputError naming the first field out of its range (VisitDistributedSettings)
+  // or cluster_max_images below 3 times cluster_overlap; the partition stage calls it.
+  void Check() const;
 };
+
+// Every field, with its range and one line of help (tessera/option_list.h): the
+// manifest's "distributed" object is read, and Check() checks, with the same list.
+template <typename Settings, typename Visit>
+void VisitDistributedSettings(Settings& s, const Visit& visit) {
+  visit("cluster_max_images", s.cluster_max_images, 2, 1000000,
+        "a cluster holds at most this many images, overlap included");
+  visit("cluster_overlap", s.cluster_overlap, 1, 1000000,
+        "images a cluster shares with each neighbour (the strongest edges across the cut)");
+}
 
 // The whole run configuration. Parsed and checked completely before any image is
 // read; an error names the JSON path and suggests the closest valid key.

@@ -39,8 +39,13 @@ std::vector<SharedImage> SharedImages(const Reconstruction& source, const Recons
 
 }  // namespace
 
+void CenterAlignmentOptions::Check() const {
+  VisitCenterAlignmentOptions(*this, option_list::Checker("CenterAlignmentOptions"));
+}
+
 CenterAlignment AlignByCameraCenters(const Reconstruction& source, const Reconstruction& target,
                                      const CenterAlignmentOptions& options, uint64_t seed) {
+  options.Check();
   CenterAlignment result;
   const std::vector<SharedImage> shared = SharedImages(source, target);
   for (const SharedImage& s : shared) result.shared.push_back(s.name);

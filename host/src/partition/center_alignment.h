@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "geometry/similarity_transform.h"
+#include "tessera/option_list.h"
 #include "tessera/reconstruction.h"
 
 namespace tessera {
@@ -28,7 +29,27 @@ struct CenterAlignmentOptions {
   // Fewer of the shared images agreeing: no alignment (one of the models is likely
   // wrong, folded or drifted, and a merge would bend the other).
   double min_inlier_ratio = 0.7;
+
+  // Throws InputError naming the first field out of its range
+  // (VisitCenterAlignmentOptions); AlignByCameraCenters calls it.
+  void Check() const;
 };
+
+// Every field, with its range and one line of help (tessera/option_list.h).
+template <typename Options, typename Visit>
+void VisitCenterAlignmentOptions(Options& o, const Visit& visit) {
+  visit("min_shared_images", o.min_shared_images, 3, 100000000,
+        "fewer shared registered images: no alignment");
+  visit("max_center_error", o.max_center_error, 1e-6, 10.0,
+        "a shared image agrees when its moved centre lies within this fraction of the target's "
+        "scene size");
+  visit("max_rotation_error_deg", o.max_rotation_error_deg, 0.01, 180.0,
+        "degrees: and its orientations differ by at most this");
+  visit("max_num_hypotheses", o.max_num_hypotheses, 1, 100000000,
+        "samples of shared images tried at most");
+  visit("min_inlier_ratio", o.min_inlier_ratio, 0.0, 1.0,
+        "fewer of the shared images agreeing: no alignment");
+}
 
 struct CenterAlignment {
   bool success = false;

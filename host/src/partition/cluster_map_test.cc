@@ -6,6 +6,7 @@
 #include <memory>
 #include <set>
 
+#include "partition/hierarchical_map.h"
 #include "partition/partition_stage.h"
 #include "pipeline/mapping_summary.h"
 #include "pipeline/stage_test_util.h"
@@ -146,6 +147,20 @@ TEST_F(MapClusterTest, TheCommandMapsTheClusterInAProcessOfItsOwn) {
                               " is already mapped for this clusters.json"),
             std::string::npos)
       << again.output;
+}
+
+// map --hierarchical's options are checked before anything runs: a count out of its range
+// names the struct and the field.
+TEST(HierarchicalMap, OptionsOutOfRangeAreRefusedNamingTheField) {
+  EXPECT_NO_THROW(HierarchicalMapOptions().Check());
+  HierarchicalMapOptions options;
+  options.jobs = -1;
+  try {
+    options.Check();
+    ADD_FAILURE() << "jobs = -1 passed";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(), "HierarchicalMapOptions: jobs = -1 is out of range [0, 1024]");
+  }
 }
 
 }  // namespace

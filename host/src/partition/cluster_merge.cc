@@ -6,6 +6,7 @@
 #include <set>
 
 #include "geometry/similarity_transform.h"
+#include "tessera/option_list.h"
 #include "tessera/sfm/model_finishing.h"
 
 namespace tessera {
@@ -330,10 +331,16 @@ std::string ClusterMergeRecord::Line() const {
          (degenerate ? " (shared centres nearly on a line)" : "");
 }
 
+void ClusterMergeOptions::Check() const {
+  VisitClusterMergeOptions(*this, option_list::Checker("ClusterMergeOptions"));
+  alignment.Check();
+}
+
 ClusterMergeResult MergeClusterModels(const ClusterTreeNode& tree,
                                       std::map<int, std::vector<Reconstruction>> models,
                                       const BundleAdjuster& adjuster,
                                       const ClusterMergeOptions& options) {
+  options.Check();
   TreeMerger merger(std::move(models), adjuster, options);
   ClusterMergeResult result;
   result.models = merger.Merge(tree);

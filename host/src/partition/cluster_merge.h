@@ -34,7 +34,27 @@ struct ClusterMergeOptions {
   int merge_max_num_iterations = 10;
   double merge_function_tolerance = 1e-3;
   uint64_t seed = 0;
+
+  // Throws InputError naming the first field out of its range (VisitClusterMergeOptions,
+  // then alignment's); MergeClusterModels calls it.
+  void Check() const;
 };
+
+// Its own fields but the seed, with their ranges and one line of help
+// (tessera/option_list.h).
+template <typename Options, typename Visit>
+void VisitClusterMergeOptions(Options& o, const Visit& visit) {
+  visit("max_reprojection_error", o.max_reprojection_error, 1e-3, 1000.0,
+        "px: observations reprojecting further after the merge's bundle adjustment are dropped");
+  visit("max_merge_loss", o.max_merge_loss, 0.0, 1.0, "share of the images a merge may lose");
+  visit("merge_seam_rings", o.merge_seam_rings, 0, 100,
+        "rings of images around the shared ones that each merge's adjustment refines");
+  visit("merge_max_num_iterations", o.merge_max_num_iterations, 1, 10000,
+        "iterations at most of each merge's adjustment");
+  visit("merge_function_tolerance", o.merge_function_tolerance, 0.0, 1.0,
+        "each merge's adjustment stops once an iteration lowers the cost by less than this "
+        "fraction");
+}
 
 // One merge decision.
 struct ClusterMergeRecord {

@@ -9,6 +9,7 @@
 #include "eval/evaluation.h"
 #include "geometry/similarity_transform.h"
 #include "synthetic_scene.h"
+#include "tessera/errors.h"
 #include "test_support.h"
 
 namespace tessera {
@@ -274,6 +275,29 @@ TEST(CenterAlignment, RecoversASimilarityDespiteAWrongImage) {
   EXPECT_FALSE(weak.success);
   EXPECT_EQ(weak.reason,
             "share 60 registered images, of which 30 agree on one similarity (need 70%)");
+}
+
+// The merge's options are checked before any model is touched: a value out of its range
+// names the struct and the field, the alignment's as well.
+TEST(ClusterMerge, OptionsOutOfRangeAreRefusedNamingTheField) {
+  EXPECT_NO_THROW(ClusterMergeOptions().Check());
+  ClusterMergeOptions options;
+  options.max_merge_loss = 2;
+  try {
+    options.Check();
+    ADD_FAILURE() << "max_merge_loss = 2 passed";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(), "ClusterMergeOptions: max_merge_loss = 2 is out of range [0, 1]");
+  }
+  options = ClusterMergeOptions();
+  options.alignment.min_shared_images = 2;
+  try {
+    AlignByCameraCenters(Reconstruction(), Reconstruction(), options.alignment, 0);
+    ADD_FAILURE() << "min_shared_images = 2 passed";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(),
+                 "CenterAlignmentOptions: min_shared_images = 2 is out of range [3, 100000000]");
+  }
 }
 
 }  // namespace

@@ -44,9 +44,14 @@ ClustersFile CurrentClusters(const PipelineContext& context, const RunOptions& o
 
 }  // namespace
 
+void HierarchicalMapOptions::Check() const {
+  VisitHierarchicalMapOptions(*this, option_list::Checker("HierarchicalMapOptions"));
+}
+
 MapStageSummary MapHierarchically(const PipelineContext& context, const RunOptions& options,
                                   const HierarchicalMapOptions& hierarchical,
                                   const StageControl& control) {
+  hierarchical.Check();
   const Timer timer;
   context.Require("bundle_adjuster", "map");
   {

@@ -12,6 +12,7 @@
 #include "pipeline/pipeline_context.h"
 #include "pipeline/run_pipeline.h"
 #include "pipeline/stage_control.h"
+#include "tessera/option_list.h"
 
 namespace tessera {
 
@@ -21,7 +22,19 @@ struct HierarchicalMapOptions {
   std::filesystem::path camera_K;  // each cluster process's known intrinsics (empty: none)
   int jobs = 0;                    // cluster processes at once; 0: half the cores
   int threads = 0;                 // each cluster process's threads; 0: the cores / jobs
+
+  // Throws InputError naming the first numeric field out of its range
+  // (VisitHierarchicalMapOptions); MapHierarchically calls it.
+  void Check() const;
 };
+
+// Its numeric fields, with their ranges (as the command line's) and one line of help
+// (tessera/option_list.h).
+template <typename Options, typename Visit>
+void VisitHierarchicalMapOptions(Options& o, const Visit& visit) {
+  visit("jobs", o.jobs, 0, 1024, "cluster processes at once; 0: half the cores");
+  visit("threads", o.threads, 0, 1024, "each cluster process's threads; 0: the cores / jobs");
+}
 
 // Throws InputError naming each cluster whose process failed (exit codes other than 0
 // and 3, no model), after all have run; a cluster already mapped is skipped by its

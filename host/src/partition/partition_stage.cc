@@ -213,6 +213,7 @@ ClustersFile PartitionWorkspace(const Workspace& workspace, const PipelineContex
     throw InputError(database.path().string() +
                      ": no verified image pairs in the workspace; run match first");
   }
+  manifest.distributed.Check();
   PartitionOptions options;
   options.max_nodes = static_cast<size_t>(manifest.distributed.cluster_max_images);
   options.overlap = static_cast<size_t>(manifest.distributed.cluster_overlap);

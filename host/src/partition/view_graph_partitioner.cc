@@ -11,6 +11,8 @@
 #include <string>
 #include <utility>
 
+#include "tessera/errors.h"
+
 namespace tessera {
 namespace {
 
@@ -520,13 +522,17 @@ class Partitioner {
 
 }  // namespace
 
+void PartitionOptions::Check() const {
+  VisitPartitionOptions(*this, option_list::Checker("PartitionOptions"));
+  if (max_nodes < 3 * overlap) {
+    throw InputError("PartitionOptions: max_nodes = " + std::to_string(max_nodes) +
+                     " is less than 3 times overlap (" + std::to_string(overlap) + ")");
+  }
+}
+
 ViewGraphPartition PartitionViewGraph(size_t num_nodes, const std::vector<WeightedEdge>& edges,
                                       const PartitionOptions& options) {
-  if (options.overlap < 1 || options.max_nodes < 3 * options.overlap) {
-    throw std::invalid_argument(
-        "PartitionViewGraph: max_nodes " + std::to_string(options.max_nodes) +
-        " is less than 3 times the overlap " + std::to_string(options.overlap));
-  }
+  options.Check();
   return Partitioner(num_nodes, edges, options).Run();
 }
 

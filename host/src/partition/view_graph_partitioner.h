@@ -12,6 +12,8 @@
 #include <cstddef>
 #include <vector>
 
+#include "tessera/option_list.h"
+
 namespace tessera {
 
 struct WeightedEdge {
@@ -25,7 +27,21 @@ struct PartitionOptions {
   size_t max_nodes = 300;
   // Nodes a cluster takes from each neighbouring cluster (as long as it has room).
   size_t overlap = 40;
+
+  // Throws InputError naming the first field out of its range
+  // (VisitPartitionOptions), or max_nodes below 3 times overlap: a cluster must hold
+  // more than its overlaps on either side. PartitionViewGraph calls it.
+  void Check() const;
 };
+
+// Every field, with its range and one line of help (tessera/option_list.h).
+template <typename Options, typename Visit>
+void VisitPartitionOptions(Options& o, const Visit& visit) {
+  visit("max_nodes", o.max_nodes, 3, 100000000,
+        "a cluster holds at most this many nodes, overlap included");
+  visit("overlap", o.overlap, 1, 100000000,
+        "nodes a cluster takes from each neighbouring cluster, as long as it has room");
+}
 
 // The bisection tree: a leaf names a cluster, an inner node its children (two after a
 // bisection; one per connected component at the root of a disconnected graph).
@@ -77,8 +93,8 @@ struct ViewGraphPartition {
 };
 
 // Partitions nodes 0..num_nodes-1 joined by `edges` (an edge given twice counts
-// twice). Throws std::invalid_argument when options.max_nodes < 3 * options.overlap or
-// an edge names a node out of range.
+// twice). Throws InputError when `options` fail their Check(), std::invalid_argument
+// when an edge names a node out of range.
 ViewGraphPartition PartitionViewGraph(size_t num_nodes, const std::vector<WeightedEdge>& edges,
                                       const PartitionOptions& options);
 

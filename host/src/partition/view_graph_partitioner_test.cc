@@ -9,6 +9,8 @@
 #include <set>
 #include <string>
 
+#include "tessera/errors.h"
+
 namespace tessera {
 namespace {
 
@@ -333,8 +335,21 @@ TEST(ViewGraphPartitioner, TwoLoopsJoinedAreNoSingleLoop) {
 }
 
 TEST(ViewGraphPartitioner, RefusesAClusterSizeBelowThreeOverlaps) {
-  EXPECT_THROW(PartitionViewGraph(10, {}, {29, 10}), std::invalid_argument);
   EXPECT_THROW(PartitionViewGraph(2, {{0, 2, 1}}, {30, 10}), std::invalid_argument);
+  try {
+    PartitionViewGraph(10, {}, {29, 10});
+    ADD_FAILURE() << "max_nodes 29 with overlap 10 passed";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(),
+                 "PartitionOptions: max_nodes = 29 is less than 3 times overlap (10)");
+  }
+  // A value out of its range names the struct and the field.
+  try {
+    PartitionViewGraph(10, {}, {300, 0});
+    ADD_FAILURE() << "overlap 0 passed";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(), "PartitionOptions: overlap = 0 is out of range [1, 100000000]");
+  }
 }
 
 }  // namespace

@@ -402,6 +402,7 @@ void RecordSelectedPairs(const MatchSettings& settings, const MatchPlan& plan, D
 MatchingSummary MatchFeatures(const Workspace& workspace, const MatchSettings& settings,
                               const StageScope& scope, const StageControl& control) {
   const Timer timer;
+  settings.verification.Check();
   MatchingSummary summary;
   if (settings.pair_selectors == nullptr || settings.matcher == nullptr ||
       settings.pair_selectors->size() != settings.pair_selector_paths.size()) {

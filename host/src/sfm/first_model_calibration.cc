@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "sfm/model_growth.h"
+#include "tessera/option_list.h"
 #include "tessera/sfm/global_mapper_options.h"
 #include "tessera/sfm/verified_pairs.h"
 
@@ -113,9 +114,16 @@ std::map<camera_t, FirstModelFocalLength> FocalLengthsFromFirstModels(
   return refined;
 }
 
+void FirstModelCalibrationOptions::Check() const {
+  const option_list::Checker check("FirstModelCalibrationOptions");
+  check("min_view_graph_pairs", min_view_graph_pairs, 0, 1000000);
+  view_graph.Check();
+}
+
 CameraCalibration CalibrateCamerasWithoutPrior(const MapperRunState& run,
                                                const std::vector<const MapperInput::Pair*>& pairs,
                                                const FirstModelCalibrationOptions& options) {
+  options.Check();
   CameraCalibration calibration;
   calibration.cameras = run.cameras;
   std::map<camera_t, FocalLengthReport> by_camera;

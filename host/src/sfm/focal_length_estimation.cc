@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "sfm/option_ranges.h"
+#include "tessera/option_list.h"
 
 namespace tessera {
 namespace {
@@ -139,7 +139,7 @@ std::map<camera_t, FocalLengthEstimate> EstimateFocalLengths(
 }
 
 void FocalLengthEstimationOptions::Check() const {
-  const option_ranges::Checker check("FocalLengthEstimationOptions");
+  const option_list::Checker check("FocalLengthEstimationOptions");
   check("min_num_inliers", min_num_inliers, 0, 100000000);
   check("min_num_pairs", min_num_pairs, 1, 100000000);
   check("min_factor", min_factor, 1e-3, max_factor);

@@ -48,6 +48,14 @@ GlobalPipelineOptions GlobalPipelineOptions::FromJson(const nlohmann::json& opti
   return parsed;
 }
 
+nlohmann::json GlobalPipelineOptions::Describe() {
+  nlohmann::json described = GlobalMapperOptions::Describe();
+  for (const nlohmann::json& option : ModelFinishingOptions::Describe()) {
+    described.push_back(option);
+  }
+  return described;
+}
+
 nlohmann::json GlobalPipelineOptions::ToJson() const {
   nlohmann::json json = mapper.ToJson();
   json.update(finishing.ToJson());

@@ -6,7 +6,7 @@
 #include <memory>
 #include <random>
 
-#include "sfm/option_ranges.h"
+#include "tessera/option_list.h"
 #include "util/random.h"
 
 namespace tessera {
@@ -218,7 +218,7 @@ GlobalPositioningResult PositionGlobally(const std::map<camera_t, Camera>& camer
 }
 
 void GlobalPositioningOptions::Check() const {
-  const option_ranges::Checker check("GlobalPositioningOptions");
+  const option_list::Checker check("GlobalPositioningOptions");
   check("max_num_iterations", max_num_iterations, 1, 10000);
   check("huber_threshold", huber_threshold, 1e-4, 10.0);
   check("function_tolerance", function_tolerance, 0.0, 1.0);

@@ -11,7 +11,7 @@
 #include "estimators/ransac.h"
 #include "geometry/similarity_estimator.h"
 #include "geometry/similarity_transform.h"
-#include "sfm/option_ranges.h"
+#include "tessera/option_list.h"
 #include "tessera/sfm/gps_similarity.h"
 #include "util/random.h"
 #include "util/statistics.h"
@@ -339,7 +339,7 @@ GpsAnchoringReport AnchorModelToGps(const std::map<image_t, ImageMetadata>& meta
 }
 
 void GpsAnchoringOptions::Check() const {
-  const option_ranges::Checker check("GpsAnchoringOptions");
+  const option_list::Checker check("GpsAnchoringOptions");
   check("horizontal_sigma_m", horizontal_sigma_m, 1e-3, 1e6);
   check("vertical_sigma_m", vertical_sigma_m, 1e-3, 1e6);
   check("min_num_images", min_num_images, 3, 1000000);

@@ -13,9 +13,9 @@
 #include "estimators/ransac.h"
 #include "geometry/essential_matrix.h"
 #include "geometry/triangulation.h"
-#include "sfm/option_ranges.h"
 #include "sfm/rig_poses.h"
 #include "tessera/io/model_statistics.h"
+#include "tessera/option_list.h"
 #include "tessera/sfm/camera_plausibility.h"
 #include "util/angles.h"
 #include "util/random.h"
@@ -189,7 +189,7 @@ bool IncrementalMapper::EvaluateInitialPair(const MapperInput::Pair& pair,
                              2;
   ransac_options.confidence = run_.ransac.init_confidence;
   ransac_options.min_inlier_ratio = run_.ransac.init_min_inlier_ratio;
-  ransac_options.max_num_trials = run_.ransac.init_max_num_trials;
+  ransac_options.max_num_trials = run_.ransac.init_ransac_max_num_trials;
   const auto report =
       LORANSAC<EssentialMatrixFivePointEstimator, EssentialMatrixFivePointEstimator>(
           ransac_options,
@@ -875,10 +875,10 @@ void IncrementalMapper::BeginFinalRounds() {
 }
 
 void MapperRansacOptions::Check() const {
-  const option_ranges::Checker check("MapperRansacOptions");
+  const option_list::Checker check("MapperRansacOptions");
   check("init_confidence", init_confidence, 0.01, 1 - 1e-12);
   check("init_min_inlier_ratio", init_min_inlier_ratio, 1e-6, 1.0);
-  check("init_max_num_trials", init_max_num_trials, 1, 100000000);
+  check("init_ransac_max_num_trials", init_ransac_max_num_trials, 1, 100000000);
   check("abs_pose_confidence", abs_pose_confidence, 0.01, 1 - 1e-12);
   check("abs_pose_min_inlier_ratio_floor", abs_pose_min_inlier_ratio_floor, 1e-6, 1.0);
   check("abs_pose_max_num_trials", abs_pose_max_num_trials, 1, 100000000);

@@ -178,7 +178,7 @@ TEST(IncrementalMapper, RansacOptionsReachTheEstimators) {
     }
   };
   MapperSetup setup;
-  setup.run.ransac.init_max_num_trials = 0;
+  setup.run.ransac.init_ransac_max_num_trials = 0;
   expect_refused([&] { IncrementalMapper(setup.options, &setup.run).Initialize(); });
 
   // MapperRansacOptions::Check() refuses it as the mapper is built, before any step.

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "geometry/triangulation.h"
-#include "sfm/option_ranges.h"
+#include "tessera/option_list.h"
 #include "util/angles.h"
 
 namespace tessera {
@@ -182,7 +182,7 @@ size_t IncrementalTriangulator::Retriangulate() {
 }
 
 void IncrementalTriangulatorOptions::Check() const {
-  const option_ranges::Checker check("IncrementalTriangulatorOptions");
+  const option_list::Checker check("IncrementalTriangulatorOptions");
   check("max_error", max_error, 1e-3, 1000.0);
   check("min_angle", min_angle, 0.0, 180.0);
   check("max_num_pairs", max_num_pairs, 0, 100000000);

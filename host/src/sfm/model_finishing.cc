@@ -9,7 +9,7 @@
 #include <set>
 #include <utility>
 
-#include "sfm/option_ranges.h"
+#include "tessera/option_list.h"
 #include "tessera/options.h"
 #include "util/random.h"
 
@@ -82,16 +82,25 @@ std::optional<Georeference> Anchor(const MapperInput& input, const BundleAdjuste
 
 namespace {
 
-// Every field, with its range for the numbers (option_ranges.h): FromJson and Check()
-// read the same list.
+// Every field, with its range and its one line of help (tessera/option_list.h): FromJson,
+// Check() and Describe() read the same list.
 template <typename Options, typename Visitor>
 void VisitModelFinishingOptions(Options& o, const Visitor& visit) {
-  visit("reg_max_rotation_error", "max_rotation_error_deg", o.max_rotation_error_deg, 0.01, 180.0);
-  visit("min_model_agreement", o.min_model_agreement, 0.0, 1.0);
-  visit("use_gps_prior", o.use_gps_prior);
-  visit("gps_horizontal_sigma", "gps.horizontal_sigma_m", o.gps.horizontal_sigma_m, 1e-3, 1e6);
-  visit("gps_vertical_sigma", "gps.vertical_sigma_m", o.gps.vertical_sigma_m, 1e-3, 1e6);
-  visit("gps_min_images", "gps.min_num_images", o.gps.min_num_images, 3, 1000000);
+  visit("reg_max_rotation_error", "max_rotation_error_deg", o.max_rotation_error_deg, 0.01, 180.0,
+        "degrees: a pair agrees with a model when its relative rotation is the model's within "
+        "this");
+  visit("min_model_agreement", o.min_model_agreement, 0.0, 1.0,
+        "a model whose agreeing pairs hold a smaller share of its pairs' inliers may be folded: "
+        "a warning and possibly_folded in mapping_summary.json");
+  visit("use_gps_prior", o.use_gps_prior,
+        "anchor each model to its images' GPS, in a local east-north-up frame in metres, and "
+        "adjust it with every geotagged centre held to its GPS position");
+  visit("gps_horizontal_sigma", "gps.horizontal_sigma_m", o.gps.horizontal_sigma_m, 1e-3, 1e6,
+        "metres: the GPS positions' horizontal standard deviation, weighting the priors");
+  visit("gps_vertical_sigma", "gps.vertical_sigma_m", o.gps.vertical_sigma_m, 1e-3, 1e6,
+        "metres: the GPS positions' vertical standard deviation, weighting the priors");
+  visit("gps_min_images", "gps.min_num_images", o.gps.min_num_images, 3, 1000000,
+        "geotagged images a model needs to be anchored");
 }
 
 }  // namespace
@@ -100,12 +109,12 @@ ModelFinishingOptions ModelFinishingOptions::FromJson(const nlohmann::json& json
                                                       const std::string& path) {
   ModelFinishingOptions o;
   OptionReader reader(json, path);
-  VisitModelFinishingOptions(o, option_ranges::Reader(&reader));
+  VisitModelFinishingOptions(o, option_list::Reader(&reader));
   return o;
 }
 
 void ModelFinishingOptions::Check() const {
-  const option_ranges::Checker check("ModelFinishingOptions");
+  const option_list::Checker check("ModelFinishingOptions");
   VisitModelFinishingOptions(*this, check);
   check("num_threads", num_threads, 1, 1024);
   check("min_num_matches", min_num_matches, 1, 100000000);
@@ -117,6 +126,11 @@ const std::vector<std::string>& ModelFinishingOptions::JsonKeys() {
                                                 "use_gps_prior",          "gps_horizontal_sigma",
                                                 "gps_vertical_sigma",     "gps_min_images"};
   return keys;
+}
+
+nlohmann::json ModelFinishingOptions::Describe() {
+  return option_list::DescribeAsJson<ModelFinishingOptions>(
+      [](ModelFinishingOptions& o, const auto& visit) { VisitModelFinishingOptions(o, visit); });
 }
 
 nlohmann::json ModelFinishingOptions::ToJson() const {

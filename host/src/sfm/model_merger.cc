@@ -7,7 +7,7 @@
 
 #include "estimators/ransac.h"
 #include "geometry/similarity_estimator.h"
-#include "sfm/option_ranges.h"
+#include "tessera/option_list.h"
 
 namespace tessera {
 namespace {
@@ -141,7 +141,7 @@ ModelMergeReport MergeModels(const FeatureTracks& tracks, const ModelMergeOption
 }
 
 void ModelMergeOptions::Check() const {
-  const option_ranges::Checker check("ModelMergeOptions");
+  const option_list::Checker check("ModelMergeOptions");
   check("min_num_shared_points", min_num_shared_points, 3, 100000000);
   check("min_inlier_ratio", min_inlier_ratio, 0.0, 1.0);
   check("max_reproj_error", max_reproj_error, 1e-3, 1000.0);

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "tessera/errors.h"
+#include "tessera/sfm/first_model_calibration.h"
 #include "tessera/sfm/focal_length_estimation.h"
 #include "tessera/sfm/global_mapper.h"
 #include "tessera/sfm/global_mapper_options.h"
@@ -72,9 +73,9 @@ TEST(OptionsCheck, IncrementalMapperOptionsNamesTheFieldAndThePipelineChecks) {
   EXPECT_EQ(ErrorOf([&] { IncrementalPipeline(options, adjuster, 0); }),
             "IncrementalMapperOptions: num_threads = 0 is out of range [1, 1024]");
   MapperRansacOptions ransac;
-  ransac.init_max_num_trials = 0;
+  ransac.init_ransac_max_num_trials = 0;
   EXPECT_EQ(ErrorOf([&] { IncrementalPipeline({}, adjuster, 0, ransac); }),
-            "MapperRansacOptions: init_max_num_trials = 0 is out of range [1, 100000000]");
+            "MapperRansacOptions: init_ransac_max_num_trials = 0 is out of range [1, 100000000]");
 }
 
 TEST(OptionsCheck, IncrementalMapperChecksItsOptions) {
@@ -192,6 +193,18 @@ TEST(OptionsCheck, GlobalStepsCheckTheirOptions) {
   focal.max_factor = 0.1;  // below min_factor
   EXPECT_EQ(ErrorOf([&] { EstimateFocalLengths(MapperInput(), {}, focal); }),
             "FocalLengthEstimationOptions: min_factor = 0.25 is out of range [0.001, 0.1]");
+}
+
+TEST(OptionsCheck, FirstModelCalibrationChecksItsOptions) {
+  EXPECT_NO_THROW(FirstModelCalibrationOptions().Check());
+  FirstModelCalibrationOptions calibration;
+  calibration.min_view_graph_pairs = -1;
+  EXPECT_EQ(ErrorOf([&] { calibration.Check(); }),
+            "FirstModelCalibrationOptions: min_view_graph_pairs = -1 is out of range [0, 1000000]");
+  calibration = FirstModelCalibrationOptions();
+  calibration.view_graph.min_num_pairs = 0;
+  EXPECT_EQ(ErrorOf([&] { calibration.Check(); }),
+            "FocalLengthEstimationOptions: min_num_pairs = 0 is out of range [1, 100000000]");
 }
 
 }  // namespace

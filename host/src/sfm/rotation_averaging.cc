@@ -8,7 +8,7 @@
 #include <numeric>
 #include <queue>
 
-#include "sfm/option_ranges.h"
+#include "tessera/option_list.h"
 #include "util/angles.h"
 
 namespace tessera {
@@ -279,7 +279,7 @@ RotationAveragingResult AverageRotations(const std::vector<RelativeRotation>& pa
 }
 
 void RotationAveragingOptions::Check() const {
-  const option_ranges::Checker check("RotationAveragingOptions");
+  const option_list::Checker check("RotationAveragingOptions");
   check("num_l1_iterations", num_l1_iterations, 0, 10000);
   check("max_num_irls_iterations", max_num_irls_iterations, 0, 10000);
   check("robust_sigma_deg", robust_sigma_deg, 0.01, 180.0);

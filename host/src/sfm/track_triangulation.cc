@@ -4,7 +4,7 @@
 #include <limits>
 
 #include "geometry/triangulation.h"
-#include "sfm/option_ranges.h"
+#include "tessera/option_list.h"
 
 namespace tessera {
 namespace {
@@ -133,7 +133,7 @@ size_t TriangulateTracks(const std::vector<Track>& tracks, const TrackTriangulat
 }
 
 void TrackTriangulationOptions::Check() const {
-  const option_ranges::Checker check("TrackTriangulationOptions");
+  const option_list::Checker check("TrackTriangulationOptions");
   check("max_error_px", max_error_px, 1e-3, 1000.0);
   check("min_angle_deg", min_angle_deg, 0.0, 180.0);
   check("max_num_pairs", max_num_pairs, 0, 100000000);

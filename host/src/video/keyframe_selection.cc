@@ -23,8 +23,15 @@ double LocalLaplacianSharpness(const cv::Mat& gray, int cell_size) {
   return best;
 }
 
+void KeyframeSelectionOptions::Check() const {
+  const option_list::Checker check("KeyframeSelectionOptions");
+  VisitKeyframeSelectionOptions(*this, check);
+  check("min_frames", min_frames, 2, max_frames);
+}
+
 KeyframeSelection SelectKeyframes(const std::vector<FrameScore>& frames, int longer_side,
                                   const KeyframeSelectionOptions& options) {
+  options.Check();
   KeyframeSelection selection;
   const size_t n = frames.size();
   selection.segment.assign(n, -1);

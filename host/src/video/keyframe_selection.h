@@ -6,6 +6,8 @@
 #include <opencv2/core.hpp>
 #include <vector>
 
+#include "tessera/option_list.h"
+
 namespace tessera {
 
 // The highest standard deviation of the Laplacian over the cells of a grid of
@@ -20,7 +22,25 @@ struct KeyframeSelectionOptions {
   int target_frames = 0;
   // Accumulated motion between keyframes, as a fraction of the longer image side.
   double keyframe_motion = 0.08;
+
+  // Throws InputError naming the first field out of its range (VisitKeyframeSelectionOptions)
+  // or min_frames above max_frames ("KeyframeSelectionOptions: min_frames = 0 is out of
+  // range [2, 100000]"); SelectKeyframes calls it.
+  void Check() const;
 };
+
+// Every field, with its range and one line of help (tessera/option_list.h): Check() and
+// VideoFrameOptions::FromJson (the manifest's "video" object) read the same list.
+template <typename Options, typename Visit>
+void VisitKeyframeSelectionOptions(Options& o, const Visit& visit) {
+  visit("min_frames", o.min_frames, 2, 100000,
+        "keyframes kept per video at least; a video with fewer frames keeps every usable one");
+  visit("max_frames", o.max_frames, 2, 100000, "keyframes kept per video at most");
+  visit("target_frames", o.target_frames, 0, 100000,
+        "keyframes per video; 0: one per keyframe_motion of accumulated motion");
+  visit("keyframe_motion", o.keyframe_motion, 0.001, 10.0,
+        "accumulated optical flow between keyframes, as a fraction of the frame's longer side");
+}
 
 // One decoded frame: its scores.
 struct FrameScore {

@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "tessera/errors.h"
 #include "test_support.h"
 
 namespace tessera {
@@ -95,6 +96,30 @@ TEST(KeyframeSelection, FewerFramesThanTheMinimumAreAllKept) {
   EXPECT_TRUE(selection.too_few_frames);
   EXPECT_EQ(selection.selected, (std::vector<size_t>{0, 1, 2, 3}));
   EXPECT_TRUE(SelectKeyframes({}, 800, options).selected.empty());
+}
+
+// SelectKeyframes checks its options: a field out of its range, or min_frames above
+// max_frames, is refused naming the struct and the field.
+TEST(KeyframeSelection, OptionsOutOfRangeAreRefusedNamingTheField) {
+  const std::vector<FrameScore> frames(20);
+  KeyframeSelectionOptions options;
+  options.max_frames = 1;
+  try {
+    SelectKeyframes(frames, 640, options);
+    ADD_FAILURE() << "max_frames = 1 passed";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(),
+                 "KeyframeSelectionOptions: max_frames = 1 is out of range [2, 100000]");
+  }
+  options = KeyframeSelectionOptions();
+  options.min_frames = 20;
+  options.max_frames = 10;
+  try {
+    SelectKeyframes(frames, 640, options);
+    ADD_FAILURE() << "min_frames above max_frames passed";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(), "KeyframeSelectionOptions: min_frames = 20 is out of range [2, 10]");
+  }
 }
 
 }  // namespace

@@ -18,6 +18,7 @@
 #include "io/names.h"
 #include "tessera/errors.h"
 #include "tessera/io/file_io.h"
+#include "tessera/option_list.h"
 #include "tessera/options.h"
 #include "util/timer.h"
 #include "util/workspace_layout.h"
@@ -203,19 +204,20 @@ nlohmann::json VideoFrameOptions::ToJson() const {
 VideoFrameOptions VideoFrameOptions::FromJson(const nlohmann::json& json) {
   OptionReader reader(json, "video");
   VideoFrameOptions options;
-  KeyframeSelectionOptions& s = options.selection;
-  s.min_frames = reader.Get<int>("min_frames", s.min_frames, 2, 100000);
-  s.max_frames = reader.Get<int>("max_frames", s.max_frames, 2, 100000);
-  s.target_frames = reader.Get<int>("target_frames", s.target_frames, 0, 100000);
-  s.keyframe_motion = reader.Get<double>("keyframe_motion", s.keyframe_motion, 0.001, 10);
-  options.analysis_size = reader.Get<int>("analysis_size", options.analysis_size, 64, 8192);
-  options.jpeg_quality = reader.Get<int>("jpeg_quality", options.jpeg_quality, 1, 100);
+  const KeyframeSelectionOptions& s = options.selection;
+  VisitKeyframeSelectionOptions(options.selection, option_list::Reader(&reader));
+  VisitVideoFrameOptions(options, option_list::Reader(&reader));
   reader.Finish();
   if (s.min_frames > s.max_frames) {
     throw OptionError("video.min_frames",
                       "must not exceed max_frames (" + std::to_string(s.max_frames) + ")");
   }
   return options;
+}
+
+void VideoFrameOptions::Check() const {
+  selection.Check();
+  VisitVideoFrameOptions(*this, option_list::Checker("VideoFrameOptions"));
 }
 
 std::string VideoFrameName(int index, double time_s) {
@@ -226,6 +228,7 @@ std::string VideoFrameName(int index, double time_s) {
 
 VideoFrames ExtractVideoFrames(const fs::path& video, const std::string& folder,
                                const fs::path& frames_dir, const VideoFrameOptions& options) {
+  options.Check();
   VideoFrames result;
   result.video = video;
   result.folder = folder;

@@ -20,7 +20,19 @@ struct VideoFrameOptions {
   nlohmann::json ToJson() const;
   // The manifest's "video" object; throws OptionError naming `video.KEY`.
   static VideoFrameOptions FromJson(const nlohmann::json& json);
+  // Throws InputError naming the first field out of its range (selection's included);
+  // ExtractVideoFrames calls it.
+  void Check() const;
 };
+
+// Its own fields, after selection's (VisitKeyframeSelectionOptions), with their ranges
+// and help: FromJson and Check() read the same list.
+template <typename Options, typename Visit>
+void VisitVideoFrameOptions(Options& o, const Visit& visit) {
+  visit("analysis_size", o.analysis_size, 64, 8192,
+        "px: longer side of the copies whose sharpness and motion are scored");
+  visit("jpeg_quality", o.jpeg_quality, 1, 100, "JPEG quality of the kept frames");
+}
 
 // What one video gave.
 struct VideoFrames {

@@ -315,5 +315,29 @@ TEST(VideoFrames, OptionsComeFromTheManifestsVideoObject) {
   EXPECT_THROW(VideoFrameOptions::FromJson({{"min_frames", 60}, {"max_frames", 50}}), OptionError);
 }
 
+// Check(), which ExtractVideoFrames calls, refuses what FromJson refuses, naming the
+// struct and the field; the same list gives both their ranges.
+TEST(VideoFrames, CheckNamesTheStructAndTheField) {
+  EXPECT_NO_THROW(VideoFrameOptions().Check());
+  VideoFrameOptions options;
+  options.jpeg_quality = 0;
+  try {
+    options.Check();
+    ADD_FAILURE() << "jpeg_quality = 0 passed";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(), "VideoFrameOptions: jpeg_quality = 0 is out of range [1, 100]");
+  }
+  options = VideoFrameOptions();
+  options.selection.keyframe_motion = 0;
+  try {
+    options.Check();
+    ADD_FAILURE() << "keyframe_motion = 0 passed";
+  } catch (const InputError& error) {
+    EXPECT_STREQ(error.what(),
+                 "KeyframeSelectionOptions: keyframe_motion = 0 is out of range [0.001, 10]");
+  }
+  EXPECT_THROW(VideoFrameOptions::FromJson({{"keyframe_motion", 0}}), OptionError);
+}
+
 }  // namespace
 }  // namespace tessera

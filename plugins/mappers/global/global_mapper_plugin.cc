@@ -33,6 +33,7 @@ class GlobalMapperPlugin : public Mapper {
 
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS_FROM(tessera::GlobalPipelineOptions::Describe)
 TESSERA_PLUGIN(mapper, tessera::GlobalMapperPlugin, "global", "1.0.0",
                "Global mapping after GLOMAP: rotation averaging, then cameras and points "
                "positioned together, then bundle adjustment")

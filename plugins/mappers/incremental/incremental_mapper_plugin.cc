@@ -39,6 +39,7 @@ class IncrementalMapperPlugin : public Mapper {
 
 }  // namespace tessera
 
+TESSERA_PLUGIN_OPTIONS_FROM(tessera::IncrementalMapperOptions::Describe)
 TESSERA_PLUGIN(mapper, tessera::IncrementalMapperPlugin, "incremental", "1.0.0",
                "Incremental mapping after COLMAP: initial pair, next-best-view registration, "
                "triangulation, local and global bundle adjustment")

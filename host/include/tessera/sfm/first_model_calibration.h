@@ -68,6 +68,11 @@ struct FirstModelCalibrationOptions {
   FocalLengthEstimationOptions view_graph;
   // How first models are mapped.
   IncrementalMapperOptions first_model;
+
+  // Throws InputError naming the first field out of its range (min_view_graph_pairs, then
+  // view_graph's; first_model's are checked as each first model is mapped);
+  // CalibrateCamerasWithoutPrior calls it.
+  TESSERA_SFM_EXPORT void Check() const;
 };
 
 struct CameraCalibration {

@@ -96,6 +96,9 @@ struct TESSERA_SFM_EXPORT GlobalMapperOptions {
   // factory reads them: the host anchors it at pipeline.mapper.options).
   static GlobalMapperOptions FromJson(const nlohmann::json& json, const std::string& path = "");
   nlohmann::json ToJson() const;
+  // Every option FromJson reads, with its default, range and one line of help
+  // (tessera/option_list.h); GlobalPipelineOptions::Describe() adds the finishing step's.
+  static nlohmann::json Describe();
 
   // Throws InputError naming the first field out of its range, the same ranges FromJson
   // reads with (e.g. "GlobalMapperOptions: ba_num_rounds = 0 is out of range [1, 100]");

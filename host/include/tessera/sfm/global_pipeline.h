@@ -34,6 +34,10 @@ struct TESSERA_SFM_EXPORT GlobalPipelineOptions {
   // list) or a value out of its range.
   static GlobalPipelineOptions FromJson(const nlohmann::json& options);
   nlohmann::json ToJson() const;
+  // Every option FromJson reads, GlobalMapperOptions' then the finishing step's, with
+  // its default, range and one line of help (tessera/option_list.h): the global mapper
+  // plugin exports it (`tessera plugins global`).
+  static nlohmann::json Describe();
 };
 
 class TESSERA_SFM_EXPORT GlobalPipeline {

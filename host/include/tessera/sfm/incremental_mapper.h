@@ -42,10 +42,12 @@ namespace tessera {
 // The estimators' RANSAC settings, which the manifest does not set. Their thresholds
 // are IncrementalMapperOptions' (init_max_error, abs_pose_max_error, tri_max_error).
 struct MapperRansacOptions {
-  // Relative pose of a candidate initial pair: five-point LO-RANSAC on its matches.
+  // Relative pose of a candidate initial pair: five-point LO-RANSAC on its matches, of
+  // init_ransac_max_num_trials trials at most (IncrementalMapperOptions'
+  // init_max_num_trials is another bound: the candidate pairs tried).
   double init_confidence = 0.9999;
   double init_min_inlier_ratio = 0.25;
-  int init_max_num_trials = 10000;
+  int init_ransac_max_num_trials = 10000;
   // Registration: P3P/EPnP LO-RANSAC on the 2D-3D correspondences; the minimum inlier
   // ratio is abs_pose_min_inlier_ratio, but at least abs_pose_min_inlier_ratio_floor.
   double abs_pose_confidence = 0.9999;

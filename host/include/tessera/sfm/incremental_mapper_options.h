@@ -133,6 +133,10 @@ struct TESSERA_SFM_EXPORT IncrementalMapperOptions {
                                            const std::string& path = "");
   // Every option with its value, for provenance and logs.
   nlohmann::json ToJson() const;
+  // Every option FromJson reads, with its default (a default-constructed struct's, what
+  // FromJson({}) gives), range and one line of help, as tessera/option_list.h describes
+  // them: the incremental mapper plugin exports it (`tessera plugins incremental`).
+  static nlohmann::json Describe();
 
   // Throws InputError naming the first field out of its range, the same ranges FromJson
   // reads with (e.g. "IncrementalMapperOptions: min_num_matches = 2 is out of range [5, 100000]");

@@ -57,6 +57,9 @@ struct TESSERA_SFM_EXPORT ModelFinishingOptions {
   // The keys FromJson reads.
   static const std::vector<std::string>& JsonKeys();
   nlohmann::json ToJson() const;
+  // The options FromJson reads, with their defaults, ranges and one line of help each
+  // (tessera/option_list.h).
+  static nlohmann::json Describe();
 
   // Throws InputError naming the first field out of its range, the same ranges FromJson
   // reads with (e.g. "ModelFinishingOptions: min_model_agreement = 2 is out of range [0, 1]");
