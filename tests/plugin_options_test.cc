@@ -58,13 +58,14 @@ TEST(OptionDescriptions, AWellFormedDescriptionRoundTrips) {
         {"max", nullptr},
         {"help", ""}}});
   const std::vector<OptionDescription> options = ParseOptionDescriptions(described, "who");
-  ASSERT_EQ(options.size(), 4u);
+  ASSERT_EQ(options.size(), 5u);
   nlohmann::json again = nlohmann::json::array();
   for (const OptionDescription& option : options) again.push_back(option.ToJson());
   EXPECT_EQ(again, described);
   EXPECT_EQ(OptionRangeText(options[0]), "[0, 1]");
   EXPECT_EQ(OptionRangeText(options[1]), "'huber', 'cauchy'");
   EXPECT_EQ(OptionRangeText(options[3]), "");
+  EXPECT_EQ(OptionRangeText(options[4]), "(0, 1]");
 }
 
 TEST(OptionDescriptions, EachFaultIsOneLineNamingTheOption) {
@@ -74,6 +75,10 @@ TEST(OptionDescriptions, EachFaultIsOneLineNamingTheOption) {
             "who: options[0] ('ratio'): unknown type 'numbr'; did you mean 'number'?");
   EXPECT_EQ(ParseError(Option({{"default", "0.8"}})),
             "who: options[0] ('ratio'): the default \"0.8\" is not of type number");
+  EXPECT_EQ(ParseError(Option({{"default", 0}, {"min_exclusive", true}})),
+            "who: options[0] ('ratio'): the default 0 is out of its range (0, 1]");
+  EXPECT_EQ(ParseError(Option({{"min", nullptr}, {"min_exclusive", true}})),
+            "who: options[0] ('ratio'): 'min_exclusive' without 'min'");
   EXPECT_EQ(ParseError(Option({{"min", 2}})),
             "who: options[0] ('ratio'): 'min' 2 is above 'max' 1");
   EXPECT_EQ(ParseError(Option({{"helpp", "x"}})),
@@ -156,6 +161,7 @@ TEST(PluginOptions, AWrongDescriptionIsAnInputErrorNamingThePlugin) {
 nlohmann::json Outside(const OptionDescription& option, bool below) {
   const nlohmann::json& bound = below ? option.min_value : option.max_value;
   if (bound.is_null()) return nullptr;
+  if (below && option.min_exclusive) return bound;  // the open bound itself
   const double step =
       option.type == "integer" ? 1.0 : std::max(1e-3, std::abs(bound.get<double>()));
   const double value = bound.get<double>() + (below ? -step : step);

@@ -146,9 +146,9 @@ TEST(ReadMatchFilterOptions, ReadsEachKeyOnceThroughItsList) {
   }
   MatchFilterOptions options;
   OptionReader zero(nlohmann::json{{"ratio", 0}, {"max_distance", 8}}, "options");
-  EXPECT_THROW(VisitMatchFilterOptions(options, MatchFilterOptionReader(&zero)), OptionError);
+  EXPECT_THROW(VisitMatchFilterOptions(options, option_list::Reader(&zero)), OptionError);
   OptionReader given(nlohmann::json{{"ratio", 0.5}, {"max_distance", 8}}, "options");
-  VisitMatchFilterOptions(options, MatchFilterOptionReader(&given));
+  VisitMatchFilterOptions(options, option_list::Reader(&given));
   EXPECT_EQ(options.ratio, 0.5);
   EXPECT_EQ(options.max_distance, 8);
 }

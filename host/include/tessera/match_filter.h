@@ -38,47 +38,17 @@ struct MatchFilterOptions {
 };
 
 // The options, listed once: read by ReadMatchFilterOptions and described by every matcher
-// that visits this list inside its own (`tessera plugins NAME`). ratio's range is open at
-// 0, which a list's closed range cannot say: read a list that visits this one with
-// MatchFilterOptionReader.
+// that visits this list inside its own (`tessera plugins NAME`).
 template <typename Visit>
 void VisitMatchFilterOptions(MatchFilterOptions& o, const Visit& visit) {
-  visit("ratio", o.ratio, 0.0, 1.0,
-        "Lowe's ratio threshold on distances (not squared), above 0: keep a match if the best "
-        "distance < ratio * the second-best");
+  visit("ratio", o.ratio, option_list::Above{0.0}, 1.0,
+        "Lowe's ratio threshold on distances (not squared): keep a match if the best distance < "
+        "ratio * the second-best");
   visit("cross_check", o.cross_check, "keep only mutual nearest neighbours");
   visit("max_distance", o.max_distance, 0.0, 1e9,
         "largest distance kept: Euclidean in uint8 descriptor units for l2 (SIFT rows have norm "
         "about 512), bits for hamming; 0 turns it off");
 }
-
-// option_list::Reader for a list that visits VisitMatchFilterOptions: the same, except that
-// "ratio" must be in (0, 1], and an OptionError says so.
-class MatchFilterOptionReader {
- public:
-  explicit MatchFilterOptionReader(OptionReader* reader) : reader_(reader), read_(reader) {}
-
-  template <typename... Args>
-  void operator()(const char* key, Args&&... args) const {
-    read_(key, std::forward<Args>(args)...);
-  }
-  void operator()(const char* key, double& value, double min_value, double max_value,
-                  const char* help) const {
-    if (std::string(key) != "ratio") {
-      read_(key, value, min_value, max_value, help);
-      return;
-    }
-    value = reader_->Get<double>(key, value);
-    if (!(value > 0 && value <= 1)) {
-      throw OptionError(reader_->KeyPath(key),
-                        "= " + nlohmann::json(value).dump() + " is out of range (0, 1]");
-    }
-  }
-
- private:
-  OptionReader* reader_;
-  option_list::Reader read_;
-};
 
 // Reads "ratio" (in (0, 1]), "cross_check" and "max_distance" (in [0, 1e9]), in that
 // order, with `defaults` for the absent ones; an out-of-range value is an OptionError
@@ -86,7 +56,7 @@ class MatchFilterOptionReader {
 inline MatchFilterOptions ReadMatchFilterOptions(OptionReader& reader,
                                                  const MatchFilterOptions& defaults = {}) {
   MatchFilterOptions options = defaults;
-  VisitMatchFilterOptions(options, MatchFilterOptionReader(&reader));
+  VisitMatchFilterOptions(options, option_list::Reader(&reader));
   return options;
 }
 

@@ -23,7 +23,8 @@
 //                           TESSERA_PLUGIN_OPTIONS (tessera/plugin.h).
 // A field whose JSON key differs from its name is visited as (key, field, value, ...).
 // Numeric bounds use the field's type; std::numeric_limits' lowest() and max() mean
-// "unbounded" and are described as null.
+// "unbounded" and are described as null. A lower bound that the value must exceed (a ratio
+// in (0, 1]) is written option_list::Above{0.0}.
 
 #include <algorithm>
 #include <limits>
@@ -56,6 +57,7 @@ struct OptionDescription {
     if (type == "integer" || type == "number") {
       json["min"] = min_value;
       json["max"] = max_value;
+      if (min_exclusive) json["min_exclusive"] = true;
     }
     if (!choices.empty()) json["choices"] = choices;
     return json;
@@ -72,6 +74,20 @@ using Choices = std::vector<std::string>;
 struct RelativePath {
   std::string& value;
 };
+
+// A lower bound the value must exceed: visit("ratio", o.ratio, Above{0.0}, 1.0, help).
+template <typename T>
+struct Above {
+  T value;
+};
+
+// "= 0 is out of range (0, 1]": the message of a value at or below an open lower bound.
+template <typename T>
+std::string OpenRangeMessage(const nlohmann::json& value, T min_value, T max_value) {
+  std::ostringstream message;
+  message << "= " << value.dump() << " is out of range (" << min_value << ", " << max_value << "]";
+  return message.str();
+}
 
 // Keeps min and max out of template deduction: the field's type decides.
 template <typename T>
@@ -96,6 +112,15 @@ class Reader {
                   Number<typename Same<T>::type> min_value, typename Same<T>::type max_value,
                   const char* help) const {
     (*this)(key, value, min_value, max_value, help);
+  }
+  template <typename T>
+  void operator()(const char* key, T& value, Above<Number<typename Same<T>::type>> min_value,
+                  typename Same<T>::type max_value, const char* /*help*/) const {
+    value = reader_->Get<T>(key, value);
+    if (!(value > min_value.value && value <= max_value)) {
+      throw OptionError(reader_->KeyPath(key),
+                        OpenRangeMessage(nlohmann::json(value), min_value.value, max_value));
+    }
   }
   void operator()(const char* key, bool& value, const char* /*help*/) const {
     value = reader_->GetBool(key, value);
@@ -138,6 +163,14 @@ class Checker {
                   Number<typename Same<T>::type> min_value, typename Same<T>::type max_value,
                   const char* /*help*/ = nullptr) const {
     (*this)(field, value, min_value, max_value);
+  }
+  template <typename T>
+  void operator()(const char* field, const T& value,
+                  Above<Number<typename Same<T>::type>> min_value, typename Same<T>::type max_value,
+                  const char* /*help*/ = nullptr) const {
+    if (value > min_value.value && value <= max_value) return;
+    throw InputError(std::string(options_name_) + ": " + field + " " +
+                     OpenRangeMessage(nlohmann::json(value), min_value.value, max_value));
   }
   void operator()(const char* /*field*/, const bool& /*value*/,
                   const char* /*help*/ = nullptr) const {}
@@ -188,6 +221,12 @@ class Describer {
                   Number<typename Same<T>::type> min_value, typename Same<T>::type max_value,
                   const char* help) const {
     (*this)(key, value, min_value, max_value, help);
+  }
+  template <typename T>
+  void operator()(const char* key, const T& value, Above<Number<typename Same<T>::type>> min_value,
+                  typename Same<T>::type max_value, const char* help) const {
+    (*this)(key, value, min_value.value, max_value, help);
+    out_->back().min_exclusive = true;
   }
   void operator()(const char* key, const bool& value, const char* help) const {
     Add(key, "boolean", value, {}, help);

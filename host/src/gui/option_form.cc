@@ -96,9 +96,16 @@ std::string OptionValueProblem(const OptionDescription& option, const nlohmann::
                       Bound<Int>(option.min_value, std::numeric_limits<Int>::lowest()),
                       Bound<Int>(option.max_value, std::numeric_limits<Int>::max()));
     } else if (option.type == "number") {
-      reader.Get<double>(key, option.default_value.get<double>(),
-                         Bound<double>(option.min_value, std::numeric_limits<double>::lowest()),
-                         Bound<double>(option.max_value, std::numeric_limits<double>::max()));
+      const double number =
+          reader.Get<double>(key, option.default_value.get<double>(),
+                             Bound<double>(option.min_value, std::numeric_limits<double>::lowest()),
+                             Bound<double>(option.max_value, std::numeric_limits<double>::max()));
+      if (option.min_exclusive && number <= option.min_value.get<double>()) {
+        throw OptionError(key,
+                          option_list::OpenRangeMessage(
+                              value, option.min_value.get<double>(),
+                              Bound<double>(option.max_value, std::numeric_limits<double>::max())));
+      }
     } else if (option.type == "boolean") {
       reader.GetBool(key, option.default_value.get<bool>());
     } else if (option.type == "string") {

@@ -30,8 +30,8 @@ bool HasType(const nlohmann::json& value, const std::string& type) {
 OptionDescription ParseOne(const nlohmann::json& item, const std::string& where) {
   const auto fail = [&](const std::string& why) { throw InputError(where + why); };
   if (!item.is_object()) fail("expected an object, got " + OptionReader::TypeName(item));
-  static const std::vector<std::string> keys = {"name", "type",    "default", "min",
-                                                "max",  "choices", "help"};
+  static const std::vector<std::string> keys = {"name", "type",          "default", "min",
+                                                "max",  "min_exclusive", "choices", "help"};
   for (const auto& [key, value] : item.items()) {
     if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
       fail("unknown key '" + key + "'" + DidYouMean(key, keys));
@@ -57,13 +57,20 @@ OptionDescription ParseOne(const nlohmann::json& item, const std::string& where)
   }
   option.min_value = item.value("min", nlohmann::json());
   option.max_value = item.value("max", nlohmann::json());
+  if (item.contains("min_exclusive")) {
+    if (!item["min_exclusive"].is_boolean()) fail("'min_exclusive' must be true or false");
+    option.min_exclusive = item["min_exclusive"].get<bool>();
+    if (option.min_exclusive && option.min_value.is_null()) fail("'min_exclusive' without 'min'");
+  }
   const double value = IsNumeric(option.type) ? option.default_value.get<double>() : 0.0;
   if (!option.min_value.is_null() && !option.max_value.is_null() &&
       option.min_value.get<double>() > option.max_value.get<double>()) {
     fail("'min' " + option.min_value.dump() + " is above 'max' " + option.max_value.dump());
   }
-  if ((!option.min_value.is_null() && value < option.min_value.get<double>()) ||
-      (!option.max_value.is_null() && value > option.max_value.get<double>())) {
+  const bool below_min = !option.min_value.is_null() &&
+                         (option.min_exclusive ? value <= option.min_value.get<double>()
+                                               : value < option.min_value.get<double>());
+  if (below_min || (!option.max_value.is_null() && value > option.max_value.get<double>())) {
     fail("the default " + option.default_value.dump() + " is out of its range " +
          OptionRangeText(option));
   }
@@ -130,9 +137,10 @@ std::string OptionRangeText(const OptionDescription& option) {
   const bool has_min = !option.min_value.is_null();
   const bool has_max = !option.max_value.is_null();
   if (has_min && has_max) {
-    return "[" + option.min_value.dump() + ", " + option.max_value.dump() + "]";
+    return (option.min_exclusive ? "(" : "[") + option.min_value.dump() + ", " +
+           option.max_value.dump() + "]";
   }
-  if (has_min) return ">= " + option.min_value.dump();
+  if (has_min) return (option.min_exclusive ? "> " : ">= ") + option.min_value.dump();
   if (has_max) return "<= " + option.max_value.dump();
   return "";
 }

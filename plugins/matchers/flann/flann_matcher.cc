@@ -172,7 +172,7 @@ class FlannMatcher : public Matcher {
  public:
   explicit FlannMatcher(const nlohmann::json& options) {
     OptionReader reader(options);
-    VisitFlannMatchOptions(options_, MatchFilterOptionReader(&reader));
+    VisitFlannMatchOptions(options_, option_list::Reader(&reader));
     reader.Finish();
     const size_t cache_bytes = static_cast<size_t>(options_.index_cache_mb) << 20;
     const auto warn = [this](const std::string& text) { log().Warn(text); };
