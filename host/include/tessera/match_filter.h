@@ -41,7 +41,7 @@ struct MatchFilterOptions {
 // that visits this list inside its own (`tessera plugins NAME`).
 template <typename Visit>
 void VisitMatchFilterOptions(MatchFilterOptions& o, const Visit& visit) {
-  visit("ratio", o.ratio, option_list::Above{0.0}, 1.0,
+  visit("ratio", o.ratio, option_list::Above<double>{0.0}, 1.0,
         "Lowe's ratio threshold on distances (not squared): keep a match if the best distance < "
         "ratio * the second-best");
   visit("cross_check", o.cross_check, "keep only mutual nearest neighbours");

@@ -24,7 +24,7 @@
 // A field whose JSON key differs from its name is visited as (key, field, value, ...).
 // Numeric bounds use the field's type; std::numeric_limits' lowest() and max() mean
 // "unbounded" and are described as null. A lower bound that the value must exceed (a ratio
-// in (0, 1]) is written option_list::Above{0.0}.
+// in (0, 1]) is written option_list::Above<double>{0.0}.
 
 #include <algorithm>
 #include <limits>
@@ -48,6 +48,7 @@ struct OptionDescription {
   nlohmann::json default_value;
   nlohmann::json min_value;          // null: unbounded (numbers only)
   nlohmann::json max_value;          // null: unbounded (numbers only)
+  bool min_exclusive = false;        // the value must exceed min_value (option_list::Above)
   std::vector<std::string> choices;  // strings only; empty: any string
   std::string help;                  // one line
 
@@ -75,7 +76,7 @@ struct RelativePath {
   std::string& value;
 };
 
-// A lower bound the value must exceed: visit("ratio", o.ratio, Above{0.0}, 1.0, help).
+// A lower bound the value must exceed: visit("ratio", o.ratio, Above<double>{0.0}, 1.0, help).
 template <typename T>
 struct Above {
   T value;
