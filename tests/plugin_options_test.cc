@@ -251,7 +251,9 @@ TEST(PluginOptions, AnOptionNamedInTwoPlacesHasOneTypeAndRange) {
   std::map<std::string, std::pair<std::string, nlohmann::json>> first_seen;
   for (const PluginRecord& record : registry.records()) {
     if (!record.usable() || !record.describes_options) continue;
-    for (const OptionDescription& option : *registry.DescribeOptions(record)) {
+    const std::optional<std::vector<OptionDescription>> described =
+        registry.DescribeOptions(record);
+    for (const OptionDescription& option : *described) {
       const nlohmann::json stated = {option.type, option.min_value, option.max_value,
                                      option.choices};
       const auto [it, inserted] =
