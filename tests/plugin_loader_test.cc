@@ -68,7 +68,7 @@ TEST(PluginLoader, RefusesAPluginBuiltAgainstAbiOne) {
   ASSERT_EQ(kPluginAbiVersion, 12u);
   const auto file = File("abi_one", "abi_one");
   EXPECT_EQ(InspectPluginFile(file).refusal,
-            file.string() + ": wrong plugin ABI version: got version 1, supported version is 11");
+            file.string() + ": wrong plugin ABI version: got version 1, supported version is 12");
   const PluginRegistry registry = PluginRegistry::Discover({kRoot / "abi_one"});
   EXPECT_TRUE(registry.NamesOfKind("pair_selector").empty());
 }
@@ -342,8 +342,8 @@ TEST(PluginLoader, DiscoveryListsRefusedFilesWithoutThrowing) {
   // ever loading them.
   EXPECT_EQ(refused, 9u);
   EXPECT_EQ(registry.NamesOfKind("pair_selector"),
-            (std::vector<std::string>{"consecutive", "failing_pair_selector", "float_only",
-                                      "throws", "twin"}));
+            (std::vector<std::string>{"bad_description", "consecutive", "describer_throws",
+                                      "failing_pair_selector", "float_only", "throws", "twin"}));
 }
 
 // A probe child ended by SIGTERM (or SIGINT: an interrupt reaching it) was "crashes on

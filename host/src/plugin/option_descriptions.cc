@@ -146,6 +146,7 @@ std::string OptionRangeText(const OptionDescription& option) {
 }
 
 std::string OptionDescriptionsMarkdown(const std::vector<OptionDescription>& options) {
+  if (options.empty()) return "It takes no options.\n";
   std::ostringstream out;
   out << "| option | type | default | range or choices | meaning |\n";
   out << "| --- | --- | --- | --- | --- |\n";
