@@ -30,6 +30,8 @@ struct GLFWwindow;
 namespace tessera::gui {
 
 class ExportPanel;
+class ImageListPanel;
+struct ImageList;
 class LogPane;
 class ManifestEditorPanel;
 class MatchMatrixPanel;
@@ -154,6 +156,15 @@ class GuiApp {
   // message in MatchError when it cannot.
   bool OpenMatchMatrix(const std::filesystem::path& path);
   const std::string& MatchError() const;
+  // The image list of `workspace` (and of the Images field's folder), as "Image list"
+  // opens it; false with the message in ImageListError().
+  bool OpenImageList(const std::filesystem::path& workspace);
+  const std::string& ImageListError() const;
+  // The list open; nullptr when none.
+  const ImageList* ImageListShown() const;
+  // Picks the camera of the image `name` of model N (sparse/N), showing that model first;
+  // false when it is not in it. What a click on the image list's row does.
+  bool SelectImage(const std::string& name, int model);
   // The match matrix open (nullptr: none) and its workspace: the model shown's.
   const MatchMatrix* MatrixShown() const;
   const std::filesystem::path& MatrixWorkspace() const;
@@ -245,6 +256,9 @@ class GuiApp {
   void FitUiScale();
   // Checks the Images field's folder against the model shown when either changed.
   void CheckImageFolderOfModel(const std::filesystem::path& images);
+  // The workspace the image list reads: the model shown's, a model folder alone, else
+  // the Output field's folder.
+  std::filesystem::path ImageListWorkspace() const;
 
   GuiOptions options_;
   GLFWwindow* window_ = nullptr;
@@ -270,6 +284,7 @@ class GuiApp {
   std::unique_ptr<ModelPanel> model_panel_;
   std::unique_ptr<Picking> picking_;
   std::unique_ptr<MatchMatrixPanel> match_matrix_;
+  std::unique_ptr<ImageListPanel> image_list_;
   std::unique_ptr<LogPane> log_pane_;
   std::unique_ptr<ExportPanel> export_panel_;
   WidgetRects widgets_;

@@ -42,6 +42,15 @@ std::vector<fs::path> FindModelFolders(const fs::path& path) {
   return folders;
 }
 
+int ModelFolderNumber(const fs::path& folder) {
+  const std::string name = folder.filename().string();
+  if (folder.parent_path().filename() != workspace_layout::kModelsFolder || name.empty() ||
+      name.size() > 6 || !std::all_of(name.begin(), name.end(), ::isdigit)) {
+    return 0;
+  }
+  return std::stoi(name);
+}
+
 std::optional<size_t> CountModelImages(const fs::path& folder) {
   std::error_code error;
   if (fs::is_regular_file(folder / "images.bin", error)) {

@@ -20,4 +20,7 @@ std::vector<std::filesystem::path> FindModelFolders(const std::filesystem::path&
 // count line of images.txt), without reading the model; nothing when it cannot tell.
 std::optional<size_t> CountModelImages(const std::filesystem::path& folder);
 
+// N of a workspace's sparse/N model folder; 0 for a model folder outside a workspace.
+int ModelFolderNumber(const std::filesystem::path& folder);
+
 }  // namespace tessera::gui

@@ -154,6 +154,21 @@ void ModelPanel::LoadFolder(size_t index) {
                view_->scene()->cameras.size(), view_->scene()->NumPoints());
 }
 
+bool ModelPanel::ShowModelNumber(int number) {
+  if (ShownModelNumber() == number) return true;
+  for (size_t i = 0; i < folders_.size(); ++i) {
+    if (ModelFolderNumber(folders_[i]) != number) continue;
+    LoadFolder(i);
+    return error_.empty() && index_ == static_cast<int>(i);
+  }
+  return false;
+}
+
+int ModelPanel::ShownModelNumber() const {
+  const fs::path written = WrittenModel();
+  return written.empty() ? -1 : ModelFolderNumber(written);
+}
+
 void ModelPanel::Draw(WidgetRects* widgets) {
   FitText("Open a model", widgets);
   // The field takes the width the Open button leaves (its hint whole at 1024 px).

@@ -66,6 +66,11 @@ class ModelPanel {
                                                                              : "";
   }
   int model_index() const { return index_; }
+  // Shows model N (sparse/N) of the workspace opened, when it is not the one shown; false
+  // when it has none such or it cannot be read.
+  bool ShowModelNumber(int number);
+  // N of the written model shown (sparse/N); -1 when the view shows none written.
+  int ShownModelNumber() const;
   // Why the written model shown is stale (its workspace's matches were discarded since);
   // empty when it is not.
   const std::string& Stale() const { return showing_written_ ? stale_ : kNone; }
