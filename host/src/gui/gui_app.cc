@@ -571,6 +571,9 @@ bool GuiApp::SelectImage(const std::string& name, int model) {
   return false;
 }
 
+void GuiApp::SetPointColouring(PointColouring colouring) { view_->SetColouring(colouring); }
+const std::string& GuiApp::ColourLegend() const { return model_panel_->Legend(); }
+
 const Scene* GuiApp::scene() const { return view_->scene(); }
 void GuiApp::SetScene(std::shared_ptr<const Scene> scene) { view_->Show(std::move(scene), true); }
 size_t GuiApp::NumScenePoints() const { return scene() == nullptr ? 0 : scene()->NumPoints(); }

@@ -20,6 +20,7 @@
 #include "gui/key_queue.h"
 #include "gui/log_sink.h"
 #include "gui/match_matrix.h"
+#include "gui/point_colouring.h"
 #include "gui/run_controller.h"
 #include "gui/scene.h"
 #include "gui/screenshot.h"
@@ -165,6 +166,10 @@ class GuiApp {
   // Picks the camera of the image `name` of model N (sparse/N), showing that model first;
   // false when it is not in it. What a click on the image list's row does.
   bool SelectImage(const std::string& name, int model);
+  // What the "Colour" choice sets: the points coloured by image, error or track length.
+  void SetPointColouring(PointColouring colouring);
+  // The colour legend as last drawn ("0 px to 1.2 px or more"); empty before one.
+  const std::string& ColourLegend() const;
   // The match matrix open (nullptr: none) and its workspace: the model shown's.
   const MatchMatrix* MatrixShown() const;
   const std::filesystem::path& MatrixWorkspace() const;
