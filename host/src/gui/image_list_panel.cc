@@ -68,7 +68,7 @@ void ImageListPanel::Draw(const WidgetRect& view_rect, const std::string& select
   if (ImGui::BeginTable("images", 3, kFlags)) {
     ImGui::TableSetupScrollFreeze(0, 1);
     ImGui::TableSetupColumn("image", ImGuiTableColumnFlags_WidthFixed, 12 * ImGui::GetFontSize());
-    ImGui::TableSetupColumn("model", ImGuiTableColumnFlags_WidthFixed, 4 * ImGui::GetFontSize());
+    ImGui::TableSetupColumn("model", ImGuiTableColumnFlags_WidthFixed, 5 * ImGui::GetFontSize());
     ImGui::TableSetupColumn("why left out", ImGuiTableColumnFlags_WidthStretch);
     ImGui::TableHeadersRow();
     ImGuiListClipper clipper;
