@@ -16,14 +16,6 @@ namespace tessera::gui {
 namespace fs = std::filesystem;
 namespace {
 
-bool IsImageName(const fs::path& file) {
-  std::string extension = file.extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension == ".jpg" || extension == ".jpeg" || extension == ".png" ||
-         extension == ".tif" || extension == ".tiff";
-}
-
 // Each image's model: mapping_summary.json's when the workspace has one (with its
 // reasons), else each model folder's own image names (read whole).
 void ReadModelsOfImages(const fs::path& workspace, std::map<std::string, int>* model_of,
@@ -64,6 +56,29 @@ size_t ImageList::NumInModels() const {
       entries.begin(), entries.end(), [](const auto& entry) { return entry.model != kInNoModel; }));
 }
 
+bool IsImageFileName(const fs::path& file) {
+  std::string extension = file.extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension == ".jpg" || extension == ".jpeg" || extension == ".png" ||
+         extension == ".tif" || extension == ".tiff";
+}
+
+size_t CountImageFiles(const fs::path& dir, size_t max_entries) {
+  size_t count = 0, seen = 0;
+  std::error_code error;
+  for (fs::directory_iterator it(dir, fs::directory_options::skip_permission_denied, error), end;
+       !error && it != end && seen < max_entries; it.increment(error), ++seen) {
+    const std::string name = it->path().filename().string();
+    std::error_code type_error;
+    if (!name.empty() && name[0] != '.' && IsImageFileName(it->path()) &&
+        it->is_regular_file(type_error)) {
+      ++count;
+    }
+  }
+  return count;
+}
+
 std::vector<std::string> ListImageFiles(const fs::path& dir) {
   std::vector<std::string> names;
   std::error_code error;
@@ -75,7 +90,7 @@ std::vector<std::string> ListImageFiles(const fs::path& dir) {
       if (it->is_directory(error)) it.disable_recursion_pending();
       continue;
     }
-    if (it->is_regular_file(error) && IsImageName(it->path())) {
+    if (it->is_regular_file(error) && IsImageFileName(it->path())) {
       names.push_back(it->path().lexically_relative(dir).generic_string());
     }
   }

@@ -31,6 +31,13 @@ struct ImageList {
 ImageList ReadImageList(const std::filesystem::path& workspace,
                         const std::filesystem::path& image_dir);
 
+// Whether `file` is named like an image (.jpg, .jpeg, .png, .tif, .tiff in any case).
+bool IsImageFileName(const std::filesystem::path& file);
+
+// The image files directly in `dir` (not its sub-folders), by name, looking at no more
+// than `max_entries` entries; 0 when it cannot be listed.
+size_t CountImageFiles(const std::filesystem::path& dir, size_t max_entries = 20000);
+
 // The image files under `dir` (sub-folders too, hidden ones left out) by extension
 // (.jpg, .jpeg, .png, .tif, .tiff in any case), relative to `dir` and sorted; without
 // reading them. Nothing when `dir` is not a folder.
