@@ -18,6 +18,7 @@
 #include "gui/image_list_panel.h"
 #include "gui/log_pane.h"
 #include "gui/match_matrix_panel.h"
+#include "gui/model_loader.h"
 #include "gui/model_panel.h"
 #include "gui/picking.h"
 #include "gui/renderer.h"
@@ -332,6 +333,7 @@ void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
 void GuiApp::DrawWindows(const RunStatus& status) {
   const WidgetRect view = ViewRect();
   if (!options_.view_only) {
+    FillImagesFromWorkspace();
     const fs::path images(setup_->ImagesField());
     CheckImageFolderOfModel(images);
     DrawSetupWindow(status);
@@ -551,6 +553,23 @@ fs::path GuiApp::ImageListWorkspace() const {
   const fs::path written = model_panel_->WrittenModel();
   if (!written.empty()) return written;
   return fs::path(setup_->OutputField());
+}
+
+void GuiApp::FillImagesFromWorkspace() {
+  const std::string output = setup_->OutputField();
+  if (output == output_seen_) return;
+  output_seen_ = output;
+  if (!setup_->ImagesField().empty() || setup_->ImagesFieldActive()) return;
+  const fs::path recorded = RecordedImageFolder(output);
+  std::error_code error;
+  if (recorded.empty()) return;
+  if (!fs::is_directory(recorded, error)) {
+    spdlog::warn("gui: {} recorded the image folder {}, which is not there now; set Images", output,
+                 recorded.string());
+    return;
+  }
+  setup_->SetImagesField(recorded);
+  spdlog::info("gui: Images set to {}, the image folder {} recorded", recorded.string(), output);
 }
 
 bool GuiApp::SelectImage(const std::string& name, int model) {

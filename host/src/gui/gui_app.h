@@ -264,6 +264,9 @@ class GuiApp {
   // The workspace the image list reads: the model shown's, a model folder alone, else
   // the Output field's folder.
   std::filesystem::path ImageListWorkspace() const;
+  // When the Output field names another folder and the Images field is empty: the
+  // Images field gets the image folder that workspace recorded (a run's), logged.
+  void FillImagesFromWorkspace();
 
   GuiOptions options_;
   GLFWwindow* window_ = nullptr;
@@ -282,6 +285,7 @@ class GuiApp {
   float asked_scale_ = 1;    // GuiOptions::ui_scale, or the monitor's
   float applied_scale_ = 0;  // FitUiScale's last (0: none yet)
   std::string frame_error_;
+  std::string output_seen_;  // the Output field FillImagesFromWorkspace last looked at
 
   // The panels (destroyed before the OpenGL context: they hold textures).
   std::unique_ptr<SceneView> view_;

@@ -62,6 +62,32 @@ TEST_F(GuiImageListTest, AClickOnAnImageOfAnotherModelShowsThatModel) {
   EXPECT_EQ(app.selected_image(), 1u);
 }
 
+// Issue 63: Output set to a run's workspace fills the empty Images field with the
+// folder the run recorded; an Images field already set is kept.
+TEST_F(GuiImageListTest, TheOutputFolderFillsTheImagesFieldFromWhatItRecorded) {
+  WriteImageListWorkspace(dir_.path() / "ws", /*with_summary=*/true);
+  const fs::path photos = dir_.path() / "ws" / "images";
+  Database(dir_.path() / "ws" / "database.db")
+      .WriteStageProvenance(Database::kImagesStage, {{"folder", photos.string()}});
+  {
+    GuiApp app(GuiOptions{});
+    app.Frame();
+    app.Frame();
+    Click(&app, "output");
+    Type(&app, (dir_.path() / "ws").string());
+    app.Frame();
+    EXPECT_EQ(app.ImagesField(), photos.string());
+    EXPECT_TRUE(LogHas(app, std::regex("Images set to .*ws/images")));
+  }
+  GuiOptions kept;  // one window at a time
+  kept.images = dir_.path() / "other";
+  kept.output = dir_.path() / "ws";
+  GuiApp other(kept);
+  other.Frame();
+  other.Frame();
+  EXPECT_EQ(other.ImagesField(), (dir_.path() / "other").string());
+}
+
 TEST_F(GuiImageListTest, NoWorkspaceIsOneLine) {
   GuiApp app(GuiOptions{});
   app.Frame();

@@ -5,6 +5,8 @@
 #include <fstream>
 #include <string>
 
+#include "database/database.h"
+#include "pipeline/workspace.h"
 #include "tessera/errors.h"
 #include "tessera/io/colmap_model_io.h"
 #include "util/workspace_layout.h"
@@ -40,6 +42,17 @@ std::vector<fs::path> FindModelFolders(const fs::path& path) {
   std::vector<fs::path> folders;
   for (const auto& [index, folder] : models) folders.push_back(folder);
   return folders;
+}
+
+fs::path RecordedImageFolder(const fs::path& folder) {
+  std::error_code error;
+  const fs::path database_file = folder / workspace_layout::kDatabase;
+  if (folder.empty() || !fs::is_regular_file(database_file, error)) return {};
+  try {
+    return ImageFolder({}, Database(database_file, Database::Mode::kReadOnly));
+  } catch (const std::exception&) {
+    return {};  // not a database this build reads: nothing recorded to use
+  }
 }
 
 int ModelFolderNumber(const fs::path& folder) {
