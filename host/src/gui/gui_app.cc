@@ -358,6 +358,7 @@ void GuiApp::DrawWindows(const RunStatus& status) {
       const auto found = scene->model->images.find(view_->selected_image);
       if (found != scene->model->images.end()) selected = found->second.name;
     }
+    image_list_->Follow(ImageListWorkspace(), images, controller_->Running());
     image_list_->Draw(view, selected, &widgets_);
   }
   picking_->HandleMouse(view);

@@ -43,6 +43,13 @@ TEST_F(GuiImageListTest, ListsTheImagesAndAClickPicksTheCamera) {
   Click(&app, "image row frame_4.jpg");
   EXPECT_EQ(app.selected_image(), 2u);
   if (const char* file = std::getenv("TESSERA_GUI_TEST_SCREENSHOT")) app.SaveScreenshot(file);
+  // The list follows the model shown: a model folder alone lists its images.
+  fs::copy(dir_.path() / "sparse" / "1", dir_.path() / "alone");
+  ASSERT_TRUE(app.OpenModel(dir_.path() / "alone"));
+  app.Frame();
+  ASSERT_NE(app.ImageListShown(), nullptr) << app.ImageListError();
+  EXPECT_EQ(app.ImageListShown()->workspace, dir_.path() / "alone");
+  EXPECT_EQ(app.ImageListShown()->NumInModels(), 1u);
 }
 
 TEST_F(GuiImageListTest, AClickOnAnImageOfAnotherModelShowsThatModel) {

@@ -33,6 +33,12 @@ bool ImageListPanel::Open(const fs::path& workspace, const fs::path& image_dir) 
   return true;
 }
 
+void ImageListPanel::Follow(const fs::path& workspace, const fs::path& image_dir,
+                            bool being_written) {
+  if (!show_ || !list_ || being_written || workspace.empty()) return;
+  if (workspace != list_->workspace || image_dir != image_dir_) Open(workspace, image_dir);
+}
+
 void ImageListPanel::DrawOpenButton(const fs::path& workspace, const fs::path& image_dir,
                                     WidgetRects* widgets) {
   if (ImGui::Button("Image list")) Open(workspace, image_dir);

@@ -23,8 +23,12 @@ class ImageListPanel {
   // Reads the list of `workspace` (its images beside `image_dir`'s) and opens the
   // window; false with the message in Error() (also logged) when it cannot.
   bool Open(const std::filesystem::path& workspace, const std::filesystem::path& image_dir);
-  // The list is read anew on the next frame it is drawn (a run ended, a model opened).
+  // The list is read anew on the next frame it is drawn (a run ended).
   void Invalidate() { stale_ = true; }
+  // Called each frame with the workspace of the model shown and the Images field: an
+  // open list of another is read anew for these (not while `being_written` by a run).
+  void Follow(const std::filesystem::path& workspace, const std::filesystem::path& image_dir,
+              bool being_written);
 
   // The "Image list" button of the set-up window (records "image list") and its message.
   void DrawOpenButton(const std::filesystem::path& workspace,
