@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <vector>
 
+#include "gui/image_list.h"
+
 namespace tessera::gui {
 namespace fs = std::filesystem;
 
@@ -16,14 +18,27 @@ void FolderBrowser::Draw(const std::string& name, PathField* path, WidgetRects* 
     browse_dir_ =
         (*path)[0] != '\0' ? fs::absolute(fs::path(path->data()), error) : fs::current_path(error);
     if (!fs::is_directory(browse_dir_, error)) browse_dir_ = browse_dir_.parent_path();
+    listing_ = Listing{};  // read anew: the folder may have changed since
+    go_error_.clear();
+    SetPathField(browse_dir_, &typed_);
     ImGui::OpenPopup(popup.c_str());
   }
   widgets->RecordLastItem(popup);
   if (!ImGui::BeginPopup(popup.c_str())) return;
-  // A long path wraps at 30 lines' height of width (the popup fits its contents).
-  ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + ImGui::GetFontSize() * 30);
-  ImGui::TextUnformatted(browse_dir_.string().c_str());
-  ImGui::PopTextWrapPos();
+  ListBrowseDir(file_extension);
+  // Where the folder listed changes in this frame, the typed path follows it.
+  const fs::path listed = browse_dir_;
+  // The folder listed, as a path to edit: Return goes where it names.
+  ImGui::SetNextItemWidth(ImGui::GetFontSize() * 30);
+  if (ImGui::InputTextWithHint("##browse path", "type a folder and press Return", typed_.data(),
+                               typed_.size(), ImGuiInputTextFlags_EnterReturnsTrue) &&
+      GoToTyped(file_extension, path)) {
+    ImGui::EndPopup();
+    return;
+  }
+  widgets->RecordLastItem("browse path");
+  ErrorText(go_error_, widgets);
+  ImGui::TextDisabled("%zu images in this folder", listing_.images);
   if (file_extension.empty()) {
     if (ImGui::Button("Choose this folder")) {
       SetPathField(browse_dir_, path);
@@ -55,7 +70,34 @@ void FolderBrowser::Draw(const std::string& name, PathField* path, WidgetRects* 
     SetPathField(next, path);
     ImGui::CloseCurrentPopup();
   }
+  if (browse_dir_ != listed) {
+    SetPathField(browse_dir_, &typed_);
+    go_error_.clear();
+  }
   ImGui::EndPopup();
+}
+
+bool FolderBrowser::GoToTyped(const std::string& file_extension, PathField* path) {
+  go_error_.clear();
+  const std::string typed = typed_.data();
+  std::error_code error;
+  const fs::path target = fs::absolute(fs::path(typed), error);
+  if (typed.empty() || error) {
+    go_error_ = "type a folder's path";
+  } else if (fs::is_directory(target, error)) {
+    browse_dir_ = target.lexically_normal();
+    SetPathField(browse_dir_, &typed_);
+    return false;  // the popup stays, listing it
+  } else if (!file_extension.empty() && target.extension() == file_extension &&
+             fs::is_regular_file(target, error)) {
+    SetPathField(target, path);
+    ImGui::CloseCurrentPopup();
+    return true;
+  } else {
+    go_error_ = typed + ": no such folder" +
+                (file_extension.empty() ? "" : " or " + file_extension + " file");
+  }
+  return false;
 }
 
 bool FolderBrowser::CreateFolder() {
@@ -78,32 +120,57 @@ bool FolderBrowser::CreateFolder() {
   return true;
 }
 
-fs::path FolderBrowser::DrawFolderList(const std::string& file_extension, WidgetRects* widgets) {
-  // At most 1000 entries, so that a huge folder costs little on the UI thread.
-  std::vector<std::string> folders, files;
+void FolderBrowser::ListBrowseDir(const std::string& file_extension) {
+  if (listing_.dir == browse_dir_ && listing_.file_extension == file_extension &&
+      !listing_.dir.empty()) {
+    return;
+  }
+  listing_ = Listing{};
+  listing_.dir = browse_dir_;
+  listing_.file_extension = file_extension;
   std::error_code error;
   for (fs::directory_iterator it(browse_dir_, fs::directory_options::skip_permission_denied, error),
        end;
-       !error && it != end && folders.size() + files.size() < 1000; it.increment(error)) {
+       !error && it != end && listing_.folders.size() + listing_.files.size() < 1000;
+       it.increment(error)) {
     std::error_code type_error;
     if (it->is_directory(type_error)) {
-      folders.push_back(it->path().filename().string());
+      listing_.folders.push_back(it->path().filename().string());
     } else if (!file_extension.empty() && it->path().extension() == file_extension) {
-      files.push_back(it->path().filename().string());
+      listing_.files.push_back(it->path().filename().string());
     }
   }
-  std::sort(folders.begin(), folders.end());
-  std::sort(files.begin(), files.end());
+  std::sort(listing_.folders.begin(), listing_.folders.end());
+  std::sort(listing_.files.begin(), listing_.files.end());
+  for (const std::string& folder : listing_.folders) {
+    listing_.folder_images.push_back(CountImageFiles(browse_dir_ / folder));
+  }
+  listing_.images = CountImageFiles(browse_dir_);
+}
+
+fs::path FolderBrowser::DrawFolderList(const std::string& /*file_extension*/,
+                                       WidgetRects* widgets) {
   fs::path next;
-  for (const std::string& folder : folders) {
+  // The counts in a column after the names.
+  float name_width = 0;
+  for (const std::string& folder : listing_.folders) {
+    name_width = std::max(name_width, ImGui::CalcTextSize((folder + "/").c_str()).x);
+  }
+  const float count_at = ImGui::GetCursorPosX() + name_width + 2 * ImGui::GetFontSize();
+  for (size_t i = 0; i < listing_.folders.size(); ++i) {
+    const std::string& folder = listing_.folders[i];
     if (ImGui::Selectable((folder + "/").c_str(), false, ImGuiSelectableFlags_DontClosePopups)) {
-      next = browse_dir_ / folder;
+      next = listing_.dir / folder;
     }
     widgets->RecordLastItem("folder " + folder);
+    ImGui::SameLine(count_at);
+    const size_t images = listing_.folder_images[i];
+    ImGui::TextDisabled("%zu image%s", images, images == 1 ? "" : "s");
+    widgets->RecordLastItem("images in " + folder + ": " + std::to_string(images));
   }
-  for (const std::string& file : files) {
+  for (const std::string& file : listing_.files) {
     if (ImGui::Selectable(file.c_str(), false, ImGuiSelectableFlags_DontClosePopups)) {
-      next = browse_dir_ / file;
+      next = listing_.dir / file;
     }
     widgets->RecordLastItem("file " + file);
   }

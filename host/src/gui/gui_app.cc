@@ -15,8 +15,10 @@
 #include "gui/checked_read.h"
 #include "gui/export_panel.h"
 #include "gui/gl.h"
+#include "gui/image_list_panel.h"
 #include "gui/log_pane.h"
 #include "gui/match_matrix_panel.h"
+#include "gui/model_loader.h"
 #include "gui/model_panel.h"
 #include "gui/picking.h"
 #include "gui/renderer.h"
@@ -152,6 +154,8 @@ GuiApp::GuiApp(const GuiOptions& options) : options_(options) {
   });
   picking_ = std::make_unique<Picking>(view_.get());
   match_matrix_ = std::make_unique<MatchMatrixPanel>();
+  image_list_ = std::make_unique<ImageListPanel>(
+      [this](const std::string& name, int model) { SelectImage(name, model); });
   log_pane_ = std::make_unique<LogPane>(log_sink_);
   export_panel_ = std::make_unique<ExportPanel>();
   if (!options.model.empty()) OpenModel(options.model);
@@ -169,6 +173,7 @@ GuiApp::~GuiApp() {
   log_pane_.reset();
   export_panel_.reset();
   match_matrix_.reset();
+  image_list_.reset();
   picking_.reset();
   setup_.reset();
   model_panel_.reset();
@@ -276,6 +281,7 @@ RunStatus GuiApp::FollowRun() {
   const RunStatus status = controller_->Status();
   if (status.state != last_state_) {
     if (status.state != RunState::kRunning) match_matrix_->RunEnded();
+    image_list_->Invalidate();  // the run rewrites the database and the models
     last_state_ = status.state;
     if (status.state == RunState::kCompleted) {
       model_panel_->RunCompleted(status.output_dir, setup_->follow_run());
@@ -327,6 +333,7 @@ void GuiApp::Frame(const SyntheticInput* input, RgbImage* capture) {
 void GuiApp::DrawWindows(const RunStatus& status) {
   const WidgetRect view = ViewRect();
   if (!options_.view_only) {
+    FillImagesFromWorkspace();
     const fs::path images(setup_->ImagesField());
     CheckImageFolderOfModel(images);
     DrawSetupWindow(status);
@@ -346,6 +353,13 @@ void GuiApp::DrawWindows(const RunStatus& status) {
       matrix_room.min_y = camera->min_y + ImGui::GetFrameHeight();
     }
     match_matrix_->Draw(matrix_room, images, &widgets_);
+    std::string selected;  // the picked camera's image, highlighted in the list
+    if (const Scene* scene = view_->scene(); scene != nullptr) {
+      const auto found = scene->model->images.find(view_->selected_image);
+      if (found != scene->model->images.end()) selected = found->second.name;
+    }
+    image_list_->Follow(ImageListWorkspace(), images, controller_->Running());
+    image_list_->Draw(view, selected, &widgets_);
   }
   picking_->HandleMouse(view);
   if (view_->scene() == nullptr && !options_.view_only && OverwriteQuestion().empty() &&
@@ -398,6 +412,7 @@ void GuiApp::DrawSetupWindow(const RunStatus& status) {
   match_matrix_->DrawOpenButton(
       !shown.empty() ? shown : fs::path(output.empty() ? model_panel_->ModelField() : output),
       &widgets_);
+  image_list_->DrawOpenButton(ImageListWorkspace(), fs::path(setup_->ImagesField()), &widgets_);
   export_panel_->Draw(model_panel_->WrittenModel(), model_panel_->model_index(),
                       fs::path(setup_->ImagesField()), &widgets_);
   ImGui::Separator();
@@ -525,6 +540,59 @@ const std::string& GuiApp::PairPhotoProblem() const { return match_matrix_->pair
 const PairInliers& GuiApp::SelectedPairInliers() const {
   return match_matrix_->SelectedPairInliers();
 }
+
+bool GuiApp::OpenImageList(const fs::path& workspace) {
+  return image_list_->Open(workspace, fs::path(setup_->ImagesField()));
+}
+const std::string& GuiApp::ImageListError() const { return image_list_->Error(); }
+const ImageList* GuiApp::ImageListShown() const { return image_list_->list(); }
+
+fs::path GuiApp::ImageListWorkspace() const {
+  // The model shown's workspace; a model folder alone; else the output folder's.
+  const fs::path shown = model_panel_->Workspace();
+  if (!shown.empty()) return shown;
+  const fs::path written = model_panel_->WrittenModel();
+  if (!written.empty()) return written;
+  return fs::path(setup_->OutputField());
+}
+
+void GuiApp::FillImagesFromWorkspace() {
+  const std::string output = setup_->OutputField();
+  if (output == output_seen_) return;
+  output_seen_ = output;
+  if (!setup_->ImagesField().empty() || setup_->ImagesFieldActive()) return;
+  const fs::path recorded = RecordedImageFolder(output);
+  std::error_code error;
+  if (recorded.empty()) return;
+  if (!fs::is_directory(recorded, error)) {
+    spdlog::warn("gui: {} recorded the image folder {}, which is not there now; set Images", output,
+                 recorded.string());
+    return;
+  }
+  setup_->SetImagesField(recorded);
+  spdlog::info("gui: Images set to {}, the image folder {} recorded", recorded.string(), output);
+}
+
+bool GuiApp::SelectImage(const std::string& name, int model) {
+  // A model of the workspace opened other than the one shown is shown first.
+  if (model_panel_->ShownModelNumber() >= 0 && !model_panel_->ShowModelNumber(model)) {
+    return false;
+  }
+  const Scene* scene = view_->scene();
+  if (scene == nullptr) return false;
+  for (const auto& [image_id, image] : scene->model->images) {
+    if (image.name != name || !image.registered) continue;
+    view_->selected_image = image_id;
+    view_->selected_point = kInvalidPoint3DId;
+    changed_.store(true);
+    return true;
+  }
+  spdlog::warn("gui: {} is not in the model shown", name);
+  return false;
+}
+
+void GuiApp::SetPointColouring(PointColouring colouring) { view_->SetColouring(colouring); }
+const std::string& GuiApp::ColourLegend() const { return model_panel_->Legend(); }
 
 const Scene* GuiApp::scene() const { return view_->scene(); }
 void GuiApp::SetScene(std::shared_ptr<const Scene> scene) { view_->Show(std::move(scene), true); }

@@ -20,6 +20,7 @@
 #include "gui/key_queue.h"
 #include "gui/log_sink.h"
 #include "gui/match_matrix.h"
+#include "gui/point_colouring.h"
 #include "gui/run_controller.h"
 #include "gui/scene.h"
 #include "gui/screenshot.h"
@@ -30,6 +31,8 @@ struct GLFWwindow;
 namespace tessera::gui {
 
 class ExportPanel;
+class ImageListPanel;
+struct ImageList;
 class LogPane;
 class ManifestEditorPanel;
 class MatchMatrixPanel;
@@ -154,6 +157,19 @@ class GuiApp {
   // message in MatchError when it cannot.
   bool OpenMatchMatrix(const std::filesystem::path& path);
   const std::string& MatchError() const;
+  // The image list of `workspace` (and of the Images field's folder), as "Image list"
+  // opens it; false with the message in ImageListError().
+  bool OpenImageList(const std::filesystem::path& workspace);
+  const std::string& ImageListError() const;
+  // The list open; nullptr when none.
+  const ImageList* ImageListShown() const;
+  // Picks the camera of the image `name` of model N (sparse/N), showing that model first;
+  // false when it is not in it. What a click on the image list's row does.
+  bool SelectImage(const std::string& name, int model);
+  // What the "Colour" choice sets: the points coloured by image, error or track length.
+  void SetPointColouring(PointColouring colouring);
+  // The colour legend as last drawn ("0 px to 1.2 px or more"); empty before one.
+  const std::string& ColourLegend() const;
   // The match matrix open (nullptr: none) and its workspace: the model shown's.
   const MatchMatrix* MatrixShown() const;
   const std::filesystem::path& MatrixWorkspace() const;
@@ -245,6 +261,12 @@ class GuiApp {
   void FitUiScale();
   // Checks the Images field's folder against the model shown when either changed.
   void CheckImageFolderOfModel(const std::filesystem::path& images);
+  // The workspace the image list reads: the model shown's, a model folder alone, else
+  // the Output field's folder.
+  std::filesystem::path ImageListWorkspace() const;
+  // When the Output field names another folder and the Images field is empty: the
+  // Images field gets the image folder that workspace recorded (a run's), logged.
+  void FillImagesFromWorkspace();
 
   GuiOptions options_;
   GLFWwindow* window_ = nullptr;
@@ -263,6 +285,7 @@ class GuiApp {
   float asked_scale_ = 1;    // GuiOptions::ui_scale, or the monitor's
   float applied_scale_ = 0;  // FitUiScale's last (0: none yet)
   std::string frame_error_;
+  std::string output_seen_;  // the Output field FillImagesFromWorkspace last looked at
 
   // The panels (destroyed before the OpenGL context: they hold textures).
   std::unique_ptr<SceneView> view_;
@@ -270,6 +293,7 @@ class GuiApp {
   std::unique_ptr<ModelPanel> model_panel_;
   std::unique_ptr<Picking> picking_;
   std::unique_ptr<MatchMatrixPanel> match_matrix_;
+  std::unique_ptr<ImageListPanel> image_list_;
   std::unique_ptr<LogPane> log_pane_;
   std::unique_ptr<ExportPanel> export_panel_;
   WidgetRects widgets_;

@@ -2,7 +2,8 @@
 //   gui_docs_figures WORKSPACE IMAGES MANIFEST OUT_DIR
 // writes OUT_DIR/gui_camera.png (the workspace's model with a camera picked: its
 // window, its photograph and observations) and OUT_DIR/gui_pair_view.png (the match
-// matrix with a pair's photographs and inlier matches). WORKSPACE: a finished run of
+// matrix with a pair's photographs and inlier matches) and OUT_DIR/gui_image_list.png
+// (the image list, an image picked from it). WORKSPACE: a finished run of
 // IMAGES with MANIFEST, e.g. `tessera run --images examples/fountain-P11-small/images
 // --manifest manifests/fast.json --output WS`. The window is 1600x900.
 
@@ -13,6 +14,7 @@
 #include <filesystem>
 
 #include "gui/gui_app.h"
+#include "gui/image_list.h"
 
 namespace {
 namespace fs = std::filesystem;
@@ -84,6 +86,23 @@ int PairFigure(const fs::path& workspace, const fs::path& images, const fs::path
   return 0;
 }
 
+// The image list with an image of the model picked from it (its camera window open).
+int ImageListFigure(const fs::path& workspace, const fs::path& images, const fs::path& out) {
+  GuiApp app(Options(workspace, images));
+  app.Frame();
+  app.Frame();
+  const std::optional<WidgetRect> button = app.Widget("image list");
+  if (!button) return 1;
+  Click(&app, button->CenterX(), button->CenterY());
+  const tessera::gui::ImageList* list = app.ImageListShown();
+  if (list == nullptr || list->entries.size() < 2) return 1;
+  const std::optional<WidgetRect> row = app.Widget("image row " + list->entries[1].name);
+  if (!row) return 1;
+  Click(&app, row->CenterX(), row->CenterY());
+  app.SaveScreenshot(out / "gui_image_list.png");
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -93,8 +112,9 @@ int main(int argc, char** argv) {
   }
   try {
     manifest_file = argv[3];
-    const int code = CameraFigure(argv[1], argv[2], argv[4]);
-    return code != 0 ? code : PairFigure(argv[1], argv[2], argv[4]);
+    int code = CameraFigure(argv[1], argv[2], argv[4]);
+    if (code == 0) code = PairFigure(argv[1], argv[2], argv[4]);
+    return code != 0 ? code : ImageListFigure(argv[1], argv[2], argv[4]);
   } catch (const std::exception& error) {
     std::fprintf(stderr, "%s\n", error.what());
     return 1;

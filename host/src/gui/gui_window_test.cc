@@ -639,6 +639,46 @@ TEST_F(GuiWindowTest, FolderBrowserChoosesTheImageFolder) {
   EXPECT_EQ(app.ImagesField(), (dir_.path() / "photos").string());
 }
 
+// Issue 63: each folder listed with the images it holds; a typed path goes there (a
+// wrong one is named).
+TEST_F(GuiWindowTest, FolderBrowserCountsImagesAndGoesToATypedPath) {
+  fs::create_directories(dir_.path() / "photos" / "day 2");
+  fs::create_directories(dir_.path() / "other");
+  for (const char* name : {"a.jpg", "b.JPG", "c.png", "notes.txt"}) {
+    std::ofstream(dir_.path() / "photos" / name) << "x";
+  }
+  std::ofstream(dir_.path() / "photos" / "day 2" / "d.tif") << "x";
+  GuiOptions options;
+  options.images = dir_.path();
+  GuiApp app(options);
+  app.Frame();
+  app.Frame();
+  Click(&app, "browse images");
+  app.Frame();
+  EXPECT_TRUE(app.Widget("images in photos: 3").has_value());
+  EXPECT_TRUE(app.Widget("images in other: 0").has_value());
+  const auto press_return = [&app] {
+    SyntheticInput enter;
+    enter.x = enter.y = -1;
+    enter.keys = {ImGuiKey_Enter};
+    app.Frame(&enter);
+    enter.keys.clear();
+    app.Frame(&enter);
+  };
+  Click(&app, "browse path");
+  ReplaceFocusedText(&app, (dir_.path() / "nowhere").string());
+  press_return();
+  ASSERT_FALSE(app.ErrorsShown().empty());
+  EXPECT_NE(app.ErrorsShown().back().find("nowhere: no such folder"), std::string::npos)
+      << app.ErrorsShown().back();
+  Click(&app, "browse path");
+  ReplaceFocusedText(&app, (dir_.path() / "photos").string());
+  press_return();
+  EXPECT_TRUE(app.Widget("images in day 2: 1").has_value());
+  Click(&app, "choose folder");
+  EXPECT_EQ(app.ImagesField(), (dir_.path() / "photos").string());
+}
+
 // The recipe list: manifests/ (as copied next to the executable), each chosen one the
 // manifest field's file and the editor's text; a Run then runs it.
 TEST_F(GuiWindowTest, RecipeListChoosesARecipeThatRunUses) {

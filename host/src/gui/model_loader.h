@@ -19,5 +19,15 @@ std::vector<std::filesystem::path> FindModelFolders(const std::filesystem::path&
 // The number of images a model folder holds, from the head of its images.bin (or the
 // count line of images.txt), without reading the model; nothing when it cannot tell.
 std::optional<size_t> CountModelImages(const std::filesystem::path& folder);
+// Likewise its points (points3D.bin's head, or points3D.txt's count line).
+std::optional<size_t> CountModelPoints(const std::filesystem::path& folder);
+
+// The image folder a run recorded in the workspace `folder` (its database.db: the
+// folder extract read, absolute); empty when it has no database or none is recorded, or
+// the database cannot be read.
+std::filesystem::path RecordedImageFolder(const std::filesystem::path& folder);
+
+// N of a workspace's sparse/N model folder; 0 for a model folder outside a workspace.
+int ModelFolderNumber(const std::filesystem::path& folder);
 
 }  // namespace tessera::gui

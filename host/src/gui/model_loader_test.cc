@@ -29,6 +29,9 @@ TEST(ModelLoader, FindsAModelFolderAWorkspaceAndItsDatabase) {
   EXPECT_EQ(CountModelImages(dir.path() / "sparse" / "0"), model.images.size());
   EXPECT_EQ(CountModelImages(dir.path() / "sparse" / "1"), model.images.size());
   EXPECT_EQ(CountModelImages(dir.path() / "sparse" / "2"), std::nullopt);
+  EXPECT_EQ(CountModelPoints(dir.path() / "sparse" / "0"), model.points3D.size());
+  EXPECT_EQ(CountModelPoints(dir.path() / "sparse" / "1"), model.points3D.size());
+  EXPECT_EQ(CountModelPoints(dir.path() / "sparse" / "2"), std::nullopt);
 }
 
 TEST(ModelLoader, RefusesWhatIsNotAModelNamingIt) {

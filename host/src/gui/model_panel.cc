@@ -3,6 +3,8 @@
 #include <imgui.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cstdio>
 #include <optional>
 
 #include "gui/checked_read.h"
@@ -14,6 +16,16 @@
 
 namespace tessera::gui {
 namespace fs = std::filesystem;
+namespace {
+
+// A scale's end as the legend writes it: "0", "2.5", "12".
+std::string FormatScaleValue(float value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.3g", static_cast<double>(value));
+  return text;
+}
+
+}  // namespace
 
 ModelPanel::ModelPanel(SceneView* view, const fs::path& path) : view_(view) {
   SetPathField(path, &path_);
@@ -154,6 +166,21 @@ void ModelPanel::LoadFolder(size_t index) {
                view_->scene()->cameras.size(), view_->scene()->NumPoints());
 }
 
+bool ModelPanel::ShowModelNumber(int number) {
+  if (ShownModelNumber() == number) return true;
+  for (size_t i = 0; i < folders_.size(); ++i) {
+    if (ModelFolderNumber(folders_[i]) != number) continue;
+    LoadFolder(i);
+    return error_.empty() && index_ == static_cast<int>(i);
+  }
+  return false;
+}
+
+int ModelPanel::ShownModelNumber() const {
+  const fs::path written = WrittenModel();
+  return written.empty() ? -1 : ModelFolderNumber(written);
+}
+
 void ModelPanel::Draw(WidgetRects* widgets) {
   FitText("Open a model", widgets);
   // The field takes the width the Open button leaves (its hint whole at 1024 px).
@@ -195,6 +222,7 @@ void ModelPanel::Draw(WidgetRects* widgets) {
     ImGui::PopTextWrapPos();
     widgets->RecordLastItem("model stale");
   }
+  DrawColouring(widgets);
   if (ImGui::SliderFloat("Point size", &view_->point_size, 1, 10, "%.0f px")) {
     view_->point_size_chosen = true;
   }
@@ -209,14 +237,60 @@ void ModelPanel::Draw(WidgetRects* widgets) {
   HintText("drag: orbit, shift+drag or right button: pan, wheel: zoom, click: details");
 }
 
+void ModelPanel::DrawColouring(WidgetRects* widgets) {
+  static constexpr const char* kNames[] = {"image", "error", "track length"};
+  int chosen = static_cast<int>(view_->colouring());
+  if (ImGui::Combo("Colour", &chosen, kNames, IM_ARRAYSIZE(kNames))) {
+    view_->SetColouring(static_cast<PointColouring>(chosen));
+    spdlog::info("gui: points coloured by {}", kNames[chosen]);
+  }
+  widgets->RecordLastItem("colouring");
+  if (view_->colouring() == PointColouring::kImage || view_->scene() == nullptr) return;
+  // The legend: the scale as a bar, its two ends' values under it.
+  const ColourScale& scale = view_->colour_scale();
+  const bool error = view_->colouring() == PointColouring::kError;
+  const std::string low = error ? FormatScaleValue(scale.low) + " px" : FormatScaleValue(scale.low);
+  const std::string high =
+      (error ? FormatScaleValue(scale.high) + " px" : FormatScaleValue(scale.high)) +
+      (error ? " or more" : " images or more");
+  const float width = ImGui::CalcItemWidth();
+  const float height = ImGui::GetTextLineHeight();
+  const ImVec2 at = ImGui::GetCursorScreenPos();
+  ImDrawList* draw = ImGui::GetWindowDrawList();
+  constexpr int kSteps = 32;
+  for (int i = 0; i < kSteps; ++i) {
+    const auto left = ScaleColour(static_cast<float>(i) / kSteps);
+    const auto right = ScaleColour(static_cast<float>(i + 1) / kSteps);
+    const ImU32 left_colour = IM_COL32(left[0], left[1], left[2], 255);
+    const ImU32 right_colour = IM_COL32(right[0], right[1], right[2], 255);
+    draw->AddRectFilledMultiColor(ImVec2(at.x + width * i / kSteps, at.y),
+                                  ImVec2(at.x + width * (i + 1) / kSteps, at.y + height),
+                                  left_colour, right_colour, right_colour, left_colour);
+  }
+  ImGui::Dummy(ImVec2(width, height));
+  widgets->RecordLastItem("colour legend");
+  ImGui::SameLine();
+  FitText(error ? "mean reprojection error" : "track length", widgets);
+  // The ends' values under the bar's ends.
+  const float line_start = ImGui::GetCursorPosX();
+  ImGui::TextUnformatted(low.c_str());
+  ImGui::SameLine(
+      std::max(line_start + ImGui::CalcTextSize(low.c_str()).x + ImGui::GetStyle().ItemSpacing.x,
+               line_start + width - ImGui::CalcTextSize(high.c_str()).x));
+  ImGui::TextUnformatted(high.c_str());
+  legend_ = low + " to " + high;
+}
+
 void ModelPanel::DrawModelChoice() {
   if (folders_.size() <= 1) return;
   // Each model with its images, counted from its files' heads once per folder list.
   if (image_counts_.size() != folders_.size()) {
     image_counts_.clear();
     for (const fs::path& folder : folders_) {
-      const std::optional<size_t> count = CountModelImages(folder);
-      image_counts_.push_back(count ? std::to_string(*count) + " images" : "? images");
+      const std::optional<size_t> images = CountModelImages(folder);
+      const std::optional<size_t> points = CountModelPoints(folder);
+      image_counts_.push_back((images ? std::to_string(*images) : "?") + " images, " +
+                              (points ? std::to_string(*points) : "?") + " points");
     }
   }
   const auto label_of = [&](size_t i) {

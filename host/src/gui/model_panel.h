@@ -66,15 +66,24 @@ class ModelPanel {
                                                                              : "";
   }
   int model_index() const { return index_; }
+  // Shows model N (sparse/N) of the workspace opened, when it is not the one shown; false
+  // when it has none such or it cannot be read.
+  bool ShowModelNumber(int number);
+  // N of the written model shown (sparse/N); -1 when the view shows none written.
+  int ShownModelNumber() const;
   // Why the written model shown is stale (its workspace's matches were discarded since);
   // empty when it is not.
   const std::string& Stale() const { return showing_written_ ? stale_ : kNone; }
   std::string ModelField() const { return path_.data(); }
+  // The colour legend's text as last drawn ("0 px to 1.2 px or more"); empty before one.
+  const std::string& Legend() const { return legend_; }
 
  private:
   // Shows model `index` of folders_; the message in error_ when it cannot be read.
   void LoadFolder(size_t index);
   void DrawModelChoice();
+  // The "Colour" choice (image, error, track length) and, for a scale, its legend.
+  void DrawColouring(WidgetRects* widgets);
   // Sets stale_ for the model folder shown.
   void CheckStale(const std::filesystem::path& folder);
   static inline const std::string kNone;
@@ -87,6 +96,7 @@ class ModelPanel {
   std::string showing_;
   bool showing_written_ = false;
   std::vector<std::string> image_counts_;
+  std::string legend_;
   std::string stale_;  // per folder of folders_, for the picker
   bool follows_run_ = false;
   std::filesystem::path run_workspace_;  // of the run shown (growing, stopped or completed)

@@ -96,6 +96,14 @@ void Renderer::SetScene(std::shared_ptr<const Scene> scene) {
   glBindBuffer(GL_ARRAY_BUFFER, 0);
 }
 
+void Renderer::SetPointColours(const std::vector<uint8_t>& colours) {
+  if (num_points_ == 0 || colours.size() != 3 * num_points_) return;
+  glBindBuffer(GL_ARRAY_BUFFER, point_buffers_[1]);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(colours.size()), colours.data(),
+               GL_STATIC_DRAW);
+  glBindBuffer(GL_ARRAY_BUFFER, 0);
+}
+
 void Renderer::Draw(const std::array<int, 4>& viewport, const Eigen::Matrix4f& world_to_clip,
                     float point_size, float frustum_size, image_t selected_image,
                     const Overlay& overlay) {

@@ -39,6 +39,9 @@ class Renderer {
 
   // Uploads the scene's points (once per scene).
   void SetScene(std::shared_ptr<const Scene> scene);
+  // Replaces the colours of the scene's points (RGB per point, its order): another
+  // colouring (point_colouring.h).
+  void SetPointColours(const std::vector<uint8_t>& colours);
   // Clears the viewport (x, y from the bottom-left, in framebuffer pixels) and draws.
   // frustum_size: the frustum depth as a fraction of the scene radius.
   void Draw(const std::array<int, 4>& viewport, const Eigen::Matrix4f& world_to_clip,

@@ -21,11 +21,22 @@ size_t DefaultPointSize(size_t num_points) {
 void SceneView::Show(std::shared_ptr<const Scene> scene, bool frame) {
   scene_ = std::move(scene);
   renderer_->SetScene(scene_);
+  if (scene_ != nullptr && colouring_ != PointColouring::kImage) {
+    renderer_->SetPointColours(PointColours(*scene_, colouring_, &colour_scale_));
+  }
   if (frame) Recentre();
   // A model framed anew gets the point size for its density, unless the user chose one.
   if (frame && scene_ != nullptr && !point_size_chosen) {
     point_size = static_cast<float>(DefaultPointSize(scene_->NumPoints()));
   }
+  on_change_();
+}
+
+void SceneView::SetColouring(PointColouring colouring) {
+  if (colouring == colouring_) return;
+  colouring_ = colouring;
+  if (scene_ != nullptr)
+    renderer_->SetPointColours(PointColours(*scene_, colouring_, &colour_scale_));
   on_change_();
 }
 

@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "gui/orbit_camera.h"
+#include "gui/point_colouring.h"
 #include "gui/scene.h"
 #include "gui/widget_rects.h"
 
@@ -44,6 +45,11 @@ class SceneView {
                                                       const WidgetRect& view) const;
 
   const Scene* scene() const { return scene_.get(); }
+  // Colours the points by `colouring`, this model and the next ones.
+  void SetColouring(PointColouring colouring);
+  PointColouring colouring() const { return colouring_; }
+  // The range the colour scale spans (the legend); meaningless for kImage.
+  const ColourScale& colour_scale() const { return colour_scale_; }
   OrbitCamera& camera() { return camera_; }
 
   // Set by the panels' sliders and the picking.
@@ -63,6 +69,8 @@ class SceneView {
   std::function<void()> on_change_;
   std::shared_ptr<const Scene> scene_;
   OrbitCamera camera_;
+  PointColouring colouring_ = PointColouring::kImage;
+  ColourScale colour_scale_;
 };
 
 }  // namespace tessera::gui

@@ -58,6 +58,7 @@ class SetupPanel {
     return field == "images" ? images_error_ : manifest_error_;
   }
   std::string ImagesField() const { return images_.data(); }
+  void SetImagesField(const std::filesystem::path& folder) { SetPathField(folder, &images_); }
   // Whether the Images field was being typed in (focused) in the last frame.
   bool ImagesFieldActive() const { return images_active_; }
   std::string OutputField() const { return output_.data(); }
