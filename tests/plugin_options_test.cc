@@ -56,7 +56,14 @@ TEST(OptionDescriptions, AWellFormedDescriptionRoundTrips) {
         {"default", 3},
         {"min", nullptr},
         {"max", nullptr},
-        {"help", ""}}});
+        {"help", ""}},
+       {{"name", "share"},
+        {"type", "number"},
+        {"default", 0.5},
+        {"min", 0},
+        {"max", 1},
+        {"min_exclusive", true},
+        {"help", "above 0"}}});
   const std::vector<OptionDescription> options = ParseOptionDescriptions(described, "who");
   ASSERT_EQ(options.size(), 5u);
   nlohmann::json again = nlohmann::json::array();
