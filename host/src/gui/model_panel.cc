@@ -270,7 +270,7 @@ void ModelPanel::DrawColouring(WidgetRects* widgets) {
   ImGui::Dummy(ImVec2(width, height));
   widgets->RecordLastItem("colour legend");
   ImGui::SameLine();
-  FitText(error ? "mean reprojection error" : "track length", widgets);
+  FitText(error ? "error in px" : "track length", widgets);
   // The ends' values under the bar's ends.
   const float line_start = ImGui::GetCursorPosX();
   ImGui::TextUnformatted(low.c_str());

@@ -164,23 +164,24 @@ std::string OptionDescriptionsMarkdown(const std::vector<OptionDescription>& opt
 }
 
 std::string OptionDescriptionsText(const std::vector<OptionDescription>& options) {
-  size_t name_width = 6;
-  size_t default_width = 7;
+  size_t name_width = 0;
+  size_t default_width = 0;
+  size_t range_width = 0;
   for (const OptionDescription& option : options) {
     name_width = std::max(name_width, option.name.size());
     default_width = std::max(default_width, DefaultText(option).size());
+    range_width = std::max(range_width, OptionRangeText(option).size());
   }
+  // Columns: name, type, default, range or choices, help.
+  const auto padded = [](std::string text, size_t width) {
+    text.resize(std::max(text.size(), width) + 2, ' ');
+    return text;
+  };
   std::ostringstream out;
   for (const OptionDescription& option : options) {
-    std::string head = option.name;
-    head.resize(name_width + 2, ' ');
-    std::string type = option.type;
-    type.resize(9, ' ');
-    std::string default_text = DefaultText(option);
-    default_text.resize(default_width + 2, ' ');
-    const std::string range = OptionRangeText(option);
-    out << "  " << head << type << default_text << (range.empty() ? "" : range + "  ")
-        << option.help << "\n";
+    out << "  " << padded(option.name, name_width) << padded(option.type, 7)
+        << padded(DefaultText(option), default_width)
+        << padded(OptionRangeText(option), range_width) << option.help << "\n";
   }
   return out.str();
 }
