@@ -60,16 +60,7 @@ void BindPlugins(py::module_& module) {
         // In a child process: a plugin that crashes when loaded must not end the interpreter.
         return ToPython(RunInChildProcess("plugin_options", py::none(), [&](const StageControl&) {
           const PluginRegistry registry = PluginRegistry::Discover(paths.SearchPath());
-          const PluginRecord& record = registry.Find(name);
-          nlohmann::json json = record.ToJson();
-          json["options"] = nullptr;
-          if (const auto described = registry.DescribeOptions(record)) {
-            json["options"] = nlohmann::json::array();
-            for (const OptionDescription& option : *described) {
-              json["options"].push_back(option.ToJson());
-            }
-          }
-          return json;
+          return DescribedPluginJson(registry, registry.Find(name));
         }));
       },
       py::arg("name"), py::arg("manifest") = py::none(),

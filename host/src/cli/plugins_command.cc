@@ -25,17 +25,11 @@ int DescribePlugin(const PluginRegistry& registry, const std::string& name,
                    const Options& options) {
   if (options.json && options.markdown) throw InputError("--json and --markdown: give one");
   const PluginRecord& record = registry.Find(name);
-  const std::optional<std::vector<OptionDescription>> described = registry.DescribeOptions(record);
   if (options.json) {
-    nlohmann::json json = record.ToJson();
-    json["options"] = nlohmann::json();
-    if (described) {
-      json["options"] = nlohmann::json::array();
-      for (const OptionDescription& option : *described) json["options"].push_back(option.ToJson());
-    }
-    std::cout << json.dump(2) << std::endl;
+    std::cout << DescribedPluginJson(registry, record).dump(2) << std::endl;
     return static_cast<int>(kExitSuccess);
   }
+  const std::optional<std::vector<OptionDescription>> described = registry.DescribeOptions(record);
   if (options.markdown) {
     if (!described) throw InputError(PluginDoesNotDescribe(record));
     std::cout << OptionDescriptionsMarkdown(*described);

@@ -127,6 +127,16 @@ std::string PluginDoesNotDescribe(const PluginRecord& record) {
          "(TESSERA_PLUGIN_OPTIONS in tessera/plugin.h)";
 }
 
+nlohmann::json DescribedPluginJson(const PluginRegistry& registry, const PluginRecord& record) {
+  nlohmann::json json = record.ToJson();
+  json["options"] = nullptr;
+  if (const auto described = registry.DescribeOptions(record)) {
+    json["options"] = nlohmann::json::array();
+    for (const OptionDescription& option : *described) json["options"].push_back(option.ToJson());
+  }
+  return json;
+}
+
 std::string OptionRangeText(const OptionDescription& option) {
   if (!option.choices.empty()) {
     std::string text;

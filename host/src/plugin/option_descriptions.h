@@ -30,6 +30,12 @@ struct PluginRecord;
 // "plugin 'x' (FILE) does not describe its options (it exports no tessera_plugin_options)".
 std::string PluginDoesNotDescribe(const PluginRecord& record);
 
+class PluginRegistry;
+// What `tessera plugins NAME --json` prints and tessera.plugin_options returns: the
+// record (PluginRecord::ToJson) with "options", the described options as JSON, or null
+// when the plugin does not describe them. Throws as PluginRegistry::DescribeOptions.
+nlohmann::json DescribedPluginJson(const PluginRegistry& registry, const PluginRecord& record);
+
 // The options as aligned plain text, for a terminal.
 std::string OptionDescriptionsText(const std::vector<OptionDescription>& options);
 
